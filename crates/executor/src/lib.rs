@@ -1,0 +1,1 @@
+//! ROS-free trajectory executor core: validation, interpolation, tolerances, motion state machine

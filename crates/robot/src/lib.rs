@@ -1,0 +1,1 @@
+//! Robot descriptions: URDF plus joint-limits YAML into a kinematic model

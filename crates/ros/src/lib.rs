@@ -1,0 +1,1 @@
+//! ROS 2 plumbing shared by every kerf node

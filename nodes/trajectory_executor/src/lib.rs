@@ -1,0 +1,1 @@
+//! kerf trajectory executor node
