@@ -1,0 +1,304 @@
+//! [`KerfNode`]: one ROS 2 node with its own Context, spinner thread, parameters, names and logger.
+//!
+//! ros2-client loses events when two spinning nodes share a Context, so every node owns one.
+//! On drop the node is dropped first, then its spinner thread is joined, then the Context,
+//! the order ros2-client needs for a clean shutdown.
+
+use std::thread::JoinHandle;
+
+use ros2_client::{
+    action::ActionServer, ActionTypeName, Context, Message, MessageTypeName, Name, Node, NodeName,
+    NodeOptions, Publisher, QosProfile, Server, ServiceMapping, ServiceTypeName, Subscription,
+};
+use serde::{de::DeserializeOwned, Serialize};
+
+use crate::{names, qos, LogLevel, Logger, Params, RosArgs, RosEnv, RosError, StopToken};
+
+/// What a node binary declares about itself.
+#[derive(Debug, Clone, Copy)]
+pub struct NodeSpec<'a> {
+    /// Base name before `__node:=` remapping.
+    pub default_name: &'a str,
+    /// Namespace before `__ns:=` remapping.
+    pub default_namespace: &'a str,
+    /// Parameter names the node reads; `prefix.*` admits a group. Others are refused.
+    pub known_params: &'a [&'a str],
+}
+
+/// A running ROS 2 node.
+pub struct KerfNode {
+    node: Option<Node>,
+    spinner: Option<JoinHandle<()>>,
+    context: Option<Context>,
+    name: String,
+    namespace: String,
+    remaps: Vec<names::Remap>,
+    params: Params,
+    logger: Logger,
+    stop: StopToken,
+}
+
+/// Splits `pkg/kind/Name` and checks the kind.
+fn split_type<'t>(ros_type: &'t str, kind: &str) -> Result<(&'t str, &'t str), RosError> {
+    let parts: Vec<&str> = ros_type.split('/').collect();
+    match parts.as_slice() {
+        [pkg, k, name] if *k == kind && !pkg.is_empty() && !name.is_empty() => Ok((pkg, name)),
+        _ => Err(RosError::Name {
+            name: ros_type.into(),
+            reason: format!("expected a type name of the form package/{kind}/Name"),
+        }),
+    }
+}
+
+fn dds_err(what: String) -> impl FnOnce(ros2_client::CreateError) -> RosError {
+    move |e| RosError::Dds {
+        what,
+        reason: e.to_string(),
+    }
+}
+
+impl KerfNode {
+    /// Creates the node from the process's ROS arguments and environment.
+    ///
+    /// # Arguments
+    /// * `spec` – default name/namespace and the parameters the node knows.
+    /// * `args` – parsed `--ros-args`; `env` – `ROS_DOMAIN_ID` and discovery range.
+    /// * `stop` – the token that stops this node.
+    ///
+    /// # Returns
+    /// The node, or an error for a bad name, an unknown or malformed parameter, or a DDS failure.
+    pub fn new(
+        spec: NodeSpec<'_>,
+        args: &RosArgs,
+        env: &RosEnv,
+        stop: StopToken,
+    ) -> Result<Self, RosError> {
+        let name = args.node_name(spec.default_name)?;
+        let namespace = args.namespace(spec.default_name, spec.default_namespace)?;
+        let fqn = if namespace == "/" {
+            format!("/{name}")
+        } else {
+            format!("{namespace}/{name}")
+        };
+        let params = args.params_for(&fqn, &name)?;
+        params.reject_unknown(spec.known_params)?;
+
+        let context = env.create_context()?;
+        let mut options = NodeOptions::new()
+            .enable_rosout(args.rosout_logs)
+            .start_parameter_services(true)
+            .parameter_validator(Box::new(|name: &str, _| {
+                Err(format!(
+                    "kerf node parameters are read at start-up; restart the node to change '{name}'"
+                ))
+            }));
+        for (k, v) in params.iter() {
+            options = options.declare_parameter(k, v.to_ros());
+        }
+        let node_name = NodeName::new(&namespace, &name).map_err(|e| RosError::Name {
+            name: fqn.clone(),
+            reason: format!("{e:?}"),
+        })?;
+        let mut node = context
+            .new_node(node_name, options)
+            .map_err(|e| RosError::Dds {
+                what: format!("node {fqn}"),
+                reason: format!("{e:?}"),
+            })?;
+        let spinner = node
+            .spinner()
+            .map_err(dds_err(format!("spinner of {fqn}")))?;
+        let spin_thread = std::thread::Builder::new()
+            .name(format!("spin-{name}"))
+            .spawn(move || {
+                if let Err(e) = futures::executor::block_on(spinner.spin()) {
+                    eprintln!("kerf: spinner stopped with an error: {e:?}");
+                }
+            })
+            .map_err(|e| RosError::Dds {
+                what: "spinner thread".into(),
+                reason: e.to_string(),
+            })?;
+        let logger_name = fqn.trim_start_matches('/').replace('/', ".");
+        let logger = Logger::new(
+            &logger_name,
+            args.rosout_logs.then(|| node.logging_handle()),
+            args.log_level.unwrap_or(LogLevel::Info),
+            args.stdout_logs,
+        );
+        Ok(Self {
+            node: Some(node),
+            spinner: Some(spin_thread),
+            context: Some(context),
+            name,
+            namespace,
+            remaps: args.remaps.clone(),
+            params,
+            logger,
+            stop,
+        })
+    }
+
+    fn node_mut(&mut self) -> &mut Node {
+        // `node` is only None during drop.
+        self.node.as_mut().expect("node present until drop")
+    }
+
+    /// Node base name.
+    pub fn name(&self) -> &str {
+        &self.name
+    }
+
+    /// Node namespace (`/` or `/a/b`).
+    pub fn namespace(&self) -> &str {
+        &self.namespace
+    }
+
+    /// Fully qualified node name.
+    pub fn fqn(&self) -> String {
+        names::expand("~", &self.namespace, &self.name).unwrap_or_else(|_| self.name.clone())
+    }
+
+    /// The node's parameters.
+    pub fn params(&self) -> &Params {
+        &self.params
+    }
+
+    /// The node's logger (stderr and `/rosout`).
+    pub fn logger(&self) -> Logger {
+        self.logger.clone()
+    }
+
+    /// The node's stop token.
+    pub fn stop_token(&self) -> StopToken {
+        self.stop.clone()
+    }
+
+    /// Whether the node should stop (its token, or Ctrl-C).
+    pub fn should_stop(&self) -> bool {
+        self.stop.is_stopped()
+    }
+
+    /// Expands and remaps a topic or service name as this node sees it.
+    pub fn resolve(&self, name: &str) -> Result<String, RosError> {
+        names::resolve(name, &self.namespace, &self.name, &self.remaps)
+    }
+
+    fn ros_name(&self, name: &str) -> Result<Name, RosError> {
+        let full = self.resolve(name)?;
+        Name::parse(&full).map_err(|e| RosError::Name {
+            name: full.clone(),
+            reason: format!("{e:?}"),
+        })
+    }
+
+    /// Creates a publisher on `topic` (e.g. `~/joint_command`, `/joint_states`).
+    ///
+    /// # Arguments
+    /// * `ros_type` – `package/msg/Name`, e.g. `sensor_msgs/msg/JointState`.
+    pub fn publisher<M: Serialize>(
+        &mut self,
+        topic: &str,
+        ros_type: &str,
+        qos: QosProfile,
+    ) -> Result<Publisher<M>, RosError> {
+        let (pkg, ty) = split_type(ros_type, "msg")?;
+        let name = self.ros_name(topic)?;
+        let node = self.node_mut();
+        let t = node
+            .create_topic(&name, MessageTypeName::new(pkg, ty), &qos)
+            .map_err(dds_err(format!("topic {name}")))?;
+        node.create_publisher(&t, Some(qos))
+            .map_err(dds_err(format!("publisher on {name}")))
+    }
+
+    /// Creates a subscription on `topic`.
+    pub fn subscription<M: DeserializeOwned + 'static>(
+        &mut self,
+        topic: &str,
+        ros_type: &str,
+        qos: QosProfile,
+    ) -> Result<Subscription<M>, RosError> {
+        let (pkg, ty) = split_type(ros_type, "msg")?;
+        let name = self.ros_name(topic)?;
+        let node = self.node_mut();
+        let t = node
+            .create_topic(&name, MessageTypeName::new(pkg, ty), &qos)
+            .map_err(dds_err(format!("topic {name}")))?;
+        node.create_subscription(&t, Some(qos))
+            .map_err(dds_err(format!("subscription on {name}")))
+    }
+
+    /// Creates an action server (`package/action/Name`) with rcl_action's QoS and the
+    /// Enhanced service mapping (Fast DDS, Jazzy's default RMW).
+    pub fn action_server<G, R, F>(
+        &mut self,
+        name: &str,
+        ros_type: &str,
+    ) -> Result<ActionServer<G, R, F>, RosError>
+    where
+        G: Message + Clone + 'static,
+        R: Message + Clone + 'static,
+        F: Message + 'static,
+    {
+        let (pkg, ty) = split_type(ros_type, "action")?;
+        let name = self.ros_name(name)?;
+        self.node_mut()
+            .create_action_server(
+                ServiceMapping::Enhanced,
+                &name,
+                &ActionTypeName::new(pkg, ty),
+                qos::action_server(),
+            )
+            .map_err(dds_err(format!("action server {name}")))
+    }
+
+    /// Creates a service server (`package/srv/Name`) with the Enhanced service mapping.
+    pub fn service_server<Req, Resp>(
+        &mut self,
+        name: &str,
+        ros_type: &str,
+    ) -> Result<Server<Req, Resp>, RosError>
+    where
+        Req: Message + Clone + 'static,
+        Resp: Message + 'static,
+    {
+        let (pkg, ty) = split_type(ros_type, "srv")?;
+        let name = self.ros_name(name)?;
+        self.node_mut()
+            .create_server(
+                ServiceMapping::Enhanced,
+                &name,
+                &ServiceTypeName::new(pkg, ty),
+                qos::services(),
+                qos::services(),
+            )
+            .map_err(dds_err(format!("service {name}")))
+    }
+}
+
+impl Drop for KerfNode {
+    fn drop(&mut self) {
+        // Node first (signals the spinner), then the spinner thread, then the Context.
+        drop(self.node.take());
+        if let Some(h) = self.spinner.take() {
+            let _ = h.join();
+        }
+        drop(self.context.take());
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn type_names_are_checked() {
+        assert_eq!(
+            split_type("trajectory_msgs/msg/JointTrajectory", "msg").unwrap(),
+            ("trajectory_msgs", "JointTrajectory")
+        );
+        assert!(split_type("trajectory_msgs/JointTrajectory", "msg").is_err());
+        assert!(split_type("control_msgs/action/FollowJointTrajectory", "msg").is_err());
+    }
+}
