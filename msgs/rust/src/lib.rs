@@ -1,1 +1,36 @@
-//! Serde mirrors of the kerf_msgs ROS 2 interfaces and of the standard ROS 2 messages kerf uses
+//! Serde mirrors of the kerf_msgs ROS 2 interfaces and of the standard ROS 2
+//! (Jazzy) messages kerf uses.
+//!
+//! ros2-client serializes messages with CDR through serde: struct fields go on
+//! the wire in declaration order, so every mirror declares exactly the fields of
+//! its ROS 2 interface definition, in the same order and with the matching Rust
+//! type (`string` → [`String`](std::string::String), `float64` → `f64`,
+//! `int32` → `i32`, `uint32` → `u32`, `uint16` → `u16`, `uint8` → `u8`,
+//! `bool` → `bool`, `T[]` → `Vec<T>`, `T[N]` → `[T; N]`, nested message →
+//! struct). The integration test `tests/drift.rs` checks every mirror against
+//! the interface files: kerf's own in `msgs/msg` and `msgs/srv`, the standard
+//! ones transcribed under `msgs/rust/interfaces/`.
+//!
+//! Module layout follows the ROS 2 packages: [`builtin_interfaces`],
+//! [`std_msgs`], [`geometry_msgs`], [`trajectory_msgs`], [`sensor_msgs`],
+//! [`control_msgs`]; kerf's own interfaces are in [`msg`] and [`srv`].
+//! Every mirror implements [`RosType`]. With the `ros2` feature every mirror
+//! also implements `ros2_client::Message`.
+//!
+//! [`idl`] parses `.msg`, `.srv` and `.action` files (the ROS 2 interface
+//! definition format, as `rosidl_adapter` reads it).
+
+pub mod builtin_interfaces;
+pub mod control_msgs;
+mod error;
+pub mod geometry_msgs;
+pub mod idl;
+pub mod msg;
+mod ros_type;
+pub mod sensor_msgs;
+pub mod srv;
+pub mod std_msgs;
+pub mod trajectory_msgs;
+
+pub use error::Error;
+pub use ros_type::{InterfaceKind, RosType};
