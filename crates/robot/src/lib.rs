@@ -1,1 +1,60 @@
-//! Robot descriptions: URDF plus joint-limits YAML into a kinematic model
+//! Robot descriptions for kerf: a URDF plus a MoveIt `joint_limits.yaml`
+//! loaded into a validated serial kinematic model.
+//!
+//! [`RobotModel`] is used by every other kerf crate: the trajectory
+//! executor checks joint vectors against its limits, planners evaluate its
+//! forward kinematics, and collision checking and simulation read the link
+//! geometry from [`RobotModel::urdf`] placed by [`RobotModel::link_poses`].
+//!
+//! * The URDF gives the tree, joint origins and axes, position, velocity
+//!   and effort limits. Supported joints: revolute, prismatic, fixed.
+//! * The optional limits YAML (MoveIt format) adds acceleration and jerk
+//!   limits and may tighten, never widen, the URDF position and velocity
+//!   limits.
+//! * Units are SI throughout: m, rad, s.
+//!
+//! The repository's `urdf/` directory holds the two machines of kerf: the
+//! 6-axis laser cutting machine of seed 001 (`laser_cutter.urdf`) and the
+//! ABB IRB 6660-130/3.1 (`irb6660.urdf`), each with its `*_limits.yaml`.
+//!
+//! # Example
+//!
+//! ```
+//! use std::path::Path;
+//! use kerf_robot::{JointKind, RobotModel};
+//!
+//! let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../urdf");
+//! let robot = RobotModel::from_files(
+//!     &dir.join("irb6660.urdf"),
+//!     Some(&dir.join("irb6660_limits.yaml")),
+//! )?;
+//! assert_eq!(robot.dof(), 6);
+//! assert_eq!(robot.tip_link(), "tool0");
+//! let j2 = &robot.joints()[1];
+//! assert_eq!((j2.name.as_str(), j2.kind), ("joint_2", JointKind::Revolute));
+//! assert_eq!(j2.max_acceleration, Some(4.0)); // rad/s², from the YAML
+//!
+//! // All joints at zero: the flange is 0.3 + 1.5055 + 0.2 m in front of the
+//! // base axis and 0.8145 + 1.28 + 0.28 m above the floor.
+//! let q = [0.0; 6];
+//! robot.check_positions(&q)?;
+//! let tool0 = robot.forward_kinematics(&q)?;
+//! assert!((tool0.translation.x - 2.0055).abs() < 1e-12);
+//! assert!((tool0.translation.z - 2.3745).abs() < 1e-12);
+//!
+//! // Joint vectors are validated.
+//! assert!(robot.check_positions(&[0.0, 2.0, 0.0, 0.0, 0.0, 0.0]).is_err()); // J2 > 85°
+//! assert!(robot.forward_kinematics(&[f64::NAN; 6]).is_err());
+//! # Ok::<(), kerf_robot::RobotError>(())
+//! ```
+
+mod chain;
+mod error;
+mod joint;
+mod limits;
+mod model;
+mod pose;
+
+pub use error::RobotError;
+pub use joint::{JointKind, JointSpec};
+pub use model::RobotModel;
