@@ -37,7 +37,7 @@ struct LimitsFile {
 }
 
 /// Limits of one joint as written in the YAML (SI units).
-#[derive(Debug, Default, Deserialize)]
+#[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 struct YamlJointLimits {
     has_position_limits: Option<bool>,

@@ -168,3 +168,55 @@ fn every_link_has_a_pose_and_the_head_has_collision_geometry() {
         );
     }
 }
+
+#[test]
+fn laser_nozzle_never_touches_the_c_axis_housing_or_fork() {
+    // Nozzle (q6 link) and c_axis (q4 link) are not adjacent, so their
+    // collision shapes must stay apart over the whole q5/q6 range.
+    let robot = common::laser_cutter();
+    let link = |name: &str| robot.urdf().links.iter().find(|l| l.name == name).unwrap();
+    // c_axis shapes (axis-aligned in the c_axis frame): the motor housing
+    // cylinder bottom and the inner faces of the fork boxes.
+    let mut housing_bottom = f64::INFINITY;
+    let mut fork_inner = f64::INFINITY;
+    for c in &link("c_axis").collision {
+        match c.geometry {
+            urdf_rs::Geometry::Cylinder { length, .. } => {
+                housing_bottom = housing_bottom.min(c.origin.xyz.0[2] - length / 2.0)
+            }
+            urdf_rs::Geometry::Box { ref size } => {
+                fork_inner = fork_inner.min(c.origin.xyz.0[1].abs() - size.0[1] / 2.0)
+            }
+            _ => panic!("unexpected c_axis shape"),
+        }
+    }
+    assert!(housing_bottom.is_finite() && fork_inner.is_finite());
+    let mut rng = common::SplitMix64::new(11);
+    for _ in 0..500 {
+        let q = rng.joint_vector(&robot);
+        let poses = robot.link_poses(&q).unwrap();
+        let pose_of = |name: &str| poses.iter().find(|(n, _)| n == name).unwrap().1;
+        let nozzle_in_c = pose_of("c_axis").inverse() * pose_of("nozzle");
+        for c in &link("nozzle").collision {
+            let urdf_rs::Geometry::Cylinder { radius, length } = c.geometry else {
+                panic!("nozzle shapes are cylinders");
+            };
+            let z_mid = c.origin.xyz.0[2];
+            for end in [z_mid - length / 2.0, z_mid + length / 2.0] {
+                for k in 0..32 {
+                    let a = k as f64 * std::f64::consts::TAU / 32.0;
+                    let p = nozzle_in_c
+                        * nalgebra::Point3::new(radius * a.cos(), radius * a.sin(), end);
+                    assert!(
+                        p.z < housing_bottom,
+                        "nozzle reaches C housing at q = {q:?}"
+                    );
+                    assert!(
+                        p.y.abs() < fork_inner,
+                        "nozzle reaches the fork at q = {q:?}"
+                    );
+                }
+            }
+        }
+    }
+}
