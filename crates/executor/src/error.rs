@@ -55,7 +55,9 @@ pub enum ExecutorError {
         requirement: &'static str,
     },
     /// A joint sample (initial, current or measured state) has the wrong number of values.
-    #[error("{what}: {field} has {actual} values, expected {expected} (one per joint{empty_note})")]
+    #[error(
+        "{what}: {field} has {actual} values, expected {expected} (one per joint{empty_note})"
+    )]
     StateLength {
         /// Which state ("initial positions", "measured state", ...).
         what: &'static str,
@@ -273,7 +275,9 @@ pub enum ExecutorError {
         max: f64,
     },
     /// The velocity limit is exceeded on the interpolated curve.
-    #[error("joint '{joint}': velocity {value} at t = {time} s ({location}) exceeds the limit {limit}")]
+    #[error(
+        "joint '{joint}': velocity {value} at t = {time} s ({location}) exceeds the limit {limit}"
+    )]
     VelocityLimit {
         /// Joint name.
         joint: String,

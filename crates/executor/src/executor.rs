@@ -431,8 +431,16 @@ fn compute_error(reference: &JointSample, measured: &JointSample, error: &mut Jo
             e.extend(r.iter().zip(m).map(|(r, m)| r - m));
         }
     };
-    diff(&reference.positions, &measured.positions, &mut error.positions);
-    diff(&reference.velocities, &measured.velocities, &mut error.velocities);
+    diff(
+        &reference.positions,
+        &measured.positions,
+        &mut error.positions,
+    );
+    diff(
+        &reference.velocities,
+        &measured.velocities,
+        &mut error.velocities,
+    );
     diff(
         &reference.accelerations,
         &measured.accelerations,

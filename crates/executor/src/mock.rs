@@ -31,7 +31,10 @@ impl MockHardware {
     ///
     /// # Returns
     /// `Err(InvalidConfig)` unless `time_constant` is finite and ≥ 0 (0 = ideal).
-    pub fn with_lag(initial_positions: Vec<f64>, time_constant: f64) -> Result<Self, ExecutorError> {
+    pub fn with_lag(
+        initial_positions: Vec<f64>,
+        time_constant: f64,
+    ) -> Result<Self, ExecutorError> {
         if !(time_constant.is_finite() && time_constant >= 0.0) {
             return Err(ExecutorError::InvalidConfig {
                 field: "mock time_constant".to_string(),

@@ -19,12 +19,7 @@ pub enum Interpolation {
 impl Interpolation {
     /// The JTC rule: quintic if both ends have velocities and accelerations, cubic if both
     /// have velocities, else linear.
-    pub fn between(
-        from_vel: bool,
-        from_acc: bool,
-        to_vel: bool,
-        to_acc: bool,
-    ) -> Interpolation {
+    pub fn between(from_vel: bool, from_acc: bool, to_vel: bool, to_acc: bool) -> Interpolation {
         let vel = from_vel && to_vel;
         let acc = from_acc && to_acc;
         match (vel, acc) {

@@ -152,7 +152,11 @@ pub fn check(
         let quantities = [
             ("position", tol.position, position_error.get(joint)),
             ("velocity", tol.velocity, velocity_error.get(joint)),
-            ("acceleration", tol.acceleration, acceleration_error.get(joint)),
+            (
+                "acceleration",
+                tol.acceleration,
+                acceleration_error.get(joint),
+            ),
         ];
         for (quantity, tolerance, error) in quantities {
             if let Some(&error) = error {

@@ -32,7 +32,11 @@ impl Segment {
                 "start segment, current state → point 0 ({})",
                 self.kind.name()
             ),
-            Some(k) => format!("between point {k} and point {} ({})", k + 1, self.kind.name()),
+            Some(k) => format!(
+                "between point {k} and point {} ({})",
+                k + 1,
+                self.kind.name()
+            ),
         }
     }
 }
@@ -151,7 +155,8 @@ impl ValidatedTrajectory {
     fn copy_initial(&self, out: &mut JointSample) {
         out.positions.copy_from_slice(&self.initial.positions);
         out.velocities.copy_from_slice(&self.initial.velocities);
-        out.accelerations.copy_from_slice(&self.initial.accelerations);
+        out.accelerations
+            .copy_from_slice(&self.initial.accelerations);
     }
 
     /// Index of the segment with `t0 <= t < t1`, for `segments[0].t0 <= t < end_time`.

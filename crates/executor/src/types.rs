@@ -303,7 +303,10 @@ impl ExecutorConfig {
             ));
         }
         for (field, value) in [
-            ("stopped_velocity_tolerance", self.stopped_velocity_tolerance),
+            (
+                "stopped_velocity_tolerance",
+                self.stopped_velocity_tolerance,
+            ),
             ("goal_time_tolerance", self.goal_time_tolerance),
             ("start_tolerance", self.start_tolerance),
         ] {

@@ -442,9 +442,9 @@ fn check_velocity_steps(
     let n = traj.n;
     let mut left = traj.initial.velocities.clone();
     let check = |left: &[f64],
-                     right: &dyn Fn(usize) -> f64,
-                     time: f64,
-                     location: &dyn Fn() -> String|
+                 right: &dyn Fn(usize) -> f64,
+                 time: f64,
+                 location: &dyn Fn() -> String|
      -> Result<(), ExecutorError> {
         for (j, l) in limits.iter().enumerate() {
             let to = right(j);
