@@ -113,4 +113,24 @@ mod tests {
             "control_msgs::action::dds_::FollowJointTrajectory_Feedback_"
         );
     }
+
+    /// With the `ros2` feature the mirrors are `ros2_client::Message`s (a
+    /// compile-time check: this does not build if one is not).
+    #[cfg(feature = "ros2")]
+    #[test]
+    fn mirrors_are_ros2_client_messages() {
+        fn message_type_name<T: ros2_client::Message + RosType>() -> ros2_client::MessageTypeName {
+            ros2_client::MessageTypeName::new(T::PACKAGE, T::NAME)
+        }
+        let name = message_type_name::<crate::msg::TrajectoryStatus>();
+        assert_eq!(
+            name.dds_msg_type(),
+            crate::msg::TrajectoryStatus::dds_type_name()
+        );
+        message_type_name::<control_msgs::FollowJointTrajectoryGoal>();
+        message_type_name::<control_msgs::FollowJointTrajectoryResult>();
+        message_type_name::<control_msgs::FollowJointTrajectoryFeedback>();
+        message_type_name::<srv::ValidateTrajectoryRequest>();
+        message_type_name::<srv::ValidateTrajectoryResponse>();
+    }
 }
