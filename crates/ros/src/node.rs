@@ -84,13 +84,21 @@ impl KerfNode {
         params.reject_unknown(spec.known_params)?;
 
         let context = env.create_context()?;
+        // Parameters are declared (and validated) while the node is built; after that they are
+        // read-only: `ros2 param set` is refused with a reason.
+        let started = std::sync::Arc::new(std::sync::atomic::AtomicBool::new(false));
+        let started_v = std::sync::Arc::clone(&started);
         let mut options = NodeOptions::new()
             .enable_rosout(args.rosout_logs)
             .start_parameter_services(true)
-            .parameter_validator(Box::new(|name: &str, _| {
-                Err(format!(
-                    "kerf node parameters are read at start-up; restart the node to change '{name}'"
-                ))
+            .parameter_validator(Box::new(move |name: &str, _| {
+                if started_v.load(std::sync::atomic::Ordering::SeqCst) {
+                    Err(format!(
+                        "kerf node parameters are read at start-up; restart the node to change '{name}'"
+                    ))
+                } else {
+                    Ok(())
+                }
             }));
         for (k, v) in params.iter() {
             options = options.declare_parameter(k, v.to_ros());

@@ -1,1 +1,725 @@
-//! kerf trajectory executor node
+//! The kerf trajectory executor node.
+//!
+//! Validates, interpolates and streams joint trajectories for one robot (URDF + limits YAML
+//! given as parameters), with ros2_control's `joint_trajectory_controller` as the reference
+//! semantics (see `kerf_executor` for the differences).
+//!
+//! | endpoint | type | |
+//! |---|---|---|
+//! | `~/joint_trajectory` | `trajectory_msgs/msg/JointTrajectory` | subscription |
+//! | `~/follow_joint_trajectory` | `control_msgs/action/FollowJointTrajectory` | action server |
+//! | `~/validate_trajectory` | `kerf_msgs/srv/ValidateTrajectory` | service (dry run) |
+//! | `joint_states` | `sensor_msgs/msg/JointState` | measured state, every control cycle |
+//! | `~/controller_state` | `control_msgs/msg/JointTrajectoryControllerState` | every control cycle |
+//! | `~/joint_command` | `sensor_msgs/msg/JointState` | command stream for a hardware driver |
+//! | `~/trajectory_status` | `kerf_msgs/msg/TrajectoryStatus` | accepted / rejected / finished |
+//!
+//! Every cycle follows ros2_control's read → update → write order: the measured state is read
+//! from the (mock) hardware, the executor computes the reference, the reference is written to
+//! the hardware and published on `~/joint_command`.
+
+pub mod action;
+pub mod config;
+pub mod convert;
+
+use std::{
+    collections::HashMap,
+    time::{Duration as StdDuration, Instant},
+};
+
+use kerf_executor::{
+    Cycle, Executor, ExecutorError, GoalId as ExecGoalId, GoalTolerances, JointSample,
+    MockHardware, Outcome, INVALID_GOAL, SUCCESSFUL,
+};
+use kerf_msgs::{
+    builtin_interfaces::Time,
+    control_msgs::{
+        FollowJointTrajectoryFeedback, FollowJointTrajectoryGoal, FollowJointTrajectoryResult,
+        JointTrajectoryControllerState,
+    },
+    msg::TrajectoryStatus,
+    sensor_msgs::JointState,
+    srv::{ValidateTrajectoryRequest, ValidateTrajectoryResponse},
+    std_msgs::Header,
+    trajectory_msgs::JointTrajectory,
+    RosType,
+};
+use kerf_robot::RobotError;
+use kerf_ros::{qos, KerfNode, Logger, NodeSpec, RosArgs, RosEnv, RosError, StopToken};
+use ros2_client::{
+    action::{
+        ActionServer, CancelGoalRequest, CancelGoalResponse, GetResultResponse, GoalId, GoalInfo,
+        GoalStatusEnum, SendGoalRequest, SendGoalResponse,
+    },
+    action_msgs::CancelGoalResponseEnum,
+    builtin_interfaces::Time as RosTime,
+    Publisher, Server, Subscription,
+};
+
+pub use config::{NodeConfig, KNOWN_PARAMS};
+use convert::{Clock, Rejection};
+
+/// Default node name.
+pub const DEFAULT_NAME: &str = "trajectory_executor";
+
+/// Why the node could not start.
+#[derive(Debug, thiserror::Error)]
+pub enum NodeError {
+    /// Environment, arguments, names or DDS.
+    #[error(transparent)]
+    Ros(#[from] RosError),
+    /// The robot description could not be loaded.
+    #[error("robot description: {0}")]
+    Robot(#[from] RobotError),
+    /// The executor refused the configuration.
+    #[error("executor configuration: {0}")]
+    Executor(#[from] ExecutorError),
+    /// A parameter is inconsistent with the robot.
+    #[error("parameter '{name}': {reason}")]
+    Config {
+        /// Parameter.
+        name: String,
+        /// What is wrong.
+        reason: String,
+    },
+}
+
+type FjtServer = ActionServer<
+    FollowJointTrajectoryGoal,
+    FollowJointTrajectoryResult,
+    FollowJointTrajectoryFeedback,
+>;
+
+/// Where an executor goal came from.
+#[derive(Debug, Clone)]
+enum Source {
+    Topic { stamp: Time },
+    Action { id: GoalId, stamp: Time },
+}
+
+/// Runs the node until its stop token (or Ctrl-C) stops it.
+///
+/// # Returns
+/// `Ok` after a clean shutdown; an error if the node could not start (bad parameter,
+/// unreadable robot description, DDS failure). Request errors never end the node.
+pub fn run(args: &RosArgs, env: &RosEnv, stop: StopToken) -> Result<(), NodeError> {
+    let node = KerfNode::new(
+        NodeSpec {
+            default_name: DEFAULT_NAME,
+            default_namespace: "/",
+            known_params: KNOWN_PARAMS,
+        },
+        args,
+        env,
+        stop,
+    )?;
+    let log = node.logger();
+    let cfg = match NodeConfig::from_params(node.params()) {
+        Ok(c) => c,
+        Err(e) => {
+            log.error(&format!("cannot start: {e}"));
+            return Err(e);
+        }
+    };
+    let mut n = ExecutorNode::new(node, cfg)?;
+    n.spin();
+    Ok(())
+}
+
+/// The node's state. Fields drop in declaration order: DDS endpoints first, `node` (and its
+/// Context) last.
+struct ExecutorNode {
+    traj_sub: Subscription<JointTrajectory>,
+    action: FjtServer,
+    validate_srv: Server<ValidateTrajectoryRequest, ValidateTrajectoryResponse>,
+    joint_states: Publisher<JointState>,
+    controller_state: Publisher<JointTrajectoryControllerState>,
+    command: Publisher<JointState>,
+    status: Publisher<TrajectoryStatus>,
+    goals: action::ActionGoals,
+    sources: HashMap<ExecGoalId, Source>,
+    exec: Executor,
+    hw: MockHardware,
+    cfg: NodeConfig,
+    names: Vec<String>,
+    cycle: Cycle,
+    next_feedback: f64,
+    statuses_changed: bool,
+    publish_failures: u64,
+    clock: Clock,
+    log: Logger,
+    node: KerfNode,
+}
+
+impl ExecutorNode {
+    fn new(mut node: KerfNode, cfg: NodeConfig) -> Result<Self, NodeError> {
+        let exec = Executor::new(
+            cfg.limits.clone(),
+            cfg.executor.clone(),
+            cfg.initial_positions.clone(),
+        )?;
+        let hw = MockHardware::with_lag(cfg.initial_positions.clone(), cfg.lag_time_constant)?;
+        let traj_sub = node.subscription(
+            "~/joint_trajectory",
+            JointTrajectory::ROS_TYPE,
+            qos::commands(),
+        )?;
+        let action = node.action_server(
+            "~/follow_joint_trajectory",
+            "control_msgs/action/FollowJointTrajectory",
+        )?;
+        let validate_srv =
+            node.service_server("~/validate_trajectory", "kerf_msgs/srv/ValidateTrajectory")?;
+        let joint_states = node.publisher("joint_states", JointState::ROS_TYPE, qos::state())?;
+        let controller_state = node.publisher(
+            "~/controller_state",
+            JointTrajectoryControllerState::ROS_TYPE,
+            qos::state(),
+        )?;
+        let command = node.publisher("~/joint_command", JointState::ROS_TYPE, qos::state())?;
+        let status = node.publisher(
+            "~/trajectory_status",
+            TrajectoryStatus::ROS_TYPE,
+            qos::latched(),
+        )?;
+        let names = cfg
+            .limits
+            .iter()
+            .map(|l| l.name.clone())
+            .collect::<Vec<_>>();
+        let log = node.logger();
+        log.info(&format!(
+            "ready: robot '{}', joints [{}], {} Hz; trajectories on {}, action {}",
+            cfg.robot.name(),
+            names.join(", "),
+            cfg.control_rate,
+            node.resolve("~/joint_trajectory")?,
+            node.resolve("~/follow_joint_trajectory")?,
+        ));
+        Ok(Self {
+            traj_sub,
+            action,
+            validate_srv,
+            joint_states,
+            controller_state,
+            command,
+            status,
+            goals: action::ActionGoals::default(),
+            sources: HashMap::new(),
+            exec,
+            hw,
+            cfg,
+            names,
+            cycle: Cycle::default(),
+            next_feedback: 0.0,
+            statuses_changed: false,
+            publish_failures: 0,
+            clock: Clock::start(),
+            log,
+            node,
+        })
+    }
+
+    fn spin(&mut self) {
+        let period = StdDuration::from_secs_f64(1.0 / self.cfg.control_rate);
+        let mut next = Instant::now();
+        let mut overruns = 0u64;
+        while !self.node.should_stop() {
+            self.poll_trajectories();
+            self.poll_goals();
+            self.poll_cancels();
+            self.poll_result_requests();
+            self.poll_validate();
+            self.control_cycle();
+            next += period;
+            let now = Instant::now();
+            if next > now {
+                std::thread::sleep(next - now);
+            } else if now - next > period * 10 {
+                overruns += 1;
+                if overruns.is_power_of_two() {
+                    self.log.warn(&format!(
+                        "control loop fell {:.1} ms behind; skipping ahead ({overruns} times so far)",
+                        (now - next).as_secs_f64() * 1e3
+                    ));
+                }
+                next = now;
+            }
+        }
+        self.log.info("shutting down");
+    }
+
+    fn publish<M: serde::Serialize + std::fmt::Debug>(
+        pubr: &Publisher<M>,
+        msg: M,
+        failures: &mut u64,
+        log: &Logger,
+        what: &str,
+    ) {
+        if let Err(e) = pubr.publish(msg) {
+            *failures += 1;
+            if failures.is_power_of_two() {
+                log.warn(&format!(
+                    "publishing {what} failed ({failures} failures so far): {e:?}"
+                ));
+            }
+        }
+    }
+
+    fn header(&self, t: f64) -> Header {
+        Header {
+            stamp: self.clock.stamp(t),
+            frame_id: String::new(),
+        }
+    }
+
+    fn trajectory_status(&mut self, source: &Source, status: u8, code: i32, message: &str) {
+        let (src, goal_id, stamp) = match source {
+            Source::Topic { stamp } => (TrajectoryStatus::SOURCE_TOPIC, String::new(), *stamp),
+            Source::Action { id, stamp } => (
+                TrajectoryStatus::SOURCE_ACTION,
+                action::goal_id_hex(id),
+                *stamp,
+            ),
+        };
+        let msg = TrajectoryStatus {
+            header: self.header(self.clock.now()),
+            trajectory_stamp: stamp,
+            source: src.to_string(),
+            goal_id,
+            status,
+            error_code: code,
+            message: message.to_string(),
+        };
+        Self::publish(
+            &self.status,
+            msg,
+            &mut self.publish_failures,
+            &self.log,
+            "trajectory status",
+        );
+    }
+
+    fn ros_now(&self) -> RosTime {
+        RosTime::from_nanos(self.clock.stamp(self.clock.now()).as_nanos())
+    }
+
+    fn poll_trajectories(&mut self) {
+        loop {
+            match self.traj_sub.take() {
+                Ok(Some((msg, _))) => {
+                    let source = Source::Topic {
+                        stamp: msg.header.stamp,
+                    };
+                    let now = self.clock.now();
+                    let submitted =
+                        convert::trajectory_request(&msg, &self.clock).and_then(|req| {
+                            Ok(self.exec.submit(&req, &GoalTolerances::default(), now)?)
+                        });
+                    match submitted {
+                        Ok(id) => {
+                            self.log.info(&format!(
+                                "accepted trajectory from topic: {} points over {:.3} s",
+                                msg.points.len(),
+                                msg.points
+                                    .last()
+                                    .map_or(0.0, |p| p.time_from_start.as_secs_f64())
+                            ));
+                            self.trajectory_status(
+                                &source,
+                                TrajectoryStatus::ACCEPTED,
+                                SUCCESSFUL,
+                                "accepted",
+                            );
+                            self.sources.insert(id, source);
+                        }
+                        Err(rej) => {
+                            self.log
+                                .warn(&format!("rejected trajectory from topic: {}", rej.message));
+                            self.trajectory_status(
+                                &source,
+                                TrajectoryStatus::REJECTED,
+                                rej.code,
+                                &rej.message,
+                            );
+                        }
+                    }
+                }
+                Ok(None) => break,
+                Err(e) => {
+                    let msg = format!("could not read a JointTrajectory sample: {e:?}");
+                    self.log.error(&msg);
+                    self.trajectory_status(
+                        &Source::Topic { stamp: Time::ZERO },
+                        TrajectoryStatus::REJECTED,
+                        INVALID_GOAL,
+                        &msg,
+                    );
+                    break;
+                }
+            }
+        }
+    }
+
+    fn poll_goals(&mut self) {
+        loop {
+            let (req_id, SendGoalRequest { goal_id, goal }) = match self.action.receive_goal() {
+                Ok(Some(g)) => g,
+                Ok(None) => break,
+                Err(e) => {
+                    self.log.error(&format!(
+                        "could not read a FollowJointTrajectory goal: {e:?}"
+                    ));
+                    break;
+                }
+            };
+            let accepted = self.ros_now();
+            let source = Source::Action {
+                id: goal_id,
+                stamp: goal.trajectory.header.stamp,
+            };
+            let now = self.clock.now();
+            let submitted = convert::goal_request(&goal, &self.clock)
+                .and_then(|(req, tol)| Ok(self.exec.submit(&req, &tol, now)?));
+            // A ROS 2 goal rejection carries no reason, so an invalid goal is accepted and
+            // immediately aborted with its error code and message (JTC rejects without a reason).
+            if let Err(e) = self.action.send_goal_response(
+                req_id,
+                SendGoalResponse {
+                    accepted: true,
+                    stamp: accepted,
+                },
+            ) {
+                self.log
+                    .error(&format!("could not answer goal {goal_id:?}: {e:?}"));
+            }
+            let mut entry = action::ActionGoal {
+                id: goal_id,
+                accepted,
+                status: GoalStatusEnum::Executing,
+                exec_id: None,
+                result: None,
+            };
+            match submitted {
+                Ok(id) => {
+                    self.log.info(&format!(
+                        "accepted goal {goal_id:?}: {} points over {:.3} s",
+                        goal.trajectory.points.len(),
+                        goal.trajectory
+                            .points
+                            .last()
+                            .map_or(0.0, |p| p.time_from_start.as_secs_f64())
+                    ));
+                    entry.exec_id = Some(id);
+                    self.goals.add(entry);
+                    self.trajectory_status(
+                        &source,
+                        TrajectoryStatus::ACCEPTED,
+                        SUCCESSFUL,
+                        "accepted",
+                    );
+                    self.sources.insert(id, source);
+                }
+                Err(Rejection { code, message }) => {
+                    self.log
+                        .warn(&format!("rejected goal {goal_id:?}: {message}"));
+                    entry.status = GoalStatusEnum::Aborted;
+                    entry.result = Some(FollowJointTrajectoryResult {
+                        error_code: code,
+                        error_string: message.clone(),
+                    });
+                    self.goals.add(entry);
+                    self.trajectory_status(&source, TrajectoryStatus::REJECTED, code, &message);
+                }
+            }
+            self.statuses_changed = true;
+        }
+    }
+
+    fn poll_cancels(&mut self) {
+        loop {
+            let (req_id, req) = match self.action.receive_cancel_request() {
+                Ok(Some(r)) => r,
+                Ok(None) => break,
+                Err(e) => {
+                    self.log
+                        .error(&format!("could not read a cancel request: {e:?}"));
+                    break;
+                }
+            };
+            let response = match cancel_target(&req) {
+                Ok(info) => self.cancel(&info),
+                Err(reason) => {
+                    self.log
+                        .error(&format!("malformed cancel request: {reason}"));
+                    CancelGoalResponse {
+                        return_code: CancelGoalResponseEnum::Rejected,
+                        goals_canceling: Vec::new(),
+                    }
+                }
+            };
+            if let Err(e) = self.action.send_cancel_response(req_id, response) {
+                self.log
+                    .error(&format!("could not answer a cancel request: {e:?}"));
+            }
+        }
+    }
+
+    fn cancel(&mut self, info: &GoalInfo) -> CancelGoalResponse {
+        let selected = self.goals.select_for_cancel(info);
+        let now = self.clock.now();
+        let mut canceling = Vec::new();
+        for id in &selected {
+            let Some(g) = self.goals.get_mut(id) else {
+                continue;
+            };
+            if g.status != GoalStatusEnum::Executing {
+                continue;
+            }
+            let Some(exec_id) = g.exec_id else { continue };
+            g.status = GoalStatusEnum::Canceling;
+            canceling.push(GoalInfo {
+                goal_id: g.id,
+                stamp: g.accepted,
+            });
+            if let Err(e) = self.exec.cancel(exec_id, now) {
+                self.log.warn(&format!("cancel of goal {id:?}: {e}"));
+            }
+        }
+        if !canceling.is_empty() {
+            self.log.info(&format!(
+                "canceling {} goal(s); the motion stops within the acceleration limits",
+                canceling.len()
+            ));
+            self.statuses_changed = true;
+        }
+        let return_code = if !canceling.is_empty() {
+            CancelGoalResponseEnum::None
+        } else if selected.is_empty() {
+            CancelGoalResponseEnum::UnknownGoal
+        } else {
+            CancelGoalResponseEnum::GoalTerminated
+        };
+        CancelGoalResponse {
+            return_code,
+            goals_canceling: canceling,
+        }
+    }
+
+    fn poll_result_requests(&mut self) {
+        loop {
+            match self.action.receive_result_request() {
+                Ok(Some((req_id, req))) => self.goals.pending_results.push((req.goal_id, req_id)),
+                Ok(None) => break,
+                Err(e) => {
+                    self.log
+                        .error(&format!("could not read a result request: {e:?}"));
+                    break;
+                }
+            }
+        }
+        for (req_id, status, result) in self.goals.take_ready_results() {
+            if let Err(e) = self
+                .action
+                .send_result(req_id, GetResultResponse { status, result })
+            {
+                self.log
+                    .error(&format!("could not send a goal result: {e:?}"));
+            }
+        }
+    }
+
+    fn poll_validate(&mut self) {
+        loop {
+            let (req_id, req) = match self.validate_srv.receive_request() {
+                Ok(Some(r)) => r,
+                Ok(None) => break,
+                Err(e) => {
+                    self.log
+                        .error(&format!("could not read a validate request: {e:?}"));
+                    break;
+                }
+            };
+            let now = self.clock.now();
+            let checked = convert::trajectory_request(&req.trajectory, &self.clock)
+                .and_then(|r| Ok(self.exec.validate(&r, &GoalTolerances::default(), now)?));
+            let resp = match checked {
+                Ok(traj) => ValidateTrajectoryResponse {
+                    valid: true,
+                    error_code: SUCCESSFUL,
+                    message: "valid".into(),
+                    duration: traj.duration(),
+                },
+                Err(rej) => ValidateTrajectoryResponse {
+                    valid: false,
+                    error_code: rej.code,
+                    message: rej.message,
+                    duration: 0.0,
+                },
+            };
+            if let Err(e) = self.validate_srv.send_response(req_id, resp) {
+                self.log
+                    .error(&format!("could not answer a validate request: {e:?}"));
+            }
+        }
+    }
+
+    fn control_cycle(&mut self) {
+        let now = self.clock.now();
+        let measured = self.hw.state().clone();
+        let mut cycle = std::mem::take(&mut self.cycle);
+        if let Err(e) = self.exec.update_into(now, &measured, &mut cycle) {
+            self.log.error(&format!("control cycle failed: {e}"));
+            self.cycle = cycle;
+            return;
+        }
+        if let Err(e) = self.hw.write(
+            &self.cfg.limits,
+            &cycle.reference,
+            self.cfg.executor.control_period,
+        ) {
+            self.log
+                .error(&format!("hardware refused the command: {e}"));
+        }
+        let header = self.header(now);
+        let joint_state = |s: &JointSample| JointState {
+            header: header.clone(),
+            name: self.names.clone(),
+            position: s.positions.clone(),
+            velocity: s.velocities.clone(),
+            effort: Vec::new(),
+        };
+        let js = joint_state(&measured);
+        let cmd = joint_state(&cycle.reference);
+        let tfs = cycle.feedback.map_or(0.0, |f| f.time_from_start.max(0.0));
+        let state = JointTrajectoryControllerState {
+            header: header.clone(),
+            joint_names: self.names.clone(),
+            reference: convert::point(&cycle.reference, tfs),
+            feedback: convert::point(&measured, tfs),
+            error: convert::point(&cycle.error, tfs),
+            output: convert::point(&cycle.reference, tfs),
+            ..Default::default()
+        };
+        Self::publish(
+            &self.joint_states,
+            js,
+            &mut self.publish_failures,
+            &self.log,
+            "joint states",
+        );
+        Self::publish(
+            &self.command,
+            cmd,
+            &mut self.publish_failures,
+            &self.log,
+            "joint command",
+        );
+        Self::publish(
+            &self.controller_state,
+            state,
+            &mut self.publish_failures,
+            &self.log,
+            "controller state",
+        );
+
+        for ev in std::mem::take(&mut cycle.events) {
+            self.finish(ev.id, ev.outcome);
+        }
+        if let Some(fb) = cycle.feedback {
+            if now >= self.next_feedback {
+                self.next_feedback = now + 1.0 / self.cfg.action_monitor_rate;
+                if let Some(Source::Action { id, .. }) = self.sources.get(&fb.id) {
+                    let feedback = FollowJointTrajectoryFeedback {
+                        header,
+                        joint_names: self.names.clone(),
+                        desired: convert::point(&cycle.reference, tfs),
+                        actual: convert::point(&measured, tfs),
+                        error: convert::point(&cycle.error, tfs),
+                        ..Default::default()
+                    };
+                    if let Err(e) = self.action.send_feedback(*id, feedback) {
+                        self.log.debug(&format!("feedback not sent: {e:?}"));
+                    }
+                }
+            }
+        }
+        if self.statuses_changed {
+            self.statuses_changed = false;
+            if let Err(e) = self.action.send_goal_statuses(self.goals.status_array()) {
+                self.log.warn(&format!("goal status not published: {e:?}"));
+            }
+        }
+        self.cycle = cycle;
+    }
+
+    fn finish(&mut self, id: ExecGoalId, outcome: Outcome) {
+        let Some(source) = self.sources.remove(&id) else {
+            return;
+        };
+        let (status, action_status, code, message) = match outcome {
+            Outcome::Succeeded => (
+                TrajectoryStatus::SUCCEEDED,
+                GoalStatusEnum::Succeeded,
+                SUCCESSFUL,
+                String::new(),
+            ),
+            Outcome::Aborted {
+                error_code,
+                message,
+            } => (
+                TrajectoryStatus::ABORTED,
+                GoalStatusEnum::Aborted,
+                error_code,
+                message,
+            ),
+            // JTC ends a preempted goal as CANCELED with INVALID_GOAL and this kind of message.
+            Outcome::Preempted => (
+                TrajectoryStatus::PREEMPTED,
+                GoalStatusEnum::Canceled,
+                INVALID_GOAL,
+                "preempted by a newer trajectory, which continues from the current commanded state"
+                    .to_string(),
+            ),
+            Outcome::Canceled => (
+                TrajectoryStatus::CANCELED,
+                GoalStatusEnum::Canceled,
+                SUCCESSFUL,
+                "canceled; the motion was brought to a controlled stop".to_string(),
+            ),
+        };
+        let name = TrajectoryStatus::status_name(status).unwrap_or("?");
+        if code == SUCCESSFUL {
+            self.log.info(&format!("trajectory {name} {message}"));
+        } else {
+            self.log.warn(&format!("trajectory {name}: {message}"));
+        }
+        self.trajectory_status(&source, status, code, &message);
+        if let Source::Action { id: goal_id, .. } = source {
+            self.goals.finish(
+                &goal_id,
+                action_status,
+                FollowJointTrajectoryResult {
+                    error_code: code,
+                    error_string: message,
+                },
+            );
+            self.statuses_changed = true;
+        }
+    }
+}
+
+/// The goal selector of a CancelGoal request.
+///
+/// ros2-client keeps `CancelGoalRequest::goal_info` private; its serde form is public, so the
+/// request is read back through a serde value into a mirror of `action_msgs/srv/CancelGoal`.
+fn cancel_target(req: &CancelGoalRequest) -> Result<GoalInfo, String> {
+    #[derive(serde::Deserialize)]
+    struct Mirror {
+        goal_info: GoalInfo,
+    }
+    let v = serde_yaml_ng::to_value(req).map_err(|e| e.to_string())?;
+    serde_yaml_ng::from_value::<Mirror>(v)
+        .map(|m| m.goal_info)
+        .map_err(|e| e.to_string())
+}

@@ -1,0 +1,191 @@
+//! The node's parameters, read once at start-up and checked.
+
+use std::path::PathBuf;
+
+use kerf_executor::{ExecutorConfig, JointLimits, JointTolerance};
+use kerf_robot::RobotModel;
+use kerf_ros::Params;
+
+use crate::NodeError;
+
+/// Parameter names this node reads (`constraints.*` and `hardware.*` are groups).
+pub const KNOWN_PARAMS: &[&str] = &[
+    "urdf_file",
+    "joint_limits_file",
+    "control_rate",
+    "action_monitor_rate",
+    "initial_positions",
+    "start_tolerance",
+    "constraints.*",
+    "hardware.*",
+];
+
+/// Everything the node needs, checked.
+#[derive(Debug, Clone)]
+pub struct NodeConfig {
+    /// The robot.
+    pub robot: RobotModel,
+    /// Joint limits in model order (from the URDF and the limits YAML).
+    pub limits: Vec<JointLimits>,
+    /// Executor settings (control period, default tolerances, start tolerance).
+    pub executor: ExecutorConfig,
+    /// Control rate (Hz).
+    pub control_rate: f64,
+    /// Rate of action feedback (Hz), like JTC's `action_monitor_rate`.
+    pub action_monitor_rate: f64,
+    /// Initial positions, model order.
+    pub initial_positions: Vec<f64>,
+    /// Mock hardware first-order lag (s); 0 follows commands exactly.
+    pub lag_time_constant: f64,
+}
+
+fn param_err(name: &str, reason: String) -> NodeError {
+    NodeError::Config {
+        name: name.to_string(),
+        reason,
+    }
+}
+
+fn positive(params: &Params, name: &str, default: f64) -> Result<f64, NodeError> {
+    let v = params.f64_or(name, default)?;
+    if v <= 0.0 {
+        return Err(param_err(name, format!("must be > 0, got {v}")));
+    }
+    Ok(v)
+}
+
+fn non_negative(params: &Params, name: &str, default: f64) -> Result<f64, NodeError> {
+    let v = params.f64_or(name, default)?;
+    if v < 0.0 {
+        return Err(param_err(name, format!("must be >= 0, got {v}")));
+    }
+    Ok(v)
+}
+
+impl NodeConfig {
+    /// Reads and checks every parameter, and loads the robot.
+    ///
+    /// # Parameters
+    /// * `urdf_file` (string, required), `joint_limits_file` (string, required: acceleration
+    ///   limits are needed to validate trajectories).
+    /// * `control_rate` (Hz, default 250: the 4 ms of seed 001), `action_monitor_rate` (Hz, 20).
+    /// * `initial_positions` (one per joint, model order; default all 0, which must be in range).
+    /// * `start_tolerance` (default 1e-3): see `kerf_executor::ExecutorConfig`.
+    /// * `constraints.stopped_velocity_tolerance` (0.01), `constraints.goal_time` (s, 0 = wait
+    ///   forever), `constraints.<joint>.trajectory` and `constraints.<joint>.goal` (position
+    ///   tolerances, 0 = unchecked): JTC's names and defaults.
+    /// * `hardware.lag_time_constant` (s, default 0: the mock follows commands exactly).
+    pub fn from_params(params: &Params) -> Result<Self, NodeError> {
+        let urdf = PathBuf::from(params.required_string("urdf_file")?);
+        let limits_file = PathBuf::from(params.required_string("joint_limits_file")?);
+        let robot = RobotModel::from_files(&urdf, Some(&limits_file))?;
+
+        let mut limits = Vec::with_capacity(robot.dof());
+        for j in robot.joints() {
+            let max_acceleration = j.max_acceleration.ok_or_else(|| {
+                param_err(
+                    "joint_limits_file",
+                    format!(
+                        "{} gives no max_acceleration for joint '{}'; the executor needs it to \
+                         check trajectories",
+                        limits_file.display(),
+                        j.name
+                    ),
+                )
+            })?;
+            limits.push(JointLimits {
+                name: j.name.clone(),
+                min_position: j.min_position,
+                max_position: j.max_position,
+                max_velocity: j.max_velocity,
+                max_acceleration,
+            });
+        }
+
+        let control_rate = positive(params, "control_rate", 250.0)?;
+        let action_monitor_rate = positive(params, "action_monitor_rate", 20.0)?;
+        let mut executor = ExecutorConfig {
+            control_period: 1.0 / control_rate,
+            stopped_velocity_tolerance: non_negative(
+                params,
+                "constraints.stopped_velocity_tolerance",
+                0.01,
+            )?,
+            goal_time_tolerance: non_negative(params, "constraints.goal_time", 0.0)?,
+            start_tolerance: non_negative(params, "start_tolerance", 1e-3)?,
+            ..ExecutorConfig::default()
+        };
+        for (name, _) in params.iter() {
+            let Some(rest) = name.strip_prefix("constraints.") else {
+                continue;
+            };
+            if rest == "stopped_velocity_tolerance" || rest == "goal_time" {
+                continue;
+            }
+            let known = rest
+                .rsplit_once('.')
+                .filter(|(joint, kind)| {
+                    robot.joint_index(joint).is_some() && (*kind == "trajectory" || *kind == "goal")
+                })
+                .ok_or_else(|| {
+                    param_err(
+                        name,
+                        format!(
+                            "expected constraints.<joint>.trajectory or constraints.<joint>.goal \
+                             with a joint of {}",
+                            robot.joint_names().join(", ")
+                        ),
+                    )
+                })?;
+            let tol = JointTolerance {
+                name: known.0.to_string(),
+                position: non_negative(params, name, 0.0)?,
+                velocity: 0.0,
+                acceleration: 0.0,
+            };
+            if known.1 == "trajectory" {
+                executor.path_tolerances.push(tol);
+            } else {
+                executor.goal_tolerances.push(tol);
+            }
+        }
+        for (name, _) in params.iter() {
+            if name.starts_with("hardware.") && name != "hardware.lag_time_constant" {
+                return Err(param_err(
+                    name,
+                    "unknown; hardware.lag_time_constant is the only hardware parameter".into(),
+                ));
+            }
+        }
+        let lag_time_constant = non_negative(params, "hardware.lag_time_constant", 0.0)?;
+
+        let initial_positions = match params.f64_array("initial_positions")? {
+            Some(v) => v,
+            None => vec![0.0; robot.dof()],
+        };
+        if initial_positions.len() != robot.dof() {
+            return Err(param_err(
+                "initial_positions",
+                format!(
+                    "needs {} values (joints {}), got {}",
+                    robot.dof(),
+                    robot.joint_names().join(", "),
+                    initial_positions.len()
+                ),
+            ));
+        }
+        robot
+            .check_positions(&initial_positions)
+            .map_err(|e| param_err("initial_positions", e.to_string()))?;
+
+        Ok(Self {
+            robot,
+            limits,
+            executor,
+            control_rate,
+            action_monitor_rate,
+            initial_positions,
+            lag_time_constant,
+        })
+    }
+}

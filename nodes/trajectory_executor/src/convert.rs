@@ -1,0 +1,222 @@
+//! Conversions between ROS messages and the executor core's plain types.
+
+use kerf_executor::{
+    ExecutorError, GoalTolerances, JointSample, JointTolerance, TrajectoryPoint, TrajectoryRequest,
+    INVALID_GOAL, INVALID_JOINTS,
+};
+use kerf_msgs::{
+    builtin_interfaces::{Duration, Time},
+    control_msgs::{FollowJointTrajectoryGoal, JointTolerance as JointToleranceMsg},
+    trajectory_msgs::{JointTrajectory, JointTrajectoryPoint},
+};
+
+/// Why a request was refused: a `control_msgs/FollowJointTrajectory` result code and a message.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Rejection {
+    /// Result code (`INVALID_GOAL`, `INVALID_JOINTS`, …).
+    pub code: i32,
+    /// What exactly is wrong.
+    pub message: String,
+}
+
+impl From<ExecutorError> for Rejection {
+    fn from(e: ExecutorError) -> Self {
+        Self {
+            code: e.error_code(),
+            message: e.to_string(),
+        }
+    }
+}
+
+/// The clock of a node: a monotonic origin and the system time it corresponds to.
+///
+/// The executor core runs on seconds since the origin (an `f64` keeps sub-ns resolution for
+/// months), messages carry system time (ROS time without `use_sim_time`).
+#[derive(Debug, Clone, Copy)]
+pub struct Clock {
+    origin: std::time::Instant,
+    origin_ns: i64,
+}
+
+impl Clock {
+    /// Starts the clock now.
+    pub fn start() -> Self {
+        let origin_ns = std::time::SystemTime::now()
+            .duration_since(std::time::UNIX_EPOCH)
+            .map(|d| d.as_nanos() as i64)
+            .unwrap_or(0);
+        Self {
+            origin: std::time::Instant::now(),
+            origin_ns,
+        }
+    }
+
+    /// Seconds since the origin.
+    pub fn now(&self) -> f64 {
+        self.origin.elapsed().as_secs_f64()
+    }
+
+    /// The ROS time of a clock reading.
+    pub fn stamp(&self, t: f64) -> Time {
+        Time::from_nanos(self.origin_ns + (t * 1e9).round() as i64).unwrap_or(Time::ZERO)
+    }
+
+    /// A ROS time on this clock (s since the origin).
+    pub fn from_stamp(&self, stamp: &Time) -> f64 {
+        (stamp.as_nanos() - self.origin_ns) as f64 * 1e-9
+    }
+}
+
+fn duration_secs(d: &Duration, what: &str) -> Result<f64, Rejection> {
+    if d.nanosec >= 1_000_000_000 {
+        return Err(Rejection {
+            code: INVALID_GOAL,
+            message: format!("{what}: nanosec {} is not below 1e9", d.nanosec),
+        });
+    }
+    Ok(d.as_secs_f64())
+}
+
+/// Converts a `trajectory_msgs/JointTrajectory` (stamp 0 = start now).
+pub fn trajectory_request(
+    msg: &JointTrajectory,
+    clock: &Clock,
+) -> Result<TrajectoryRequest, Rejection> {
+    if msg.header.stamp.nanosec >= 1_000_000_000 {
+        return Err(Rejection {
+            code: INVALID_GOAL,
+            message: format!(
+                "header.stamp.nanosec {} is not below 1e9",
+                msg.header.stamp.nanosec
+            ),
+        });
+    }
+    let start_time = (!msg.header.stamp.is_zero()).then(|| clock.from_stamp(&msg.header.stamp));
+    let points = msg
+        .points
+        .iter()
+        .enumerate()
+        .map(|(i, p)| {
+            Ok(TrajectoryPoint {
+                positions: p.positions.clone(),
+                velocities: p.velocities.clone(),
+                accelerations: p.accelerations.clone(),
+                effort: p.effort.clone(),
+                time_from_start: duration_secs(
+                    &p.time_from_start,
+                    &format!("point {i} time_from_start"),
+                )?,
+            })
+        })
+        .collect::<Result<Vec<_>, Rejection>>()?;
+    Ok(TrajectoryRequest {
+        joint_names: msg.joint_names.clone(),
+        points,
+        start_time,
+    })
+}
+
+fn tolerances(list: &[JointToleranceMsg]) -> Vec<JointTolerance> {
+    list.iter()
+        .map(|t| JointTolerance {
+            name: t.name.clone(),
+            position: t.position,
+            velocity: t.velocity,
+            acceleration: t.acceleration,
+        })
+        .collect()
+}
+
+/// Converts a FollowJointTrajectory goal. Multi-DOF trajectories and component tolerances are
+/// refused: this executor drives single-DOF joints only.
+pub fn goal_request(
+    goal: &FollowJointTrajectoryGoal,
+    clock: &Clock,
+) -> Result<(TrajectoryRequest, GoalTolerances), Rejection> {
+    let md = &goal.multi_dof_trajectory;
+    if !md.joint_names.is_empty() || !md.points.is_empty() {
+        return Err(Rejection {
+            code: INVALID_JOINTS,
+            message: format!(
+                "multi_dof_trajectory is not supported (joints {:?}); this executor drives \
+                 single-DOF joints only",
+                md.joint_names
+            ),
+        });
+    }
+    if !goal.component_path_tolerance.is_empty() || !goal.component_goal_tolerance.is_empty() {
+        return Err(Rejection {
+            code: INVALID_GOAL,
+            message: "component_path_tolerance / component_goal_tolerance apply to multi-DOF \
+                      joints, which this executor does not drive"
+                .into(),
+        });
+    }
+    let req = trajectory_request(&goal.trajectory, clock)?;
+    let tol = GoalTolerances {
+        path: tolerances(&goal.path_tolerance),
+        goal: tolerances(&goal.goal_tolerance),
+        goal_time: duration_secs(&goal.goal_time_tolerance, "goal_time_tolerance")?,
+    };
+    Ok((req, tol))
+}
+
+/// A `JointTrajectoryPoint` from a joint sample (time_from_start given).
+pub fn point(sample: &JointSample, time_from_start: f64) -> JointTrajectoryPoint {
+    JointTrajectoryPoint {
+        positions: sample.positions.clone(),
+        velocities: sample.velocities.clone(),
+        accelerations: sample.accelerations.clone(),
+        effort: Vec::new(),
+        time_from_start: Duration::from_secs_f64(time_from_start).unwrap_or(Duration::ZERO),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use kerf_msgs::trajectory_msgs::MultiDOFJointTrajectory;
+
+    #[test]
+    fn converts_times_and_refuses_malformed_durations() {
+        let clock = Clock::start();
+        let mut msg = JointTrajectory {
+            joint_names: vec!["a".into()],
+            points: vec![JointTrajectoryPoint {
+                positions: vec![1.0],
+                time_from_start: Duration {
+                    sec: 1,
+                    nanosec: 500_000_000,
+                },
+                ..Default::default()
+            }],
+            ..Default::default()
+        };
+        let req = trajectory_request(&msg, &clock).unwrap();
+        assert_eq!(req.start_time, None);
+        assert_eq!(req.points[0].time_from_start, 1.5);
+        msg.header.stamp = clock.stamp(2.0);
+        let req = trajectory_request(&msg, &clock).unwrap();
+        assert!((req.start_time.unwrap() - 2.0).abs() < 1e-6);
+        msg.points[0].time_from_start.nanosec = 1_000_000_000;
+        let err = trajectory_request(&msg, &clock).unwrap_err();
+        assert_eq!(err.code, INVALID_GOAL);
+        assert!(err.message.contains("point 0"), "{}", err.message);
+    }
+
+    #[test]
+    fn refuses_multi_dof_goals() {
+        let clock = Clock::start();
+        let goal = FollowJointTrajectoryGoal {
+            multi_dof_trajectory: MultiDOFJointTrajectory {
+                joint_names: vec!["base".into()],
+                ..Default::default()
+            },
+            ..Default::default()
+        };
+        assert_eq!(
+            goal_request(&goal, &clock).unwrap_err().code,
+            INVALID_JOINTS
+        );
+    }
+}
