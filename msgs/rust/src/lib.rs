@@ -4,7 +4,7 @@
 //! ros2-client serializes messages with CDR through serde: struct fields go on
 //! the wire in declaration order, so every mirror declares exactly the fields of
 //! its ROS 2 interface definition, in the same order and with the matching Rust
-//! type (`string` → [`String`](std::string::String), `float64` → `f64`,
+//! type (`string` → [`String`], `float64` → `f64`,
 //! `int32` → `i32`, `uint32` → `u32`, `uint16` → `u16`, `uint8` → `u8`,
 //! `bool` → `bool`, `T[]` → `Vec<T>`, `T[N]` → `[T; N]`, nested message →
 //! struct). The integration test `tests/drift.rs` checks every mirror against
