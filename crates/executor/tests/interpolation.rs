@@ -1,4 +1,5 @@
 //! Interpolation against closed-form curves, and limits on a dense time grid.
+#![allow(clippy::needless_range_loop)] // joints index several parallel arrays
 
 mod common;
 
@@ -323,9 +324,9 @@ fn limit_checks_are_tight_against_dense_sampling() {
         checked += 1;
         let limits = limits6();
         let traj = validate(&limits, &cfg(), &req, &current, 0.0).unwrap();
-        let mut max_v = vec![0.0f64; 6];
-        let mut max_a = vec![0.0f64; 6];
-        let mut max_p = vec![f64::MIN; 6];
+        let mut max_v = [0.0f64; 6];
+        let mut max_a = [0.0f64; 6];
+        let mut max_p = [f64::MIN; 6];
         let h = 1e-4;
         for k in 0..=(traj.end_time() / h) as usize {
             let s = traj.sample(k as f64 * h);

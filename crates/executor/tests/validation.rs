@@ -1,4 +1,5 @@
 //! Every rejection of `validate` and of tolerances: variant, result code, message.
+#![allow(clippy::needless_range_loop)] // joints index several parallel arrays
 
 mod common;
 
