@@ -187,6 +187,30 @@ impl KerfNode {
         self.stop.is_stopped()
     }
 
+    /// Topics with a discovered publisher (DDS writer) on the domain: (fully qualified ROS
+    /// name, DDS type name), e.g. `("/joint_states", "sensor_msgs::msg::dds_::JointState_")`.
+    /// Only ROS topics (`rt/…`) are listed; this node's own writers are included.
+    pub fn discovered_topics(&self) -> Vec<(String, String)> {
+        let Some(c) = self.context.as_ref() else {
+            return Vec::new();
+        };
+        let mut out: Vec<(String, String)> = c
+            .domain_participant()
+            .discovered_writers()
+            .into_iter()
+            .filter_map(|w| {
+                let t = w.publication_topic_data;
+                t.topic_name
+                    .strip_prefix("rt")
+                    .filter(|n| n.starts_with('/'))
+                    .map(|n| (n.to_string(), t.type_name.clone()))
+            })
+            .collect();
+        out.sort();
+        out.dedup();
+        out
+    }
+
     /// Expands and remaps a topic or service name as this node sees it.
     pub fn resolve(&self, name: &str) -> Result<String, RosError> {
         names::resolve(name, &self.namespace, &self.name, &self.remaps)

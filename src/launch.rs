@@ -1,0 +1,105 @@
+//! `kerf launch`: every node in one process, each with its own Context and thread.
+
+use std::path::PathBuf;
+
+use clap::{Args, ValueEnum};
+use kerf_ros::{shutdown, ParamSource, ParamValue, RosArgs, RosEnv, StopToken};
+
+/// The robots whose descriptions ship in `urdf/`.
+#[derive(Debug, Clone, Copy, ValueEnum)]
+pub enum Robot {
+    /// The 6-axis laser cutting machine of seed 001.
+    LaserCutter,
+    /// ABB IRB 6660-130/3.1.
+    Irb6660,
+}
+
+impl Robot {
+    fn stem(self) -> &'static str {
+        match self {
+            Robot::LaserCutter => "laser_cutter",
+            Robot::Irb6660 => "irb6660",
+        }
+    }
+}
+
+/// Arguments of `kerf launch`.
+#[derive(Args, Debug)]
+pub struct LaunchArgs {
+    /// Robot for the trajectory executor (sets `urdf_file` and `joint_limits_file` from the
+    /// shipped descriptions; `-p` arguments after `--ros-args` override them).
+    #[arg(long, value_enum, default_value = "laser-cutter")]
+    robot: Robot,
+    /// Directory holding the robot descriptions (default: `$KERF_URDF_DIR`, else the `urdf/`
+    /// of the source tree kerf was built from).
+    #[arg(long)]
+    urdf_dir: Option<PathBuf>,
+    /// ROS arguments, as for any ROS 2 node: `--ros-args -r __ns:=/cell -p control_rate:=100.0
+    /// --params-file params.yaml`. Node-specific rules use the node's default name
+    /// (`-r trajectory_executor:__ns:=/cell`).
+    #[arg(trailing_var_arg = true, allow_hyphen_values = true)]
+    ros_args: Vec<String>,
+}
+
+fn urdf_dir(arg: Option<PathBuf>) -> PathBuf {
+    arg.or_else(|| std::env::var_os("KERF_URDF_DIR").map(PathBuf::from))
+        .unwrap_or_else(|| PathBuf::from(concat!(env!("CARGO_MANIFEST_DIR"), "/urdf")))
+}
+
+/// Runs `kerf launch` until Ctrl-C or until a node fails.
+pub fn run(a: LaunchArgs) -> Result<(), String> {
+    let mut args = RosArgs::parse(a.ros_args.iter().cloned()).map_err(|e| e.to_string())?;
+    if let Some(extra) = args.other.first() {
+        return Err(format!(
+            "unexpected argument {extra:?}; ROS arguments go after --ros-args"
+        ));
+    }
+    let dir = urdf_dir(a.urdf_dir);
+    let stem = a.robot.stem();
+    // Defaults first: later sources (the user's -p and --params-file) override them.
+    let defaults = [
+        ("urdf_file", dir.join(format!("{stem}.urdf"))),
+        ("joint_limits_file", dir.join(format!("{stem}_limits.yaml"))),
+    ];
+    for (i, (name, path)) in defaults.into_iter().enumerate() {
+        args.params.insert(
+            i,
+            ParamSource::Inline(name.into(), ParamValue::String(path.display().to_string())),
+        );
+    }
+    let env = RosEnv::from_env().map_err(|e| e.to_string())?;
+    shutdown::install_handler()?;
+    let stop = StopToken::new();
+
+    type NodeMain = fn(&RosArgs, &RosEnv, StopToken) -> Result<(), String>;
+    let nodes: [(&str, NodeMain); 1] = [(kerf_trajectory_executor::DEFAULT_NAME, |a, e, s| {
+        kerf_trajectory_executor::run(a, e, s).map_err(|e| e.to_string())
+    })];
+    let mut handles = Vec::new();
+    for (name, main) in nodes {
+        let (args, env, stop) = (args.clone(), env.clone(), stop.clone());
+        let h = std::thread::Builder::new()
+            .name(name.to_string())
+            .spawn(move || {
+                let r = main(&args, &env, stop.clone());
+                // One node failing stops the launch, as a required node does in ros2 launch.
+                stop.stop();
+                r.map_err(|e| format!("{name}: {e}"))
+            })
+            .map_err(|e| format!("cannot start {name}: {e}"))?;
+        handles.push(h);
+    }
+    let mut errors = Vec::new();
+    for h in handles {
+        match h.join() {
+            Ok(Ok(())) => {}
+            Ok(Err(e)) => errors.push(e),
+            Err(_) => errors.push("a node thread panicked".to_string()),
+        }
+    }
+    if errors.is_empty() {
+        Ok(())
+    } else {
+        Err(errors.join("; "))
+    }
+}
