@@ -161,7 +161,7 @@ impl Echo<'_> {
             match sub.take() {
                 Ok(Some((msg, _))) => {
                     let yaml = serde_yaml_ng::to_string(&msg).map_err(|e| e.to_string())?;
-                    print!("{yaml}---\n");
+                    println!("{yaml}---");
                     n += 1;
                 }
                 Ok(None) => {
