@@ -12,7 +12,7 @@
 //! time) is 238 ns; a node that wants sub-µs timing passes times relative to a recent origin.
 //!
 //! # Overview
-//! * [`validate`] checks a request against the robot model ([`JointLimits`]) and a current
+//! * [`validate()`] checks a request against the robot model ([`JointLimits`]) and a current
 //!   state, and builds a [`ValidatedTrajectory`]: segment polynomials in model joint order on
 //!   absolute time, sampled in O(1) amortized per cycle.
 //! * [`Executor`] runs one goal at a time: preemption, cancel with a controlled stop

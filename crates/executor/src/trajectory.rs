@@ -41,7 +41,7 @@ impl Segment {
     }
 }
 
-/// A trajectory that passed [`crate::validate`]: in robot-model joint order, on absolute time,
+/// A trajectory that passed [`crate::validate()`]: in robot-model joint order, on absolute time,
 /// within all limits on the whole interpolated curve.
 ///
 /// Before its first segment it holds the state it started from; after its last point it holds
@@ -119,9 +119,8 @@ impl ValidatedTrajectory {
     /// As [`Self::sample`], writing into `out` (resized to the joint count).
     ///
     /// # Performance
-    /// O(1) amortized for non-decreasing `t` (a segment cursor moves forward); at most
-    /// [`MAX_LINEAR_STEPS`] cursor steps, else a binary search, so O(log n) worst case; any
-    /// `t` is allowed. No allocation once `out` has the capacity.
+    /// O(1) amortized for non-decreasing `t` (a segment cursor moves forward); at most 8
+    /// cursor steps, else a binary search, so O(log n) worst case; any `t` is allowed. No allocation once `out` has the capacity.
     pub fn sample_into(&self, t: f64, out: &mut JointSample) {
         out.resize_full(self.n);
         if t.is_nan() || t >= self.end_time {

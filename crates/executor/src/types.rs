@@ -247,23 +247,23 @@ impl JointSample {
     }
 }
 
-/// Configuration of the executor (JTC parameters of the same meaning in brackets).
+/// Configuration of the executor (JTC parameters of the same meaning in parentheses).
 #[derive(Debug, Clone, PartialEq)]
 pub struct ExecutorConfig {
     /// Control period (s); velocity steps are commanded within one period. Default 0.004
-    /// (250 Hz) [`update_rate`].
+    /// (250 Hz); JTC `update_rate`.
     pub control_period: f64,
     /// Default path tolerances by joint name; joints not listed are unchecked. Values: 0 =
     /// unchecked, > 0 = tolerance [`constraints.<joint>.trajectory` (position only)].
     pub path_tolerances: Vec<JointTolerance>,
     /// Default goal tolerances by joint name; joints not listed are unchecked (except the
-    /// velocity, see `stopped_velocity_tolerance`) [`constraints.<joint>.goal`].
+    /// velocity, see `stopped_velocity_tolerance`) (JTC `constraints.<joint>.goal`).
     pub goal_tolerances: Vec<JointTolerance>,
     /// Default goal velocity tolerance of every joint whose `goal_tolerances` entry gives no
-    /// velocity; default 0.01 [`constraints.stopped_velocity_tolerance`].
+    /// velocity; default 0.01 (JTC `constraints.stopped_velocity_tolerance`).
     pub stopped_velocity_tolerance: f64,
     /// Default time after the trajectory end to reach the goal tolerances (s); 0 = wait
-    /// forever. Default 0 [`constraints.goal_time`].
+    /// forever. Default 0 (JTC `constraints.goal_time`).
     pub goal_time_tolerance: f64,
     /// Largest position difference (joint units) between the current commanded position and a
     /// first point due at the start time (`time_from_start` 0). Default 1e-3. No JTC equivalent.

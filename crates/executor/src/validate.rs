@@ -69,8 +69,8 @@ impl ModelPoint {
 /// [`ExecutorError::error_code`].
 ///
 /// # Performance
-/// O(points · joints); each segment costs a few root isolations of degree ≤ 4 (about 10 µs
-/// per joint and segment in debug builds, well under that in release builds).
+/// O(points · joints); each joint of each segment costs three root isolations of degree ≤ 4,
+/// about 1 µs in a release build (6 joints × 1000 quintic points: about 6.5 ms).
 pub fn validate(
     limits: &[JointLimits],
     cfg: &ExecutorConfig,
