@@ -621,3 +621,20 @@ fn invalid_robot_model_config_and_initial_positions() {
     assert!(e.to_string().contains("'j2'"));
     let _ = names(&l);
 }
+
+#[test]
+fn velocity_step_from_a_moving_state_into_a_linear_start_segment() {
+    // Current velocity 0.5 on j5; a linear start segment to a point 10 s away has slope ~0:
+    // Δv 0.5 in 4 ms = 125 > 14 (j5's limit).
+    let l = limits6();
+    let mut current = rest(6, 0.0);
+    current.velocities[4] = 0.5;
+    let req = request(&l, vec![pt(10.0, &[0.01; 6], &[], &[])]);
+    let e = validate(&l, &cfg(), &req, &current, 0.0).map(|_| ());
+    let e = rejected(
+        e,
+        INVALID_GOAL,
+        &["'j5'", "start of the start segment", "from 0.5"],
+    );
+    assert!(matches!(e, ExecutorError::VelocityStep { limit, .. } if limit == 14.0));
+}
