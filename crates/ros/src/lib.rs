@@ -25,7 +25,7 @@ pub use args::{LogLevel, ParamSource, RosArgs};
 pub use env::{DiscoveryRange, RosEnv, MAX_DOMAIN_ID};
 pub use error::RosError;
 pub use logger::Logger;
-pub use node::{KerfNode, NodeSpec};
+pub use node::{block_on_timeout, KerfNode, NodeSpec};
 pub use params::{ParamValue, Params};
 pub use shutdown::StopToken;
 pub use worker::{Worker, WorkerError};

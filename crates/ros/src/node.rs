@@ -7,8 +7,9 @@
 use std::thread::JoinHandle;
 
 use ros2_client::{
-    action::ActionServer, ActionTypeName, Context, Message, MessageTypeName, Name, Node, NodeName,
-    NodeOptions, Publisher, QosProfile, Server, ServiceMapping, ServiceTypeName, Subscription,
+    action::{ActionClient, ActionClientQosPolicies, ActionServer},
+    ActionTypeName, Client, Context, Message, MessageTypeName, Name, Node, NodeName, NodeOptions,
+    Publisher, QosProfile, Server, ServiceMapping, ServiceTypeName, Subscription,
 };
 use serde::{de::DeserializeOwned, Serialize};
 
@@ -306,6 +307,124 @@ impl KerfNode {
                 qos::services(),
             )
             .map_err(dds_err(format!("service {name}")))
+    }
+}
+
+impl KerfNode {
+    /// Creates an action client (`package/action/Name`) with rcl_action's QoS and the
+    /// Enhanced service mapping. Used by tools and tests that play a cell controller.
+    pub fn action_client<G, R, F>(
+        &mut self,
+        name: &str,
+        ros_type: &str,
+    ) -> Result<ActionClient<G, R, F>, RosError>
+    where
+        G: Message + Clone + 'static,
+        R: Message + Clone + 'static,
+        F: Message + 'static,
+    {
+        let (pkg, ty) = split_type(ros_type, "action")?;
+        let name = self.ros_name(name)?;
+        let s = qos::action_server();
+        let policies = ActionClientQosPolicies {
+            goal_service: s.goal_service,
+            result_service: s.result_service,
+            cancel_service: s.cancel_service,
+            feedback_subscription: s.feedback_publisher,
+            status_subscription: s.status_publisher,
+        };
+        self.node_mut()
+            .create_action_client(
+                ServiceMapping::Enhanced,
+                &name,
+                &ActionTypeName::new(pkg, ty),
+                policies,
+            )
+            .map_err(dds_err(format!("action client {name}")))
+    }
+
+    /// Creates a service client (`package/srv/Name`) with the Enhanced service mapping.
+    pub fn service_client<Req, Resp>(
+        &mut self,
+        name: &str,
+        ros_type: &str,
+    ) -> Result<Client<Req, Resp>, RosError>
+    where
+        Req: Message + Clone + 'static,
+        Resp: Message + 'static,
+    {
+        let (pkg, ty) = split_type(ros_type, "srv")?;
+        let name = self.ros_name(name)?;
+        self.node_mut()
+            .create_client(
+                ServiceMapping::Enhanced,
+                &name,
+                &ServiceTypeName::new(pkg, ty),
+                qos::services(),
+                qos::services(),
+            )
+            .map_err(dds_err(format!("service client {name}")))
+    }
+
+    /// Waits until a server is matched on all three services of an action client.
+    ///
+    /// # Returns
+    /// `false` if `timeout` passed first. A request sent before matching would be lost
+    /// (volatile QoS), so a client waits for this before its first goal.
+    pub fn wait_for_action_server<G, R, F>(
+        &self,
+        client: &ActionClient<G, R, F>,
+        timeout: std::time::Duration,
+    ) -> bool
+    where
+        G: Message + Clone + 'static,
+        R: Message + Clone + 'static,
+        F: Message + 'static,
+    {
+        let Some(node) = self.node.as_ref() else {
+            return false;
+        };
+        let all = async {
+            futures::join!(
+                client.goal_client().wait_for_service(node),
+                client.cancel_client().wait_for_service(node),
+                client.result_client().wait_for_service(node),
+            )
+        };
+        block_on_timeout(all, timeout).is_some()
+    }
+
+    /// Waits until a server is matched for a service client; `false` on timeout.
+    pub fn wait_for_service<Req, Resp>(
+        &self,
+        client: &Client<Req, Resp>,
+        timeout: std::time::Duration,
+    ) -> bool
+    where
+        Req: Message + 'static,
+        Resp: Message + 'static,
+    {
+        let Some(node) = self.node.as_ref() else {
+            return false;
+        };
+        block_on_timeout(client.wait_for_service(node), timeout).is_some()
+    }
+}
+
+/// Runs a future to completion on this thread, giving up after `timeout`.
+pub fn block_on_timeout<F: std::future::Future>(
+    f: F,
+    timeout: std::time::Duration,
+) -> Option<F::Output> {
+    let (tx, rx) = futures::channel::oneshot::channel::<()>();
+    std::thread::spawn(move || {
+        std::thread::sleep(timeout);
+        let _ = tx.send(());
+    });
+    let f = std::pin::pin!(f);
+    match futures::executor::block_on(futures::future::select(f, rx)) {
+        futures::future::Either::Left((out, _)) => Some(out),
+        futures::future::Either::Right(_) => None,
     }
 }
 

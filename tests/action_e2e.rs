@@ -1,0 +1,399 @@
+//! End to end over DDS (loopback only): a Rust cell controller drives the trajectory executor
+//! through `control_msgs/action/FollowJointTrajectory`: success, rejection with reasons,
+//! preemption, cancel, and the `~/validate_trajectory` dry-run service.
+//!
+//! Each test runs its own executor (in this process, own Context) on its own ROS domain.
+
+use std::{
+    thread::JoinHandle,
+    time::{Duration, Instant},
+};
+
+use kerf_msgs::{
+    builtin_interfaces::Duration as RosDuration,
+    control_msgs::{
+        FollowJointTrajectoryFeedback, FollowJointTrajectoryGoal, FollowJointTrajectoryResult,
+    },
+    sensor_msgs::JointState,
+    srv::{ValidateTrajectoryRequest, ValidateTrajectoryResponse},
+    trajectory_msgs::{JointTrajectory, JointTrajectoryPoint},
+    RosType,
+};
+use kerf_ros::{qos, DiscoveryRange, KerfNode, NodeSpec, RosArgs, RosEnv, StopToken};
+use ros2_client::{
+    action::{ActionClient, GoalId, GoalStatusEnum},
+    Client, Subscription,
+};
+
+const JOINTS: [&str; 6] = [
+    "joint_1", "joint_2", "joint_3", "joint_4", "joint_5", "joint_6",
+];
+const TIMEOUT: Duration = Duration::from_secs(20);
+
+type Fjt = ActionClient<
+    FollowJointTrajectoryGoal,
+    FollowJointTrajectoryResult,
+    FollowJointTrajectoryFeedback,
+>;
+
+struct Cell {
+    action: Fjt,
+    validate: Client<ValidateTrajectoryRequest, ValidateTrajectoryResponse>,
+    states: Subscription<JointState>,
+    last: Option<JointState>,
+    /// Keeps the client node (and its Context) alive; dropped after the endpoints above.
+    _client: KerfNode,
+    stop: StopToken,
+    executor: Option<JoinHandle<Result<(), String>>>,
+}
+
+impl Cell {
+    fn start(domain: u16) -> Cell {
+        let env = RosEnv {
+            domain_id: domain,
+            range: DiscoveryRange::Localhost,
+        };
+        let urdf = concat!(env!("CARGO_MANIFEST_DIR"), "/urdf");
+        let args = RosArgs::parse([
+            "--ros-args".to_string(),
+            "-p".into(),
+            format!("urdf_file:={urdf}/irb6660.urdf"),
+            "-p".into(),
+            format!("joint_limits_file:={urdf}/irb6660_limits.yaml"),
+            "--disable-rosout-logs".into(),
+        ])
+        .unwrap();
+        let stop = StopToken::new();
+        let (a, e, s) = (args.clone(), env.clone(), stop.clone());
+        let executor = std::thread::spawn(move || {
+            kerf_trajectory_executor::run(&a, &e, s).map_err(|e| e.to_string())
+        });
+
+        let mut client = KerfNode::new(
+            NodeSpec {
+                default_name: "cell_controller",
+                default_namespace: "/",
+                known_params: &[],
+            },
+            &RosArgs {
+                rosout_logs: false,
+                ..RosArgs::default()
+            },
+            &env,
+            StopToken::new(),
+        )
+        .unwrap();
+        let action: Fjt = client
+            .action_client(
+                "/trajectory_executor/follow_joint_trajectory",
+                "control_msgs/action/FollowJointTrajectory",
+            )
+            .unwrap();
+        let validate = client
+            .service_client(
+                "/trajectory_executor/validate_trajectory",
+                "kerf_msgs/srv/ValidateTrajectory",
+            )
+            .unwrap();
+        let states = client
+            .subscription("/joint_states", JointState::ROS_TYPE, qos::state())
+            .unwrap();
+        assert!(
+            client.wait_for_action_server(&action, TIMEOUT),
+            "action server not discovered"
+        );
+        assert!(
+            client.wait_for_service(&validate, TIMEOUT),
+            "validate service not discovered"
+        );
+        let mut cell = Cell {
+            action,
+            validate,
+            states,
+            last: None,
+            _client: client,
+            stop,
+            executor: Some(executor),
+        };
+        cell.wait_state(|_| true, "first joint state");
+        cell
+    }
+
+    /// Reads joint states until `pred` holds for one; returns every state read on the way.
+    fn wait_state(
+        &mut self,
+        mut pred: impl FnMut(&JointState) -> bool,
+        what: &str,
+    ) -> Vec<JointState> {
+        let deadline = Instant::now() + TIMEOUT;
+        let mut seen = Vec::new();
+        while Instant::now() < deadline {
+            match self.states.take() {
+                Ok(Some((s, _))) => {
+                    self.last = Some(s.clone());
+                    seen.push(s.clone());
+                    if pred(&s) {
+                        return seen;
+                    }
+                }
+                Ok(None) => std::thread::sleep(Duration::from_millis(1)),
+                Err(e) => panic!("reading joint states: {e:?}"),
+            }
+        }
+        panic!("timed out waiting for {what}; last state {:?}", self.last);
+    }
+
+    fn position(&mut self) -> Vec<f64> {
+        self.wait_state(|_| true, "a joint state");
+        self.last.as_ref().map(|s| s.position.clone()).unwrap()
+    }
+
+    fn send(&self, goal: FollowJointTrajectoryGoal) -> GoalId {
+        let (req, id) = self.action.send_goal(goal).expect("send goal");
+        let deadline = Instant::now() + TIMEOUT;
+        loop {
+            if let Some(resp) = self
+                .action
+                .receive_goal_response(req)
+                .expect("goal response")
+            {
+                assert!(
+                    resp.accepted,
+                    "kerf accepts every goal and reports problems in the result"
+                );
+                return id;
+            }
+            assert!(Instant::now() < deadline, "no goal response");
+            std::thread::sleep(Duration::from_millis(2));
+        }
+    }
+
+    fn result(&self, id: GoalId) -> (GoalStatusEnum, FollowJointTrajectoryResult) {
+        let req = self.action.request_result(id).expect("request result");
+        let deadline = Instant::now() + TIMEOUT;
+        loop {
+            if let Some(r) = self.action.receive_result(req).expect("result") {
+                return r;
+            }
+            assert!(Instant::now() < deadline, "no result for goal {id:?}");
+            std::thread::sleep(Duration::from_millis(2));
+        }
+    }
+
+    fn validate(&self, trajectory: JointTrajectory) -> ValidateTrajectoryResponse {
+        let req = self
+            .validate
+            .send_request(ValidateTrajectoryRequest { trajectory })
+            .expect("validate request");
+        let deadline = Instant::now() + TIMEOUT;
+        loop {
+            if let Some((id, resp)) = self.validate.receive_response().expect("validate response") {
+                if id == req {
+                    return resp;
+                }
+            }
+            assert!(Instant::now() < deadline, "no validate response");
+            std::thread::sleep(Duration::from_millis(2));
+        }
+    }
+}
+
+impl Drop for Cell {
+    fn drop(&mut self) {
+        self.stop.stop();
+        if let Some(h) = self.executor.take() {
+            let r = h.join().expect("executor thread");
+            if !std::thread::panicking() {
+                r.expect("executor ended cleanly");
+            }
+        }
+    }
+}
+
+/// Minimum-jerk rest-to-rest motion `from` → `to` over `t` seconds, `n` segments, with exact
+/// velocities and accelerations (quintic interpolation in the executor reproduces it).
+fn min_jerk(names: &[&str], from: &[f64], to: &[f64], t: f64, n: usize) -> JointTrajectory {
+    let points = (1..=n)
+        .map(|k| {
+            let s = k as f64 / n as f64;
+            let (p, v, a) = (
+                10.0 * s.powi(3) - 15.0 * s.powi(4) + 6.0 * s.powi(5),
+                (30.0 * s.powi(2) - 60.0 * s.powi(3) + 30.0 * s.powi(4)) / t,
+                (60.0 * s - 180.0 * s.powi(2) + 120.0 * s.powi(3)) / (t * t),
+            );
+            JointTrajectoryPoint {
+                positions: from.iter().zip(to).map(|(f, g)| f + (g - f) * p).collect(),
+                velocities: from.iter().zip(to).map(|(f, g)| (g - f) * v).collect(),
+                accelerations: from.iter().zip(to).map(|(f, g)| (g - f) * a).collect(),
+                effort: vec![],
+                time_from_start: RosDuration::from_secs_f64(s * t).unwrap(),
+            }
+        })
+        .collect();
+    JointTrajectory {
+        joint_names: names.iter().map(|s| s.to_string()).collect(),
+        points,
+        ..Default::default()
+    }
+}
+
+fn goal(trajectory: JointTrajectory) -> FollowJointTrajectoryGoal {
+    FollowJointTrajectoryGoal {
+        trajectory,
+        ..Default::default()
+    }
+}
+
+fn max_diff(a: &[f64], b: &[f64]) -> f64 {
+    a.iter()
+        .zip(b)
+        .map(|(x, y)| (x - y).abs())
+        .fold(0.0, f64::max)
+}
+
+#[test]
+fn follows_a_goal_and_reports_success() {
+    let mut cell = Cell::start(41);
+    let start = cell.position();
+    let target = [0.3, -0.2, 0.25, 0.5, -0.4, 1.0];
+    // Joints in another order than the model's: the executor maps them by name.
+    let order = [5, 2, 0, 4, 1, 3];
+    let names: Vec<&str> = order.iter().map(|&i| JOINTS[i]).collect();
+    let from: Vec<f64> = order.iter().map(|&i| start[i]).collect();
+    let to: Vec<f64> = order.iter().map(|&i| target[i]).collect();
+    let id = cell.send(goal(min_jerk(&names, &from, &to, 1.5, 15)));
+    let (status, result) = cell.result(id);
+    assert_eq!(status, GoalStatusEnum::Succeeded, "{result:?}");
+    assert_eq!(result.error_code, FollowJointTrajectoryResult::SUCCESSFUL);
+    cell.wait_state(
+        |s| max_diff(&s.position, &target) < 1e-6,
+        "arrival at the target",
+    );
+}
+
+#[test]
+fn refuses_bad_goals_with_code_and_reason_and_keeps_serving() {
+    let mut cell = Cell::start(42);
+    let start = cell.position();
+    let target = [0.2; 6];
+
+    let mut unknown = min_jerk(&JOINTS, &start, &target, 1.0, 5);
+    unknown.joint_names[2] = "joint_7".into();
+    let (status, r) = cell.result(cell.send(goal(unknown)));
+    assert_eq!(status, GoalStatusEnum::Aborted);
+    assert_eq!(r.error_code, FollowJointTrajectoryResult::INVALID_JOINTS);
+    assert!(r.error_string.contains("joint_7"), "{}", r.error_string);
+
+    let mut nan = min_jerk(&JOINTS, &start, &target, 1.0, 5);
+    nan.points[2].positions[4] = f64::NAN;
+    let (status, r) = cell.result(cell.send(goal(nan)));
+    assert_eq!(status, GoalStatusEnum::Aborted);
+    assert_eq!(r.error_code, FollowJointTrajectoryResult::INVALID_GOAL);
+    assert!(r.error_string.contains("joint_5"), "{}", r.error_string);
+
+    // 0.2 rad in 0.05 s: far over joint_1's 1.92 rad/s somewhere on the curve.
+    let fast = min_jerk(&JOINTS, &start, &target, 0.05, 3);
+    let (status, r) = cell.result(cell.send(goal(fast.clone())));
+    assert_eq!(status, GoalStatusEnum::Aborted);
+    assert!(
+        r.error_string.contains("velocity") || r.error_string.contains("acceleration"),
+        "{}",
+        r.error_string
+    );
+    let v = cell.validate(fast);
+    assert!(!v.valid);
+    assert_eq!(v.error_code, FollowJointTrajectoryResult::INVALID_GOAL);
+
+    // Nothing moved.
+    assert!(max_diff(&cell.position(), &start) < 1e-12);
+
+    // Still serving: a valid goal succeeds.
+    let ok = min_jerk(&JOINTS, &start, &target, 1.0, 10);
+    let v = cell.validate(ok.clone());
+    assert!(v.valid, "{}", v.message);
+    assert!((v.duration - 1.0).abs() < 1e-9);
+    let (status, r) = cell.result(cell.send(goal(ok)));
+    assert_eq!(status, GoalStatusEnum::Succeeded, "{r:?}");
+    cell.wait_state(|s| max_diff(&s.position, &target) < 1e-6, "arrival");
+}
+
+#[test]
+fn a_new_goal_preempts_the_active_one_without_a_jump() {
+    let mut cell = Cell::start(43);
+    let start = cell.position();
+    let far = [1.0, 0.5, 0.8, 1.5, 1.0, 2.0];
+    let a = cell.send(goal(min_jerk(&JOINTS, &start, &far, 4.0, 20)));
+    // Let it get under way, then replace it with a goal that starts where the robot is.
+    let seen = cell.wait_state(|s| s.velocity.iter().any(|v| v.abs() > 0.2), "motion");
+    let here = seen.last().unwrap().position.clone();
+    let back = [0.1; 6];
+    // First point 0.5 s ahead: the executor interpolates from its current state to it.
+    let mut tr = min_jerk(&JOINTS, &here, &back, 3.0, 15);
+    for p in &mut tr.points {
+        let t = p.time_from_start.as_secs_f64() + 0.5;
+        p.time_from_start = RosDuration::from_secs_f64(t).unwrap();
+    }
+    let b = cell.send(goal(tr));
+    let (status_a, ra) = cell.result(a);
+    assert_eq!(status_a, GoalStatusEnum::Canceled, "{ra:?}");
+    assert!(ra.error_string.contains("preempted"), "{}", ra.error_string);
+    let seen = cell.wait_state(
+        |s| max_diff(&s.position, &back) < 1e-6,
+        "arrival at the second target",
+    );
+    let (status_b, rb) = cell.result(b);
+    assert_eq!(status_b, GoalStatusEnum::Succeeded, "{rb:?}");
+    // Continuity across the switch: no sample-to-sample jump larger than joint_1's velocity
+    // limit allows (1.92 rad/s), allowing for a dropped sample or two.
+    for w in seen.windows(2) {
+        let dt = (w[1].header.stamp.as_secs_f64() - w[0].header.stamp.as_secs_f64()).max(0.004);
+        let step = max_diff(&w[0].position, &w[1].position);
+        assert!(
+            step <= 2.62 * dt * 1.01 + 1e-9,
+            "jump of {step} rad in {dt} s"
+        );
+    }
+}
+
+#[test]
+fn cancel_stops_the_motion_within_the_limits() {
+    let mut cell = Cell::start(44);
+    let start = cell.position();
+    let far = [1.0, 0.5, 0.8, 1.5, 1.0, 2.0];
+    let id = cell.send(goal(min_jerk(&JOINTS, &start, &far, 4.0, 20)));
+    cell.wait_state(|s| s.velocity.iter().any(|v| v.abs() > 0.2), "motion");
+    let req = cell.action.cancel_goal(id).expect("cancel");
+    let deadline = Instant::now() + TIMEOUT;
+    let resp = loop {
+        if let Some(r) = cell
+            .action
+            .receive_cancel_response(req)
+            .expect("cancel response")
+        {
+            break r;
+        }
+        assert!(Instant::now() < deadline, "no cancel response");
+        std::thread::sleep(Duration::from_millis(2));
+    };
+    assert_eq!(resp.goals_canceling.len(), 1);
+    let (status, r) = cell.result(id);
+    assert_eq!(status, GoalStatusEnum::Canceled, "{r:?}");
+    let stopped = cell.wait_state(|s| s.velocity.iter().all(|v| *v == 0.0), "standstill");
+    let end = &stopped.last().unwrap().position;
+    assert!(
+        max_diff(end, &far) > 0.1,
+        "the canceled motion must not reach its target"
+    );
+    // Velocity changes respect the largest acceleration limit (5 rad/s², joint_4). Measured
+    // over windows of 10 samples (40 ms): a published state is the previous cycle's command,
+    // as with ros2_control's mock hardware, so single-sample differences carry stamp jitter.
+    for w in stopped.windows(11) {
+        let dt = w[10].header.stamp.as_secs_f64() - w[0].header.stamp.as_secs_f64();
+        let dv = max_diff(&w[0].velocity, &w[10].velocity);
+        assert!(
+            dv / dt <= 5.0 * 1.3,
+            "velocity change {} rad/s² over {dt} s",
+            dv / dt
+        );
+    }
+}
