@@ -689,8 +689,10 @@ impl ExecutorNode {
             ),
         };
         let name = TrajectoryStatus::status_name(status).unwrap_or("?");
-        if code == SUCCESSFUL {
-            self.log.info(&format!("trajectory {name} {message}"));
+        if message.is_empty() {
+            self.log.info(&format!("trajectory {name}"));
+        } else if code == SUCCESSFUL {
+            self.log.info(&format!("trajectory {name}: {message}"));
         } else {
             self.log.warn(&format!("trajectory {name}: {message}"));
         }

@@ -1,0 +1,68 @@
+"""Launch kerf's nodes on a ROS 2 Jazzy install.
+
+kerf's binaries are plain executables built by cargo (pure-Rust ROS 2 over RustDDS), not
+ament packages, so they are started with ExecuteProcess and the usual --ros-args.
+
+    ros2 launch launch_scripts/kerf.launch.py robot:=irb6660
+    ros2 launch launch_scripts/kerf.launch.py robot:=laser_cutter namespace:=/cell
+
+Arguments:
+    robot       laser_cutter | irb6660 (selects urdf/<robot>.urdf and its limits YAML)
+    namespace   node namespace (default /)
+    params_file executor parameters (default launch_scripts/params/<robot>.yaml)
+    kerf_root   the kerf source tree (default: the parent of this file's directory)
+    profile     cargo profile whose binaries to run: release (default) or debug
+
+Build first: cargo build --release --workspace
+The nodes honour ROS_DOMAIN_ID and ROS_AUTOMATIC_DISCOVERY_RANGE like any Jazzy node.
+"""
+
+import os
+
+from launch import LaunchDescription
+from launch.actions import DeclareLaunchArgument, ExecuteProcess, OpaqueFunction
+from launch.substitutions import LaunchConfiguration
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+
+
+def _nodes(context):
+    root = LaunchConfiguration("kerf_root").perform(context) or os.path.dirname(HERE)
+    robot = LaunchConfiguration("robot").perform(context)
+    if robot not in ("laser_cutter", "irb6660"):
+        raise RuntimeError(f"robot must be laser_cutter or irb6660, got {robot!r}")
+    namespace = LaunchConfiguration("namespace").perform(context)
+    profile = LaunchConfiguration("profile").perform(context)
+    params = LaunchConfiguration("params_file").perform(context) or os.path.join(
+        HERE, "params", f"{robot}.yaml"
+    )
+    urdf_dir = os.path.join(root, "urdf")
+    binary = os.path.join(root, "target", profile, "trajectory_executor")
+    if not os.path.exists(binary):
+        raise RuntimeError(f"{binary} not found: run 'cargo build --{profile} --workspace' in {root}")
+    executor = ExecuteProcess(
+        name="trajectory_executor",
+        output="screen",
+        cmd=[
+            binary,
+            "--ros-args",
+            "-r", f"__ns:={namespace}",
+            "--params-file", params,
+            "-p", f"urdf_file:={os.path.join(urdf_dir, robot + '.urdf')}",
+            "-p", f"joint_limits_file:={os.path.join(urdf_dir, robot + '_limits.yaml')}",
+        ],
+    )
+    return [executor]
+
+
+def generate_launch_description():
+    return LaunchDescription(
+        [
+            DeclareLaunchArgument("robot", default_value="laser_cutter"),
+            DeclareLaunchArgument("namespace", default_value="/"),
+            DeclareLaunchArgument("params_file", default_value=""),
+            DeclareLaunchArgument("kerf_root", default_value=""),
+            DeclareLaunchArgument("profile", default_value="release"),
+            OpaqueFunction(function=_nodes),
+        ]
+    )
