@@ -1,0 +1,116 @@
+//! The `kerf` tool as a user runs it: `kerf launch` serves, `kerf echo` prints a topic as YAML,
+//! Ctrl-C (SIGINT) stops the launch cleanly, and bad ROS arguments are refused. Loopback DDS.
+
+use std::{
+    io::{BufRead, BufReader},
+    process::{Child, Command, Stdio},
+    sync::mpsc,
+    time::{Duration, Instant},
+};
+
+const DOMAIN: &str = "48";
+
+fn kerf() -> Command {
+    let mut c = Command::new(env!("CARGO_BIN_EXE_kerf"));
+    c.env("ROS_DOMAIN_ID", DOMAIN)
+        .env("ROS_AUTOMATIC_DISCOVERY_RANGE", "LOCALHOST")
+        .env_remove("ROS_STATIC_PEERS");
+    c
+}
+
+struct Killed(Child);
+impl Drop for Killed {
+    fn drop(&mut self) {
+        let _ = self.0.kill();
+        let _ = self.0.wait();
+    }
+}
+
+#[test]
+fn launch_echo_and_ctrl_c() {
+    let child = kerf()
+        .args(["launch", "--robot", "laser-cutter"])
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("start kerf launch");
+    let mut launch = Killed(child);
+    let stderr = launch.0.stderr.take().expect("stderr");
+    let (tx, rx) = mpsc::channel();
+    std::thread::spawn(move || {
+        for line in BufReader::new(stderr).lines().map_while(Result::ok) {
+            let _ = tx.send(line);
+        }
+    });
+    let wait_line = |needle: &str| -> String {
+        let deadline = Instant::now() + Duration::from_secs(20);
+        while let Ok(line) = rx.recv_timeout(deadline.saturating_duration_since(Instant::now())) {
+            if line.contains(needle) {
+                return line;
+            }
+        }
+        panic!("kerf launch never printed {needle:?}");
+    };
+    let ready = wait_line("ready");
+    assert!(ready.contains("q1, q2, q3, q4, q5, q6"), "{ready}");
+
+    let out = kerf()
+        .args(["echo", "/joint_states", "-n", "1", "--timeout", "20"])
+        .output()
+        .expect("run kerf echo");
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let yaml = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        yaml.contains("- q6") && yaml.contains("position:"),
+        "{yaml}"
+    );
+
+    // Ctrl-C: a clean shutdown and exit status 0.
+    let pid = launch.0.id().to_string();
+    assert!(Command::new("kill")
+        .args(["-INT", &pid])
+        .status()
+        .unwrap()
+        .success());
+    wait_line("shutting down");
+    let deadline = Instant::now() + Duration::from_secs(10);
+    loop {
+        if let Some(status) = launch.0.try_wait().unwrap() {
+            assert!(status.success(), "exit status {status}");
+            break;
+        }
+        assert!(
+            Instant::now() < deadline,
+            "kerf launch did not exit after SIGINT"
+        );
+        std::thread::sleep(Duration::from_millis(20));
+    }
+}
+
+#[test]
+fn bad_arguments_and_environment_are_refused() {
+    let out = kerf()
+        .args(["launch", "--ros-args", "-p", "no_such_param:=1"])
+        .output()
+        .unwrap();
+    assert!(!out.status.success());
+    assert!(String::from_utf8_lossy(&out.stderr).contains("no_such_param"));
+
+    let out = kerf()
+        .args(["launch"])
+        .env("ROS_AUTOMATIC_DISCOVERY_RANGE", "NEARBY")
+        .output()
+        .unwrap();
+    assert!(!out.status.success());
+    assert!(String::from_utf8_lossy(&out.stderr).contains("ROS_AUTOMATIC_DISCOVERY_RANGE"));
+
+    let out = kerf()
+        .args(["echo", "/nothing_here", "--discovery-timeout", "0.5"])
+        .output()
+        .unwrap();
+    assert!(!out.status.success());
+    assert!(String::from_utf8_lossy(&out.stderr).contains("no publisher of /nothing_here"));
+}
