@@ -7,6 +7,7 @@
 //! * [`qos`] holds the named QoS profiles (reliable, keep-last ≥ 10).
 //! * [`Logger`] writes to stderr and `/rosout`.
 //! * [`shutdown`] turns Ctrl-C into a flag every node loop polls; [`StopToken`] stops one node.
+//! * [`Streamer`] publishes high-rate streams from a thread, so a control loop never blocks.
 //! * [`Worker`] runs slow requests in the background so a node keeps serving.
 //! * [`KerfNode`] ties these together: one Context per node, names resolved and remapped.
 
@@ -19,6 +20,7 @@ mod node;
 mod params;
 pub mod qos;
 pub mod shutdown;
+mod streamer;
 mod worker;
 
 pub use args::{LogLevel, ParamSource, RosArgs};
@@ -28,6 +30,7 @@ pub use logger::Logger;
 pub use node::{block_on_timeout, KerfNode, NodeSpec};
 pub use params::{ParamValue, Params};
 pub use shutdown::StopToken;
+pub use streamer::Streamer;
 pub use worker::{Worker, WorkerError};
 
 /// Re-export, so node crates use exactly the ros2-client version kerf was built against.

@@ -13,7 +13,7 @@ use ros2_client::{
 };
 use serde::{de::DeserializeOwned, Serialize};
 
-use crate::{names, qos, LogLevel, Logger, Params, RosArgs, RosEnv, RosError, StopToken};
+use crate::{names, qos, LogLevel, Logger, Params, RosArgs, RosEnv, RosError, StopToken, Streamer};
 
 /// What a node binary declares about itself.
 #[derive(Debug, Clone, Copy)]
@@ -243,6 +243,24 @@ impl KerfNode {
             .map_err(dds_err(format!("topic {name}")))?;
         node.create_publisher(&t, Some(qos))
             .map_err(dds_err(format!("publisher on {name}")))
+    }
+
+    /// Creates a publisher on `topic` that runs on its own thread behind a queue of `capacity`
+    /// samples ([`Streamer`]): publishing never blocks the caller.
+    pub fn streamer<M: Serialize + Send + 'static>(
+        &mut self,
+        topic: &str,
+        ros_type: &str,
+        qos: QosProfile,
+        capacity: usize,
+    ) -> Result<Streamer<M>, RosError> {
+        let p = self.publisher(topic, ros_type, qos)?;
+        Streamer::new(p, capacity, topic.trim_start_matches(['~', '/'])).map_err(|e| {
+            RosError::Dds {
+                what: format!("publisher thread for {topic}"),
+                reason: e.to_string(),
+            }
+        })
     }
 
     /// Creates a subscription on `topic`.

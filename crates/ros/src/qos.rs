@@ -53,7 +53,11 @@ pub fn action_server() -> ActionServerQosPolicies {
         goal_service: services(),
         result_service: services(),
         cancel_service: services(),
-        feedback_publisher: reliable(DEFAULT_DEPTH),
+        // Feedback is periodic: a stalled client must not block the server, so a full send
+        // window drops the sample at once instead of waiting.
+        feedback_publisher: reliable(DEFAULT_DEPTH).reliability(Reliability::Reliable {
+            when_full: WhenFull::Fail,
+        }),
         status_publisher: reliable(1).durability(Durability::TransientLocal),
     }
 }

@@ -45,7 +45,7 @@ use kerf_msgs::{
     RosType,
 };
 use kerf_robot::RobotError;
-use kerf_ros::{qos, KerfNode, Logger, NodeSpec, RosArgs, RosEnv, RosError, StopToken};
+use kerf_ros::{qos, KerfNode, Logger, NodeSpec, RosArgs, RosEnv, RosError, StopToken, Streamer};
 use ros2_client::{
     action::{
         ActionServer, CancelGoalRequest, CancelGoalResponse, GetResultResponse, GoalId, GoalInfo,
@@ -53,7 +53,7 @@ use ros2_client::{
     },
     action_msgs::CancelGoalResponseEnum,
     builtin_interfaces::Time as RosTime,
-    Publisher, Server, Subscription,
+    Server, Subscription,
 };
 
 pub use config::{NodeConfig, KNOWN_PARAMS};
@@ -61,6 +61,9 @@ use convert::{Clock, Rejection};
 
 /// Default node name.
 pub const DEFAULT_NAME: &str = "trajectory_executor";
+
+/// Samples each outgoing stream may queue before new ones are dropped (0.25 s at 250 Hz).
+const STREAM_QUEUE: usize = 64;
 
 /// Why the node could not start.
 #[derive(Debug, thiserror::Error)]
@@ -132,10 +135,10 @@ struct ExecutorNode {
     traj_sub: Subscription<JointTrajectory>,
     action: FjtServer,
     validate_srv: Server<ValidateTrajectoryRequest, ValidateTrajectoryResponse>,
-    joint_states: Publisher<JointState>,
-    controller_state: Publisher<JointTrajectoryControllerState>,
-    command: Publisher<JointState>,
-    status: Publisher<TrajectoryStatus>,
+    joint_states: Streamer<JointState>,
+    controller_state: Streamer<JointTrajectoryControllerState>,
+    command: Streamer<JointState>,
+    status: Streamer<TrajectoryStatus>,
     goals: action::ActionGoals,
     sources: HashMap<ExecGoalId, Source>,
     exec: Executor,
@@ -170,17 +173,22 @@ impl ExecutorNode {
         )?;
         let validate_srv =
             node.service_server("~/validate_trajectory", "kerf_msgs/srv/ValidateTrajectory")?;
-        let joint_states = node.publisher("joint_states", JointState::ROS_TYPE, qos::state())?;
-        let controller_state = node.publisher(
+        // Outgoing streams leave the control thread through bounded queues: a stalled
+        // subscriber can cost samples but never blocks the control loop.
+        let q = STREAM_QUEUE;
+        let joint_states = node.streamer("joint_states", JointState::ROS_TYPE, qos::state(), q)?;
+        let controller_state = node.streamer(
             "~/controller_state",
             JointTrajectoryControllerState::ROS_TYPE,
             qos::state(),
+            q,
         )?;
-        let command = node.publisher("~/joint_command", JointState::ROS_TYPE, qos::state())?;
-        let status = node.publisher(
+        let command = node.streamer("~/joint_command", JointState::ROS_TYPE, qos::state(), q)?;
+        let status = node.streamer(
             "~/trajectory_status",
             TrajectoryStatus::ROS_TYPE,
             qos::latched(),
+            q,
         )?;
         let names = cfg
             .limits
@@ -249,18 +257,18 @@ impl ExecutorNode {
         self.log.info("shutting down");
     }
 
-    fn publish<M: serde::Serialize + std::fmt::Debug>(
-        pubr: &Publisher<M>,
+    fn publish<M: serde::Serialize + Send + 'static>(
+        stream: &Streamer<M>,
         msg: M,
         failures: &mut u64,
         log: &Logger,
         what: &str,
     ) {
-        if let Err(e) = pubr.publish(msg) {
+        if !stream.publish(msg) {
             *failures += 1;
             if failures.is_power_of_two() {
                 log.warn(&format!(
-                    "publishing {what} failed ({failures} failures so far): {e:?}"
+                    "{what}: sample dropped, a subscriber is not keeping up ({failures} drops so far)"
                 ));
             }
         }
