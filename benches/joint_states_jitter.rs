@@ -50,6 +50,7 @@ fn main() {
     let env = RosEnv {
         domain_id: 97,
         range: DiscoveryRange::Localhost,
+        ..RosEnv::default()
     };
     let urdf = concat!(env!("CARGO_MANIFEST_DIR"), "/urdf");
     let args = RosArgs::parse([

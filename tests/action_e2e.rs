@@ -22,7 +22,7 @@ use kerf_msgs::{
 use kerf_ros::{qos, DiscoveryRange, KerfNode, NodeSpec, RosArgs, RosEnv, StopToken};
 use ros2_client::{
     action::{ActionClient, GoalId, GoalStatusEnum},
-    Client, Subscription,
+    Client, ServiceMapping, Subscription,
 };
 
 const JOINTS: [&str; 6] = [
@@ -49,9 +49,14 @@ struct Cell {
 
 impl Cell {
     fn start(domain: u16) -> Cell {
+        Self::start_with(domain, ServiceMapping::Enhanced)
+    }
+
+    fn start_with(domain: u16, service_mapping: ServiceMapping) -> Cell {
         let env = RosEnv {
             domain_id: domain,
             range: DiscoveryRange::Localhost,
+            service_mapping,
         };
         let urdf = concat!(env!("CARGO_MANIFEST_DIR"), "/urdf");
         let args = RosArgs::parse([
@@ -265,6 +270,22 @@ fn follows_a_goal_and_reports_success() {
     let (status, result) = cell.result(id);
     assert_eq!(status, GoalStatusEnum::Succeeded, "{result:?}");
     assert_eq!(result.error_code, FollowJointTrajectoryResult::SUCCESSFUL);
+    cell.wait_state(
+        |s| max_diff(&s.position, &target) < 1e-6,
+        "arrival at the target",
+    );
+}
+
+/// `RMW_IMPLEMENTATION=rmw_cyclonedds_cpp` selects Cyclone's request/reply mapping for the
+/// action's services; a client with the same mapping drives the executor.
+#[test]
+fn follows_a_goal_with_the_cyclone_rpc_mapping() {
+    let mut cell = Cell::start_with(45, ServiceMapping::Cyclone);
+    let start = cell.position();
+    let target = [-0.2; 6];
+    let id = cell.send(goal(min_jerk(&JOINTS, &start, &target, 1.0, 10)));
+    let (status, result) = cell.result(id);
+    assert_eq!(status, GoalStatusEnum::Succeeded, "{result:?}");
     cell.wait_state(
         |s| max_diff(&s.position, &target) < 1e-6,
         "arrival at the target",

@@ -9,10 +9,11 @@
 //! | `ROS_AUTOMATIC_DISCOVERY_RANGE` | `SUBNET` (default), `LOCALHOST` (loopback only), `OFF`, `SYSTEM_DEFAULT`. |
 //! | `ROS_LOCALHOST_ONLY` | deprecated in Jazzy; `1` means `LOCALHOST` when the range is not set. |
 //! | `ROS_STATIC_PEERS` | not supported (RustDDS has no static peer list): refused with an error. |
+//! | `RMW_IMPLEMENTATION` | which RMW the *peers* use, so services and actions use their RPC mapping: unset or `rmw_fastrtps_cpp` / `rmw_fastrtps_dynamic_cpp` / `rmw_connextdds` → Enhanced (Jazzy's default), `rmw_cyclonedds_cpp` → Cyclone's mapping; anything else is refused. Topics are the same for every RMW. |
 
 use std::net::Ipv4Addr;
 
-use ros2_client::Context;
+use ros2_client::{Context, ServiceMapping};
 
 use crate::RosError;
 
@@ -28,13 +29,16 @@ pub enum DiscoveryRange {
     SystemDefault,
 }
 
-/// The ROS 2 environment of a process: domain id and discovery range.
+/// The ROS 2 environment of a process: domain id, discovery range, and the RPC mapping of
+/// services and actions.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct RosEnv {
     /// DDS domain id (`ROS_DOMAIN_ID`).
     pub domain_id: u16,
     /// Discovery range (`ROS_AUTOMATIC_DISCOVERY_RANGE`).
     pub range: DiscoveryRange,
+    /// Request/reply mapping of services and actions (from `RMW_IMPLEMENTATION`).
+    pub service_mapping: ServiceMapping,
 }
 
 impl Default for RosEnv {
@@ -42,6 +46,7 @@ impl Default for RosEnv {
         Self {
             domain_id: 0,
             range: DiscoveryRange::Subnet,
+            service_mapping: ServiceMapping::Enhanced,
         }
     }
 }
@@ -116,7 +121,28 @@ impl RosEnv {
                 _ => DiscoveryRange::Subnet,
             },
         };
-        Ok(Self { domain_id, range })
+        let service_mapping = match get("RMW_IMPLEMENTATION").map(|s| s.trim().to_string()) {
+            None => ServiceMapping::Enhanced,
+            Some(s) => match s.as_str() {
+                "" | "rmw_fastrtps_cpp" | "rmw_fastrtps_dynamic_cpp" | "rmw_connextdds" => {
+                    ServiceMapping::Enhanced
+                }
+                "rmw_cyclonedds_cpp" => ServiceMapping::Cyclone,
+                _ => {
+                    return Err(RosError::UnsupportedEnv {
+                        variable: "RMW_IMPLEMENTATION".into(),
+                        value: s,
+                        reason: "kerf speaks DDS with the service mappings of rmw_fastrtps_cpp,                                  rmw_connextdds and rmw_cyclonedds_cpp"
+                            .into(),
+                    })
+                }
+            },
+        };
+        Ok(Self {
+            domain_id,
+            range,
+            service_mapping,
+        })
     }
 
     /// Creates a ros2-client [`Context`] (one DDS participant) for this environment.
@@ -199,5 +225,23 @@ mod tests {
         assert!(err.to_string().contains("LOCALHOST"), "{err}");
         assert!(env(&[("ROS_AUTOMATIC_DISCOVERY_RANGE", "OFF")]).is_err());
         assert!(env(&[("ROS_STATIC_PEERS", "10.0.0.1")]).is_err());
+        assert!(env(&[("RMW_IMPLEMENTATION", "rmw_zenoh_cpp")]).is_err());
+    }
+
+    #[test]
+    fn rmw_chooses_the_service_mapping() {
+        assert_eq!(env(&[]).unwrap().service_mapping, ServiceMapping::Enhanced);
+        assert_eq!(
+            env(&[("RMW_IMPLEMENTATION", "rmw_cyclonedds_cpp")])
+                .unwrap()
+                .service_mapping,
+            ServiceMapping::Cyclone
+        );
+        assert_eq!(
+            env(&[("RMW_IMPLEMENTATION", "rmw_fastrtps_cpp")])
+                .unwrap()
+                .service_mapping,
+            ServiceMapping::Enhanced
+        );
     }
 }

@@ -37,6 +37,7 @@ pub struct KerfNode {
     params: Params,
     logger: Logger,
     stop: StopToken,
+    service_mapping: ServiceMapping,
 }
 
 /// Splits `pkg/kind/Name` and checks the kind.
@@ -145,6 +146,7 @@ impl KerfNode {
             params,
             logger,
             stop,
+            service_mapping: env.service_mapping,
         })
     }
 
@@ -280,8 +282,9 @@ impl KerfNode {
             .map_err(dds_err(format!("subscription on {name}")))
     }
 
-    /// Creates an action server (`package/action/Name`) with rcl_action's QoS and the
-    /// Enhanced service mapping (Fast DDS, Jazzy's default RMW).
+    /// Creates an action server (`package/action/Name`) with rcl_action's QoS and the service
+    /// mapping of the environment ([`RosEnv::service_mapping`]; Enhanced for Fast DDS, Jazzy's
+    /// default RMW).
     pub fn action_server<G, R, F>(
         &mut self,
         name: &str,
@@ -294,9 +297,10 @@ impl KerfNode {
     {
         let (pkg, ty) = split_type(ros_type, "action")?;
         let name = self.ros_name(name)?;
+        let mapping = self.service_mapping;
         self.node_mut()
             .create_action_server(
-                ServiceMapping::Enhanced,
+                mapping,
                 &name,
                 &ActionTypeName::new(pkg, ty),
                 qos::action_server(),
@@ -304,7 +308,7 @@ impl KerfNode {
             .map_err(dds_err(format!("action server {name}")))
     }
 
-    /// Creates a service server (`package/srv/Name`) with the Enhanced service mapping.
+    /// Creates a service server (`package/srv/Name`) with the environment's service mapping.
     pub fn service_server<Req, Resp>(
         &mut self,
         name: &str,
@@ -316,9 +320,10 @@ impl KerfNode {
     {
         let (pkg, ty) = split_type(ros_type, "srv")?;
         let name = self.ros_name(name)?;
+        let mapping = self.service_mapping;
         self.node_mut()
             .create_server(
-                ServiceMapping::Enhanced,
+                mapping,
                 &name,
                 &ServiceTypeName::new(pkg, ty),
                 qos::services(),
@@ -330,7 +335,7 @@ impl KerfNode {
 
 impl KerfNode {
     /// Creates an action client (`package/action/Name`) with rcl_action's QoS and the
-    /// Enhanced service mapping. Used by tools and tests that play a cell controller.
+    /// environment's service mapping. Used by tools and tests that play a cell controller.
     pub fn action_client<G, R, F>(
         &mut self,
         name: &str,
@@ -351,17 +356,13 @@ impl KerfNode {
             feedback_subscription: s.feedback_publisher,
             status_subscription: s.status_publisher,
         };
+        let mapping = self.service_mapping;
         self.node_mut()
-            .create_action_client(
-                ServiceMapping::Enhanced,
-                &name,
-                &ActionTypeName::new(pkg, ty),
-                policies,
-            )
+            .create_action_client(mapping, &name, &ActionTypeName::new(pkg, ty), policies)
             .map_err(dds_err(format!("action client {name}")))
     }
 
-    /// Creates a service client (`package/srv/Name`) with the Enhanced service mapping.
+    /// Creates a service client (`package/srv/Name`) with the environment's service mapping.
     pub fn service_client<Req, Resp>(
         &mut self,
         name: &str,
@@ -373,9 +374,10 @@ impl KerfNode {
     {
         let (pkg, ty) = split_type(ros_type, "srv")?;
         let name = self.ros_name(name)?;
+        let mapping = self.service_mapping;
         self.node_mut()
             .create_client(
-                ServiceMapping::Enhanced,
+                mapping,
                 &name,
                 &ServiceTypeName::new(pkg, ty),
                 qos::services(),
