@@ -22,7 +22,7 @@ use kerf_msgs::{
 use kerf_ros::{qos, DiscoveryRange, KerfNode, NodeSpec, RosArgs, RosEnv, StopToken};
 use ros2_client::{
     action::{ActionClient, GoalId, GoalStatusEnum},
-    Client, ServiceMapping, Subscription,
+    Client, Publisher, ServiceMapping, Subscription,
 };
 
 const JOINTS: [&str; 6] = [
@@ -40,6 +40,7 @@ struct Cell {
     action: Fjt,
     validate: Client<ValidateTrajectoryRequest, ValidateTrajectoryResponse>,
     states: Subscription<JointState>,
+    topic: Publisher<JointTrajectory>,
     last: Option<JointState>,
     /// Keeps the client node (and its Context) alive; dropped after the endpoints above.
     _client: KerfNode,
@@ -103,6 +104,17 @@ impl Cell {
         let states = client
             .subscription("/joint_states", JointState::ROS_TYPE, qos::state())
             .unwrap();
+        let topic = client
+            .publisher(
+                "/trajectory_executor/joint_trajectory",
+                JointTrajectory::ROS_TYPE,
+                qos::commands(),
+            )
+            .unwrap();
+        assert!(
+            client.wait_for_subscriber(&topic, TIMEOUT),
+            "trajectory topic not matched"
+        );
         assert!(
             client.wait_for_action_server(&action, TIMEOUT),
             "action server not discovered"
@@ -115,6 +127,7 @@ impl Cell {
             action,
             validate,
             states,
+            topic,
             last: None,
             _client: client,
             stop,
@@ -417,4 +430,22 @@ fn cancel_stops_the_motion_within_the_limits() {
             dv / dt
         );
     }
+}
+
+/// As in JTC, an empty trajectory on the topic interface stops the current motion, here also
+/// an action goal's: it ends CANCELED and the robot comes to rest short of its target.
+#[test]
+fn an_empty_topic_trajectory_stops_the_active_goal() {
+    let mut cell = Cell::start(46);
+    let start = cell.position();
+    let far = [1.0, 0.5, 0.8, 1.5, 1.0, 2.0];
+    let id = cell.send(goal(min_jerk(&JOINTS, &start, &far, 4.0, 20)));
+    cell.wait_state(|s| s.velocity.iter().any(|v| v.abs() > 0.2), "motion");
+    cell.topic
+        .publish(JointTrajectory::default())
+        .expect("publish");
+    let (status, r) = cell.result(id);
+    assert_eq!(status, GoalStatusEnum::Canceled, "{r:?}");
+    let stopped = cell.wait_state(|s| s.velocity.iter().all(|v| *v == 0.0), "standstill");
+    assert!(max_diff(&stopped.last().unwrap().position, &far) > 0.1);
 }

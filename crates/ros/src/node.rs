@@ -414,6 +414,19 @@ impl KerfNode {
         block_on_timeout(all, timeout).is_some()
     }
 
+    /// Waits until `publisher` has a matched subscription; `false` on timeout. A volatile
+    /// sample published before matching is lost, so one-shot publishers wait for this first.
+    pub fn wait_for_subscriber<M: Serialize>(
+        &self,
+        publisher: &Publisher<M>,
+        timeout: std::time::Duration,
+    ) -> bool {
+        let Some(node) = self.node.as_ref() else {
+            return false;
+        };
+        block_on_timeout(publisher.wait_for_subscription(node), timeout).is_some()
+    }
+
     /// Waits until a server is matched for a service client; `false` on timeout.
     pub fn wait_for_service<Req, Resp>(
         &self,

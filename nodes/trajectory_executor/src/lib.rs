@@ -14,6 +14,9 @@
 //! | `~/joint_command` | `sensor_msgs/msg/JointState` | command stream for a hardware driver |
 //! | `~/trajectory_status` | `kerf_msgs/msg/TrajectoryStatus` | accepted / rejected / finished |
 //!
+//! As in JTC, an empty `JointTrajectory` (no points) on `~/joint_trajectory` stops the current
+//! motion (here: a controlled stop within the acceleration limits) and the robot holds.
+//!
 //! Every cycle follows ros2_control's read → update → write order: the measured state is read
 //! from the (mock) hardware, the executor computes the reference, the reference is written to
 //! the hardware and published on `~/joint_command`.
@@ -319,6 +322,10 @@ impl ExecutorNode {
                     let source = Source::Topic {
                         stamp: msg.header.stamp,
                     };
+                    if msg.points.is_empty() {
+                        self.stop_on_empty_trajectory(&source);
+                        continue;
+                    }
                     let now = self.clock.now();
                     let submitted =
                         convert::trajectory_request(&msg, &self.clock).and_then(|req| {
@@ -367,6 +374,21 @@ impl ExecutorNode {
                 }
             }
         }
+    }
+
+    /// JTC: an empty trajectory on the topic interface stops the current motion and holds.
+    /// Here the stop is the executor's controlled stop within the acceleration limits; the
+    /// stopped goal (topic or action) ends CANCELED.
+    fn stop_on_empty_trajectory(&mut self, source: &Source) {
+        let message = match self.exec.active_goal() {
+            Some(id) => match self.exec.cancel(id, self.clock.now()) {
+                Ok(()) => "empty trajectory: stopping the current motion".to_string(),
+                Err(e) => format!("empty trajectory: {e}"),
+            },
+            None => "empty trajectory: no active motion to stop".to_string(),
+        };
+        self.log.info(&message);
+        self.trajectory_status(source, TrajectoryStatus::ACCEPTED, SUCCESSFUL, &message);
     }
 
     fn poll_goals(&mut self) {
