@@ -220,8 +220,8 @@ pub enum ExecutorError {
     },
 
     // ----- timing -----------------------------------------------------------------------
-    /// The start time (header stamp) is negative or not finite.
-    #[error("start time (header stamp) is {value} s, must be finite and >= 0")]
+    /// The start time (header stamp) is not finite.
+    #[error("start time (header stamp) is {value} s, must be finite")]
     InvalidStartTime {
         /// The value.
         value: f64,

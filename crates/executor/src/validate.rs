@@ -101,7 +101,9 @@ pub fn validate(
         None => now,
         Some(0.0) => now,
         Some(s) => {
-            if !(s.is_finite() && s >= 0.0) {
+            // Any finite time on the executor's clock; negative times lie before its origin
+            // (e.g. a stamp from before the node started) and are simply in the past.
+            if !s.is_finite() {
                 return Err(ExecutorError::InvalidStartTime { value: s });
             }
             s

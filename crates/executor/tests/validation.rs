@@ -398,11 +398,17 @@ fn start_time_future_past_and_old() {
     );
     assert!(e.to_string().contains("start segment"));
     // Invalid stamps.
-    for bad in [f64::NAN, -1.0, f64::INFINITY] {
+    for bad in [f64::NAN, f64::INFINITY, f64::NEG_INFINITY] {
         let e = run(Some(bad)).unwrap_err();
         assert!(matches!(e, ExecutorError::InvalidStartTime { .. }));
         assert_eq!(e.error_code(), INVALID_GOAL);
     }
+    // A negative time is before the clock's origin: simply in the past.
+    let e = run(Some(-1.0)).unwrap_err();
+    assert!(
+        matches!(e, ExecutorError::OldHeaderTimestamp { .. }),
+        "{e:?}"
+    );
 }
 
 #[test]
