@@ -316,62 +316,45 @@ impl ExecutorNode {
     }
 
     fn poll_trajectories(&mut self) {
-        loop {
-            match self.traj_sub.take() {
-                Ok(Some((msg, _))) => {
-                    let source = Source::Topic {
-                        stamp: msg.header.stamp,
-                    };
-                    if msg.points.is_empty() {
-                        self.stop_on_empty_trajectory(&source);
-                        continue;
-                    }
-                    let now = self.clock.now();
-                    let submitted =
-                        convert::trajectory_request(&msg, &self.clock).and_then(|req| {
-                            Ok(self.exec.submit(&req, &GoalTolerances::default(), now)?)
-                        });
-                    match submitted {
-                        Ok(id) => {
-                            self.log.info(&format!(
-                                "accepted trajectory from topic: {} points over {:.3} s",
-                                msg.points.len(),
-                                msg.points
-                                    .last()
-                                    .map_or(0.0, |p| p.time_from_start.as_secs_f64())
-                            ));
-                            self.trajectory_status(
-                                &source,
-                                TrajectoryStatus::ACCEPTED,
-                                SUCCESSFUL,
-                                "accepted",
-                            );
-                            self.sources.insert(id, source);
-                        }
-                        Err(rej) => {
-                            self.log
-                                .warn(&format!("rejected trajectory from topic: {}", rej.message));
-                            self.trajectory_status(
-                                &source,
-                                TrajectoryStatus::REJECTED,
-                                rej.code,
-                                &rej.message,
-                            );
-                        }
-                    }
-                }
-                Ok(None) => break,
-                Err(e) => {
-                    let msg = format!("could not read a JointTrajectory sample: {e:?}");
-                    self.log.error(&msg);
-                    self.trajectory_status(
-                        &Source::Topic { stamp: Time::ZERO },
-                        TrajectoryStatus::REJECTED,
-                        INVALID_GOAL,
-                        &msg,
-                    );
-                    break;
-                }
+        let (msgs, error) = drain(|| self.traj_sub.take());
+        for (msg, _) in msgs {
+            self.on_trajectory(msg);
+        }
+        if let Some(e) = error {
+            let msg = format!("could not read a JointTrajectory sample: {e}");
+            self.log.error(&msg);
+            let source = Source::Topic { stamp: Time::ZERO };
+            self.trajectory_status(&source, TrajectoryStatus::REJECTED, INVALID_GOAL, &msg);
+        }
+    }
+
+    fn on_trajectory(&mut self, msg: JointTrajectory) {
+        let source = Source::Topic {
+            stamp: msg.header.stamp,
+        };
+        if msg.points.is_empty() {
+            self.stop_on_empty_trajectory(&source);
+            return;
+        }
+        let now = self.clock.now();
+        let submitted = convert::trajectory_request(&msg, &self.clock)
+            .and_then(|req| Ok(self.exec.submit(&req, &GoalTolerances::default(), now)?));
+        match submitted {
+            Ok(id) => {
+                self.log.info(&format!(
+                    "accepted trajectory from topic: {} points over {:.3} s",
+                    msg.points.len(),
+                    msg.points
+                        .last()
+                        .map_or(0.0, |p| p.time_from_start.as_secs_f64())
+                ));
+                self.trajectory_status(&source, TrajectoryStatus::ACCEPTED, SUCCESSFUL, "accepted");
+                self.sources.insert(id, source);
+            }
+            Err(rej) => {
+                self.log
+                    .warn(&format!("rejected trajectory from topic: {}", rej.message));
+                self.trajectory_status(&source, TrajectoryStatus::REJECTED, rej.code, &rej.message);
             }
         }
     }
@@ -392,17 +375,12 @@ impl ExecutorNode {
     }
 
     fn poll_goals(&mut self) {
-        loop {
-            let (req_id, SendGoalRequest { goal_id, goal }) = match self.action.receive_goal() {
-                Ok(Some(g)) => g,
-                Ok(None) => break,
-                Err(e) => {
-                    self.log.error(&format!(
-                        "could not read a FollowJointTrajectory goal: {e:?}"
-                    ));
-                    break;
-                }
-            };
+        let (goals, error) = drain(|| self.action.receive_goal());
+        if let Some(e) = error {
+            self.log
+                .error(&format!("could not read a FollowJointTrajectory goal: {e}"));
+        }
+        for (req_id, SendGoalRequest { goal_id, goal }) in goals {
             let accepted = self.ros_now();
             let source = Source::Action {
                 id: goal_id,
@@ -467,16 +445,12 @@ impl ExecutorNode {
     }
 
     fn poll_cancels(&mut self) {
-        loop {
-            let (req_id, req) = match self.action.receive_cancel_request() {
-                Ok(Some(r)) => r,
-                Ok(None) => break,
-                Err(e) => {
-                    self.log
-                        .error(&format!("could not read a cancel request: {e:?}"));
-                    break;
-                }
-            };
+        let (requests, error) = drain(|| self.action.receive_cancel_request());
+        if let Some(e) = error {
+            self.log
+                .error(&format!("could not read a cancel request: {e}"));
+        }
+        for (req_id, req) in requests {
             let response = match cancel_target(&req) {
                 Ok(info) => self.cancel(&info),
                 Err(reason) => {
@@ -537,16 +511,13 @@ impl ExecutorNode {
     }
 
     fn poll_result_requests(&mut self) {
-        loop {
-            match self.action.receive_result_request() {
-                Ok(Some((req_id, req))) => self.goals.pending_results.push((req.goal_id, req_id)),
-                Ok(None) => break,
-                Err(e) => {
-                    self.log
-                        .error(&format!("could not read a result request: {e:?}"));
-                    break;
-                }
-            }
+        let (requests, error) = drain(|| self.action.receive_result_request());
+        if let Some(e) = error {
+            self.log
+                .error(&format!("could not read a result request: {e}"));
+        }
+        for (req_id, req) in requests {
+            self.goals.pending_results.push((req.goal_id, req_id));
         }
         for (req_id, status, result) in self.goals.take_ready_results() {
             if let Err(e) = self
@@ -560,16 +531,12 @@ impl ExecutorNode {
     }
 
     fn poll_validate(&mut self) {
-        loop {
-            let (req_id, req) = match self.validate_srv.receive_request() {
-                Ok(Some(r)) => r,
-                Ok(None) => break,
-                Err(e) => {
-                    self.log
-                        .error(&format!("could not read a validate request: {e:?}"));
-                    break;
-                }
-            };
+        let (requests, error) = drain(|| self.validate_srv.receive_request());
+        if let Some(e) = error {
+            self.log
+                .error(&format!("could not read a validate request: {e}"));
+        }
+        for (req_id, req) in requests {
             let now = self.clock.now();
             let checked = convert::trajectory_request(&req.trajectory, &self.clock)
                 .and_then(|r| Ok(self.exec.validate(&r, &GoalTolerances::default(), now)?));
@@ -737,6 +704,24 @@ impl ExecutorNode {
                 },
             );
             self.statuses_changed = true;
+        }
+    }
+}
+
+/// Takes every sample or request available now, in arrival order.
+///
+/// # Returns
+/// The items, and the read error that ended the drain early, if any (e.g. a sample that does
+/// not deserialize); items read before it are kept.
+fn drain<T, E: std::fmt::Debug>(
+    mut read: impl FnMut() -> Result<Option<T>, E>,
+) -> (Vec<T>, Option<String>) {
+    let mut items = Vec::new();
+    loop {
+        match read() {
+            Ok(Some(x)) => items.push(x),
+            Ok(None) => return (items, None),
+            Err(e) => return (items, Some(format!("{e:?}"))),
         }
     }
 }
