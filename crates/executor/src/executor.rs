@@ -7,7 +7,7 @@ use crate::stop::StopProfile;
 use crate::tolerance::{self, ResolvedTolerances, Violation};
 use crate::trajectory::ValidatedTrajectory;
 use crate::types::{check_limits, ExecutorConfig, GoalTolerances, JointLimits, JointSample};
-use crate::validate::validate;
+use crate::validate::{prepare, validate, PreparedTrajectory};
 use crate::TrajectoryRequest;
 
 /// Identifier of an accepted goal, unique per [`Executor`].
@@ -216,6 +216,19 @@ impl Executor {
         validate(&self.limits, &self.cfg, req, &self.commanded_at(t), t)
     }
 
+    /// Dry run of [`Executor::submit_prepared`]: finishes `prepared` against the commanded
+    /// state at `now` without changing anything.
+    pub fn validate_prepared(
+        &self,
+        prepared: &PreparedTrajectory,
+        tolerances: &GoalTolerances,
+        now: f64,
+    ) -> Result<ValidatedTrajectory, ExecutorError> {
+        let t = self.request_time("now", now)?;
+        tolerance::resolve(&self.limits, &self.cfg, tolerances)?;
+        prepared.finish(&self.limits, &self.cfg, &self.commanded_at(t), t)
+    }
+
     /// Validates and, if valid, starts a goal, preempting the active one (JTC).
     ///
     /// The trajectory starts from the commanded state at `max(now, last update)`. The
@@ -223,15 +236,34 @@ impl Executor {
     ///
     /// # Returns
     /// The new goal's id, or the rejection; a rejected goal changes nothing.
+    ///
+    /// # Performance
+    /// Dominated by [`prepare`] (O(points · joints)); a control loop that must not stall
+    /// prepares on another thread and calls [`Executor::submit_prepared`].
     pub fn submit(
         &mut self,
         req: &TrajectoryRequest,
         tolerances: &GoalTolerances,
         now: f64,
     ) -> Result<GoalId, ExecutorError> {
+        self.request_time("now", now)?;
+        tolerance::resolve(&self.limits, &self.cfg, tolerances)?;
+        let prepared = prepare(&self.limits, &self.cfg, req)?;
+        self.submit_prepared(&prepared, tolerances, now)
+    }
+
+    /// As [`Executor::submit`], for a trajectory already checked by [`prepare`] against this
+    /// executor's limits and configuration: only the start (state- and clock-dependent part)
+    /// is validated here, in O(joints).
+    pub fn submit_prepared(
+        &mut self,
+        prepared: &PreparedTrajectory,
+        tolerances: &GoalTolerances,
+        now: f64,
+    ) -> Result<GoalId, ExecutorError> {
         let t = self.request_time("now", now)?;
         let resolved = tolerance::resolve(&self.limits, &self.cfg, tolerances)?;
-        let traj = validate(&self.limits, &self.cfg, req, &self.commanded_at(t), t)?;
+        let traj = prepared.finish(&self.limits, &self.cfg, &self.commanded_at(t), t)?;
         if let Some(old) = self.active.take() {
             self.pending.push(GoalEvent {
                 id: old.id,

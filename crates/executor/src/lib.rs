@@ -15,6 +15,8 @@
 //! * [`validate()`] checks a request against the robot model ([`JointLimits`]) and a current
 //!   state, and builds a [`ValidatedTrajectory`]: segment polynomials in model joint order on
 //!   absolute time, sampled in O(1) amortized per cycle.
+//! * [`prepare`] does the request-only part of validation (nearly all its cost) so that it
+//!   can run off the control thread; [`Executor::submit_prepared`] finishes it in O(joints).
 //! * [`Executor`] runs one goal at a time: preemption, cancel with a controlled stop
 //!   ([`StopProfile`]), path and goal tolerances ([`tolerance`]).
 //! * [`MockHardware`] follows commands, exactly or with a first-order lag.
@@ -95,4 +97,4 @@ pub use types::{
     ExecutorConfig, GoalTolerances, JointLimits, JointSample, JointTolerance, TrajectoryPoint,
     TrajectoryRequest,
 };
-pub use validate::{validate, LIMIT_SLACK};
+pub use validate::{prepare, validate, PreparedTrajectory, LIMIT_SLACK};

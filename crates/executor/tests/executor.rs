@@ -571,3 +571,53 @@ fn stop_profile_keeps_position_limits() {
     assert!((s.velocities[0] - 0.5).abs() < 1e-12 && (s.accelerations[0] + 10.0).abs() < 1e-12);
     assert!((s.velocities[1] - 0.95).abs() < 1e-12 && (s.accelerations[1] + 1.0).abs() < 1e-12);
 }
+
+/// A trajectory prepared earlier (as on a worker thread) is finished against the state at
+/// submission: it behaves exactly as `submit` at that time, and its start segment is checked
+/// then, against the state the robot has then.
+#[test]
+fn prepared_trajectories_start_from_the_state_at_submission() {
+    let limits = limits6();
+    let cfg = ExecutorConfig::default();
+    let a = min_jerk_request(&[0.0; 6], &TARGET, 4.0, 8);
+    let z = [0.0; 6];
+    let b = request(&limits, vec![pt(2.0, &[-0.3; 6], &z, &z)]);
+
+    // Reference: plain submit at t = 1 during A.
+    let mut plain = executor(&limits, cfg.clone(), 0.0);
+    let mut hw_plain = MockHardware::new(vec![0.0; 6]);
+    plain.submit(&a, &GoalTolerances::default(), 0.0).unwrap();
+    run(&mut plain, &mut hw_plain, 0.0, 1.0);
+    plain.submit(&b, &GoalTolerances::default(), 1.0).unwrap();
+    let plain_cycles = run(&mut plain, &mut hw_plain, 1.0, 4.0);
+
+    // Same, with B prepared at t = 0 (before A even moved) and submitted at t = 1.
+    let prepared_b = kerf_executor::prepare(&limits, &cfg, &b).unwrap();
+    assert_eq!(prepared_b.duration(), 2.0);
+    let mut split = executor(&limits, cfg.clone(), 0.0);
+    let mut hw_split = MockHardware::new(vec![0.0; 6]);
+    split.submit(&a, &GoalTolerances::default(), 0.0).unwrap();
+    run(&mut split, &mut hw_split, 0.0, 1.0);
+    split
+        .submit_prepared(&prepared_b, &GoalTolerances::default(), 1.0)
+        .unwrap();
+    let split_cycles = run(&mut split, &mut hw_split, 1.0, 4.0);
+    assert_eq!(plain_cycles, split_cycles);
+    assert_continuous(&split_cycles);
+
+    // A first point due at once is valid at rest where it is, but not once the robot has
+    // moved away: the state-dependent check happens at submission.
+    let here = request(&limits, vec![pt(0.0, &z, &[], &[])]);
+    let prepared = kerf_executor::prepare(&limits, &cfg, &here).unwrap();
+    let mut exec = executor(&limits, cfg.clone(), 0.0);
+    let mut hw = MockHardware::new(vec![0.0; 6]);
+    exec.submit(&a, &GoalTolerances::default(), 0.0).unwrap();
+    run(&mut exec, &mut hw, 0.0, 2.0);
+    let err = exec
+        .submit_prepared(&prepared, &GoalTolerances::default(), 2.0)
+        .unwrap_err();
+    assert!(
+        matches!(err, ExecutorError::StartMismatch { .. }),
+        "{err:?}"
+    );
+}
