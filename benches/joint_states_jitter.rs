@@ -7,12 +7,56 @@
 //! * the arrival period, from the subscriber's receive times (adds DDS and polling delay;
 //!   the subscriber polls every 50 µs).
 //!
+//! With `KERF_JITTER_LOAD=1`, a 5000-point six-joint quintic trajectory (20 s at 4 ms, the
+//! density a planner produces) is sent on `~/joint_trajectory` after 1000 and 3000 samples, so
+//! the figures include validating large trajectories while the loop runs.
+//!
 //! Run: `cargo bench --bench joint_states_jitter`. Timings are reported, never asserted.
 
 use std::time::{Duration, Instant};
 
-use kerf_msgs::{sensor_msgs::JointState, RosType};
+use kerf_msgs::{
+    builtin_interfaces::Duration as RosDuration,
+    sensor_msgs::JointState,
+    trajectory_msgs::{JointTrajectory, JointTrajectoryPoint},
+    RosType,
+};
 use kerf_ros::{qos, DiscoveryRange, KerfNode, NodeSpec, RosArgs, RosEnv, StopToken};
+
+/// Minimum-jerk rest-to-rest motion of every joint from 0 to `d` and back over `t` seconds,
+/// sampled every 4 ms with exact velocities and accelerations.
+fn dense_trajectory(d: f64, t: f64) -> JointTrajectory {
+    let n = (t / 0.004).round() as usize;
+    let names = (1..=6).map(|i| format!("joint_{i}")).collect();
+    let points = (1..=n)
+        .map(|k| {
+            let s = k as f64 / n as f64;
+            // Out and back: phase 2s in [0, 1] twice.
+            let (u, sign) = if s <= 0.5 {
+                (2.0 * s, 1.0)
+            } else {
+                (2.0 - 2.0 * s, -1.0)
+            };
+            let h = t / 2.0;
+            let p = d * (10.0 * u.powi(3) - 15.0 * u.powi(4) + 6.0 * u.powi(5));
+            let v = sign * d * (30.0 * u.powi(2) - 60.0 * u.powi(3) + 30.0 * u.powi(4)) / h;
+            let a = d * (60.0 * u - 180.0 * u.powi(2) + 120.0 * u.powi(3)) / (h * h);
+            let last = k == n;
+            JointTrajectoryPoint {
+                positions: vec![if last { 0.0 } else { p }; 6],
+                velocities: vec![if last { 0.0 } else { v }; 6],
+                accelerations: vec![if last { 0.0 } else { a }; 6],
+                effort: vec![],
+                time_from_start: RosDuration::from_secs_f64(s * t).expect("finite"),
+            }
+        })
+        .collect();
+    JointTrajectory {
+        joint_names: names,
+        points,
+        ..Default::default()
+    }
+}
 
 fn percentile(sorted: &[f64], p: f64) -> f64 {
     let i = ((sorted.len() - 1) as f64 * p).round() as usize;
@@ -83,6 +127,22 @@ fn main() {
     let sub = sub_node
         .subscription::<JointState>("/joint_states", JointState::ROS_TYPE, qos::state())
         .expect("subscription");
+    let load = std::env::var("KERF_JITTER_LOAD").as_deref() == Ok("1");
+    let traj_pub = sub_node
+        .publisher::<JointTrajectory>(
+            "/trajectory_executor/joint_trajectory",
+            JointTrajectory::ROS_TYPE,
+            qos::commands(),
+        )
+        .expect("publisher");
+    if load {
+        assert!(
+            sub_node.wait_for_subscriber(&traj_pub, Duration::from_secs(20)),
+            "executor did not subscribe"
+        );
+    }
+    let heavy = dense_trajectory(0.3, 20.0);
+    let mut sent = 0;
     let mut stamps = Vec::with_capacity(samples);
     let mut arrivals = Vec::with_capacity(samples);
     let deadline =
@@ -96,6 +156,10 @@ fn main() {
                 if now > warmup {
                     stamps.push(msg.header.stamp.as_secs_f64());
                     arrivals.push(now);
+                    if load && (stamps.len() == 1000 || stamps.len() == 3000) {
+                        traj_pub.publish(heavy.clone()).expect("publish trajectory");
+                        sent += 1;
+                    }
                 }
             }
             Ok(None) => std::thread::sleep(Duration::from_micros(50)),
@@ -110,9 +174,11 @@ fn main() {
         .windows(2)
         .map(|w| (w[1] - w[0]).as_secs_f64())
         .collect();
+    drop(traj_pub);
     println!(
-        "joint_states jitter at 250 Hz over loopback ({} samples)",
-        stamps.len()
+        "joint_states jitter at 250 Hz over loopback ({} samples; {sent} trajectories of {} points sent during the run)",
+        stamps.len(),
+        heavy.points.len()
     );
     report("publish (header.stamp)", publish, 0.004);
     report("arrival (subscriber)  ", arrive, 0.004);
