@@ -28,76 +28,32 @@ import os
 import random
 import sys
 import time
-import xml.etree.ElementTree as ET
-from dataclasses import dataclass, field
 from typing import Callable, Dict, List, Optional
 
 from cyclonedds.core import Policy, Qos
 from cyclonedds.domain import DomainParticipant
-from cyclonedds.idl import IdlStruct
-from cyclonedds.idl.types import float64, int32, sequence, uint8, uint32
 from cyclonedds.pub import DataWriter
 from cyclonedds.sub import DataReader
 from cyclonedds.topic import Topic
 from cyclonedds.util import duration
 
-
-# ----- ROS 2 message types, field for field as rosidl generates them -------------------------
-
-
-@dataclass
-class Time(IdlStruct, typename="builtin_interfaces::msg::dds_::Time_"):
-    sec: int32 = 0
-    nanosec: uint32 = 0
-
-
-@dataclass
-class Duration(IdlStruct, typename="builtin_interfaces::msg::dds_::Duration_"):
-    sec: int32 = 0
-    nanosec: uint32 = 0
-
-
-@dataclass
-class Header(IdlStruct, typename="std_msgs::msg::dds_::Header_"):
-    stamp: Time = field(default_factory=Time)
-    frame_id: str = ""
-
-
-@dataclass
-class JointTrajectoryPoint(IdlStruct, typename="trajectory_msgs::msg::dds_::JointTrajectoryPoint_"):
-    positions: sequence[float64] = field(default_factory=list)
-    velocities: sequence[float64] = field(default_factory=list)
-    accelerations: sequence[float64] = field(default_factory=list)
-    effort: sequence[float64] = field(default_factory=list)
-    time_from_start: Duration = field(default_factory=Duration)
-
-
-@dataclass
-class JointTrajectory(IdlStruct, typename="trajectory_msgs::msg::dds_::JointTrajectory_"):
-    header: Header = field(default_factory=Header)
-    joint_names: sequence[str] = field(default_factory=list)
-    points: sequence[JointTrajectoryPoint] = field(default_factory=list)
-
-
-@dataclass
-class JointState(IdlStruct, typename="sensor_msgs::msg::dds_::JointState_"):
-    header: Header = field(default_factory=Header)
-    name: sequence[str] = field(default_factory=list)
-    position: sequence[float64] = field(default_factory=list)
-    velocity: sequence[float64] = field(default_factory=list)
-    effort: sequence[float64] = field(default_factory=list)
-
-
-@dataclass
-class TrajectoryStatus(IdlStruct, typename="kerf_msgs::msg::dds_::TrajectoryStatus_"):
-    header: Header = field(default_factory=Header)
-    trajectory_stamp: Time = field(default_factory=Time)
-    source: str = ""
-    goal_id: str = ""
-    status: uint8 = 0
-    error_code: int32 = 0
-    message: str = ""
-
+from helpers import (
+    JOINTS,
+    POSITION_TOLERANCE,
+    CheckFailed,
+    choose_target,
+    dur,
+    read_limits,
+    smooth_trajectory,
+    stamp_ns,
+)
+from ros_types import (
+    Header,
+    JointState,
+    JointTrajectory,
+    JointTrajectoryPoint,
+    TrajectoryStatus,
+)
 
 ACCEPTED, REJECTED, SUCCEEDED, ABORTED, PREEMPTED, CANCELED = 1, 2, 3, 4, 5, 6
 STATUS_NAMES = {
@@ -110,25 +66,9 @@ STATUS_NAMES = {
 }
 INVALID_GOAL, INVALID_JOINTS = -1, -2
 
-JOINTS = [f"joint_{i}" for i in range(1, 7)]
-POSITION_TOLERANCE = 1e-3
-
-
-class CheckFailed(Exception):
-    """A check of the scenario failed; the message says which and why."""
-
 
 def log(msg: str) -> None:
     print(f"[peer {time.monotonic() - T0:7.3f}s] {msg}", flush=True)
-
-
-def dur(seconds: float) -> Duration:
-    ns = int(round(seconds * 1e9))
-    return Duration(sec=ns // 1_000_000_000, nanosec=ns % 1_000_000_000)
-
-
-def stamp_ns(t: Time) -> int:
-    return t.sec * 1_000_000_000 + t.nanosec
 
 
 def status_str(s: TrajectoryStatus) -> str:
@@ -136,31 +76,6 @@ def status_str(s: TrajectoryStatus) -> str:
         f"{STATUS_NAMES.get(s.status, s.status)} (code {s.error_code}, source '{s.source}'): "
         f"'{s.message}'"
     )
-
-
-# ----- robot limits from the URDF ------------------------------------------------------------
-
-
-@dataclass
-class Limit:
-    lower: float
-    upper: float
-    velocity: float
-
-
-def read_limits(urdf: str) -> Dict[str, Limit]:
-    root = ET.parse(urdf).getroot()
-    out = {}
-    for j in root.findall("joint"):
-        lim = j.find("limit")
-        if j.get("name") in JOINTS and lim is not None:
-            out[j.get("name")] = Limit(
-                float(lim.get("lower")), float(lim.get("upper")), float(lim.get("velocity"))
-            )
-    missing = [n for n in JOINTS if n not in out]
-    if missing:
-        raise CheckFailed(f"{urdf} has no <limit> for {missing}")
-    return out
 
 
 # ----- the DDS side --------------------------------------------------------------------------
@@ -247,28 +162,6 @@ def shuffled_joints(rng: random.Random) -> List[str]:
     return order
 
 
-def smooth_trajectory(
-    start: Dict[str, float], goal: Dict[str, float], order: List[str], total: float
-) -> JointTrajectory:
-    """Cubic smoothstep start → goal over `total` s, sampled at 1/4, 1/2 and 1 (ends at rest).
-
-    The smoothstep is itself a cubic, so the executor's Hermite segments reproduce it: peak
-    velocity 1.5 d / total, peak acceleration 6 d / total².
-    """
-    points = []
-    for u in (0.25, 0.5, 1.0):
-        s = 3 * u * u - 2 * u ** 3
-        ds = 6 * u * (1 - u) / total
-        points.append(
-            JointTrajectoryPoint(
-                positions=[start[j] + s * (goal[j] - start[j]) for j in order],
-                velocities=[ds * (goal[j] - start[j]) for j in order],
-                time_from_start=dur(u * total),
-            )
-        )
-    return JointTrajectory(header=Header(), joint_names=list(order), points=points)
-
-
 def hold_trajectory(
     start: Dict[str, float], order: List[str], times: List[float]
 ) -> JointTrajectory:
@@ -285,19 +178,6 @@ def hold_trajectory(
             for t in times
         ],
     )
-
-
-def choose_target(start: Dict[str, float], limits: Dict[str, Limit]) -> Dict[str, float]:
-    """A distinct offset per joint (a joint mix-up would show), towards the middle of the range."""
-    offsets = dict(zip(JOINTS, (0.30, 0.22, 0.26, 0.40, 0.34, 0.50)))
-    target = {}
-    for j in JOINTS:
-        lim = limits[j]
-        d = offsets[j] if start[j] <= (lim.lower + lim.upper) / 2 else -offsets[j]
-        target[j] = start[j] + d
-        if not lim.lower < target[j] < lim.upper:
-            raise CheckFailed(f"cannot choose a target for {j} from {start[j]} within {lim}")
-    return target
 
 
 def move_and_check(peer: Peer, name: str, traj: JointTrajectory, goal: Dict[str, float]) -> None:
