@@ -60,6 +60,9 @@
 //!   decelerate together, linearly in velocity, each within its acceleration limit
 //!   ([`StopProfile`]). JTC holds the position instantly, which would exceed the acceleration
 //!   limits at speed.
+//!   As in JTC, the goal's outcome (CANCELED, or ABORTED for a path tolerance) is reported when
+//!   the stop begins; the stop lasts at most max |v| / a_max, and a new goal may start from the
+//!   stopping state at any time.
 //! * **Invalid tolerances** in a goal (unknown joint, negative value other than −1, invalid
 //!   goal time) reject the goal; JTC logs them and falls back to the defaults.
 //! * **Effort** in a point is rejected (no effort command interface); JTC accepts effort with

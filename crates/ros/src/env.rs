@@ -132,7 +132,8 @@ impl RosEnv {
                     return Err(RosError::UnsupportedEnv {
                         variable: "RMW_IMPLEMENTATION".into(),
                         value: s,
-                        reason: "kerf speaks DDS with the service mappings of rmw_fastrtps_cpp,                                  rmw_connextdds and rmw_cyclonedds_cpp"
+                        reason: "kerf speaks DDS with the service mappings of rmw_fastrtps_cpp, \
+                                 rmw_connextdds and rmw_cyclonedds_cpp"
                             .into(),
                     })
                 }
@@ -225,7 +226,11 @@ mod tests {
         assert!(err.to_string().contains("LOCALHOST"), "{err}");
         assert!(env(&[("ROS_AUTOMATIC_DISCOVERY_RANGE", "OFF")]).is_err());
         assert!(env(&[("ROS_STATIC_PEERS", "10.0.0.1")]).is_err());
-        assert!(env(&[("RMW_IMPLEMENTATION", "rmw_zenoh_cpp")]).is_err());
+        let err = env(&[("RMW_IMPLEMENTATION", "rmw_zenoh_cpp")]).unwrap_err();
+        assert!(
+            err.to_string().contains("rmw_fastrtps_cpp, rmw_connextdds"),
+            "{err}"
+        );
     }
 
     #[test]
