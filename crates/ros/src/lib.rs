@@ -7,6 +7,7 @@
 //! * [`qos`] holds the named QoS profiles (reliable, keep-last ≥ 10).
 //! * [`Logger`] writes to stderr and `/rosout`.
 //! * [`shutdown`] turns Ctrl-C into a flag every node loop polls; [`StopToken`] stops one node.
+//! * [`Inbox`] reads (and deserializes) a subscription on its own thread.
 //! * [`Streamer`] publishes high-rate streams from a thread, so a control loop never blocks.
 //! * [`Worker`] runs slow requests in the background so a node keeps serving.
 //! * [`KerfNode`] ties these together: one Context per node, names resolved and remapped.
@@ -14,6 +15,7 @@
 mod args;
 mod env;
 mod error;
+mod inbox;
 mod logger;
 pub mod names;
 mod node;
@@ -26,6 +28,7 @@ mod worker;
 pub use args::{LogLevel, ParamSource, RosArgs};
 pub use env::{DiscoveryRange, RosEnv, MAX_DOMAIN_ID};
 pub use error::RosError;
+pub use inbox::{Inbox, INBOX_POLL};
 pub use logger::Logger;
 pub use node::{block_on_timeout, KerfNode, NodeSpec};
 pub use params::{ParamValue, Params};

@@ -13,7 +13,9 @@ use ros2_client::{
 };
 use serde::{de::DeserializeOwned, Serialize};
 
-use crate::{names, qos, LogLevel, Logger, Params, RosArgs, RosEnv, RosError, StopToken, Streamer};
+use crate::{
+    names, qos, Inbox, LogLevel, Logger, Params, RosArgs, RosEnv, RosError, StopToken, Streamer,
+};
 
 /// What a node binary declares about itself.
 #[derive(Debug, Clone, Copy)]
@@ -280,6 +282,21 @@ impl KerfNode {
             .map_err(dds_err(format!("topic {name}")))?;
         node.create_subscription(&t, Some(qos))
             .map_err(dds_err(format!("subscription on {name}")))
+    }
+
+    /// Creates a subscription read on its own thread ([`Inbox`]): taking and deserializing
+    /// samples never costs the caller's thread.
+    pub fn inbox<M: DeserializeOwned + Send + 'static>(
+        &mut self,
+        topic: &str,
+        ros_type: &str,
+        qos: QosProfile,
+    ) -> Result<Inbox<M>, RosError> {
+        let sub = self.subscription(topic, ros_type, qos)?;
+        Inbox::new(sub, topic.trim_start_matches(['~', '/'])).map_err(|e| RosError::Dds {
+            what: format!("subscription thread for {topic}"),
+            reason: e.to_string(),
+        })
     }
 
     /// Creates an action server (`package/action/Name`) with rcl_action's QoS and the service

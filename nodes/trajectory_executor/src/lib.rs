@@ -56,7 +56,7 @@ use kerf_msgs::{
 };
 use kerf_robot::RobotError;
 use kerf_ros::{
-    qos, KerfNode, Logger, NodeSpec, RosArgs, RosEnv, RosError, StopToken, Streamer, Worker,
+    qos, Inbox, KerfNode, Logger, NodeSpec, RosArgs, RosEnv, RosError, StopToken, Streamer, Worker,
 };
 use ros2_client::{
     action::{
@@ -65,7 +65,7 @@ use ros2_client::{
     },
     action_msgs::CancelGoalResponseEnum,
     builtin_interfaces::Time as RosTime,
-    RmwRequestId, Server, Subscription,
+    RmwRequestId, Server,
 };
 
 pub use config::{NodeConfig, KNOWN_PARAMS};
@@ -104,6 +104,20 @@ type FjtServer = ActionServer<
     FollowJointTrajectoryResult,
     FollowJointTrajectoryFeedback,
 >;
+
+/// A request for the preparation worker: converted from its message and checked against the
+/// robot there, off the control thread.
+enum Incoming {
+    /// A topic trajectory or a ValidateTrajectory request's trajectory.
+    Trajectory(JointTrajectory),
+    /// A FollowJointTrajectory goal.
+    Goal(Box<FollowJointTrajectoryGoal>),
+    /// An empty topic trajectory: nothing to prepare, kept in order with the others.
+    Stop,
+}
+
+/// What the worker returns: `None` for [`Incoming::Stop`].
+type Prepared = Result<(PreparedTrajectory, GoalTolerances), Rejection>;
 
 /// What to do with a prepared request.
 #[derive(Debug, Clone)]
@@ -155,7 +169,7 @@ pub fn run(args: &RosArgs, env: &RosEnv, stop: StopToken) -> Result<(), NodeErro
 /// The node's state. Fields drop in declaration order: DDS endpoints first, `node` (and its
 /// Context) last.
 struct ExecutorNode {
-    traj_sub: Subscription<JointTrajectory>,
+    traj_sub: Inbox<JointTrajectory>,
     action: FjtServer,
     validate_srv: Server<ValidateTrajectoryRequest, ValidateTrajectoryResponse>,
     joint_states: Streamer<JointState>,
@@ -166,8 +180,8 @@ struct ExecutorNode {
     sources: HashMap<ExecGoalId, Source>,
     /// Validation of incoming trajectories (O(points · joints)) runs here, off the control
     /// thread; one thread, so results come back in arrival order.
-    prep: Worker<Option<TrajectoryRequest>, Option<Result<PreparedTrajectory, ExecutorError>>>,
-    jobs: HashMap<u64, (Job, GoalTolerances)>,
+    prep: Worker<Incoming, Option<Prepared>>,
+    jobs: HashMap<u64, Job>,
     exec: Executor,
     hw: MockHardware,
     cfg: NodeConfig,
@@ -189,7 +203,8 @@ impl ExecutorNode {
             cfg.initial_positions.clone(),
         )?;
         let hw = MockHardware::with_lag(cfg.initial_positions.clone(), cfg.lag_time_constant)?;
-        let traj_sub = node.subscription(
+        // Read on its own thread: deserializing a large trajectory takes milliseconds.
+        let traj_sub = node.inbox(
             "~/joint_trajectory",
             JointTrajectory::ROS_TYPE,
             qos::commands(),
@@ -231,9 +246,22 @@ impl ExecutorNode {
             node.resolve("~/joint_trajectory")?,
             node.resolve("~/follow_joint_trajectory")?,
         ));
+        let clock = Clock::start();
         let (limits, exec_cfg) = (cfg.limits.clone(), cfg.executor.clone());
-        let prep = Worker::spawn("prepare", 1, move |req: Option<TrajectoryRequest>| {
-            req.map(|r| prepare(&limits, &exec_cfg, &r))
+        let prep = Worker::spawn("prepare", 1, move |incoming: Incoming| {
+            let prepared = |req: TrajectoryRequest, tol: GoalTolerances| -> Prepared {
+                Ok((prepare(&limits, &exec_cfg, &req)?, tol))
+            };
+            match incoming {
+                Incoming::Stop => None,
+                Incoming::Trajectory(msg) => Some(
+                    convert::trajectory_request(&msg, &clock)
+                        .and_then(|req| prepared(req, GoalTolerances::default())),
+                ),
+                Incoming::Goal(goal) => Some(
+                    convert::goal_request(&goal, &clock).and_then(|(req, tol)| prepared(req, tol)),
+                ),
+            }
         })
         .map_err(|e| RosError::Dds {
             what: "trajectory preparation thread".into(),
@@ -259,7 +287,7 @@ impl ExecutorNode {
             next_feedback: 0.0,
             statuses_changed: false,
             publish_failures: 0,
-            clock: Clock::start(),
+            clock,
             log,
             node,
         })
@@ -351,15 +379,16 @@ impl ExecutorNode {
     }
 
     fn poll_trajectories(&mut self) {
-        let (msgs, error) = drain(|| self.traj_sub.take());
-        for (msg, _) in msgs {
-            self.on_trajectory(msg);
-        }
-        if let Some(e) = error {
-            let msg = format!("could not read a JointTrajectory sample: {e}");
-            self.log.error(&msg);
-            let source = Source::Topic { stamp: Time::ZERO };
-            self.trajectory_status(&source, TrajectoryStatus::REJECTED, INVALID_GOAL, &msg);
+        while let Some(received) = self.traj_sub.try_recv() {
+            match received {
+                Ok(msg) => self.on_trajectory(msg),
+                Err(e) => {
+                    let msg = format!("could not read a JointTrajectory sample: {e}");
+                    self.log.error(&msg);
+                    let source = Source::Topic { stamp: Time::ZERO };
+                    self.trajectory_status(&source, TrajectoryStatus::REJECTED, INVALID_GOAL, &msg);
+                }
+            }
         }
     }
 
@@ -370,19 +399,16 @@ impl ExecutorNode {
         if msg.points.is_empty() {
             // Queued behind the trajectories still being prepared, so it stops whatever was
             // sent before it.
-            self.enqueue(Job::Stop(source), None, GoalTolerances::default());
-            return;
-        }
-        match convert::trajectory_request(&msg, &self.clock) {
-            Ok(req) => self.enqueue(Job::Run(source), Some(req), GoalTolerances::default()),
-            Err(rej) => self.rejected(&source, rej),
+            self.enqueue(Job::Stop(source), Incoming::Stop);
+        } else {
+            self.enqueue(Job::Run(source), Incoming::Trajectory(msg));
         }
     }
 
     /// Hands a request to the preparation worker; results come back in order.
-    fn enqueue(&mut self, job: Job, req: Option<TrajectoryRequest>, tol: GoalTolerances) {
-        let ticket = self.prep.submit(req);
-        self.jobs.insert(ticket, (job, tol));
+    fn enqueue(&mut self, job: Job, incoming: Incoming) {
+        let ticket = self.prep.submit(incoming);
+        self.jobs.insert(ticket, job);
     }
 
     fn rejected(&mut self, source: &Source, rej: Rejection) {
@@ -408,50 +434,37 @@ impl ExecutorNode {
     /// Finishes the requests the worker has prepared, in the order they arrived.
     fn poll_prepared(&mut self) {
         while let Some((ticket, result)) = self.prep.try_recv() {
-            let Some((job, tol)) = self.jobs.remove(&ticket) else {
+            let Some(job) = self.jobs.remove(&ticket) else {
                 continue;
             };
+            let missing = || Rejection {
+                code: INVALID_GOAL,
+                message: "no trajectory in the request".into(),
+            };
             let prepared = match result {
-                Ok(p) => p.map(|r| r.map_err(Rejection::from)),
+                Ok(p) => p,
                 Err(e) => Some(Err(Rejection {
                     code: INVALID_GOAL,
                     message: format!("internal error while validating: {e}"),
                 })),
             };
             let now = self.clock.now();
-            match (job, prepared) {
-                (Job::Stop(source), _) => self.stop_on_empty_trajectory(&source),
-                (Job::Validate(req_id), prepared) => {
+            match job {
+                Job::Stop(source) => self.stop_on_empty_trajectory(&source),
+                Job::Validate(req_id) => {
                     let checked = prepared
-                        .unwrap_or_else(|| {
-                            Err(Rejection {
-                                code: INVALID_GOAL,
-                                message: "empty request".into(),
-                            })
-                        })
-                        .and_then(|p| Ok(self.exec.validate_prepared(&p, &tol, now)?));
+                        .unwrap_or_else(|| Err(missing()))
+                        .and_then(|(p, tol)| Ok(self.exec.validate_prepared(&p, &tol, now)?));
                     self.answer_validate(req_id, checked);
                 }
-                (Job::Run(source), prepared) => {
-                    let prepared = prepared.unwrap_or_else(|| {
-                        Err(Rejection {
-                            code: INVALID_GOAL,
-                            message: "empty request".into(),
-                        })
-                    });
-                    self.start(source, prepared, &tol, now);
+                Job::Run(source) => {
+                    self.start(source, prepared.unwrap_or_else(|| Err(missing())), now);
                 }
             }
         }
     }
 
-    fn start(
-        &mut self,
-        source: Source,
-        prepared: Result<PreparedTrajectory, Rejection>,
-        tol: &GoalTolerances,
-        now: f64,
-    ) {
+    fn start(&mut self, source: Source, prepared: Prepared, now: f64) {
         if let Source::Action { id, .. } = &source {
             if self
                 .goals
@@ -473,8 +486,8 @@ impl ExecutorNode {
                 return;
             }
         }
-        let submitted = prepared.and_then(|p| {
-            let id = self.exec.submit_prepared(&p, tol, now)?;
+        let submitted = prepared.and_then(|(p, tol)| {
+            let id = self.exec.submit_prepared(&p, &tol, now)?;
             Ok((id, p.point_count(), p.duration()))
         });
         match submitted {
@@ -546,10 +559,7 @@ impl ExecutorNode {
                 result: None,
             });
             self.statuses_changed = true;
-            match convert::goal_request(&goal, &self.clock) {
-                Ok((req, tol)) => self.enqueue(Job::Run(source), Some(req), tol),
-                Err(rej) => self.rejected(&source, rej),
-            }
+            self.enqueue(Job::Run(source), Incoming::Goal(Box::new(goal)));
         }
     }
 
@@ -648,10 +658,7 @@ impl ExecutorNode {
                 .error(&format!("could not read a validate request: {e}"));
         }
         for (req_id, req) in requests {
-            match convert::trajectory_request(&req.trajectory, &self.clock) {
-                Ok(r) => self.enqueue(Job::Validate(req_id), Some(r), GoalTolerances::default()),
-                Err(rej) => self.answer_validate(req_id, Err(rej)),
-            }
+            self.enqueue(Job::Validate(req_id), Incoming::Trajectory(req.trajectory));
         }
     }
 

@@ -1,0 +1,77 @@
+//! [`Inbox`]: a subscription read on its own thread.
+//!
+//! Taking a sample deserializes it; a large message (a 5000-point trajectory is about 1 MB)
+//! costs milliseconds, more than a control period. The inbox thread takes and deserializes
+//! samples and hands them over through a channel, so a control loop only moves them.
+
+use std::{
+    sync::{
+        atomic::{AtomicBool, Ordering},
+        mpsc::{channel, Receiver},
+        Arc,
+    },
+    thread::JoinHandle,
+    time::Duration,
+};
+
+use ros2_client::Subscription;
+use serde::de::DeserializeOwned;
+
+/// How often the inbox thread looks for new samples when it found none.
+pub const INBOX_POLL: Duration = Duration::from_millis(1);
+
+/// A subscription drained by a background thread.
+pub struct Inbox<M> {
+    rx: Receiver<Result<M, String>>,
+    stop: Arc<AtomicBool>,
+    thread: Option<JoinHandle<()>>,
+}
+
+impl<M: DeserializeOwned + Send + 'static> Inbox<M> {
+    /// Moves `sub` to a thread named `name`.
+    pub fn new(sub: Subscription<M>, name: &str) -> std::io::Result<Self> {
+        let (tx, rx) = channel();
+        let stop = Arc::new(AtomicBool::new(false));
+        let stop_t = Arc::clone(&stop);
+        let thread = std::thread::Builder::new()
+            .name(format!("in-{name}"))
+            .spawn(move || {
+                while !stop_t.load(Ordering::Relaxed) {
+                    match sub.take() {
+                        Ok(Some((m, _))) => {
+                            if tx.send(Ok(m)).is_err() {
+                                return;
+                            }
+                        }
+                        Ok(None) => std::thread::sleep(INBOX_POLL),
+                        Err(e) => {
+                            if tx.send(Err(format!("{e:?}"))).is_err() {
+                                return;
+                            }
+                            std::thread::sleep(INBOX_POLL);
+                        }
+                    }
+                }
+            })?;
+        Ok(Self {
+            rx,
+            stop,
+            thread: Some(thread),
+        })
+    }
+
+    /// The next received sample (or read error, e.g. a sample that did not deserialize), if
+    /// any. Never blocks.
+    pub fn try_recv(&self) -> Option<Result<M, String>> {
+        self.rx.try_recv().ok()
+    }
+}
+
+impl<M> Drop for Inbox<M> {
+    fn drop(&mut self) {
+        self.stop.store(true, Ordering::Relaxed);
+        if let Some(t) = self.thread.take() {
+            let _ = t.join();
+        }
+    }
+}
