@@ -11,6 +11,9 @@
 //! density a planner produces) is sent on `~/joint_trajectory` after 1000 and 3000 samples, so
 //! the figures include validating large trajectories while the loop runs.
 //!
+//! With `KERF_JITTER_RT=N`, the executor's control thread runs `SCHED_FIFO` at priority N
+//! (parameter `realtime_priority`; needs CAP_SYS_NICE).
+//!
 //! Run: `cargo bench --bench joint_states_jitter`. Timings are reported, never asserted.
 
 use std::time::{Duration, Instant};
@@ -97,8 +100,11 @@ fn main() {
         ..RosEnv::default()
     };
     let urdf = concat!(env!("CARGO_MANIFEST_DIR"), "/urdf");
+    let rt = std::env::var("KERF_JITTER_RT").unwrap_or_else(|_| "0".into());
     let args = RosArgs::parse([
         "--ros-args".to_string(),
+        "-p".into(),
+        format!("realtime_priority:={rt}"),
         "-p".into(),
         format!("urdf_file:={urdf}/irb6660.urdf"),
         "-p".into(),

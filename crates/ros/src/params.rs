@@ -188,6 +188,15 @@ impl Params {
         Ok(self.f64(name)?.unwrap_or(default))
     }
 
+    /// An integer, or `default` when unset.
+    pub fn i64_or(&self, name: &str, default: i64) -> Result<i64, RosError> {
+        match self.get(name) {
+            None => Ok(default),
+            Some(ParamValue::Integer(i)) => Ok(*i),
+            Some(other) => Err(Self::wrong_type(name, "integer", other)),
+        }
+    }
+
     /// A boolean, or `default` when unset.
     pub fn bool_or(&self, name: &str, default: bool) -> Result<bool, RosError> {
         match self.get(name) {

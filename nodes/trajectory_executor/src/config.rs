@@ -16,6 +16,7 @@ pub const KNOWN_PARAMS: &[&str] = &[
     "action_monitor_rate",
     "initial_positions",
     "start_tolerance",
+    "realtime_priority",
     "constraints.*",
     "hardware.*",
 ];
@@ -37,6 +38,8 @@ pub struct NodeConfig {
     pub initial_positions: Vec<f64>,
     /// Mock hardware first-order lag (s); 0 follows commands exactly.
     pub lag_time_constant: f64,
+    /// `SCHED_FIFO` priority of the control thread (1–99); 0 = normal scheduling.
+    pub realtime_priority: i64,
 }
 
 fn param_err(name: &str, reason: String) -> NodeError {
@@ -75,6 +78,8 @@ impl NodeConfig {
     ///   forever), `constraints.<joint>.trajectory` and `constraints.<joint>.goal` (position
     ///   tolerances, 0 = unchecked): JTC's names and defaults.
     /// * `hardware.lag_time_constant` (s, default 0: the mock follows commands exactly).
+    /// * `realtime_priority` (0 = normal scheduling, 1–99 = `SCHED_FIFO` for the control
+    ///   thread; refused at start-up if the OS does not allow it).
     pub fn from_params(params: &Params) -> Result<Self, NodeError> {
         let urdf = PathBuf::from(params.required_string("urdf_file")?);
         let limits_file = PathBuf::from(params.required_string("joint_limits_file")?);
@@ -158,6 +163,13 @@ impl NodeConfig {
             }
         }
         let lag_time_constant = non_negative(params, "hardware.lag_time_constant", 0.0)?;
+        let realtime_priority = params.i64_or("realtime_priority", 0)?;
+        if !(0..=99).contains(&realtime_priority) {
+            return Err(param_err(
+                "realtime_priority",
+                format!("must be 0 (off) or 1..=99, got {realtime_priority}"),
+            ));
+        }
 
         let initial_positions = match params.f64_array("initial_positions")? {
             Some(v) => v,
@@ -186,6 +198,7 @@ impl NodeConfig {
             action_monitor_rate,
             initial_positions,
             lag_time_constant,
+            realtime_priority,
         })
     }
 }

@@ -161,7 +161,21 @@ pub fn run(args: &RosArgs, env: &RosEnv, stop: StopToken) -> Result<(), NodeErro
             return Err(e);
         }
     };
+    let priority = cfg.realtime_priority;
     let mut n = ExecutorNode::new(node, cfg)?;
+    if priority > 0 {
+        // The control loop runs on this thread.
+        kerf_ros::set_realtime_priority(priority).map_err(|reason| {
+            log.error(&format!("cannot start: {reason}"));
+            NodeError::Config {
+                name: "realtime_priority".into(),
+                reason,
+            }
+        })?;
+        log.info(&format!(
+            "control thread runs SCHED_FIFO at priority {priority}"
+        ));
+    }
     n.spin();
     Ok(())
 }

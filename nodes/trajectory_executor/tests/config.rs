@@ -52,6 +52,8 @@ fn bad_parameters_are_named() {
         ("constraints.joint_9.goal:=0.1", "constraints.joint_9.goal"),
         ("constraints.joint_1.goal:=-0.1", "constraints.joint_1.goal"),
         ("hardware.lag:=0.1", "hardware.lag"),
+        ("realtime_priority:=120", "realtime_priority"),
+        ("realtime_priority:=0.5", "realtime_priority"),
         ("urdf_file:=/nonexistent.urdf", "nonexistent"),
     ];
     for (p, needle) in cases {
