@@ -68,6 +68,30 @@ fn launch_echo_and_ctrl_c() {
         "{yaml}"
     );
 
+    // The node logs to /rosout too (transient-local, last message kept): its start-up line.
+    let out = kerf()
+        .args([
+            "echo",
+            "/rosout",
+            "--transient-local",
+            "-n",
+            "1",
+            "--timeout",
+            "20",
+        ])
+        .output()
+        .expect("run kerf echo /rosout");
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let log = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        log.contains("trajectory_executor") && log.contains("ready"),
+        "{log}"
+    );
+
     // Ctrl-C: a clean shutdown and exit status 0.
     let pid = launch.0.id().to_string();
     assert!(Command::new("kill")
