@@ -24,7 +24,10 @@ use kerf_msgs::{
     trajectory_msgs::{JointTrajectory, JointTrajectoryPoint},
     RosType,
 };
-use kerf_ros::{qos, DiscoveryRange, KerfNode, NodeSpec, RosArgs, RosEnv, StopToken};
+#[path = "../tests/support/mod.rs"]
+mod support;
+
+use kerf_ros::{qos, ros2_client::ServiceMapping};
 
 /// Minimum-jerk rest-to-rest motion of every joint from 0 to `d` and back over `t` seconds,
 /// sampled every 4 ms with exact velocities and accelerations.
@@ -94,42 +97,10 @@ fn main() {
         .ok()
         .and_then(|s| s.parse().ok())
         .unwrap_or(5000);
-    let env = RosEnv {
-        domain_id: 97,
-        range: DiscoveryRange::Localhost,
-        ..RosEnv::default()
-    };
-    let urdf = concat!(env!("CARGO_MANIFEST_DIR"), "/urdf");
+    let env = support::loopback(97, ServiceMapping::Enhanced);
     let rt = std::env::var("KERF_JITTER_RT").unwrap_or_else(|_| "0".into());
-    let args = RosArgs::parse([
-        "--ros-args".to_string(),
-        "-p".into(),
-        format!("realtime_priority:={rt}"),
-        "-p".into(),
-        format!("urdf_file:={urdf}/irb6660.urdf"),
-        "-p".into(),
-        format!("joint_limits_file:={urdf}/irb6660_limits.yaml"),
-        "--disable-rosout-logs".into(),
-    ])
-    .expect("args");
-    let stop = StopToken::new();
-    let (a, e, s) = (args.clone(), env.clone(), stop.clone());
-    let exec = std::thread::spawn(move || kerf_trajectory_executor::run(&a, &e, s));
-
-    let mut sub_node = KerfNode::new(
-        NodeSpec {
-            default_name: "jitter_probe",
-            default_namespace: "/",
-            known_params: &[],
-        },
-        &RosArgs {
-            rosout_logs: false,
-            ..RosArgs::default()
-        },
-        &env,
-        StopToken::new(),
-    )
-    .expect("probe node");
+    let (stop, exec) = support::spawn_executor(&env, &[format!("realtime_priority:={rt}")]);
+    let mut sub_node = support::client_node("jitter_probe", &env);
     let sub = sub_node
         .subscription::<JointState>("/joint_states", JointState::ROS_TYPE, qos::state())
         .expect("subscription");

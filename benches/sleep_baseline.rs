@@ -10,7 +10,10 @@ fn main() {
     if std::env::args().any(|a| a == "--list") {
         return;
     }
-    if let Some(p) = std::env::var("KERF_JITTER_RT").ok().and_then(|s| s.parse().ok()) {
+    if let Some(p) = std::env::var("KERF_JITTER_RT")
+        .ok()
+        .and_then(|s| s.parse().ok())
+    {
         if p > 0 {
             kerf_ros::set_realtime_priority(p).expect("SCHED_FIFO");
         }

@@ -19,7 +19,9 @@ use kerf_msgs::{
     trajectory_msgs::{JointTrajectory, JointTrajectoryPoint},
     RosType,
 };
-use kerf_ros::{qos, DiscoveryRange, KerfNode, NodeSpec, RosArgs, RosEnv, StopToken};
+mod support;
+
+use kerf_ros::{qos, KerfNode, StopToken};
 use ros2_client::{
     action::{ActionClient, GoalId, GoalStatusEnum},
     Client, Publisher, ServiceMapping, Subscription,
@@ -54,41 +56,9 @@ impl Cell {
     }
 
     fn start_with(domain: u16, service_mapping: ServiceMapping) -> Cell {
-        let env = RosEnv {
-            domain_id: domain,
-            range: DiscoveryRange::Localhost,
-            service_mapping,
-        };
-        let urdf = concat!(env!("CARGO_MANIFEST_DIR"), "/urdf");
-        let args = RosArgs::parse([
-            "--ros-args".to_string(),
-            "-p".into(),
-            format!("urdf_file:={urdf}/irb6660.urdf"),
-            "-p".into(),
-            format!("joint_limits_file:={urdf}/irb6660_limits.yaml"),
-            "--disable-rosout-logs".into(),
-        ])
-        .unwrap();
-        let stop = StopToken::new();
-        let (a, e, s) = (args.clone(), env.clone(), stop.clone());
-        let executor = std::thread::spawn(move || {
-            kerf_trajectory_executor::run(&a, &e, s).map_err(|e| e.to_string())
-        });
-
-        let mut client = KerfNode::new(
-            NodeSpec {
-                default_name: "cell_controller",
-                default_namespace: "/",
-                known_params: &[],
-            },
-            &RosArgs {
-                rosout_logs: false,
-                ..RosArgs::default()
-            },
-            &env,
-            StopToken::new(),
-        )
-        .unwrap();
+        let env = support::loopback(domain, service_mapping);
+        let (stop, executor) = support::spawn_executor(&env, &[]);
+        let mut client = support::client_node("cell_controller", &env);
         let action: Fjt = client
             .action_client(
                 "/trajectory_executor/follow_joint_trajectory",
