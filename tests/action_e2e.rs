@@ -56,8 +56,12 @@ impl Cell {
     }
 
     fn start_with(domain: u16, service_mapping: ServiceMapping) -> Cell {
+        Self::start_full(domain, service_mapping, &[])
+    }
+
+    fn start_full(domain: u16, service_mapping: ServiceMapping, params: &[String]) -> Cell {
         let env = support::loopback(domain, service_mapping);
-        let (stop, executor) = support::spawn_executor(&env, &[]);
+        let (stop, executor) = support::spawn_executor(&env, params);
         let mut client = support::client_node("cell_controller", &env);
         let action: Fjt = client
             .action_client(
@@ -418,4 +422,55 @@ fn an_empty_topic_trajectory_stops_the_active_goal() {
     assert_eq!(status, GoalStatusEnum::Canceled, "{r:?}");
     let stopped = cell.wait_state(|s| s.velocity.iter().all(|v| *v == 0.0), "standstill");
     assert!(max_diff(&stopped.last().unwrap().position, &far) > 0.1);
+}
+
+/// Path and goal tolerances from the goal are honoured: with hardware that lags its commands
+/// (first-order, 50 ms), a tight path tolerance aborts the goal with PATH_TOLERANCE_VIOLATED
+/// and a loose one lets it succeed.
+#[test]
+fn path_tolerances_from_the_goal_are_honoured() {
+    let mut cell = Cell::start_full(
+        47,
+        ServiceMapping::Enhanced,
+        &["hardware.lag_time_constant:=0.05".to_string()],
+    );
+    let start = cell.position();
+    let target = [0.4; 6];
+    let tolerance = |position: f64| {
+        JOINTS
+            .iter()
+            .map(|j| kerf_msgs::control_msgs::JointTolerance {
+                name: j.to_string(),
+                position,
+                velocity: 0.0,
+                acceleration: 0.0,
+            })
+            .collect::<Vec<_>>()
+    };
+    let mut tight = goal(min_jerk(&JOINTS, &start, &target, 1.0, 10));
+    tight.path_tolerance = tolerance(0.001);
+    let (status, r) = cell.result(cell.send(tight));
+    assert_eq!(status, GoalStatusEnum::Aborted, "{r:?}");
+    assert_eq!(
+        r.error_code,
+        FollowJointTrajectoryResult::PATH_TOLERANCE_VIOLATED
+    );
+    assert!(
+        r.error_string.contains("path tolerance"),
+        "{}",
+        r.error_string
+    );
+    let here = cell
+        .wait_state(|s| s.velocity.iter().all(|v| v.abs() < 1e-6), "standstill")
+        .last()
+        .unwrap()
+        .position
+        .clone();
+
+    let mut loose = goal(min_jerk(&JOINTS, &here, &target, 1.0, 10));
+    loose.path_tolerance = tolerance(0.5);
+    loose.goal_tolerance = tolerance(0.01);
+    loose.goal_time_tolerance = RosDuration::from_secs_f64(2.0).unwrap();
+    let (status, r) = cell.result(cell.send(loose));
+    assert_eq!(status, GoalStatusEnum::Succeeded, "{r:?}");
 }
