@@ -3,89 +3,17 @@
 //! Run: `cargo bench -p kerf_executor --bench interpolation`. For the worst case per call see
 //! `examples/cycle_cost.rs`.
 
-use std::f64::consts::PI;
+mod common;
+
 use std::hint::black_box;
 use std::time::{Duration, Instant};
 
+use common::{cosine_request, limits, tolerances, DT, N};
 use criterion::{criterion_group, criterion_main, Criterion};
-use kerf_executor::{
-    validate, Cycle, Executor, ExecutorConfig, GoalTolerances, JointLimits, JointSample,
-    JointTolerance, TrajectoryPoint, TrajectoryRequest,
-};
-
-const N: usize = 6;
-const DT: f64 = 0.004;
-
-fn limits() -> Vec<JointLimits> {
-    (0..N)
-        .map(|i| JointLimits {
-            name: format!("j{}", i + 1),
-            min_position: -3.0,
-            max_position: 3.0,
-            max_velocity: 2.0,
-            max_acceleration: 10.0,
-        })
-        .collect()
-}
-
-/// `points` quintic waypoints `spacing` s apart of p_j(t) = A (1 − cos ω_j t), ending at rest.
-fn request(points: usize, spacing: f64) -> TrajectoryRequest {
-    let end = spacing * (points - 1) as f64;
-    let amp = 0.5;
-    let omega: Vec<f64> = (0..N).map(|j| 2.0 * PI * (3 + j) as f64 / end).collect();
-    let pts = (0..points)
-        .map(|k| {
-            let t = spacing * k as f64;
-            let last = k == points - 1;
-            TrajectoryPoint {
-                positions: omega.iter().map(|w| amp * (1.0 - (w * t).cos())).collect(),
-                velocities: omega
-                    .iter()
-                    .map(|w| if last { 0.0 } else { amp * w * (w * t).sin() })
-                    .collect(),
-                accelerations: omega
-                    .iter()
-                    .map(|w| {
-                        if last {
-                            0.0
-                        } else {
-                            amp * w * w * (w * t).cos()
-                        }
-                    })
-                    .collect(),
-                effort: vec![],
-                time_from_start: t,
-            }
-        })
-        .collect();
-    TrajectoryRequest {
-        joint_names: limits().iter().map(|l| l.name.clone()).collect(),
-        points: pts,
-        start_time: None,
-    }
-}
-
-fn tolerances() -> GoalTolerances {
-    let tol = |position| -> Vec<JointTolerance> {
-        limits()
-            .iter()
-            .map(|l| JointTolerance {
-                name: l.name.clone(),
-                position,
-                velocity: 1.0,
-                acceleration: 0.0,
-            })
-            .collect()
-    };
-    GoalTolerances {
-        path: tol(0.1),
-        goal: tol(1e-3),
-        goal_time: 1.0,
-    }
-}
+use kerf_executor::{validate, Cycle, Executor, ExecutorConfig, JointSample};
 
 fn benches(c: &mut Criterion) {
-    let req = request(1000, 0.1);
+    let req = cosine_request(1000, 0.1, |j| (3 + j) as f64);
     let cfg = ExecutorConfig::default();
     let rest = JointSample::at_rest(vec![0.0; N]);
 

@@ -5,81 +5,23 @@
 //! p99.9 and max in µs. Timings include `Instant::now()` overhead (tens of ns) and any
 //! preemption by the OS; no real-time scheduling is set up.
 
-use std::f64::consts::PI;
+#[path = "../benches/common/mod.rs"]
+mod common;
+
 use std::time::Instant;
 
-use kerf_executor::{
-    Cycle, Executor, ExecutorConfig, GoalTolerances, JointLimits, JointSample, JointTolerance,
-    TrajectoryPoint, TrajectoryRequest,
-};
+use common::{cosine_request, limits, tolerances, DT, N};
+use kerf_executor::{Cycle, Executor, ExecutorConfig, JointSample};
 
-const N: usize = 6;
-const DT: f64 = 0.004;
 const CALLS: usize = 1_000_000;
 
 fn main() -> Result<(), kerf_executor::ExecutorError> {
-    let limits: Vec<JointLimits> = (0..N)
-        .map(|i| JointLimits {
-            name: format!("j{}", i + 1),
-            min_position: -3.0,
-            max_position: 3.0,
-            max_velocity: 2.0,
-            max_acceleration: 10.0,
-        })
-        .collect();
+    let limits = limits();
     let points = 1001;
     let end = CALLS as f64 * DT;
     let spacing = end / (points - 1) as f64;
-    let amp = 0.5;
-    let omega: Vec<f64> = (0..N)
-        .map(|j| 2.0 * PI * (50 + 7 * j) as f64 / end)
-        .collect();
-    let pts = (0..points)
-        .map(|k| {
-            let t = spacing * k as f64;
-            let last = k == points - 1;
-            TrajectoryPoint {
-                positions: omega.iter().map(|w| amp * (1.0 - (w * t).cos())).collect(),
-                velocities: omega
-                    .iter()
-                    .map(|w| if last { 0.0 } else { amp * w * (w * t).sin() })
-                    .collect(),
-                accelerations: omega
-                    .iter()
-                    .map(|w| {
-                        if last {
-                            0.0
-                        } else {
-                            amp * w * w * (w * t).cos()
-                        }
-                    })
-                    .collect(),
-                effort: vec![],
-                time_from_start: t,
-            }
-        })
-        .collect();
-    let req = TrajectoryRequest {
-        joint_names: limits.iter().map(|l| l.name.clone()).collect(),
-        points: pts,
-        start_time: None,
-    };
-    let tol = |position| -> Vec<JointTolerance> {
-        limits
-            .iter()
-            .map(|l| JointTolerance {
-                name: l.name.clone(),
-                position,
-                velocity: 1.0,
-                acceleration: 0.0,
-            })
-            .collect()
-    };
-    let tolerances = GoalTolerances {
-        path: tol(0.1),
-        goal: tol(1e-3),
-        goal_time: 1.0,
-    };
+    let req = cosine_request(points, spacing, |j| (50 + 7 * j) as f64);
+    let tolerances = tolerances();
 
     let mut exec = Executor::new(limits.clone(), ExecutorConfig::default(), vec![0.0; N])?;
     let t_validate = Instant::now();
