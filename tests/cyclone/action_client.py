@@ -67,6 +67,7 @@ from cyclonedds.topic import Topic
 from cyclonedds.util import duration
 
 from helpers import (
+    run_checked,
     JOINTS,
     POSITION_TOLERANCE,
     CheckFailed,
@@ -776,27 +777,10 @@ def main() -> int:
     ap.add_argument("--urdf", required=True, help="the robot URDF the executor runs with")
     ap.add_argument("--discovery-timeout", type=float, default=15.0)
     args = ap.parse_args()
-    if not 0 <= args.domain <= 232:
-        print("action_client.py: give --domain (or ROS_DOMAIN_ID) in 0..232", file=sys.stderr)
-        return 2
-    if not os.environ.get("CYCLONEDDS_URI"):
-        print(
-            "action_client.py: CYCLONEDDS_URI is not set; refusing to run with Cyclone's "
-            "default (multicast on every interface). Use tests/cyclone/cyclonedds.xml.",
-            file=sys.stderr,
-        )
-        return 2
     if sys.byteorder != "little":
         print("action_client.py: the header checks assume a little-endian host", file=sys.stderr)
         return 2
-    log(f"domain {args.domain}, CYCLONEDDS_URI={os.environ['CYCLONEDDS_URI']}")
-    try:
-        scenario(args)
-    except CheckFailed as e:
-        log(f"FAILED: {e}")
-        return 1
-    log(f"PASSED in {time.monotonic() - T0:.3f} s")
-    return 0
+    return run_checked("action_client.py", args, scenario, log, T0)
 
 
 T0 = time.monotonic()

@@ -86,3 +86,33 @@ def choose_target(
         if not lim.lower < target[j] < lim.upper:
             raise CheckFailed(f"cannot choose a target for {j} from {start[j]} within {lim}")
     return target
+
+
+def run_checked(name, args, scenario, log, t0: float) -> int:
+    """Common entry of the peer scripts.
+
+    Refuses to run without a domain in 0..232 or without the loopback-only Cyclone config
+    (CYCLONEDDS_URI), runs `scenario(args)`, and maps a CheckFailed to exit status 1.
+    """
+    import os
+    import sys
+    import time
+
+    if not 0 <= args.domain <= 232:
+        print(f"{name}: give --domain (or ROS_DOMAIN_ID) in 0..232", file=sys.stderr)
+        return 2
+    if not os.environ.get("CYCLONEDDS_URI"):
+        print(
+            f"{name}: CYCLONEDDS_URI is not set; refusing to run with Cyclone's default "
+            "(multicast on every interface). Use tests/cyclone/cyclonedds.xml.",
+            file=sys.stderr,
+        )
+        return 2
+    log(f"domain {args.domain}, CYCLONEDDS_URI={os.environ['CYCLONEDDS_URI']}")
+    try:
+        scenario(args)
+    except CheckFailed as e:
+        log(f"FAILED: {e}")
+        return 1
+    log(f"PASSED in {time.monotonic() - t0:.3f} s")
+    return 0
