@@ -246,10 +246,10 @@ impl Executor {
         tolerances: &GoalTolerances,
         now: f64,
     ) -> Result<GoalId, ExecutorError> {
-        self.request_time("now", now)?;
-        tolerance::resolve(&self.limits, &self.cfg, tolerances)?;
+        let t = self.request_time("now", now)?;
+        let resolved = tolerance::resolve(&self.limits, &self.cfg, tolerances)?;
         let prepared = prepare(&self.limits, &self.cfg, req)?;
-        self.submit_prepared(&prepared, tolerances, now)
+        self.start(&prepared, resolved, t)
     }
 
     /// As [`Executor::submit`], for a trajectory already checked by [`prepare`] against this
@@ -263,6 +263,17 @@ impl Executor {
     ) -> Result<GoalId, ExecutorError> {
         let t = self.request_time("now", now)?;
         let resolved = tolerance::resolve(&self.limits, &self.cfg, tolerances)?;
+        self.start(prepared, resolved, t)
+    }
+
+    /// Finishes `prepared` against the commanded state at `t` and makes it the active goal,
+    /// preempting the previous one.
+    fn start(
+        &mut self,
+        prepared: &PreparedTrajectory,
+        tolerances: ResolvedTolerances,
+        t: f64,
+    ) -> Result<GoalId, ExecutorError> {
         let traj = prepared.finish(&self.limits, &self.cfg, &self.commanded_at(t), t)?;
         if let Some(old) = self.active.take() {
             self.pending.push(GoalEvent {
@@ -274,7 +285,7 @@ impl Executor {
         self.next_id += 1;
         self.active = Some(ActiveGoal {
             id,
-            tolerances: resolved,
+            tolerances,
             start_time: traj.start_time(),
             end_time: traj.end_time(),
         });

@@ -137,6 +137,16 @@ enum Source {
     Action { id: GoalId, stamp: Time },
 }
 
+impl Source {
+    /// "trajectory from topic" or "goal <id>", for log lines.
+    fn describe(&self) -> String {
+        match self {
+            Source::Topic { .. } => "trajectory from topic".to_string(),
+            Source::Action { id, .. } => format!("goal {id:?}"),
+        }
+    }
+}
+
 /// Runs the node until its stop token (or Ctrl-C) stops it.
 ///
 /// # Returns
@@ -426,11 +436,8 @@ impl ExecutorNode {
     }
 
     fn rejected(&mut self, source: &Source, rej: Rejection) {
-        let what = match source {
-            Source::Topic { .. } => "trajectory from topic".to_string(),
-            Source::Action { id, .. } => format!("goal {id:?}"),
-        };
-        self.log.warn(&format!("rejected {what}: {}", rej.message));
+        self.log
+            .warn(&format!("rejected {}: {}", source.describe(), rej.message));
         self.trajectory_status(source, TrajectoryStatus::REJECTED, rej.code, &rej.message);
         if let Source::Action { id, .. } = source {
             self.goals.finish(
@@ -506,10 +513,7 @@ impl ExecutorNode {
         });
         match submitted {
             Ok((exec_id, points, duration)) => {
-                let what = match &source {
-                    Source::Topic { .. } => "trajectory from topic".to_string(),
-                    Source::Action { id, .. } => format!("goal {id:?}"),
-                };
+                let what = source.describe();
                 self.log.info(&format!(
                     "accepted {what}: {points} points over {duration:.3} s"
                 ));
