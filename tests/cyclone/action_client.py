@@ -68,6 +68,7 @@ from cyclonedds.util import duration
 
 from helpers import (
     run_checked,
+    wait_until,
     JOINTS,
     POSITION_TOLERANCE,
     CheckFailed,
@@ -393,14 +394,7 @@ class ActionClient:
             c.pump()
 
     def wait_until(self, what: str, cond: Callable[[], bool], timeout: float) -> None:
-        deadline = time.monotonic() + timeout
-        while True:
-            self.pump()
-            if cond():
-                return
-            if time.monotonic() > deadline:
-                raise CheckFailed(f"timed out after {timeout:.1f} s waiting for {what}")
-            time.sleep(0.002)
+        wait_until(self.pump, what, cond, timeout)
 
     def wait_reply(self, client: RmwCycloneClient, seq: int, timeout: float):
         """The reply to request `seq`, or None after `timeout` s."""

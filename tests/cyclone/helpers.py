@@ -116,3 +116,17 @@ def run_checked(name, args, scenario, log, t0: float) -> int:
         return 1
     log(f"PASSED in {time.monotonic() - t0:.3f} s")
     return 0
+
+
+def wait_until(pump, what: str, cond, timeout: float) -> None:
+    """Calls `pump()` every 2 ms until `cond()` holds; CheckFailed after `timeout` s."""
+    import time
+
+    deadline = time.monotonic() + timeout
+    while True:
+        pump()
+        if cond():
+            return
+        if time.monotonic() > deadline:
+            raise CheckFailed(f"timed out after {timeout:.1f} s waiting for {what}")
+        time.sleep(0.002)

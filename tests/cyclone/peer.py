@@ -39,6 +39,7 @@ from cyclonedds.util import duration
 
 from helpers import (
     run_checked,
+    wait_until,
     JOINTS,
     POSITION_TOLERANCE,
     CheckFailed,
@@ -127,14 +128,7 @@ class Peer:
         return got
 
     def wait_until(self, what: str, cond: Callable[[], bool], timeout: float) -> None:
-        deadline = time.monotonic() + timeout
-        while True:
-            self.pump()
-            if cond():
-                return
-            if time.monotonic() > deadline:
-                raise CheckFailed(f"timed out after {timeout:.1f} s waiting for {what}")
-            time.sleep(0.002)
+        wait_until(self.pump, what, cond, timeout)
 
     def next_status(self, timeout: float) -> TrajectoryStatus:
         self.wait_until("a trajectory status", lambda: bool(self.statuses), timeout)
