@@ -1,0 +1,447 @@
+//! A cut request: the CL path, process parameters, workpiece and options.
+//!
+//! This is the planner's own (ROS-free) form of `kerf_msgs/msg/CutRequest`.
+//! It is also the YAML/JSON request file of `kerf plan cut` and the YAML
+//! form of the `~/cut_request_text` topic. SI units throughout: m, m/s,
+//! m/s², m/s³, s, rad.
+
+use nalgebra::{Isometry3, Quaternion, Translation3, UnitQuaternion, Vector3};
+use serde::{Deserialize, Serialize};
+
+use crate::PlanError;
+
+/// Smallest accepted distance between consecutive CL points (m). Closer
+/// points are "repeated points": the arc-length parameter would not be
+/// strictly increasing.
+pub const MIN_SEGMENT_LENGTH: f64 = 1e-7;
+
+/// Largest accepted deviation of an axis norm from 1.
+pub const AXIS_NORM_TOLERANCE: f64 = 1e-6;
+
+/// Pose of the workpiece frame in the machine frame (`base_link`).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PoseSpec {
+    /// Position (m).
+    pub position: [f64; 3],
+    /// Orientation quaternion [x, y, z, w] (normalised on use; must not be zero).
+    pub orientation: [f64; 4],
+}
+
+impl Default for PoseSpec {
+    fn default() -> Self {
+        Self {
+            position: [0.0; 3],
+            orientation: [0.0, 0.0, 0.0, 1.0],
+        }
+    }
+}
+
+impl PoseSpec {
+    /// The pose as an isometry, after checking it is finite and the
+    /// quaternion is not (near) zero.
+    pub fn isometry(&self) -> Result<Isometry3<f64>, PlanError> {
+        if self
+            .position
+            .iter()
+            .chain(self.orientation.iter())
+            .any(|v| !v.is_finite())
+        {
+            return Err(PlanError::invalid("workpiece_pose", "not finite"));
+        }
+        let [x, y, z, w] = self.orientation;
+        let q = Quaternion::new(w, x, y, z);
+        let n = q.norm();
+        if (n - 1.0).abs() > 1e-3 {
+            return Err(PlanError::invalid(
+                "workpiece_pose.orientation",
+                format!("quaternion norm {n:.6} is not 1"),
+            ));
+        }
+        let p = self.position;
+        Ok(Isometry3::from_parts(
+            Translation3::new(p[0], p[1], p[2]),
+            UnitQuaternion::from_quaternion(q),
+        ))
+    }
+}
+
+/// The sampling grid of one 3D GFD (section 2.4), centred on the
+/// reference configuration of the RTO.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct GfdGrid {
+    /// Samples over q4 (odd, ≥ 1).
+    pub q4_steps: usize,
+    /// Samples over q5 (odd, ≥ 1).
+    pub q5_steps: usize,
+    /// Samples over q6 (≥ 1), spread over the admissible standoff range.
+    pub q6_steps: usize,
+    /// Half width of the q4 range around the reference (rad).
+    pub q4_half_range: f64,
+    /// Half width of the q5 range around the reference (rad).
+    pub q5_half_range: f64,
+}
+
+impl Default for GfdGrid {
+    fn default() -> Self {
+        Self {
+            q4_steps: 9,
+            q5_steps: 9,
+            q6_steps: 5,
+            q4_half_range: 0.35,
+            q5_half_range: 0.3,
+        }
+    }
+}
+
+/// Weights of eq. 55 (k4, k5, k6) and eq. 56 (k1, k2).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct Weights {
+    /// Weight of the distance-to-reference term of eq. 56.
+    pub k1: f64,
+    /// Weight of the RTO-to-RTO change per path length of eq. 56 (m).
+    pub k2: f64,
+    /// Weight of q4 in eq. 55 (1/rad²).
+    pub k4: f64,
+    /// Weight of q5 in eq. 55 (1/rad²).
+    pub k5: f64,
+    /// Weight of q6 in eq. 55 (1/m²).
+    pub k6: f64,
+}
+
+impl Default for Weights {
+    fn default() -> Self {
+        Self {
+            k1: 1.0,
+            k2: 0.05,
+            k4: 1.0,
+            k5: 1.0,
+            k6: 100.0,
+        }
+    }
+}
+
+/// Planner options.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct CutOptions {
+    /// Number of B-spline control coefficients n + 1; 0 = one per CL point
+    /// (the paper's choice). Otherwise 6 ≤ n + 1 ≤ number of CL points.
+    pub control_points: usize,
+    /// Maximum iterations of the loop of Figure 6 (≥ 1).
+    pub max_iterations: usize,
+    /// GFD sampling grid.
+    pub gfd: GfdGrid,
+    /// Weights of eq. 55 and 56.
+    pub weights: Weights,
+    /// CL indices of the initial RTOs (strictly increasing, first 0, last
+    /// N - 1); empty = automatic (see `rto_spacing`, `rto_angle`).
+    pub rto_indices: Vec<usize>,
+    /// Automatic initial RTOs: largest path length between two RTOs (m).
+    pub rto_spacing: f64,
+    /// Automatic initial RTOs: largest change of the nominal tool axis
+    /// between two RTOs (rad).
+    pub rto_angle: f64,
+    /// Preferred standoff q6 (m): the q6 of the GFD reference and the
+    /// regularisation target of the M-path QP.
+    pub reference_standoff: f64,
+    /// Required clearance between head and workpiece (m, ≥ 0); 0 = contact
+    /// is a collision.
+    pub clearance: f64,
+}
+
+impl Default for CutOptions {
+    fn default() -> Self {
+        Self {
+            control_points: 0,
+            max_iterations: 10,
+            gfd: GfdGrid::default(),
+            weights: Weights::default(),
+            rto_indices: Vec::new(),
+            rto_spacing: 0.15,
+            rto_angle: 20f64.to_radians(),
+            reference_standoff: -0.07,
+            clearance: 0.0,
+        }
+    }
+}
+
+fn default_feed_acceleration() -> f64 {
+    8.0
+}
+fn default_feed_jerk() -> f64 {
+    80.0
+}
+
+/// A cut request (planner form).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CutRequest {
+    /// Echoed in the plan.
+    #[serde(default)]
+    pub request_id: String,
+    /// CL points in the workpiece frame (m).
+    pub points: Vec<[f64; 3]>,
+    /// Unit tool axes in the workpiece frame, one per CL point (from the
+    /// surface towards the head).
+    pub axes: Vec<[f64; 3]>,
+    /// Feedrate f along the path (m/s), constant outside the ramps.
+    pub feedrate: f64,
+    /// Path acceleration limit of the feed ramps (m/s²; Table 1: 8).
+    #[serde(default = "default_feed_acceleration")]
+    pub feed_acceleration: f64,
+    /// Path jerk limit of the feed ramps (m/s³; Table 1: 80).
+    #[serde(default = "default_feed_jerk")]
+    pub feed_jerk: f64,
+    /// Controller sample period Δt (s).
+    pub sample_period: f64,
+    /// Lead angle limit φ_max (rad), in (0, π/2).
+    pub max_lead_angle: f64,
+    /// Tilt angle limit ϕ_max (rad), in (0, π/2).
+    pub max_tilt_angle: f64,
+    /// Workpiece mesh: a file path, `file://` URI or `package://kerf/...` URI
+    /// (STL, binary or ASCII, or OBJ), in metres, in the workpiece frame.
+    pub mesh: String,
+    /// Pose of the workpiece frame in the machine frame.
+    #[serde(default)]
+    pub workpiece_pose: PoseSpec,
+    /// Options.
+    #[serde(default)]
+    pub options: CutOptions,
+}
+
+/// A request after validation, in the machine frame.
+#[derive(Debug, Clone)]
+pub struct ValidatedRequest {
+    /// CL points in the machine frame (m).
+    pub points: Vec<Vector3<f64>>,
+    /// Unit tool axes in the machine frame.
+    pub axes: Vec<Vector3<f64>>,
+    /// Cumulative arc length at each CL point (m), starting at 0.
+    pub arc_length: Vec<f64>,
+    /// Normalized arc length u_i = s_i / σ (eq. 1).
+    pub u: Vec<f64>,
+    /// Total path length σ (m).
+    pub sigma: f64,
+    /// Workpiece pose in the machine frame.
+    pub workpiece_pose: Isometry3<f64>,
+}
+
+fn finite(field: &str, v: f64) -> Result<f64, PlanError> {
+    if v.is_finite() {
+        Ok(v)
+    } else {
+        Err(PlanError::invalid(
+            field,
+            format!("{v} is not a finite number"),
+        ))
+    }
+}
+
+fn positive(field: &str, v: f64) -> Result<f64, PlanError> {
+    finite(field, v)?;
+    if v > 0.0 {
+        Ok(v)
+    } else {
+        Err(PlanError::invalid(field, format!("{v} must be > 0")))
+    }
+}
+
+impl CutRequest {
+    /// Parses a YAML (or JSON, a YAML subset) request document.
+    pub fn from_yaml(text: &str) -> Result<Self, PlanError> {
+        serde_yaml_ng::from_str(text).map_err(|e| PlanError::invalid("request", e.to_string()))
+    }
+
+    /// Checks every field and transforms the path into the machine frame.
+    ///
+    /// # Errors
+    /// [`PlanError::InvalidRequest`] naming the field (with index) for:
+    /// different numbers of points and axes, fewer than two points, NaN or
+    /// infinite values, zero or non-unit axes, repeated points, non-positive
+    /// feedrate / sample period / ramp limits, angle limits outside
+    /// (0, π/2), bad options.
+    pub fn validate(&self) -> Result<ValidatedRequest, PlanError> {
+        let n = self.points.len();
+        if n != self.axes.len() {
+            return Err(PlanError::invalid(
+                "axes",
+                format!(
+                    "{} axes for {} CL points: one unit axis per point is required",
+                    self.axes.len(),
+                    n
+                ),
+            ));
+        }
+        if n < 2 {
+            return Err(PlanError::invalid(
+                "points",
+                format!("{n} CL point(s): at least 2 are required"),
+            ));
+        }
+        positive("feedrate", self.feedrate)?;
+        positive("feed_acceleration", self.feed_acceleration)?;
+        positive("feed_jerk", self.feed_jerk)?;
+        positive("sample_period", self.sample_period)?;
+        for (name, v) in [
+            ("max_lead_angle", self.max_lead_angle),
+            ("max_tilt_angle", self.max_tilt_angle),
+        ] {
+            positive(name, v)?;
+            if v >= std::f64::consts::FRAC_PI_2 {
+                return Err(PlanError::invalid(
+                    name,
+                    format!("{v} rad must be below π/2"),
+                ));
+            }
+        }
+        if self.mesh.trim().is_empty() {
+            return Err(PlanError::invalid(
+                "mesh",
+                "empty: a workpiece mesh is required",
+            ));
+        }
+        let pose = self.workpiece_pose.isometry()?;
+        self.validate_options(n)?;
+
+        let mut points = Vec::with_capacity(n);
+        let mut axes = Vec::with_capacity(n);
+        for (i, (p, a)) in self.points.iter().zip(&self.axes).enumerate() {
+            if p.iter().any(|v| !v.is_finite()) {
+                return Err(PlanError::invalid(
+                    format!("points[{i}]"),
+                    format!("{p:?} is not finite"),
+                ));
+            }
+            if a.iter().any(|v| !v.is_finite()) {
+                return Err(PlanError::invalid(
+                    format!("axes[{i}]"),
+                    format!("{a:?} is not finite"),
+                ));
+            }
+            let a = Vector3::new(a[0], a[1], a[2]);
+            let norm = a.norm();
+            if norm == 0.0 {
+                return Err(PlanError::invalid(
+                    format!("axes[{i}]"),
+                    "zero vector: the tool axis must be a unit vector",
+                ));
+            }
+            if (norm - 1.0).abs() > AXIS_NORM_TOLERANCE {
+                return Err(PlanError::invalid(
+                    format!("axes[{i}]"),
+                    format!("norm {norm:.9} is not 1 (tolerance {AXIS_NORM_TOLERANCE:e})"),
+                ));
+            }
+            points.push((pose * nalgebra::Point3::new(p[0], p[1], p[2])).coords);
+            axes.push(pose.rotation * (a / norm));
+        }
+        let mut arc_length = Vec::with_capacity(n);
+        arc_length.push(0.0);
+        for i in 1..n {
+            let d = (points[i] - points[i - 1]).norm();
+            if d < MIN_SEGMENT_LENGTH {
+                return Err(PlanError::invalid(
+                    format!("points[{i}]"),
+                    format!(
+                        "repeats points[{}] (segment length {d:e} m < {MIN_SEGMENT_LENGTH:e} m)",
+                        i - 1
+                    ),
+                ));
+            }
+            arc_length.push(arc_length[i - 1] + d);
+        }
+        let sigma = arc_length[n - 1];
+        let mut u: Vec<f64> = arc_length.iter().map(|s| s / sigma).collect();
+        u[n - 1] = 1.0;
+        Ok(ValidatedRequest {
+            points,
+            axes,
+            arc_length,
+            u,
+            sigma,
+            workpiece_pose: pose,
+        })
+    }
+
+    fn validate_options(&self, n: usize) -> Result<(), PlanError> {
+        let o = &self.options;
+        if o.control_points != 0 && (o.control_points < 6 || o.control_points > n) {
+            return Err(PlanError::invalid(
+                "options.control_points",
+                format!(
+                    "{} must be 0 (one per CL point) or in [6, {n}]",
+                    o.control_points
+                ),
+            ));
+        }
+        if o.max_iterations == 0 {
+            return Err(PlanError::invalid("options.max_iterations", "must be ≥ 1"));
+        }
+        let g = &o.gfd;
+        for (name, steps) in [("q4_steps", g.q4_steps), ("q5_steps", g.q5_steps)] {
+            if steps == 0 || steps % 2 == 0 || steps > 101 {
+                return Err(PlanError::invalid(
+                    format!("options.gfd.{name}"),
+                    format!("{steps} must be odd, in [1, 101]"),
+                ));
+            }
+        }
+        if g.q6_steps == 0 || g.q6_steps > 101 {
+            return Err(PlanError::invalid(
+                "options.gfd.q6_steps",
+                format!("{} must be in [1, 101]", g.q6_steps),
+            ));
+        }
+        for (name, v) in [
+            ("q4_half_range", g.q4_half_range),
+            ("q5_half_range", g.q5_half_range),
+        ] {
+            finite(&format!("options.gfd.{name}"), v)?;
+            if !(0.0..=std::f64::consts::PI).contains(&v) {
+                return Err(PlanError::invalid(
+                    format!("options.gfd.{name}"),
+                    format!("{v} must be in [0, π]"),
+                ));
+            }
+        }
+        let w = &o.weights;
+        for (name, v) in [
+            ("k1", w.k1),
+            ("k2", w.k2),
+            ("k4", w.k4),
+            ("k5", w.k5),
+            ("k6", w.k6),
+        ] {
+            finite(&format!("options.weights.{name}"), v)?;
+            if v < 0.0 {
+                return Err(PlanError::invalid(
+                    format!("options.weights.{name}"),
+                    format!("{v} must be ≥ 0"),
+                ));
+            }
+        }
+        if !o.rto_indices.is_empty() {
+            let r = &o.rto_indices;
+            if r[0] != 0 || *r.last().unwrap_or(&0) != n - 1 || r.windows(2).any(|w| w[1] <= w[0]) {
+                return Err(PlanError::invalid(
+                    "options.rto_indices",
+                    format!(
+                        "must be strictly increasing from 0 to {} (got {r:?})",
+                        n - 1
+                    ),
+                ));
+            }
+        }
+        positive("options.rto_spacing", o.rto_spacing)?;
+        positive("options.rto_angle", o.rto_angle)?;
+        finite("options.reference_standoff", o.reference_standoff)?;
+        finite("options.clearance", o.clearance)?;
+        if o.clearance < 0.0 {
+            return Err(PlanError::invalid("options.clearance", "must be ≥ 0"));
+        }
+        Ok(())
+    }
+}
