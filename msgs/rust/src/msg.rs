@@ -1,10 +1,14 @@
-//! kerf's own messages (`kerf_msgs/msg`, defined in `msgs/msg/`).
+//! kerf's own messages (`kerf_msgs/msg`, defined in `msgs/msg/`): the trajectory executor's
+//! [`TrajectoryStatus`] and the MJTO planner's [`CutRequest`] / [`CutPlan`] (with [`CutRto`],
+//! [`CutMetrics`], [`CutCollision`]).
 
 use serde::{Deserialize, Serialize};
 
 use crate::builtin_interfaces::Time;
+use crate::geometry_msgs::{Point, Pose, Vector3};
 use crate::ros_type::impl_ros_type;
 use crate::std_msgs::Header;
+use crate::trajectory_msgs::JointTrajectory;
 
 /// `kerf_msgs/msg/TrajectoryStatus`: status of one trajectory received by the
 /// trajectory executor on its `~/joint_trajectory` topic or as a
@@ -64,6 +68,212 @@ impl TrajectoryStatus {
     }
 }
 
+/// `kerf_msgs/msg/CutRequest`: a laser cutting request for the MJTO planner (seed 001), sent
+/// to its `~/cut_request` topic; answered by a [`CutPlan`] on `~/cut_plan`.
+///
+/// SI units: m, m/s, m/s², m/s³, s, rad. Fields documented "0 = default" take the planner's
+/// default when 0; nothing else is changed.
+#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
+pub struct CutRequest {
+    /// Any text; echoed in the [`CutPlan`].
+    pub request_id: String,
+    /// Cutter-location points in the workpiece frame (m); at least 2.
+    pub points: Vec<Point>,
+    /// Unit tool axes in the workpiece frame, one per CL point.
+    pub axes: Vec<Vector3>,
+    /// Feedrate along the path (m/s), > 0.
+    pub feedrate: f64,
+    /// Path acceleration limit of the feed ramps (m/s²); 0 = default 8.
+    pub feed_acceleration: f64,
+    /// Path jerk limit of the feed ramps (m/s³); 0 = default 80.
+    pub feed_jerk: f64,
+    /// Controller sample period Δt (s), > 0.
+    pub sample_period: f64,
+    /// Lead angle limit (rad), in (0, π/2).
+    pub max_lead_angle: f64,
+    /// Tilt angle limit (rad), in (0, π/2).
+    pub max_tilt_angle: f64,
+    /// Workpiece mesh: a path, `file://` or `package://kerf/...` URI.
+    pub mesh: String,
+    /// Pose of the workpiece frame in the machine frame; a unit quaternion (w = 1 = identity).
+    pub workpiece_pose: Pose,
+    /// B-spline control coefficients n + 1; 0 = default (one per CL point).
+    pub control_points: u32,
+    /// Maximum iterations of the collision loop; 0 = default 10.
+    pub max_iterations: u32,
+    /// GFD samples over q4 (odd); 0 = default.
+    pub gfd_q4_steps: u32,
+    /// GFD samples over q5 (odd); 0 = default.
+    pub gfd_q5_steps: u32,
+    /// GFD samples over q6; 0 = default.
+    pub gfd_q6_steps: u32,
+    /// GFD half width over q4 (rad); 0 = default.
+    pub gfd_q4_half_range: f64,
+    /// GFD half width over q5 (rad); 0 = default.
+    pub gfd_q5_half_range: f64,
+    /// CL indices of the initial RTOs; empty = automatic.
+    pub rto_indices: Vec<u32>,
+    /// Automatic RTOs: largest path length between two RTOs (m); 0 = default.
+    pub rto_spacing: f64,
+    /// Automatic RTOs: largest tool-axis change between two RTOs (rad); 0 = default.
+    pub rto_angle: f64,
+    /// Whether [`reference_standoff`](Self::reference_standoff) is given (q6 = 0 is valid, so
+    /// 0 cannot mean "default").
+    pub has_reference_standoff: bool,
+    /// Preferred standoff q6 (m), used when `has_reference_standoff`.
+    pub reference_standoff: f64,
+    /// Required head–workpiece clearance (m, ≥ 0).
+    pub clearance: f64,
+}
+impl_ros_type!(CutRequest, "kerf_msgs", msg, "CutRequest");
+
+/// `kerf_msgs/msg/CutRto`: one representative tool orientation of a [`CutPlan`].
+#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
+pub struct CutRto {
+    /// Normalized arc length u in [0, 1].
+    pub u: f64,
+    /// Index of the CL point it sits on.
+    pub cl_index: u32,
+    /// Rotary axis q4 (rad).
+    pub q4: f64,
+    /// Rotary axis q5 (rad).
+    pub q5: f64,
+    /// Standoff axis q6 (m).
+    pub q6: f64,
+    /// 0 for the initial RTOs, else the iteration that inserted it.
+    pub inserted_at_iteration: u32,
+}
+impl_ros_type!(CutRto, "kerf_msgs", msg, "CutRto");
+
+/// `kerf_msgs/msg/CutMetrics`: kinematic figures of one trajectory on its samples, per joint
+/// q1..q6.
+#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
+pub struct CutMetrics {
+    /// Peak |velocity| per joint (m/s or rad/s).
+    pub peak_velocity: [f64; 6],
+    /// Peak |acceleration| per joint (m/s² or rad/s²).
+    pub peak_acceleration: [f64; 6],
+    /// Peak |jerk| per joint (m/s³ or rad/s³).
+    pub peak_jerk: [f64; 6],
+    /// RMS jerk per joint (m/s³ or rad/s³).
+    pub rms_jerk: [f64; 6],
+    /// True when every sample is inside every joint limit.
+    pub within_limits: bool,
+    /// One line per violated limit.
+    pub limit_violations: Vec<String>,
+    /// Largest CL point error of forward kinematics against the request (m).
+    pub max_cl_error: f64,
+    /// Largest |lead angle| (rad).
+    pub max_lead_angle: f64,
+    /// Largest |tilt angle| (rad).
+    pub max_tilt_angle: f64,
+    /// Samples at which the head touches the workpiece.
+    pub colliding_samples: u32,
+}
+impl_ros_type!(CutMetrics, "kerf_msgs", msg, "CutMetrics");
+
+/// `kerf_msgs/msg/CutCollision`: one rejected sample of a [`CutPlan`] with status
+/// [`COLLISION`](CutPlan::COLLISION).
+#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
+pub struct CutCollision {
+    /// Normalized arc length u in [0, 1].
+    pub u: f64,
+    /// Time from the trajectory start (s); −1 when no trajectory exists yet.
+    pub time: f64,
+    /// Index of the nearest CL point.
+    pub cl_index: u32,
+    /// Links of the head in contact (empty for an orientation-limit violation).
+    pub links: Vec<String>,
+    /// Why the sample is rejected.
+    pub reason: String,
+}
+impl_ros_type!(CutCollision, "kerf_msgs", msg, "CutCollision");
+
+/// `kerf_msgs/msg/CutPlan`: the planner's answer to one [`CutRequest`], published on
+/// `~/cut_plan`; failures carry their status and message.
+#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
+pub struct CutPlan {
+    /// `request_id` of the request (empty when it could not be read).
+    pub request_id: String,
+    /// One of the status constants ([`SUCCESS`](Self::SUCCESS) …).
+    pub status: u8,
+    /// Human-readable result or reason.
+    pub message: String,
+    /// The joint trajectory q1..q6, one point per sample period; empty unless SUCCESS.
+    pub trajectory: JointTrajectory,
+    /// Final RTOs in path order.
+    pub rtos: Vec<CutRto>,
+    /// Metrics of the planned trajectory.
+    pub metrics: CutMetrics,
+    /// Metrics of the quaternion-interpolation baseline.
+    pub qi_metrics: CutMetrics,
+    /// Rejected samples (status COLLISION).
+    pub collisions: Vec<CutCollision>,
+    /// Largest feasible feedrate (m/s) when the feedrate makes a QP infeasible; else 0.
+    pub max_feasible_feedrate: f64,
+    /// Iterations of the collision loop.
+    pub iterations: u32,
+    /// Collision queries made.
+    pub collision_queries: u32,
+    /// Number of B-spline control coefficients.
+    pub control_points: u32,
+    /// CL path length (m).
+    pub path_length: f64,
+    /// Validation and mesh loading (s).
+    pub time_setup: f64,
+    /// Jerk Hessian (s).
+    pub time_hessian: f64,
+    /// GFD construction (s).
+    pub time_gfd: f64,
+    /// Initial RTO selection (s).
+    pub time_selection: f64,
+    /// Rotary-axis QPs (s).
+    pub time_rotary_qp: f64,
+    /// M-path QPs (s).
+    pub time_mpath_qp: f64,
+    /// Collision checks (s).
+    pub time_collision: f64,
+    /// Sampling and metrics (s).
+    pub time_evaluation: f64,
+    /// The whole plan (s).
+    pub time_total: f64,
+}
+impl_ros_type!(CutPlan, "kerf_msgs", msg, "CutPlan");
+
+impl CutPlan {
+    /// The plan succeeded.
+    pub const SUCCESS: u8 = 0;
+    /// The request is malformed.
+    pub const INVALID_REQUEST: u8 = 1;
+    /// The workpiece mesh is missing or unreadable.
+    pub const MESH_ERROR: u8 = 2;
+    /// A CL point is outside the machine's stroke.
+    pub const UNREACHABLE: u8 = 3;
+    /// A QP is infeasible.
+    pub const INFEASIBLE: u8 = 4;
+    /// Collisions remain, or no collision-free orientation exists.
+    pub const COLLISION: u8 = 5;
+    /// A joint limit is exceeded.
+    pub const LIMIT_VIOLATION: u8 = 6;
+    /// Solver failure, overload or another internal error.
+    pub const INTERNAL_ERROR: u8 = 7;
+
+    /// Name of a status value (`"SUCCESS"` …), or `None` for an unknown value.
+    pub fn status_name(status: u8) -> Option<&'static str> {
+        match status {
+            Self::SUCCESS => Some("SUCCESS"),
+            Self::INVALID_REQUEST => Some("INVALID_REQUEST"),
+            Self::MESH_ERROR => Some("MESH_ERROR"),
+            Self::UNREACHABLE => Some("UNREACHABLE"),
+            Self::INFEASIBLE => Some("INFEASIBLE"),
+            Self::COLLISION => Some("COLLISION"),
+            Self::LIMIT_VIOLATION => Some("LIMIT_VIOLATION"),
+            Self::INTERNAL_ERROR => Some("INTERNAL_ERROR"),
+            _ => None,
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -77,5 +287,13 @@ mod tests {
         assert_eq!(TrajectoryStatus::status_name(6), Some("CANCELED"));
         assert_eq!(TrajectoryStatus::status_name(0), None);
         assert_eq!(TrajectoryStatus::status_name(7), None);
+    }
+
+    #[test]
+    fn cut_plan_status_names() {
+        assert_eq!(CutPlan::status_name(CutPlan::SUCCESS), Some("SUCCESS"));
+        assert_eq!(CutPlan::status_name(5), Some("COLLISION"));
+        assert_eq!(CutPlan::status_name(7), Some("INTERNAL_ERROR"));
+        assert_eq!(CutPlan::status_name(8), None);
     }
 }

@@ -189,6 +189,11 @@ fn all_mirrors() -> Vec<Mirror> {
         control_msgs::FollowJointTrajectoryResult,
         control_msgs::FollowJointTrajectoryFeedback,
         msg::TrajectoryStatus,
+        msg::CutRequest,
+        msg::CutPlan,
+        msg::CutRto,
+        msg::CutMetrics,
+        msg::CutCollision,
         srv::ValidateTrajectoryRequest,
         srv::ValidateTrajectoryResponse,
     ]
@@ -400,6 +405,7 @@ fn rust_constants() -> ConstantTable {
     type Jct = control_msgs::JointComponentTolerance;
     type Fjr = control_msgs::FollowJointTrajectoryResult;
     type Ts = msg::TrajectoryStatus;
+    type Cp = msg::CutPlan;
     vec![
         (
             Jct::ROS_TYPE,
@@ -431,6 +437,19 @@ fn rust_constants() -> ConstantTable {
                 c_u8("ABORTED", Ts::ABORTED),
                 c_u8("PREEMPTED", Ts::PREEMPTED),
                 c_u8("CANCELED", Ts::CANCELED),
+            ],
+        ),
+        (
+            Cp::ROS_TYPE,
+            vec![
+                c_u8("SUCCESS", Cp::SUCCESS),
+                c_u8("INVALID_REQUEST", Cp::INVALID_REQUEST),
+                c_u8("MESH_ERROR", Cp::MESH_ERROR),
+                c_u8("UNREACHABLE", Cp::UNREACHABLE),
+                c_u8("INFEASIBLE", Cp::INFEASIBLE),
+                c_u8("COLLISION", Cp::COLLISION),
+                c_u8("LIMIT_VIOLATION", Cp::LIMIT_VIOLATION),
+                c_u8("INTERNAL_ERROR", Cp::INTERNAL_ERROR),
             ],
         ),
     ]
@@ -526,7 +545,7 @@ fn every_mirror_matches_its_interface_file() {
         "mirror drift:\n{}",
         problems.join("\n")
     );
-    assert_eq!(mirrors.len(), 24, "every mirror is checked");
+    assert_eq!(mirrors.len(), 29, "every mirror is checked");
 }
 
 #[test]
@@ -573,6 +592,11 @@ fn ros_types_name_their_files() {
     check::<control_msgs::JointTrajectoryControllerState>();
     check::<srv::ValidateTrajectoryResponse>();
     check::<msg::TrajectoryStatus>();
+    check::<msg::CutRequest>();
+    check::<msg::CutPlan>();
+    check::<msg::CutRto>();
+    check::<msg::CutMetrics>();
+    check::<msg::CutCollision>();
 }
 
 // Negative tests: the comparator must catch drift.
@@ -839,5 +863,5 @@ fn rust_parser_agrees_with_rosidl() {
             mine["file"]
         );
     }
-    assert_eq!(ours.len(), 21, "every interface file is compared");
+    assert_eq!(ours.len(), 26, "every interface file is compared");
 }
