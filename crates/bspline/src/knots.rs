@@ -1,0 +1,221 @@
+//! Clamped knot vectors on [0, 1], knot spans and basis functions.
+
+use crate::error::{check_param, BsplineError};
+
+/// A clamped (open) knot vector on the normalized parameter u in [0, 1].
+///
+/// The knots are `degree + 1` zeros, strictly increasing interior knots in
+/// (0, 1), and `degree + 1` ones, so that a spline of degree k with
+/// `n + 1 = n_coeffs` coefficients interpolates its first and last
+/// coefficients (seed 001 eq. 5; *The NURBS Book*, eq. 2.13).
+#[derive(Debug, Clone, PartialEq)]
+pub struct KnotVector {
+    degree: usize,
+    knots: Vec<f64>,
+}
+
+impl KnotVector {
+    /// Clamped uniform knot vector on [0, 1].
+    ///
+    /// `k + 1` zeros, the `n - k` uniform interior knots `j / (n - k + 1)`
+    /// for `j = 1..=n-k`, and `k + 1` ones, where `n + 1 = n_coeffs` and
+    /// `k = degree` (the "uniform method" of seed 001 section 2.1).
+    ///
+    /// # Arguments
+    /// * `degree` - the degree k (the planner uses k = 5);
+    /// * `n_coeffs` - the number of coefficients n + 1.
+    ///
+    /// # Errors
+    /// [`BsplineError::TooFewCoefficients`] when `n_coeffs < degree + 1`.
+    pub fn clamped_uniform(degree: usize, n_coeffs: usize) -> Result<Self, BsplineError> {
+        if n_coeffs < degree + 1 {
+            return Err(BsplineError::TooFewCoefficients { n_coeffs, degree });
+        }
+        let n_interior = n_coeffs - degree - 1;
+        let denom = (n_interior + 1) as f64;
+        let interior: Vec<f64> = (1..=n_interior).map(|j| j as f64 / denom).collect();
+        Ok(Self::assemble(degree, &interior))
+    }
+
+    /// Clamped knot vector with the given interior knots.
+    ///
+    /// The knot vector has `degree + 1` zeros, `interior`, and `degree + 1`
+    /// ones; the spline has `interior.len() + degree + 1` coefficients.
+    ///
+    /// # Errors
+    /// [`BsplineError::NotFinite`] for a NaN/infinite knot and
+    /// [`BsplineError::InvalidKnots`] when the interior knots are not
+    /// strictly increasing inside the open interval (0, 1).
+    pub fn clamped_with_interior(degree: usize, interior: &[f64]) -> Result<Self, BsplineError> {
+        let mut prev = 0.0;
+        for (i, &t) in interior.iter().enumerate() {
+            if !t.is_finite() {
+                return Err(BsplineError::NotFinite {
+                    what: format!("interior knot {i} = {t}"),
+                });
+            }
+            if t <= prev || t >= 1.0 {
+                return Err(BsplineError::InvalidKnots {
+                    detail: format!(
+                        "interior knot {i} = {t} must lie in (0, 1) and exceed the previous knot {prev}"
+                    ),
+                });
+            }
+            prev = t;
+        }
+        Ok(Self::assemble(degree, interior))
+    }
+
+    fn assemble(degree: usize, interior: &[f64]) -> Self {
+        let mut knots = Vec::with_capacity(interior.len() + 2 * degree + 2);
+        knots.extend(std::iter::repeat_n(0.0, degree + 1));
+        knots.extend_from_slice(interior);
+        knots.extend(std::iter::repeat_n(1.0, degree + 1));
+        Self { degree, knots }
+    }
+
+    /// The degree k.
+    pub fn degree(&self) -> usize {
+        self.degree
+    }
+
+    /// All knots u_0 .. u_{n+k+1} (length `n_coeffs + degree + 1`).
+    pub fn knots(&self) -> &[f64] {
+        &self.knots
+    }
+
+    /// The interior knots u_{k+1} .. u_n (strictly inside (0, 1)).
+    pub fn interior(&self) -> &[f64] {
+        let k = self.degree;
+        let end = self.knots.len().saturating_sub(k + 1);
+        self.knots.get(k + 1..end).unwrap_or(&[])
+    }
+
+    /// The number of coefficients n + 1 = `knots().len() - degree - 1`.
+    pub fn n_coeffs(&self) -> usize {
+        self.knots.len() - self.degree - 1
+    }
+
+    /// Knot span index i with `knots[i] <= u < knots[i + 1]`
+    /// (*The NURBS Book*, algorithm A2.1).
+    ///
+    /// `u = 1` (and anything above) maps to the last non-empty span n,
+    /// anything below 0 to the first span k. A NaN maps to span k; the basis
+    /// functions evaluated there are then NaN, so a NaN never passes
+    /// silently. Use [`KnotVector::try_span`] to reject such inputs.
+    ///
+    /// # Performance
+    /// O(log n) (binary search over the interior knots).
+    pub fn span(&self, u: f64) -> usize {
+        // For a clamped vector with strictly increasing interior knots the
+        // span is k + #(interior knots <= u).
+        self.degree + self.interior().partition_point(|&t| t <= u)
+    }
+
+    /// [`KnotVector::span`] after validating `u`.
+    ///
+    /// # Errors
+    /// [`BsplineError::NotFinite`] or [`BsplineError::ParameterOutOfRange`]
+    /// (beyond 1e-12 outside [0, 1]).
+    pub fn try_span(&self, u: f64) -> Result<usize, BsplineError> {
+        Ok(self.span(check_param(u)?))
+    }
+
+    /// The k + 1 nonzero basis functions and their derivatives at u
+    /// (*The NURBS Book*, algorithm A2.3; seed 001 eq. 5, 8-10).
+    ///
+    /// # Arguments
+    /// * `u` - the parameter; values outside [0, 1] are clamped, NaN gives
+    ///   NaN values (see [`KnotVector::try_basis_derivs`] for a checked
+    ///   version);
+    /// * `nderiv` - highest derivative order; orders above the degree are
+    ///   returned as zero rows (they vanish identically).
+    ///
+    /// # Returns
+    /// `(first, ders)` where `ders[d][r]` is the d-th derivative of
+    /// `N_{first + r, k}(u)` for `d = 0..=nderiv`, `r = 0..=k`.
+    ///
+    /// # Performance
+    /// O(k^2 + nderiv k) plus two small allocations per row.
+    pub fn basis_derivs(&self, u: f64, nderiv: usize) -> (usize, Vec<Vec<f64>>) {
+        let p = self.degree;
+        let u = if u.is_nan() { u } else { u.clamp(0.0, 1.0) };
+        let i = self.span(u);
+        let kn = &self.knots;
+        let mut ders = vec![vec![0.0; p + 1]; nderiv + 1];
+        // ndu: upper triangle = basis functions, lower triangle = knot
+        // differences (A2.3).
+        let mut ndu = vec![vec![0.0; p + 1]; p + 1];
+        let mut left = vec![0.0; p + 1];
+        let mut right = vec![0.0; p + 1];
+        ndu[0][0] = 1.0;
+        for j in 1..=p {
+            left[j] = u - kn[i + 1 - j];
+            right[j] = kn[i + j] - u;
+            let mut saved = 0.0;
+            for r in 0..j {
+                ndu[j][r] = right[r + 1] + left[j - r];
+                let temp = ndu[r][j - 1] / ndu[j][r];
+                ndu[r][j] = saved + right[r + 1] * temp;
+                saved = left[j - r] * temp;
+            }
+            ndu[j][j] = saved;
+        }
+        for j in 0..=p {
+            ders[0][j] = ndu[j][p];
+        }
+        let n = nderiv.min(p);
+        let mut a = [vec![0.0; p + 1], vec![0.0; p + 1]];
+        for r in 0..=p {
+            let (mut s1, mut s2) = (0usize, 1usize);
+            a[0][0] = 1.0;
+            for k in 1..=n {
+                let mut d = 0.0;
+                let rk = r as isize - k as isize;
+                let pk = p - k;
+                if r >= k {
+                    let rku = r - k;
+                    a[s2][0] = a[s1][0] / ndu[pk + 1][rku];
+                    d = a[s2][0] * ndu[rku][pk];
+                }
+                let j1: usize = if rk >= -1 { 1 } else { (-rk) as usize };
+                let j2: usize = if r as isize - 1 <= pk as isize {
+                    k - 1
+                } else {
+                    p - r
+                };
+                for j in j1..=j2 {
+                    let idx = (rk + j as isize) as usize;
+                    a[s2][j] = (a[s1][j] - a[s1][j - 1]) / ndu[pk + 1][idx];
+                    d += a[s2][j] * ndu[idx][pk];
+                }
+                if r <= pk {
+                    a[s2][k] = -a[s1][k - 1] / ndu[pk + 1][r];
+                    d += a[s2][k] * ndu[r][pk];
+                }
+                ders[k][r] = d;
+                std::mem::swap(&mut s1, &mut s2);
+            }
+        }
+        let mut fac = p as f64;
+        for (k, row) in ders.iter_mut().enumerate().take(n + 1).skip(1) {
+            for v in row.iter_mut() {
+                *v *= fac;
+            }
+            fac *= (p - k) as f64;
+        }
+        (i - p, ders)
+    }
+
+    /// [`KnotVector::basis_derivs`] after validating `u`.
+    ///
+    /// # Errors
+    /// [`BsplineError::NotFinite`] or [`BsplineError::ParameterOutOfRange`].
+    pub fn try_basis_derivs(
+        &self,
+        u: f64,
+        nderiv: usize,
+    ) -> Result<(usize, Vec<Vec<f64>>), BsplineError> {
+        Ok(self.basis_derivs(check_param(u)?, nderiv))
+    }
+}

@@ -1,0 +1,107 @@
+//! Scalar B-spline curves q(u) = Σ Θ_j N_{j,k}(u) (seed 001 eq. 5, 8-10).
+
+use crate::derivative::{derivative_knots, derivative_operator};
+use crate::error::{check_finite, check_param, BsplineError};
+use crate::knots::KnotVector;
+
+/// A scalar clamped B-spline `q(u) = Σ_{j=0}^{n} Θ_j N_{j,k}(u)` on
+/// u in [0, 1] (seed 001 eq. 5).
+#[derive(Debug, Clone, PartialEq)]
+pub struct BSpline {
+    kv: KnotVector,
+    coeffs: Vec<f64>,
+}
+
+impl BSpline {
+    /// A spline from its knot vector and coefficients Θ_0 .. Θ_n.
+    ///
+    /// # Errors
+    /// [`BsplineError::LengthMismatch`] when `coeffs.len() != kv.n_coeffs()`,
+    /// [`BsplineError::NotFinite`] for a NaN/infinite coefficient.
+    pub fn new(kv: KnotVector, coeffs: Vec<f64>) -> Result<Self, BsplineError> {
+        if coeffs.len() != kv.n_coeffs() {
+            return Err(BsplineError::LengthMismatch {
+                what: "B-spline coefficients".into(),
+                expected: kv.n_coeffs(),
+                got: coeffs.len(),
+            });
+        }
+        check_finite("B-spline coefficient", &coeffs)?;
+        Ok(Self { kv, coeffs })
+    }
+
+    /// The knot vector.
+    pub fn knots(&self) -> &KnotVector {
+        &self.kv
+    }
+
+    /// The coefficients Θ_0 .. Θ_n.
+    pub fn coeffs(&self) -> &[f64] {
+        &self.coeffs
+    }
+
+    /// Value and derivatives `[q, q_u, q_uu, q_uuu]` at u (seed 001 eq. 5,
+    /// 8-10); derivatives above the degree are 0.
+    ///
+    /// u outside [0, 1] is clamped; a NaN u gives NaN values (use
+    /// [`BSpline::try_eval`] to reject it).
+    ///
+    /// # Performance
+    /// O(k^2).
+    pub fn eval(&self, u: f64) -> [f64; 4] {
+        let (first, ders) = self.kv.basis_derivs(u, 3);
+        let mut out = [0.0; 4];
+        for (o, row) in out.iter_mut().zip(&ders) {
+            *o = self
+                .coeffs
+                .get(first..)
+                .unwrap_or(&[])
+                .iter()
+                .zip(row)
+                .map(|(c, n)| c * n)
+                .sum();
+        }
+        out
+    }
+
+    /// [`BSpline::eval`] after validating u.
+    ///
+    /// # Errors
+    /// [`BsplineError::NotFinite`] / [`BsplineError::ParameterOutOfRange`].
+    pub fn try_eval(&self, u: f64) -> Result<[f64; 4], BsplineError> {
+        Ok(self.eval(check_param(u)?))
+    }
+
+    /// The r-th derivative `d^r q / du^r` at u, for any r (0 above the
+    /// degree).
+    ///
+    /// # Errors
+    /// [`BsplineError::NotFinite`] / [`BsplineError::ParameterOutOfRange`].
+    pub fn eval_deriv(&self, u: f64, r: usize) -> Result<f64, BsplineError> {
+        let (first, ders) = self.kv.basis_derivs(check_param(u)?, r);
+        Ok(ders
+            .get(r)
+            .map(|row| {
+                self.coeffs
+                    .get(first..)
+                    .unwrap_or(&[])
+                    .iter()
+                    .zip(row)
+                    .map(|(c, n)| c * n)
+                    .sum()
+            })
+            .unwrap_or(0.0))
+    }
+
+    /// The r-th derivative as a spline of degree k - r, with coefficients
+    /// Θ^{r} = D_r Θ (seed 001 eq. 11-12, exact recursion, see
+    /// [`derivative_operator`]).
+    ///
+    /// # Errors
+    /// [`BsplineError::DerivativeOrderTooHigh`] when r > k.
+    pub fn derivative(&self, r: usize) -> Result<BSpline, BsplineError> {
+        let d = derivative_operator(&self.kv, r)?;
+        let kv = derivative_knots(&self.kv, r)?;
+        BSpline::new(kv, d.try_mul_vec(&self.coeffs)?)
+    }
+}
