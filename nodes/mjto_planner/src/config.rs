@@ -1,0 +1,83 @@
+//! The node's parameters, read once at start-up and checked.
+
+use std::path::PathBuf;
+
+use kerf_mjto::LaserMachine;
+use kerf_ros::Params;
+
+use crate::NodeError;
+
+/// Parameter names this node reads; others are refused at start-up.
+pub const KNOWN_PARAMS: &[&str] = &["urdf_file", "joint_limits_file", "queue_depth"];
+
+/// Default of `queue_depth`: requests waiting or being planned.
+pub const DEFAULT_QUEUE_DEPTH: usize = 10;
+
+/// Everything the node needs, checked.
+#[derive(Debug, Clone)]
+pub struct NodeConfig {
+    /// The machine the planner plans for.
+    pub machine: LaserMachine,
+    /// Where the machine came from (for the start-up log).
+    pub machine_source: String,
+    /// Requests waiting or being planned before new ones are refused (≥ 1).
+    pub queue_depth: usize,
+}
+
+fn param_err(name: &str, reason: impl Into<String>) -> NodeError {
+    NodeError::Config {
+        name: name.to_string(),
+        reason: reason.into(),
+    }
+}
+
+impl NodeConfig {
+    /// Reads and checks every parameter, and loads the machine.
+    ///
+    /// # Parameters
+    /// * `urdf_file`, `joint_limits_file` (strings, the same names as the trajectory
+    ///   executor's): the machine's URDF (joints q1..q6) and its MoveIt-style limits YAML with
+    ///   acceleration and jerk limits (seed 001 Table 2). Both unset: the shipped
+    ///   `urdf/laser_cutter.urdf` and `urdf/laser_cutter_limits.yaml`. `joint_limits_file`
+    ///   without `urdf_file` is refused.
+    /// * `queue_depth` (integer ≥ 1, default 10): requests waiting or being planned; a request
+    ///   arriving when the queue is full is answered at once with status INTERNAL_ERROR.
+    ///
+    /// # Errors
+    /// [`NodeError::Config`] naming the parameter, [`NodeError::Ros`] for a wrong type,
+    /// [`NodeError::Machine`] when the machine does not load.
+    pub fn from_params(params: &Params) -> Result<Self, NodeError> {
+        let urdf = params.string("urdf_file")?;
+        let limits = params.string("joint_limits_file")?;
+        let (machine, machine_source) =
+            match (urdf, limits) {
+                (Some(urdf), limits) => {
+                    let limits = limits.map(PathBuf::from);
+                    let m = LaserMachine::from_files(&PathBuf::from(&urdf), limits.as_deref())?;
+                    let source = match &limits {
+                        Some(l) => format!("{urdf} with {}", l.display()),
+                        None => urdf,
+                    };
+                    (m, source)
+                }
+                (None, Some(_)) => return Err(param_err(
+                    "joint_limits_file",
+                    "given without urdf_file; set both, or neither for the shipped laser cutter",
+                )),
+                (None, None) => (
+                    LaserMachine::default_machine()?,
+                    "the shipped laser_cutter.urdf".to_string(),
+                ),
+            };
+        let depth = params.i64_or("queue_depth", DEFAULT_QUEUE_DEPTH as i64)?;
+        let queue_depth = usize::try_from(depth)
+            .ok()
+            .filter(|d| *d >= 1)
+            .ok_or_else(|| param_err("queue_depth", format!("must be >= 1, got {depth}")))?;
+        Ok(Self {
+            machine,
+            machine_source,
+            queue_depth,
+        })
+    }
+}

@@ -1,0 +1,62 @@
+//! The node's parameters: the shipped machine loads by default or from files, and bad
+//! parameters are refused with the parameter's name.
+
+use kerf_mjto_planner::{config::DEFAULT_QUEUE_DEPTH, NodeConfig, NodeError, KNOWN_PARAMS};
+use kerf_ros::RosArgs;
+
+const ROOT: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../..");
+
+fn config(params: &[&str]) -> Result<NodeConfig, NodeError> {
+    let mut args = vec!["--ros-args".to_string()];
+    for p in params {
+        args.push("-p".into());
+        args.push(p.to_string());
+    }
+    let args = RosArgs::parse(args)?;
+    let params = args.params_for("/mjto_planner", "mjto_planner")?;
+    params.reject_unknown(KNOWN_PARAMS)?;
+    NodeConfig::from_params(&params)
+}
+
+#[test]
+fn shipped_machine_by_default_and_from_files() {
+    let c = config(&[]).unwrap();
+    assert_eq!(c.queue_depth, DEFAULT_QUEUE_DEPTH);
+    // seed 001 Table 2: q4 jerk 200 rad/s³, q6 stroke [-0.1, 0.02] m.
+    assert_eq!(c.machine.limits()[3].jerk, 200.0);
+    assert_eq!(c.machine.limits()[5].min, -0.1);
+
+    let urdf = format!("urdf_file:={ROOT}/urdf/laser_cutter.urdf");
+    let limits = format!("joint_limits_file:={ROOT}/urdf/laser_cutter_limits.yaml");
+    let c = config(&[&urdf, &limits, "queue_depth:=3"]).unwrap();
+    assert_eq!(c.queue_depth, 3);
+    assert_eq!(c.machine.limits()[0].acc, 12.0);
+    assert!(c.machine_source.contains("laser_cutter_limits.yaml"));
+}
+
+#[test]
+fn bad_parameters_are_refused_by_name() {
+    let e = config(&["queue_depth:=0"]).unwrap_err().to_string();
+    assert!(e.contains("'queue_depth'") && e.contains(">= 1"), "{e}");
+    let e = config(&["queue_depth:=2.5"]).unwrap_err().to_string();
+    assert!(
+        e.contains("'queue_depth'") && e.contains("expected integer"),
+        "{e}"
+    );
+    let e = config(&["control_rate:=100.0"]).unwrap_err().to_string();
+    assert!(e.contains("'control_rate'") && e.contains("unknown"), "{e}");
+    let limits = format!("joint_limits_file:={ROOT}/urdf/laser_cutter_limits.yaml");
+    let e = config(&[&limits]).unwrap_err().to_string();
+    assert!(
+        e.contains("'joint_limits_file'") && e.contains("without urdf_file"),
+        "{e}"
+    );
+    // The IRB 6660 is not the laser cutter: its joints are not q1..q6.
+    let urdf = format!("urdf_file:={ROOT}/urdf/irb6660.urdf");
+    let limits = format!("joint_limits_file:={ROOT}/urdf/irb6660_limits.yaml");
+    let e = config(&[&urdf, &limits]).unwrap_err();
+    assert!(matches!(e, NodeError::Machine(_)), "{e}");
+    assert!(e.to_string().contains("q1"), "{e}");
+    let e = config(&["urdf_file:=/nonexistent/machine.urdf"]).unwrap_err();
+    assert!(matches!(e, NodeError::Machine(_)), "{e}");
+}
