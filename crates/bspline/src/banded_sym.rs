@@ -4,6 +4,10 @@
 use crate::error::BsplineError;
 use nalgebra::DMatrix;
 
+/// Relative pivot tolerance of [`BandedSym::solve_spd`]: a Cholesky pivot
+/// below `PIVOT_TOLERANCE · A_ii` means `cond_2(A) > 1 / PIVOT_TOLERANCE`.
+pub const PIVOT_TOLERANCE: f64 = 1e-10;
+
 /// Symmetric n × n matrix with `A(i, j) = 0` for `|i - j| > bandwidth`;
 /// only the lower triangle of the band is stored.
 #[derive(Debug, Clone, PartialEq)]
@@ -164,8 +168,11 @@ impl BandedSym {
     /// Solve A x = b by banded Cholesky A = L L^T (A symmetric positive
     /// definite).
     ///
-    /// A pivot below `64 n ε max|A_ii|` (or NaN) is treated as a zero pivot:
-    /// the matrix is then numerically singular or indefinite.
+    /// The i-th pivot s_i (the diagonal of the Schur complement, equal to
+    /// `1 / (A^{-1})_ii`) satisfies `s_i / A_ii >= 1 / cond_2(A)`; a pivot
+    /// below [`PIVOT_TOLERANCE`]` · A_ii` (or NaN, or a non-positive
+    /// diagonal) therefore certifies `cond_2(A) > 1e10` and is reported as
+    /// singular: the solution would be dominated by rounding.
     ///
     /// # Errors
     /// [`BsplineError::LengthMismatch`] when `b.len() != n`,
@@ -187,8 +194,6 @@ impl BandedSym {
         crate::error::check_finite("right-hand side", b)?;
         let bw = self.bandwidth;
         let w = bw + 1;
-        let max_diag = (0..n).fold(0.0f64, |m, i| m.max(self.get(i, i).abs()));
-        let tol = 64.0 * n as f64 * f64::EPSILON * max_diag;
         // l[i * w + d] = L(i, i - d).
         let mut l = vec![0.0; n * w];
         for i in 0..n {
@@ -200,10 +205,13 @@ impl BandedSym {
                     s -= l[i * w + (i - p)] * l[j * w + (j - p)];
                 }
                 if i == j {
-                    if s.is_nan() || s <= tol {
+                    let a_ii = self.get(i, i);
+                    let tol = PIVOT_TOLERANCE * a_ii;
+                    if s.is_nan() || a_ii.is_nan() || a_ii <= 0.0 || s <= tol {
                         return Err(BsplineError::Singular {
                             detail: format!(
-                                "Cholesky pivot {i} of {n} is {s:e} (tolerance {tol:e}): the matrix is not positive definite"
+                                "Cholesky pivot {i} of {n} is {s:e} for a diagonal entry {a_ii:e}: \
+                                 the matrix is not (numerically) positive definite"
                             ),
                         });
                     }

@@ -112,7 +112,7 @@ pub fn derivative_gram(kv: &KnotVector, r: usize) -> Result<BandedSym, BsplineEr
 /// [`BsplineError::DegreeTooLow`] when k < 3.
 ///
 /// # Performance
-/// O(n k^2); about a millisecond for n + 1 = 628, k = 5 (the paper reports
+/// O(n k^2); about 2 ms for n + 1 = 628, k = 5 on a 2-core dev machine (the paper reports
 /// 9.5 s in Python) - see `benches/hessian.rs`.
 pub fn jerk_hessian(kv: &KnotVector) -> Result<BandedSym, BsplineError> {
     if kv.degree() < 3 {
