@@ -20,8 +20,10 @@ pub struct BandedSym {
 }
 
 impl BandedSym {
-    /// The zero matrix of size n with the given bandwidth.
+    /// The zero matrix of size n with the given bandwidth (capped at
+    /// n - 1, beyond which a band holds nothing more).
     pub fn zeros(n: usize, bandwidth: usize) -> Self {
+        let bandwidth = bandwidth.min(n.saturating_sub(1));
         Self {
             n,
             bandwidth,

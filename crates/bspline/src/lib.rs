@@ -9,10 +9,10 @@
 //! | item | seed 001 |
 //! |---|---|
 //! | [`KnotVector`]: clamped knots, spans, basis functions and derivatives (NURBS Book A2.1, A2.3) | eq. 5, 8-10 |
-//! | [`collocation`], [`basis_row`]: rows `N^{(r)}_{j,k}(u)` as [`BandRows`] | eq. 35, 45, 49, 59 |
+//! | [`collocation()`], [`basis_row`]: rows `N^{(r)}_{j,k}(u)` as [`BandRows`] | eq. 35, 45, 49, 59 |
 //! | [`derivative_operator`], [`derivative_knots`]: Θ ↦ Θ^{r} and the knots of the derivative curve | eq. 11-12, 21-26, 36-38 |
 //! | [`jerk_hessian`]: exact `∫ N'''_i N'''_j du`, banded ([`BandedSym`]) | eq. 17-19 |
-//! | [`fit`], [`normal_matrix`]: least-squares and interpolating fits | eq. 49-52 |
+//! | [`fit()`], [`normal_matrix`]: least-squares and interpolating fits | eq. 49-52 |
 //! | [`BSpline`]: a scalar spline, value and derivatives | eq. 5, 8-10 |
 //!
 //! [`derivative_operator`] implements the exact derivative recursion, which
