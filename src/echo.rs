@@ -4,8 +4,13 @@ use std::time::{Duration, Instant};
 
 use clap::Args;
 use kerf_msgs::{
-    control_msgs::JointTrajectoryControllerState, geometry_msgs, msg::TrajectoryStatus,
-    sensor_msgs::JointState, std_msgs, trajectory_msgs::JointTrajectory, RosType,
+    control_msgs::JointTrajectoryControllerState,
+    geometry_msgs,
+    msg::{CutPlan, CutRequest, TrajectoryStatus},
+    sensor_msgs::JointState,
+    std_msgs,
+    trajectory_msgs::JointTrajectory,
+    RosType,
 };
 use kerf_ros::{qos, KerfNode, NodeSpec, RosArgs, RosEnv, StopToken};
 use ros2_client::{qos::Durability, QosProfile};
@@ -39,6 +44,8 @@ const TYPES: &[&str] = &[
     JointState::ROS_TYPE,
     JointTrajectoryControllerState::ROS_TYPE,
     TrajectoryStatus::ROS_TYPE,
+    CutRequest::ROS_TYPE,
+    CutPlan::ROS_TYPE,
     std_msgs::StringMsg::ROS_TYPE,
     std_msgs::Header::ROS_TYPE,
     geometry_msgs::Pose::ROS_TYPE,
@@ -119,6 +126,8 @@ pub fn run(a: EchoArgs) -> Result<(), String> {
             run.echo::<JointTrajectoryControllerState>(&mut node, t)
         }
         t if t == TrajectoryStatus::ROS_TYPE => run.echo::<TrajectoryStatus>(&mut node, t),
+        t if t == CutRequest::ROS_TYPE => run.echo::<CutRequest>(&mut node, t),
+        t if t == CutPlan::ROS_TYPE => run.echo::<CutPlan>(&mut node, t),
         t if t == std_msgs::StringMsg::ROS_TYPE => run.echo::<std_msgs::StringMsg>(&mut node, t),
         t if t == std_msgs::Header::ROS_TYPE => run.echo::<std_msgs::Header>(&mut node, t),
         t if t == geometry_msgs::Pose::ROS_TYPE => run.echo::<geometry_msgs::Pose>(&mut node, t),

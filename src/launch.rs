@@ -1,4 +1,5 @@
-//! `kerf launch`: every node in one process, each with its own Context and thread.
+//! `kerf launch`: every node in one process, each with its own Context and thread: the
+//! trajectory executor, and for the laser cutter also the MJTO planner.
 
 use std::path::PathBuf;
 
@@ -46,6 +47,31 @@ fn urdf_dir(arg: Option<PathBuf>) -> PathBuf {
         .unwrap_or_else(|| PathBuf::from(concat!(env!("CARGO_MANIFEST_DIR"), "/urdf")))
 }
 
+/// Whether `name` is one of `known` (`prefix.*` admits a group), as `Params::reject_unknown`
+/// decides.
+fn knows(known: &[&str], name: &str) -> bool {
+    known.iter().any(|k| {
+        *k == name
+            || k.strip_suffix('*')
+                .is_some_and(|prefix| prefix.ends_with('.') && name.starts_with(prefix))
+    })
+}
+
+/// The arguments one node of the launch gets: every `-p` parameter, except those this node
+/// does not know but another node of the launch does (they are meant for that node). A
+/// parameter no node knows stays, so the nodes refuse it as a typo. Parameter files are
+/// passed unchanged (use node keys in them).
+fn args_for(args: &RosArgs, known: &[&str], all_known: &[&[&str]]) -> RosArgs {
+    let mut out = args.clone();
+    out.params.retain(|p| match p {
+        ParamSource::Inline(name, _) => {
+            knows(known, name) || !all_known.iter().any(|other| knows(other, name))
+        }
+        ParamSource::File(_) => true,
+    });
+    out
+}
+
 /// Runs `kerf launch` until Ctrl-C or until a node fails.
 pub fn run(a: LaunchArgs) -> Result<(), String> {
     let mut args = RosArgs::parse(a.ros_args.iter().cloned()).map_err(|e| e.to_string())?;
@@ -72,12 +98,25 @@ pub fn run(a: LaunchArgs) -> Result<(), String> {
     let stop = StopToken::new();
 
     type NodeMain = fn(&RosArgs, &RosEnv, StopToken) -> Result<(), String>;
-    let nodes: [(&str, NodeMain); 1] = [(kerf_trajectory_executor::DEFAULT_NAME, |a, e, s| {
-        kerf_trajectory_executor::run(a, e, s).map_err(|e| e.to_string())
-    })];
+    let mut nodes: Vec<(&str, &[&str], NodeMain)> = vec![(
+        kerf_trajectory_executor::DEFAULT_NAME,
+        kerf_trajectory_executor::KNOWN_PARAMS,
+        |a, e, s| kerf_trajectory_executor::run(a, e, s).map_err(|e| e.to_string()),
+    )];
+    if matches!(a.robot, Robot::LaserCutter) {
+        // The MJTO planner plans for the laser cutter only. Its ~/joint_trajectory is not
+        // connected to the executor unless the user remaps it (README).
+        nodes.push((
+            kerf_mjto_planner::DEFAULT_NAME,
+            kerf_mjto_planner::KNOWN_PARAMS,
+            |a, e, s| kerf_mjto_planner::run(a, e, s).map_err(|e| e.to_string()),
+        ));
+    }
+    let all_known: Vec<&[&str]> = nodes.iter().map(|(_, known, _)| *known).collect();
     let mut handles = Vec::new();
-    for (name, main) in nodes {
-        let (args, env, stop) = (args.clone(), env.clone(), stop.clone());
+    for (name, known, main) in nodes {
+        let args = args_for(&args, known, &all_known);
+        let (env, stop) = (env.clone(), stop.clone());
         let h = std::thread::Builder::new()
             .name(name.to_string())
             .spawn(move || {
@@ -101,5 +140,56 @@ pub fn run(a: LaunchArgs) -> Result<(), String> {
         Ok(())
     } else {
         Err(errors.join("; "))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn parameters_go_to_the_nodes_that_know_them() {
+        let args = RosArgs::parse([
+            "--ros-args",
+            "-p",
+            "control_rate:=100.0",
+            "-p",
+            "queue_depth:=3",
+            "-p",
+            "urdf_file:=/u.urdf",
+            "-p",
+            "constraints.goal_time:=1.0",
+            "-p",
+            "no_such_param:=1",
+        ])
+        .unwrap();
+        let exec = kerf_trajectory_executor::KNOWN_PARAMS;
+        let planner = kerf_mjto_planner::KNOWN_PARAMS;
+        let all = [exec, planner];
+        let names = |a: RosArgs| -> Vec<String> {
+            a.params
+                .into_iter()
+                .filter_map(|p| match p {
+                    ParamSource::Inline(n, _) => Some(n),
+                    ParamSource::File(_) => None,
+                })
+                .collect()
+        };
+        assert_eq!(
+            names(args_for(&args, exec, &all)),
+            [
+                "control_rate",
+                "urdf_file",
+                "constraints.goal_time",
+                "no_such_param"
+            ]
+        );
+        assert_eq!(
+            names(args_for(&args, planner, &all)),
+            ["queue_depth", "urdf_file", "no_such_param"]
+        );
+        assert!(knows(exec, "constraints.q1.goal"));
+        assert!(!knows(exec, "constraints"));
+        assert!(!knows(planner, "queue"));
     }
 }

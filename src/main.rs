@@ -3,9 +3,11 @@
 //! * `kerf launch` starts every kerf node that exists, each with its own Context, in one
 //!   process (today: the trajectory executor).
 //! * `kerf echo TOPIC` prints a kerf or standard topic as YAML, with no ROS install.
+//! * `kerf plan cut --request FILE` plans a laser cut offline (exit code 2 on failure).
 
 mod echo;
 mod launch;
+mod plan_cut;
 
 use std::process::ExitCode;
 
@@ -28,19 +30,22 @@ enum Command {
     Launch(launch::LaunchArgs),
     /// Print the messages of a topic as YAML.
     Echo(echo::EchoArgs),
+    /// Plan offline, without ROS (`kerf plan cut --request cut.yaml`).
+    Plan(plan_cut::PlanArgs),
 }
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
-    let result = match cli.command {
-        Command::Launch(a) => launch::run(a),
-        Command::Echo(a) => echo::run(a),
+    let (result, failure) = match cli.command {
+        Command::Launch(a) => (launch::run(a), ExitCode::FAILURE),
+        Command::Echo(a) => (echo::run(a), ExitCode::FAILURE),
+        Command::Plan(a) => (plan_cut::run(a), ExitCode::from(plan_cut::EXIT_FAILURE)),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
             eprintln!("kerf: {e}");
-            ExitCode::FAILURE
+            failure
         }
     }
 }

@@ -1,0 +1,373 @@
+//! Joint trajectory plots of `kerf plan cut --plots DIR`: for each axis q1..q6 one SVG with
+//! position, velocity, acceleration and jerk against time, MJTO against the
+//! quaternion-interpolation (QI) baseline, as in seed 001 Figures 10 (rotary axes, QI red,
+//! MJTO blue, limits dotted), 13 (q4, q5) and 15 (q1..q3).
+//!
+//! Derivatives: the MJTO velocities and accelerations are the plan's analytic ones (seed 001
+//! eq. 7); MJTO jerk and every QI derivative come from
+//! [`kerf_mjto::metrics::finite_differences`], the estimator of the plan's metrics, so the
+//! plotted peaks are the ones `CutPlan.metrics` and `CutPlan.qi_metrics` report.
+
+use std::path::{Path, PathBuf};
+
+use kerf_mjto::{
+    baseline::{quaternion_interpolation, Rto},
+    machine::{AxisLimits, JOINT_NAMES},
+    metrics::finite_differences,
+    orientation::PathFrames,
+    timelaw::TimeLaw,
+    CutPlan, CutRequest, PlanError,
+};
+use plotters::prelude::*;
+
+/// Colour of the dotted limit lines.
+const LIMIT_COLOR: RGBColor = RGBColor(0x80, 0x80, 0x80);
+
+/// A sampled joint trajectory with its derivatives, one row per sample, joints q1..q6.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Series {
+    /// Sample times (s).
+    pub times: Vec<f64>,
+    /// Positions (m or rad).
+    pub positions: Vec<[f64; 6]>,
+    /// Velocities (m/s or rad/s).
+    pub velocities: Vec<[f64; 6]>,
+    /// Accelerations (m/s² or rad/s²).
+    pub accelerations: Vec<[f64; 6]>,
+    /// Jerks (m/s³ or rad/s³).
+    pub jerks: Vec<[f64; 6]>,
+}
+
+/// The plan's samples: analytic positions, velocities and accelerations (eq. 7), jerk by
+/// finite differences of the positions.
+pub fn mjto_series(plan: &CutPlan) -> Series {
+    let (_, _, jerks) = finite_differences(&plan.times, &plan.positions);
+    Series {
+        times: plan.times.clone(),
+        positions: plan.positions.clone(),
+        velocities: plan.velocities.clone(),
+        accelerations: plan.accelerations.clone(),
+        jerks,
+    }
+}
+
+/// The QI baseline through the plan's RTOs, on the plan's time law and Δt
+/// ([`quaternion_interpolation`]), with finite-difference derivatives.
+///
+/// # Errors
+/// The request's validation errors, a time-law error, or [`PlanError::Unreachable`] when the
+/// baseline leaves a stroke.
+pub fn qi_series(
+    request: &CutRequest,
+    plan: &CutPlan,
+    limits: &[AxisLimits; 6],
+) -> Result<Series, PlanError> {
+    let v = request.validate()?;
+    let frames = PathFrames::try_new(&v.points, &v.axes, &v.u)?;
+    let law = TimeLaw::new(
+        v.sigma,
+        request.feedrate,
+        request.feed_acceleration,
+        request.feed_jerk,
+    )?;
+    let rtos: Vec<Rto> = plan
+        .rtos
+        .iter()
+        .map(|r| Rto {
+            u: r.u,
+            q4: r.q4,
+            q5: r.q5,
+            q6: r.q6,
+        })
+        .collect();
+    let (times, positions) =
+        quaternion_interpolation(&frames, &rtos, &law, v.sigma, request.sample_period, limits)?;
+    let (velocities, accelerations, jerks) = finite_differences(&times, &positions);
+    Ok(Series {
+        times,
+        positions,
+        velocities,
+        accelerations,
+        jerks,
+    })
+}
+
+/// Selects one quantity (positions, velocities, …) of a [`Series`].
+type Rows = fn(&Series) -> &Vec<[f64; 6]>;
+
+/// Units of joint `j` (0-based): linear for q1..q3 and q6, angular for q4, q5.
+fn units(j: usize) -> [&'static str; 4] {
+    if j == 3 || j == 4 {
+        ["rad", "rad/s", "rad/s²", "rad/s³"]
+    } else {
+        ["m", "m/s", "m/s²", "m/s³"]
+    }
+}
+
+/// The y range covering every finite value of the given curves, padded by 5 % (a flat curve
+/// gets ±1 % of its value, or ±1).
+fn y_range<'a>(curves: impl Iterator<Item = &'a [(f64, f64)]>) -> (f64, f64) {
+    let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
+    for c in curves {
+        for &(_, y) in c {
+            if y.is_finite() {
+                lo = lo.min(y);
+                hi = hi.max(y);
+            }
+        }
+    }
+    if !(lo.is_finite() && hi.is_finite()) {
+        return (-1.0, 1.0);
+    }
+    let span = hi - lo;
+    let pad = if span > 0.0 {
+        0.05 * span
+    } else {
+        (0.01 * lo.abs())
+            .max(1e-12)
+            .max(if lo == 0.0 { 1.0 } else { 0.0 })
+    };
+    (lo - pad, hi + pad)
+}
+
+/// `(t, value of joint j)` for every sample with a finite value.
+fn curve(times: &[f64], rows: &[[f64; 6]], j: usize) -> Vec<(f64, f64)> {
+    times
+        .iter()
+        .zip(rows)
+        .map(|(t, r)| (*t, r[j]))
+        .filter(|(t, y)| t.is_finite() && y.is_finite())
+        .collect()
+}
+
+fn draw_err<E: std::fmt::Display>(path: &Path) -> impl Fn(E) -> String + '_ {
+    move |e| format!("plot {}: {e}", path.display())
+}
+
+/// Writes `q1.svg` … `q6.svg` into `dir` (created if missing).
+///
+/// # Arguments
+/// * `mjto` – the plan's series; `qi` – the baseline's, if it could be computed.
+/// * `limits` – drawn as dotted lines where they fall inside a panel's range.
+///
+/// # Returns
+/// The files written.
+///
+/// # Errors
+/// A message naming the file that could not be created or drawn.
+pub fn write_plots(
+    dir: &Path,
+    mjto: &Series,
+    qi: Option<&Series>,
+    limits: &[AxisLimits; 6],
+) -> Result<Vec<PathBuf>, String> {
+    std::fs::create_dir_all(dir).map_err(|e| format!("cannot create {}: {e}", dir.display()))?;
+    let t_end = mjto
+        .times
+        .iter()
+        .chain(qi.map_or(&[][..], |s| &s.times[..]))
+        .copied()
+        .filter(|t| t.is_finite())
+        .fold(0.0_f64, f64::max);
+    let t_end = if t_end > 0.0 { t_end } else { 1.0 };
+    let mut written = Vec::new();
+    for (j, name) in JOINT_NAMES.iter().enumerate() {
+        let path = dir.join(format!("{name}.svg"));
+        let err = draw_err(&path);
+        let root = SVGBackend::new(&path, (1000, 1100)).into_drawing_area();
+        root.fill(&WHITE).map_err(&err)?;
+        let root = root
+            .titled(
+                &format!(
+                    "{name}: MJTO (blue) vs quaternion interpolation (red){}",
+                    if qi.is_some() {
+                        ""
+                    } else {
+                        " - QI unavailable"
+                    }
+                ),
+                ("sans-serif", 22),
+            )
+            .map_err(&err)?;
+        let l = limits[j];
+        let u = units(j);
+        let panels: [(&str, &str, Rows, [f64; 2]); 4] = [
+            ("position", u[0], |s| &s.positions, [l.min, l.max]),
+            ("velocity", u[1], |s| &s.velocities, [-l.vel, l.vel]),
+            ("acceleration", u[2], |s| &s.accelerations, [-l.acc, l.acc]),
+            ("jerk", u[3], |s| &s.jerks, [-l.jerk, l.jerk]),
+        ];
+        for (area, (what, unit, rows, bounds)) in root.split_evenly((4, 1)).iter().zip(panels) {
+            let m = curve(&mjto.times, rows(mjto), j);
+            let q = qi.map(|s| curve(&s.times, rows(s), j)).unwrap_or_default();
+            let (lo, hi) = y_range([&m[..], &q[..]].into_iter());
+            let mut chart = ChartBuilder::on(area)
+                .caption(
+                    format!("{what} ({unit}), limits {} / {}", bounds[0], bounds[1]),
+                    ("sans-serif", 16),
+                )
+                .margin(8)
+                .x_label_area_size(30)
+                .y_label_area_size(70)
+                .build_cartesian_2d(0.0..t_end, lo..hi)
+                .map_err(&err)?;
+            chart
+                .configure_mesh()
+                .x_desc("t (s)")
+                .y_desc(format!("{what} ({unit})"))
+                .draw()
+                .map_err(&err)?;
+            if !q.is_empty() {
+                chart
+                    .draw_series(LineSeries::new(q, RED.stroke_width(1)))
+                    .map_err(&err)?;
+            }
+            chart
+                .draw_series(LineSeries::new(m, BLUE.stroke_width(2)))
+                .map_err(&err)?;
+            for b in bounds.into_iter().filter(|b| (lo..=hi).contains(b)) {
+                // Dotted: short segments every 1 % of the time axis.
+                let dots = (0..100).map(|k| {
+                    let t0 = t_end * k as f64 / 100.0;
+                    PathElement::new(vec![(t0, b), (t0 + t_end / 250.0, b)], LIMIT_COLOR)
+                });
+                chart.draw_series(dots).map_err(&err)?;
+            }
+        }
+        root.present().map_err(&err)?;
+        drop(root);
+        written.push(path.clone());
+    }
+    Ok(written)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use kerf_mjto::{plan::RtoRecord, LaserMachine};
+
+    /// A straight cut along +x with the head vertical: with both RTOs at q4 = q5 = 0,
+    /// q6 = -0.05, the QI baseline is exactly M = C − q6·O (seed 001 eq. 2) with O = (0, 0, 1).
+    fn straight() -> (CutRequest, CutPlan) {
+        let yaml =
+            "request_id: line\npoints: [[0.5, 0.7, 1.0], [0.55, 0.7, 1.0], [0.6, 0.7, 1.0]]\n\
+                    axes: [[0, 0, 1], [0, 0, 1], [0, 0, 1]]\nfeedrate: 0.2\nsample_period: 0.01\n\
+                    max_lead_angle: 0.1\nmax_tilt_angle: 0.1\nmesh: unused.stl\n\
+                    workpiece_pose: {position: [0.0, 0.0, 0.2], orientation: [0, 0, 0, 1]}\n";
+        let request = CutRequest::from_yaml(yaml).unwrap();
+        let rto = |u, cl_index| RtoRecord {
+            u,
+            cl_index,
+            q4: 0.0,
+            q5: 0.0,
+            q6: -0.05,
+            inserted_at_iteration: 0,
+        };
+        let plan = CutPlan {
+            request_id: "line".into(),
+            joint_names: JOINT_NAMES.iter().map(|s| s.to_string()).collect(),
+            times: vec![0.0, 0.5, 1.0],
+            positions: vec![[0.5, 0.7, 1.25, 0.0, 0.0, -0.05]; 3],
+            velocities: vec![[0.0; 6]; 3],
+            accelerations: vec![[0.0; 6]; 3],
+            rtos: vec![rto(0.0, 0), rto(1.0, 2)],
+            metrics: Default::default(),
+            qi_metrics: Default::default(),
+            iterations: 1,
+            collision_queries: 0,
+            control_points: 3,
+            path_length: 0.1,
+            times_per_stage: Default::default(),
+        };
+        (request, plan)
+    }
+
+    #[test]
+    fn qi_baseline_of_a_straight_cut() {
+        let (request, plan) = straight();
+        let machine = LaserMachine::default_machine().unwrap();
+        let qi = qi_series(&request, &plan, machine.limits()).unwrap();
+        let law = TimeLaw::new(0.1, 0.2, 8.0, 80.0).unwrap();
+        let want = law.sample_times(0.01);
+        assert_eq!(qi.times.len(), want.len());
+        assert!(qi
+            .times
+            .iter()
+            .zip(&want)
+            .all(|(a, b)| (a - b).abs() < 1e-12));
+        assert!(qi.times.len() > 50, "{}", qi.times.len());
+        let first = qi.positions.first().unwrap();
+        let last = qi.positions.last().unwrap();
+        // The workpiece frame is 0.2 m above the machine frame; M = C + 0.05 ẑ.
+        for (q, x) in [(first, 0.5), (last, 0.6)] {
+            assert!((q[0] - x).abs() < 1e-9, "{q:?}");
+            assert!((q[1] - 0.7).abs() < 1e-9, "{q:?}");
+            assert!((q[2] - 1.25).abs() < 1e-9, "{q:?}");
+            assert!(q[3].abs() < 1e-9 && q[4].abs() < 1e-9, "{q:?}");
+            assert!((q[5] + 0.05).abs() < 1e-12, "{q:?}");
+        }
+        // Along x at the feed: the finite-difference velocity of q1 peaks at the time law's
+        // peak feed (within the estimator's error at the ramp joints, 0.1 %).
+        let peak = qi.velocities.iter().map(|v| v[0]).fold(0.0, f64::max);
+        assert!((peak / law.peak_feed() - 1.0).abs() < 1e-3, "{peak}");
+        assert!(qi.jerks.iter().all(|j| j[3] == 0.0 && j[4] == 0.0));
+    }
+
+    #[test]
+    fn plots_are_written_per_axis() {
+        let (request, plan) = straight();
+        let machine = LaserMachine::default_machine().unwrap();
+        let qi = qi_series(&request, &plan, machine.limits()).unwrap();
+        let mjto = Series {
+            times: qi.times.clone(),
+            positions: qi.positions.clone(),
+            velocities: qi.velocities.clone(),
+            accelerations: qi.accelerations.clone(),
+            jerks: qi.jerks.clone(),
+        };
+        let dir = std::env::temp_dir().join(format!("kerf_plots_{}", std::process::id()));
+        let files = write_plots(&dir, &mjto, Some(&qi), machine.limits()).unwrap();
+        assert_eq!(files.len(), 6);
+        for (f, name) in files.iter().zip(JOINT_NAMES) {
+            assert_eq!(f.file_name().unwrap(), format!("{name}.svg").as_str());
+            let svg = std::fs::read_to_string(f).unwrap();
+            assert!(svg.starts_with("<svg"), "{}", &svg[..40.min(svg.len())]);
+            // Four panels, each with an MJTO (blue) and a QI (red) polyline; no limit inside
+            // any range (see below), so no grey dots.
+            assert_eq!(svg.matches(r##"stroke="#0000FF""##).count(), 4, "{name}");
+            assert_eq!(svg.matches(r##"stroke="#FF0000""##).count(), 4, "{name}");
+            assert_eq!(svg.matches(r##"stroke="#808080""##).count(), 0, "{name}");
+            for panel in ["position", "velocity", "acceleration", "jerk"] {
+                assert!(svg.contains(panel), "{name}: {panel}");
+            }
+        }
+        // q6 is constant: its limits (-0.1, 0.02) are outside the padded range, q1's velocity
+        // limit 2 m/s is outside [0, 0.2]: no dotted limit line is drawn there.
+        let q1 = std::fs::read_to_string(&files[0]).unwrap();
+        assert!(q1.contains("limits -2 / 2"), "velocity caption");
+
+        // A q1 velocity beyond its 2 m/s limit brings the +2 line (100 dots) into range, and
+        // without QI only the MJTO curves are drawn.
+        let mut fast = mjto.clone();
+        for v in &mut fast.velocities {
+            v[0] *= 15.0;
+        }
+        let files = write_plots(&dir, &fast, None, machine.limits()).unwrap();
+        let q1 = std::fs::read_to_string(&files[0]).unwrap();
+        assert_eq!(q1.matches(r##"stroke="#808080""##).count(), 100);
+        assert_eq!(q1.matches(r##"stroke="#FF0000""##).count(), 0);
+        assert!(q1.contains("QI unavailable"));
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[test]
+    fn y_range_pads_and_survives_flat_and_empty_curves() {
+        let (lo, hi) = y_range([&[(0.0, 1.0), (1.0, 3.0)][..]].into_iter());
+        assert!((lo - 0.9).abs() < 1e-12 && (hi - 3.1).abs() < 1e-12);
+        let (lo, hi) = y_range([&[(0.0, 2.0), (1.0, 2.0)][..]].into_iter());
+        assert!((lo - 1.98).abs() < 1e-12 && (hi - 2.02).abs() < 1e-12);
+        assert_eq!(y_range([&[(0.0, 0.0)][..]].into_iter()), (-1.0, 1.0));
+        assert_eq!(y_range([&[][..]].into_iter()), (-1.0, 1.0));
+        assert_eq!(y_range([&[(0.0, f64::NAN)][..]].into_iter()), (-1.0, 1.0));
+    }
+}
