@@ -1,1 +1,292 @@
-//! (being written)
+//! The 3D geometric feasible domain (GFD) of one representative tool
+//! orientation (RTO), seed 001 section 2.4 and Figure 4.
+//!
+//! At a CL point C the GFD samples the wrist coordinates q̃ = (q4, q5, q6)
+//! around the reference configuration q̂ (the IKT, eq. 3, of the nominal
+//! tool axis with the preferred standoff). A sample is a *candidate* when
+//!
+//! 1. its tool axis O(q4, q5) (eq. 2) is within the lead and tilt limits
+//!    against the nominal axis (the constrained angles (φ, ϕ) of Figure 4),
+//! 2. q4, q5, q6 are inside their joint ranges, and
+//! 3. the translational axes q1..q3 = C − q6 · O (eq. 3) are inside their
+//!    strokes.
+//!
+//! Candidates are sorted by the weighted distance of eq. 55 to q̂. Whether
+//! a candidate is collision-free is evaluated lazily, on demand, and
+//! memoised: the RTO selection (eq. 56, [`crate::selection`]) and the RTO
+//! insertion of Figure 6 usually need a handful of them.
+
+use nalgebra::Vector3;
+
+use crate::collision::CollisionWorld;
+use crate::machine::AxisLimits;
+use crate::request::{GfdGrid, Weights};
+
+/// One angle-feasible, in-stroke sample of a GFD.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Candidate {
+    /// Wrist coordinates (q4, q5, q6) (rad, rad, m).
+    pub q: [f64; 3],
+    /// Weighted distance Δd to the reference, seed 001 eq. 55.
+    pub distance: f64,
+    /// Lead angle of the tool axis against the nominal axis (rad).
+    pub lead: f64,
+    /// Tilt angle of the tool axis against the nominal axis (rad).
+    pub tilt: f64,
+}
+
+/// The GFD of one RTO.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Gfd {
+    /// Index of the CL point of this RTO.
+    pub cl_index: usize,
+    /// Its normalized arc length u.
+    pub u: f64,
+    /// The CL point C in the machine frame (m).
+    pub point: Vector3<f64>,
+    /// The reference wrist configuration q̂ = (q4, q5, q6).
+    pub reference: [f64; 3],
+    /// Angle-feasible, in-range, in-stroke samples, sorted by
+    /// [`Candidate::distance`] (ties in grid order).
+    pub candidates: Vec<Candidate>,
+    /// Samples outside the lead/tilt limits.
+    pub angle_rejected: usize,
+    /// Samples with q4, q5 or q6 outside its joint range.
+    pub range_rejected: usize,
+    /// Samples whose q1..q3 (eq. 3) leave their stroke.
+    pub stroke_rejected: usize,
+    /// Samples of the grid (the sum of the candidates and the three
+    /// rejection counts).
+    pub total: usize,
+    /// Lazy collision status per candidate: `Some(true)` free.
+    free: Vec<Option<bool>>,
+}
+
+/// Unit tool axis O(q4, q5) of seed 001 eq. 2.
+pub fn tool_axis(q4: f64, q5: f64) -> Vector3<f64> {
+    let (s4, c4) = q4.sin_cos();
+    let (s5, c5) = q5.sin_cos();
+    Vector3::new(c4 * s5, s4 * s5, c5)
+}
+
+/// Weighted distance of seed 001 eq. 55 between two wrist
+/// configurations: `sqrt(k4 Δq4² + k5 Δq5² + k6 Δq6²)`.
+///
+/// It is also the joint-space norm of the RTO-change term of eq. 56 (see
+/// [`crate::selection`]): k4, k5 (1/rad²) and k6 (1/m²) make rad and m
+/// commensurable.
+pub fn weighted_distance(a: &[f64; 3], b: &[f64; 3], w: &Weights) -> f64 {
+    let d4 = a[0] - b[0];
+    let d5 = a[1] - b[1];
+    let d6 = a[2] - b[2];
+    (w.k4 * d4 * d4 + w.k5 * d5 * d5 + w.k6 * d6 * d6).sqrt()
+}
+
+/// `n` samples centred on `centre` spanning ± `half` (the centre exactly
+/// in the middle for odd `n`; just the centre for n ≤ 1).
+fn centred(centre: f64, half: f64, n: usize) -> Vec<f64> {
+    if n <= 1 {
+        return vec![centre];
+    }
+    let mid = (n - 1) as f64 / 2.0;
+    (0..n)
+        .map(|j| {
+            if 2 * j == n - 1 {
+                centre
+            } else {
+                centre + half * (j as f64 - mid) / mid
+            }
+        })
+        .collect()
+}
+
+/// `within(v, l)`: `l.min <= v <= l.max`, false for NaN.
+fn within(v: f64, l: &AxisLimits) -> bool {
+    l.min <= v && v <= l.max
+}
+
+impl Gfd {
+    /// Samples the GFD of one RTO.
+    ///
+    /// # Arguments
+    /// * `cl_index`, `u` - the CL point's index and normalized arc length.
+    /// * `point` - the CL point C in the machine frame (m).
+    /// * `reference` - q̂ = (q4, q5, q6), the IKT (eq. 3) of the nominal
+    ///   axis with the preferred standoff.
+    /// * `grid` - q4: `q4_steps` (odd) values over reference ± half range,
+    ///   the reference in the middle; q5 likewise; q6: `q6_steps` values
+    ///   spread evenly over the q6 stroke `[limits[5].min, limits[5].max]`
+    ///   (its midpoint for one step), plus the reference q6.
+    /// * `weights` - k4, k5, k6 of eq. 55.
+    /// * `max_lead`, `max_tilt` - limits on |lead| and |tilt| (rad).
+    /// * `lead_tilt` - (lead, tilt) of a unit tool axis against the
+    ///   nominal one at this point (e.g. the path frames' `lead_tilt_at`:
+    ///   lead = atan2(O·t, O·n), tilt = atan2(O·b, O·n)).
+    /// * `limits` - the machine's joint limits q1..q6.
+    ///
+    /// # Returns
+    /// The GFD; non-finite inputs reject every sample (so an empty GFD,
+    /// never a NaN candidate).
+    ///
+    /// # Performance
+    /// O(q4_steps · q5_steps · (q6_steps + 1)) with one `lead_tilt` call
+    /// per (q4, q5) pair; no collision query.
+    #[allow(clippy::too_many_arguments)]
+    pub fn build(
+        cl_index: usize,
+        u: f64,
+        point: &Vector3<f64>,
+        reference: [f64; 3],
+        grid: &GfdGrid,
+        weights: &Weights,
+        max_lead: f64,
+        max_tilt: f64,
+        lead_tilt: &dyn Fn(&Vector3<f64>) -> (f64, f64),
+        limits: &[AxisLimits; 6],
+    ) -> Self {
+        let [l1, l2, l3, l4, l5, l6] = limits;
+        let q4s = centred(reference[0], grid.q4_half_range, grid.q4_steps);
+        let q5s = centred(reference[1], grid.q5_half_range, grid.q5_steps);
+        let mut q6s: Vec<f64> = if grid.q6_steps <= 1 {
+            vec![(l6.min + l6.max) / 2.0]
+        } else {
+            let n = grid.q6_steps - 1;
+            (0..=n)
+                .map(|k| {
+                    // Exact end points: rounding must not push them out of
+                    // the stroke.
+                    if k == n {
+                        l6.max
+                    } else {
+                        l6.min + (l6.max - l6.min) * k as f64 / n as f64
+                    }
+                })
+                .collect()
+        };
+        if !q6s.iter().any(|&v| (v - reference[2]).abs() <= 1e-12) {
+            q6s.push(reference[2]);
+        }
+        let mut gfd = Gfd {
+            cl_index,
+            u,
+            point: *point,
+            reference,
+            candidates: Vec::new(),
+            angle_rejected: 0,
+            range_rejected: 0,
+            stroke_rejected: 0,
+            total: q4s.len() * q5s.len() * q6s.len(),
+            free: Vec::new(),
+        };
+        for &q4 in &q4s {
+            for &q5 in &q5s {
+                if !within(q4, l4) || !within(q5, l5) {
+                    gfd.range_rejected += q6s.len();
+                    continue;
+                }
+                let o = tool_axis(q4, q5);
+                let (lead, tilt) = lead_tilt(&o);
+                // Written so that NaN angles or limits reject.
+                if !(lead.abs() <= max_lead && tilt.abs() <= max_tilt) {
+                    gfd.angle_rejected += q6s.len();
+                    continue;
+                }
+                for &q6 in &q6s {
+                    if !within(q6, l6) {
+                        gfd.range_rejected += 1;
+                        continue;
+                    }
+                    // Seed 001 eq. 3: M = C - q6 O.
+                    let m = point - q6 * o;
+                    if !(within(m.x, l1) && within(m.y, l2) && within(m.z, l3)) {
+                        gfd.stroke_rejected += 1;
+                        continue;
+                    }
+                    let q = [q4, q5, q6];
+                    gfd.candidates.push(Candidate {
+                        q,
+                        distance: weighted_distance(&q, &reference, weights),
+                        lead,
+                        tilt,
+                    });
+                }
+            }
+        }
+        // Stable: equal distances keep grid order.
+        gfd.candidates
+            .sort_by(|a, b| a.distance.total_cmp(&b.distance));
+        gfd.free = vec![None; gfd.candidates.len()];
+        gfd
+    }
+
+    /// Full joint vector of candidate `p` at this CL point: q1..q3 = C −
+    /// q6 · O(q4, q5) (seed 001 eq. 3), then q4, q5, q6.
+    ///
+    /// # Panics
+    /// If `p >= self.candidates.len()` (a programming error: indices come
+    /// from this GFD).
+    pub fn joint_vector(&self, p: usize) -> [f64; 6] {
+        let [q4, q5, q6] = self.candidates[p].q;
+        let m = self.point - q6 * tool_axis(q4, q5);
+        [m.x, m.y, m.z, q4, q5, q6]
+    }
+
+    /// Whether candidate `p` is collision-free, evaluated on first use and
+    /// memoised (one [`CollisionWorld`] query at most per candidate).
+    ///
+    /// # Panics
+    /// If `p >= self.candidates.len()`.
+    pub fn is_free(&mut self, p: usize, world: &CollisionWorld) -> bool {
+        if let Some(known) = self.free[p] {
+            return known;
+        }
+        let free = world.is_free(&self.joint_vector(p));
+        self.free[p] = Some(free);
+        free
+    }
+
+    /// The collision status of candidate `p` if already evaluated
+    /// (`Some(true)` free), without querying.
+    pub fn known_status(&self, p: usize) -> Option<bool> {
+        self.free.get(p).copied().flatten()
+    }
+
+    /// The free candidate nearest to `target` = (q4, q5, q6) in the metric
+    /// of eq. 55, checking candidates lazily in order of that distance
+    /// (ties in candidate order).
+    ///
+    /// # Returns
+    /// The candidate index, or `None` when every candidate collides.
+    ///
+    /// # Performance
+    /// O(n log n) sort plus as many collision queries as colliding
+    /// candidates nearer than the answer (memoised ones are free).
+    pub fn nearest_free(
+        &mut self,
+        target: [f64; 3],
+        weights: &Weights,
+        world: &CollisionWorld,
+    ) -> Option<usize> {
+        let mut order: Vec<(f64, usize)> = self
+            .candidates
+            .iter()
+            .enumerate()
+            .map(|(p, c)| (weighted_distance(&c.q, &target, weights), p))
+            .collect();
+        order.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+        order
+            .into_iter()
+            .map(|(_, p)| p)
+            .find(|&p| self.is_free(p, world))
+    }
+
+    /// Number of candidates whose collision status has been evaluated.
+    pub fn collision_checked(&self) -> usize {
+        self.free.iter().filter(|f| f.is_some()).count()
+    }
+
+    /// Number of candidates known to collide.
+    pub fn known_colliding(&self) -> usize {
+        self.free.iter().filter(|f| **f == Some(false)).count()
+    }
+}
