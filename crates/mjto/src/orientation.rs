@@ -373,7 +373,7 @@ pub fn any_perpendicular(n: &Vector3<f64>) -> Vector3<f64> {
 /// Great-circle (spherical linear) interpolation between unit vectors
 /// `a` and `b`: `(sin((1-s)θ) a + sin(sθ) b) / sin θ` with
 /// `θ = ∠(a, b)`; the rotation of `a` about `a × b` by `sθ`. This is the
-/// quaternion interpolation of a tool axis of ref. [3] of seed 001 (Ho et
+/// quaternion interpolation of a tool axis of ref. \[3\] of seed 001 (Ho et
 /// al.): the slerp of the minimal rotation taking `a` to `b`, applied to
 /// `a`.
 ///
