@@ -21,7 +21,7 @@ use nalgebra::Vector3;
 use crate::kinematics::{inverse, tool_axis};
 use crate::machine::AxisLimits;
 use crate::orientation::{slerp_unit, PathFrames};
-use crate::timelaw::TimeLaw;
+use crate::timelaw::{TimeLaw, MAX_SAMPLES};
 use crate::PlanError;
 
 /// A representative tool orientation as the baseline uses it.
@@ -141,8 +141,8 @@ fn pose_unchecked(
 ///
 /// # Errors
 /// [`PlanError::InvalidRequest`] for bad RTOs, a σ different from the
-/// law's, or a non-positive `dt`; [`PlanError::Unreachable`] when a sample
-/// leaves a stroke.
+/// law's, a non-positive `dt` or more than [`MAX_SAMPLES`] samples;
+/// [`PlanError::Unreachable`] when a sample leaves a stroke.
 ///
 /// # Performance
 /// O(samples · log(N + RTOs)).
@@ -164,13 +164,7 @@ pub fn quaternion_interpolation(
             ),
         ));
     }
-    if !(dt.is_finite() && dt > 0.0) {
-        return Err(PlanError::invalid(
-            "sample_period",
-            format!("{dt} must be finite and > 0"),
-        ));
-    }
-    let times = law.sample_times(dt);
+    let times = law.checked_sample_times(dt, MAX_SAMPLES)?;
     let mut positions = Vec::with_capacity(times.len());
     let mut previous = rtos.first().map(|r| r.q4);
     for &t in &times {

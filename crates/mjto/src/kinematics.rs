@@ -235,6 +235,10 @@ pub fn rotary_ikt(
 
     let base = o.y.atan2(o.x);
     let target = previous_q4.unwrap_or(0.0);
+    // Branches are searched around the target clamped into the stroke: the
+    // in-stroke branch nearest to the target is one of the three around
+    // it, even for a target outside the stroke.
+    let search = target.max(limits_q4.0).min(limits_q4.1);
     let mut best: Option<(f64, f64, f64, i64)> = None; // (q4, q5, score, k)
     let mut any_q5 = false;
     let mut nearest_q4 = f64::NAN;
@@ -247,7 +251,7 @@ pub fn rotary_ikt(
         // Branches of this parity: base + parity π + 2π j; the ones around
         // the target are the only candidates for "nearest".
         let offset = base + parity as f64 * std::f64::consts::PI;
-        let j0 = ((target - offset) / std::f64::consts::TAU).round();
+        let j0 = ((search - offset) / std::f64::consts::TAU).round();
         for dj in [-1.0, 0.0, 1.0] {
             let j = j0 + dj;
             let q4_raw = offset + std::f64::consts::TAU * j;

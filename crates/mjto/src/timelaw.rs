@@ -25,6 +25,11 @@
 
 use crate::PlanError;
 
+/// Largest number of samples [`TimeLaw::checked_sample_times`] callers in
+/// this crate accept (the QI baseline): 10⁶ samples are 66 min at
+/// Δt = 4 ms, and 48 MB per joint-vector array.
+pub const MAX_SAMPLES: usize = 1_000_000;
+
 /// A rest-to-rest, jerk-limited feed profile over a path of length σ.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct TimeLaw {
@@ -227,13 +232,14 @@ impl TimeLaw {
     ///   `[0, T]`; use [`TimeLaw::checked_sample_times`] to reject it.
     ///
     /// # Performance
-    /// O(T/dt) time and memory.
+    /// O(T/dt) time and memory, unbounded: on request paths use
+    /// [`TimeLaw::checked_sample_times`] with a sample cap.
     pub fn sample_times(&self, dt: f64) -> Vec<f64> {
         let total = self.duration();
         if !(dt.is_finite() && dt > 0.0) {
             return vec![0.0, total];
         }
-        let count = (total / dt).floor();
+        let count = (total / dt).floor().min(MAX_SAMPLES as f64);
         let mut times = Vec::with_capacity(count as usize + 2);
         let mut i = 0_u64;
         loop {

@@ -240,6 +240,18 @@ fn bad_rtos_and_unreachable_samples_are_errors() {
         )),
         "sample_period"
     );
+    // A period that would need more than MAX_SAMPLES samples.
+    assert_eq!(
+        invalid(quaternion_interpolation(
+            &f,
+            &rtos(),
+            &law,
+            sigma,
+            1e-9,
+            m.limits()
+        )),
+        "sample_period"
+    );
     // q6 of the last RTO outside [−0.1, 0.02]: unreachable near the end.
     let mut r = rtos();
     r[2].q6 = 0.06;

@@ -222,6 +222,10 @@ fn continuity_picks_the_nearest_of_all_branches() {
     // Previous beyond the limit: the nearest branch inside it.
     let (q4, _) = rotary_ikt(&o, Some(0.4 + TAU), Q4_LIMITS, Q5_LIMITS).unwrap();
     assert_abs_diff_eq!(q4, 0.4 + PI, epsilon = 1e-12);
+    // A previous value far outside the stroke: still the nearest branch
+    // inside it (−0.4 + 2π), not an error.
+    let (q4, _) = rotary_ikt(&tool_axis(-0.4, 0.3), Some(100.0), Q4_LIMITS, Q5_LIMITS).unwrap();
+    assert_abs_diff_eq!(q4, TAU - 0.4, epsilon = 1e-12);
     // Only negative q5 allowed: the odd branch with the smallest |q4|.
     let (q4, q5) = rotary_ikt(&o, None, Q4_LIMITS, (-FRAC_PI_2, 0.0)).unwrap();
     assert_abs_diff_eq!(q4, 0.4 - PI, epsilon = 1e-12);
