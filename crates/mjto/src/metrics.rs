@@ -15,6 +15,9 @@ use crate::plan::Metrics;
 /// rounding, not violations.
 pub const LIMIT_REL_TOL: f64 = 1e-6;
 
+/// One joint vector q1..q6 per sample.
+pub type JointSeries = Vec<[f64; 6]>;
+
 /// Points of the finite-difference stencil.
 const STENCIL: usize = 5;
 
@@ -86,7 +89,7 @@ fn fornberg(z: f64, x: &[f64]) -> [[f64; 4]; STENCIL] {
 pub fn finite_differences(
     times: &[f64],
     positions: &[[f64; 6]],
-) -> (Vec<[f64; 6]>, Vec<[f64; 6]>, Vec<[f64; 6]>) {
+) -> (JointSeries, JointSeries, JointSeries) {
     let n = times.len().min(positions.len());
     let (times, positions) = (&times[..n], &positions[..n]);
     let width = n.min(STENCIL);
