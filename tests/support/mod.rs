@@ -61,3 +61,19 @@ pub fn client_node(name: &str, env: &RosEnv) -> KerfNode {
     )
     .expect("client node")
 }
+
+/// Runs a node's `run(args, env, stop)` on its own thread (own Context) with the ROS arguments
+/// `words` (everything after the program name, e.g. `["--ros-args", "-p", "a:=1"]`). Stop it
+/// with the returned token, then join.
+#[allow(dead_code)] // used by tests/mjto_e2e.rs; not every crate including this module needs it
+pub fn spawn_node(
+    env: &RosEnv,
+    words: Vec<String>,
+    run: impl FnOnce(&RosArgs, &RosEnv, StopToken) -> Result<(), String> + Send + 'static,
+) -> (StopToken, JoinHandle<Result<(), String>>) {
+    let args = RosArgs::parse(words).expect("node arguments");
+    let stop = StopToken::new();
+    let (e, s) = (env.clone(), stop.clone());
+    let handle = std::thread::spawn(move || run(&args, &e, s));
+    (stop, handle)
+}
