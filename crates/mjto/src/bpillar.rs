@@ -520,7 +520,8 @@ impl BPillarParams {
 }
 
 /// The C² smootherstep `6w⁵ - 15w⁴ + 10w³` of `w` clamped to [0, 1]
-/// (exactly 0 and 1 at the ends, zero first and second derivatives there).
+/// (exactly 0 and 1 at the ends, zero first and second derivatives there;
+/// the quintic fade of Perlin, "Improving Noise", SIGGRAPH 2002).
 fn smootherstep(w: f64) -> f64 {
     let w = w.clamp(0.0, 1.0);
     w * w * w * (w * (w * 6.0 - 15.0) + 10.0)
@@ -706,7 +707,8 @@ impl BPillar {
     /// when the mesh would exceed the u32 vertex indices.
     ///
     /// # Performance
-    /// O(stations × profile vertices); about 1 ms for the defaults.
+    /// O(stations × profile vertices); well under a millisecond for the
+    /// defaults.
     pub fn new(params: BPillarParams) -> Result<Self, PlanError> {
         params.validate()?;
         let spine = Spine::new(&params);
@@ -1159,6 +1161,10 @@ impl Polyline {
 
     /// `count` points at `l0 + k spacing`.
     fn sample(&self, l0: f64, spacing: f64, count: usize) -> Result<ClPath, PlanError> {
+        // Check both ends before allocating (a huge count fails here).
+        let last = l0 + spacing * count.saturating_sub(1) as f64;
+        self.at(l0)?;
+        self.at(last)?;
         let mut points = Vec::with_capacity(count);
         let mut axes = Vec::with_capacity(count);
         for k in 0..count {
@@ -1324,7 +1330,14 @@ pub fn trim_case(pillar: &BPillar, p: &TrimCaseParams) -> Result<CutRequest, Pla
             format!("{} must exceed f Δt", p.length),
         ));
     }
-    let count = (p.length / spacing).round() as usize + 1;
+    let steps = (p.length / spacing).round();
+    if steps > 1e7 {
+        return Err(PlanError::invalid(
+            "case1.length",
+            format!("{} m gives more than 1e7 CL points", p.length),
+        ));
+    }
+    let count = steps as usize + 1;
     if p.rto_count < 2 || p.rto_count > count {
         return Err(PlanError::invalid(
             "case1.rto_count",
@@ -1435,8 +1448,9 @@ struct Process {
 }
 
 /// Assembles a request: places the workpiece (rotation, then the
-/// translation that centres the nominal M points `C - q6 O`, q6 = the
-/// default reference standoff, on `m_center`, rounded to 1 mm).
+/// translation that centres the nominal M points `M = C - q6 O` (seed 001
+/// eq. 2, C = M + q6 O), q6 = the default reference standoff, on
+/// `m_center`, rounded to 1 mm).
 fn make_request(
     id: &str,
     path: ClPath,
@@ -1447,6 +1461,17 @@ fn make_request(
 ) -> Result<CutRequest, PlanError> {
     if m_center.iter().any(|v| !v.is_finite()) || !rotation.coords.iter().all(|v| v.is_finite()) {
         return Err(PlanError::invalid("workpiece placement", "not finite"));
+    }
+    for (name, a) in [
+        ("max_lead_angle", process.max_lead_angle),
+        ("max_tilt_angle", process.max_tilt_angle),
+    ] {
+        if !(a.is_finite() && a > 0.0 && a < std::f64::consts::FRAC_PI_2) {
+            return Err(PlanError::invalid(
+                name,
+                format!("{a} rad must be in (0, π/2)"),
+            ));
+        }
     }
     let q6 = CutOptions::default().reference_standoff;
     let mut lo = Vector3::repeat(f64::INFINITY);

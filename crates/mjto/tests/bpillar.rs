@@ -437,6 +437,26 @@ fn invalid_parameters_are_rejected_by_name() {
     assert!(pillar.section_path(0.125, 0.1, 0.001, 900).is_err());
     assert!(pillar.flange_trim_path(0.5, 0.6, 0.001, 100).is_err());
     assert!(pillar.flange_trim_path(0.075, 0.6, f64::NAN, 100).is_err());
+    assert!(pillar
+        .flange_trim_path(0.075, 0.6, 0.001, usize::MAX)
+        .is_err());
+    // Case parameters: NaN roll, absurd length, lead angle of 90°.
+    let t = bpillar::TrimCaseParams {
+        roll: f64::NAN,
+        ..Default::default()
+    };
+    assert!(bpillar::trim_case(&pillar, &t).is_err());
+    let t = bpillar::TrimCaseParams {
+        length: 1e9,
+        ..Default::default()
+    };
+    assert!(bpillar::trim_case(&pillar, &t).is_err());
+    let c = bpillar::CornerCaseParams {
+        max_lead_angle: std::f64::consts::FRAC_PI_2,
+        ..Default::default()
+    };
+    let e = bpillar::corner_case(&pillar, &c).unwrap_err().to_string();
+    assert!(e.contains("max_lead_angle"), "{e}");
 }
 
 /// The head of `urdf/laser_cutter.urdf` as convex polyhedra, posed by the
