@@ -1,5 +1,5 @@
 //! `kerf launch`: every node in one process, each with its own Context and thread: the
-//! trajectory executor, and for the laser cutter also the MJTO planner.
+//! trajectory executor, and with `--with-planner` (laser cutter) the MJTO planner.
 
 use std::path::PathBuf;
 
@@ -31,6 +31,10 @@ pub struct LaunchArgs {
     /// shipped descriptions; `-p` arguments after `--ros-args` override them).
     #[arg(long, value_enum, default_value = "laser-cutter")]
     robot: Robot,
+    /// Also start the MJTO laser-cutting planner (`mjto_planner`; laser cutter only). Its
+    /// `~/joint_trajectory` reaches the executor only when remapped (README).
+    #[arg(long)]
+    with_planner: bool,
     /// Directory holding the robot descriptions (default: `$KERF_URDF_DIR`, else the `urdf/`
     /// of the source tree kerf was built from).
     #[arg(long)]
@@ -103,9 +107,13 @@ pub fn run(a: LaunchArgs) -> Result<(), String> {
         kerf_trajectory_executor::KNOWN_PARAMS,
         |a, e, s| kerf_trajectory_executor::run(a, e, s).map_err(|e| e.to_string()),
     )];
-    if matches!(a.robot, Robot::LaserCutter) {
-        // The MJTO planner plans for the laser cutter only. Its ~/joint_trajectory is not
-        // connected to the executor unless the user remaps it (README).
+    if a.with_planner {
+        // The MJTO planner plans for the laser cutter only.
+        if !matches!(a.robot, Robot::LaserCutter) {
+            return Err(
+                "--with-planner: the MJTO planner plans for --robot laser-cutter only".into(),
+            );
+        }
         nodes.push((
             kerf_mjto_planner::DEFAULT_NAME,
             kerf_mjto_planner::KNOWN_PARAMS,
