@@ -22,13 +22,21 @@
 //! or validated, a planner error and a planner panic are all answered with their status,
 //! message and (when known) `request_id`. When `queue_depth` requests are waiting or being
 //! planned, a new valid request is answered at once with status INTERNAL_ERROR ("busy"), and a
-//! new invalid one at once with its own status.
+//! new invalid one at once with its own status. When the node stops, the plan in progress is
+//! finished and published and queued requests are answered INTERNAL_ERROR without planning.
 
 pub mod config;
 pub mod convert;
 pub mod text;
 
-use std::{collections::BTreeMap, sync::Mutex, time::Duration as StdDuration};
+use std::{
+    collections::BTreeMap,
+    sync::{
+        atomic::{AtomicBool, Ordering},
+        Arc, Mutex,
+    },
+    time::Duration as StdDuration,
+};
 
 use kerf_mjto::{error::status, planner::Planner, CutRequest, LaserMachine, PlanError};
 use kerf_msgs::{
@@ -107,15 +115,29 @@ pub fn run(args: &RosArgs, env: &RosEnv, stop: StopToken) -> Result<(), NodeErro
     Ok(())
 }
 
-/// Plans one job on the worker thread.
+/// Plans one job on the worker thread (jobs queued after the node began to stop are answered
+/// without planning).
 ///
 /// A panic inside [`Planner::plan`] poisons the mutex; the next job then gets a fresh planner
 /// (the panicking request itself is answered by the node from the [`WorkerError`]).
-fn work(planner: &Mutex<Planner>, machine: &LaserMachine, job: Job) -> CutPlan {
+fn work(
+    planner: &Mutex<Planner>,
+    machine: &LaserMachine,
+    stopping: &AtomicBool,
+    job: Job,
+) -> CutPlan {
     let request = match job {
         Job::Answer(m) => return *m,
         Job::Plan(r) => r,
     };
+    if stopping.load(Ordering::Relaxed) {
+        // Queued when the node stopped: skipped, so that shutdown waits for one plan at most.
+        return convert::failure_msg(
+            &request.request_id,
+            status::INTERNAL_ERROR,
+            "the planner node stopped before planning this request",
+        );
+    }
     let mut guard = match planner.lock() {
         Ok(g) => g,
         Err(poisoned) => {
@@ -149,6 +171,8 @@ struct PlannerNode {
     plan_texts: Publisher<StringMsg>,
     trajectories: Publisher<JointTrajectory>,
     worker: Worker<Job, CutPlan>,
+    /// Set when the node stops: queued plans are skipped.
+    stopping: Arc<AtomicBool>,
     /// Ticket → request id of every job submitted and not yet answered.
     pending: BTreeMap<u64, String>,
     queue_depth: usize,
@@ -172,11 +196,15 @@ impl PlannerNode {
         )?;
         let machine = cfg.machine.clone();
         let planner = Mutex::new(Planner::new(cfg.machine.clone())?);
-        let worker = Worker::spawn("plan", 1, move |job: Job| work(&planner, &machine, job))
-            .map_err(|e| RosError::Dds {
-                what: "planner thread".into(),
-                reason: e.to_string(),
-            })?;
+        let stopping = Arc::new(AtomicBool::new(false));
+        let stopping_w = Arc::clone(&stopping);
+        let worker = Worker::spawn("plan", 1, move |job: Job| {
+            work(&planner, &machine, &stopping_w, job)
+        })
+        .map_err(|e| RosError::Dds {
+            what: "planner thread".into(),
+            reason: e.to_string(),
+        })?;
         let log = node.logger();
         log.info(&format!(
             "serving cut requests on {} and {}; plans on {}, trajectories on {}; machine: {}; \
@@ -195,6 +223,7 @@ impl PlannerNode {
             plan_texts,
             trajectories,
             worker,
+            stopping,
             pending: BTreeMap::new(),
             queue_depth: cfg.queue_depth,
             log,
@@ -211,14 +240,22 @@ impl PlannerNode {
                 std::thread::sleep(POLL);
             }
         }
+        // Queued requests are answered "stopped" without planning; the plan in progress (if
+        // any) is awaited and published, so no request is left without an answer.
+        self.stopping.store(true, Ordering::Relaxed);
         if !self.pending.is_empty() {
             self.log.warn(&format!(
-                "shutting down with {} request(s) unanswered",
+                "shutting down: answering {} queued request(s); waiting for the plan in progress",
                 self.pending.len()
             ));
-        } else {
-            self.log.info("shutting down");
         }
+        while !self.pending.is_empty() {
+            match self.worker.recv_timeout(StdDuration::from_secs(1)) {
+                Some(done) => self.answer(done),
+                None => continue,
+            }
+        }
+        self.log.info("shutting down");
     }
 
     /// Reads `~/cut_request`; `true` if anything was read.
@@ -301,20 +338,25 @@ impl PlannerNode {
     /// Publishes finished answers; `true` if any.
     fn poll_results(&mut self) -> bool {
         let mut any = false;
-        while let Some((ticket, result)) = self.worker.try_recv() {
+        while let Some(done) = self.worker.try_recv() {
             any = true;
-            let id = self.pending.remove(&ticket).unwrap_or_default();
-            let answer = match result {
-                Ok(plan) => plan,
-                Err(WorkerError::Panicked { message, .. }) => convert::failure_msg(
-                    &id,
-                    status::INTERNAL_ERROR,
-                    format!("the planner failed unexpectedly (panic: {message})"),
-                ),
-            };
-            self.publish(answer);
+            self.answer(done);
         }
         any
+    }
+
+    /// Publishes the answer of one finished job (a panic becomes INTERNAL_ERROR).
+    fn answer(&mut self, (ticket, result): (u64, Result<CutPlan, WorkerError>)) {
+        let id = self.pending.remove(&ticket).unwrap_or_default();
+        let answer = match result {
+            Ok(plan) => plan,
+            Err(WorkerError::Panicked { message, .. }) => convert::failure_msg(
+                &id,
+                status::INTERNAL_ERROR,
+                format!("the planner failed unexpectedly (panic: {message})"),
+            ),
+        };
+        self.publish(answer);
     }
 
     /// Publishes one answer on `~/cut_plan`, `~/cut_plan_text` and, on success,
