@@ -157,7 +157,11 @@ fn work(
         }
     };
     match guard.plan(&request) {
-        Ok(plan) => convert::plan_to_msg(&plan),
+        Ok(plan) => {
+            let mut m = convert::plan_to_msg(&plan);
+            m.request_id.clone_from(&request.request_id);
+            m
+        }
         Err(e) => convert::error_to_msg(&request.request_id, &e),
     }
 }
@@ -390,5 +394,71 @@ impl PlannerNode {
             self.log
                 .error(&format!("request '{id}': plan text not published: {e}"));
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn one_point_request() -> Box<CutRequest> {
+        Box::new(
+            text::parse_request(
+                "request_id: w1\nfeedrate: 0.3\nsample_period: 0.01\nmax_lead_angle: 0.1\n\
+                 max_tilt_angle: 0.1\nmesh: m.stl\n0.6 0.2 0.1 0 0 1\n",
+            )
+            .unwrap(),
+        )
+    }
+
+    #[test]
+    fn work_recovers_a_poisoned_planner_and_skips_when_stopping() {
+        let machine = LaserMachine::default_machine().unwrap();
+        let planner = Arc::new(Mutex::new(Planner::new(machine.clone()).unwrap()));
+        let p = Arc::clone(&planner);
+        // A panic while planning poisons the mutex.
+        let _ = std::thread::spawn(move || {
+            let _guard = p.lock().unwrap();
+            panic!("planner bug");
+        })
+        .join();
+        assert!(planner.is_poisoned());
+        let stopping = AtomicBool::new(false);
+        let m = work(
+            &planner,
+            &machine,
+            &stopping,
+            Job::Plan(one_point_request()),
+        );
+        // A fresh planner answered (validation: one point), and the mutex is usable again.
+        assert_eq!(m.status, status::INVALID_REQUEST, "{}", m.message);
+        assert_eq!(m.request_id, "w1");
+        assert!(m.message.contains("at least 2"), "{}", m.message);
+        assert!(!planner.is_poisoned());
+
+        // Already-answered jobs pass through unchanged.
+        let failed = convert::failure_msg("w2", status::MESH_ERROR, "gone");
+        let m = work(
+            &planner,
+            &machine,
+            &stopping,
+            Job::Answer(Box::new(failed.clone())),
+        );
+        assert_eq!(m, failed);
+
+        stopping.store(true, Ordering::Relaxed);
+        let m = work(
+            &planner,
+            &machine,
+            &stopping,
+            Job::Plan(one_point_request()),
+        );
+        assert_eq!(m.status, status::INTERNAL_ERROR);
+        assert!(
+            m.message.contains("stopped before planning"),
+            "{}",
+            m.message
+        );
+        assert_eq!(m.request_id, "w1");
     }
 }
