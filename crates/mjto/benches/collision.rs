@@ -18,6 +18,7 @@ use kerf_mjto::collision::{CollisionWorld, HeadModel};
 use kerf_mjto::gfd::Gfd;
 use kerf_mjto::mesh::{self, MeshData};
 use kerf_mjto::request::{GfdGrid, Weights};
+use kerf_mjto::selection::{select_rtos, select_rtos_eager};
 use kerf_mjto::LaserMachine;
 use nalgebra::{Isometry3, Vector3};
 
@@ -196,10 +197,66 @@ fn bench_gfd(c: &mut Criterion, m: &MeshData) {
     g.finish();
 }
 
+/// Eq. 56 over 6 RTOs along the top of the hat, 1 cm from its edge, with a
+/// colliding reference standoff (q6 = -0.05: the fork arms reach the
+/// sheet), so the lazy selection needs several rounds.
+fn bench_selection(c: &mut Criterion, m: &MeshData) {
+    let machine = LaserMachine::default_machine().expect("machine");
+    let pose = placement(m);
+    let w = world(m, &pose);
+    let lead_tilt = |o: &Vector3<f64>| (o.x.atan2(o.z), o.y.atan2(o.z));
+    let xs = [0.1, 0.25, 0.4, 0.55, 0.7, 0.85];
+    let gfds: Vec<Gfd> = xs
+        .iter()
+        .enumerate()
+        .map(|(i, &x)| {
+            let p = (pose * nalgebra::Point3::new(x, 0.05, 0.09)).coords;
+            Gfd::build(
+                i,
+                x,
+                &p,
+                [0.0, 0.0, -0.05],
+                &GfdGrid::default(),
+                &Weights::default(),
+                15f64.to_radians(),
+                10f64.to_radians(),
+                &lead_tilt,
+                machine.limits(),
+            )
+        })
+        .collect();
+    let sigma: Vec<f64> = xs.windows(2).map(|p| p[1] - p[0]).collect();
+    let weights = Weights::default();
+    let before = w.queries();
+    let mut once = gfds.clone();
+    let choice = select_rtos(&mut once, &sigma, &weights, &w).expect("selection");
+    eprintln!(
+        "selection: {} layers of {} candidates, {} queries, choice {choice:?}",
+        gfds.len(),
+        gfds[0].candidates.len(),
+        w.queries() - before
+    );
+    let mut g = c.benchmark_group("selection/hat_section");
+    g.bench_function("lazy (6 RTOs, default grid)", |b| {
+        b.iter(|| {
+            let mut l = gfds.clone();
+            select_rtos(&mut l, &sigma, &weights, &w).expect("selection")
+        })
+    });
+    g.bench_function("eager (6 RTOs, default grid)", |b| {
+        b.iter(|| {
+            let mut l = gfds.clone();
+            select_rtos_eager(&mut l, &sigma, &weights, &w).expect("selection")
+        })
+    });
+    g.finish();
+}
+
 fn benches(c: &mut Criterion) {
     let hat = hat_section();
     bench_queries(c, "hat_section", &hat);
     bench_gfd(c, &hat);
+    bench_selection(c, &hat);
     let bpillar = mesh::package_root().join("urdf/meshes/bpillar.obj");
     if bpillar.is_file() {
         match mesh::load(&bpillar.to_string_lossy()) {
