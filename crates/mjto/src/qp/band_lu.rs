@@ -86,16 +86,20 @@ impl BandLu {
 
     fn factor_in_place(&mut self, pivot_tol: f64) -> Result<(), BandLuError> {
         let (n, kl, ku) = (self.n, self.kl, self.ku);
+        let ldab = 2 * kl + ku + 1;
+        let mut l = vec![0.0; kl];
         for j in 0..n {
-            // Pivot search in column j, rows j ..= min(n − 1, j + kl).
+            // Pivot search in column j, rows j ..= min(n − 1, j + kl); the
+            // column is contiguous in the band storage.
             let last = (j + kl).min(n - 1);
+            let len = last - j;
+            let diag = self.idx(j, j);
             let mut p = j;
-            let mut best = self.ab[self.idx(j, j)].abs();
-            for i in j + 1..=last {
-                let v = self.ab[self.idx(i, j)].abs();
-                if v > best {
-                    best = v;
-                    p = i;
+            let mut best = self.ab[diag].abs();
+            for (t, v) in self.ab[diag + 1..=diag + len].iter().enumerate() {
+                if v.abs() > best {
+                    best = v.abs();
+                    p = j + 1 + t;
                 }
             }
             if best.is_nan() || best <= pivot_tol {
@@ -110,16 +114,19 @@ impl BandLu {
                     self.ab.swap(a, b);
                 }
             }
-            let pivot = self.ab[self.idx(j, j)];
-            for i in j + 1..=last {
-                let lij = self.ab[self.idx(i, j)] / pivot;
-                let li = self.idx(i, j);
-                self.ab[li] = lij;
-                if lij != 0.0 {
-                    for c in j + 1..=ucol {
-                        let ujc = self.ab[self.idx(j, c)];
-                        let ic = self.idx(i, c);
-                        self.ab[ic] -= lij * ujc;
+            let pivot = self.ab[diag];
+            for (lt, a) in l.iter_mut().zip(&mut self.ab[diag + 1..=diag + len]) {
+                *a /= pivot;
+                *lt = *a;
+            }
+            // Rank-one update of the trailing columns, one contiguous
+            // column segment (rows j + 1 ..= last) at a time.
+            for c in j + 1..=ucol {
+                let u = self.ab[self.idx(j, c)];
+                if u != 0.0 {
+                    let start = kl + ku + j + 1 - c + c * ldab;
+                    for (a, lt) in self.ab[start..start + len].iter_mut().zip(&l) {
+                        *a -= lt * u;
                     }
                 }
             }

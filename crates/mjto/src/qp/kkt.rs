@@ -213,7 +213,7 @@ pub(crate) fn solve_eq_qp(qp: &EqQp) -> Result<EqQpSolution, KktError> {
         .max()
         .unwrap_or(0);
     let scale = pmax.max(cmax).max(delta);
-    let lu = BandLu::factor(dim, bw, bw, entries, 1e-14 * scale).map_err(|e| match e {
+    let lu = BandLu::factor(dim, bw, bw, entries, 1e-300 * scale).map_err(|e| match e {
         BandLuError::Singular { column } => {
             KktError::Singular(format!("zero pivot at KKT position {column} of {dim}"))
         }

@@ -18,6 +18,7 @@ mod band_lu;
 mod constraints;
 mod diagnose;
 mod kkt;
+mod lifting;
 pub mod rotary;
 mod solve;
 

@@ -49,14 +49,13 @@
 //! The reported cost is evaluated as `(D₃Θ)ᵀ G (D₃Θ)` rather than `ΘᵀHΘ`:
 //! the same number, without the cancellation of summing terms of 10¹⁷.
 
-use kerf_bspline::{
-    basis_row, derivative_gram, derivative_knots, derivative_operator, BandRow, BandRows,
-    BandedSym, BsplineError, KnotVector,
-};
+use kerf_bspline::KnotVector;
+use kerf_bspline::{basis_row, derivative_operator, BandRow, BandRows, BandedSym, BsplineError};
 
 use super::active_set::{polish, LinRow, PolishQp, Side};
 use super::constraints::{Bound, ConstraintSet};
 use super::diagnose::{culprit, max_feasible_feedrate};
+use super::lifting::JerkChain;
 use super::solve::{solve, Objective, Verdict};
 use crate::error::ConstraintFamily;
 use crate::machine::AxisLimits;
@@ -77,6 +76,9 @@ pub const ROTARY_DIAGNOSIS_ORDER: [ConstraintFamily; 6] = [
 /// A bound counts as active in the interior-point answer when its slack is
 /// below this fraction of the bound.
 const ACTIVE_REL: f64 = 1e-5;
+
+/// Most rounds of lazily added bounds before all are added at once.
+const MAX_LAZY_ROUNDS: usize = 8;
 
 /// The minimum-jerk QP of one rotary axis (seed 001 eq. 61).
 #[derive(Debug, Clone, Copy)]
@@ -141,18 +143,22 @@ pub struct RotarySolution {
 pub fn solve_rotary(p: &RotaryProblem) -> Result<RotarySolution, PlanError> {
     let model = RotaryModel::new(p)?;
     let ineq = model.direct_bounds(p.feedrate);
-    // Step 1: the equality-only optimum, if it satisfies every bound.
-    if let Ok(theta) = model.polish(&ineq, Vec::new(), false) {
-        return Ok(model.solution(theta, 0));
+    // Step 1: the equality-only optimum, optimal if it satisfies every bound.
+    let reference = model.equality_optimum().ok();
+    if let Some(theta) = &reference {
+        if ineq.iter().all(|b| b.row.violated(theta).is_none()) {
+            return Ok(model.solution(theta.clone(), 0));
+        }
     }
-    // Step 2: interior point on the lifted form.
-    let lifted = model.lifted_constraints(p.feedrate)?;
-    match solve(p.axis_name, &model.lifted_objective, &lifted, &|_| true)? {
+    let reference = reference.unwrap_or_else(|| vec![0.0; model.n1]);
+    // Step 2: interior point on the lifted form, with lazily added bounds.
+    let (verdict, included) = model.lazy_solve(p.feedrate, &[], &reference)?;
+    match verdict {
         Verdict::Optimal { x, iterations } => {
             // Step 3: polish from the active bounds of the interior point.
-            let active = model.active_set(&x, &ineq);
+            let active = model.active_set(&x, &ineq, &included);
             let theta = model
-                .polish(&ineq, active, true)
+                .polish(&ineq, active)
                 .map_err(|detail| PlanError::Solver {
                     problem: p.axis_name.to_string(),
                     detail: format!(
@@ -161,7 +167,7 @@ pub fn solve_rotary(p: &RotaryProblem) -> Result<RotarySolution, PlanError> {
                 })?;
             Ok(model.solution(theta, iterations))
         }
-        Verdict::Infeasible { status } => Err(model.diagnose(&lifted, &format!("{status:?}"))?),
+        Verdict::Infeasible { status } => Err(model.diagnose(&reference, &format!("{status:?}"))?),
         Verdict::Failed { detail } => Err(PlanError::Solver {
             problem: p.axis_name.to_string(),
             detail,
@@ -169,11 +175,27 @@ pub fn solve_rotary(p: &RotaryProblem) -> Result<RotarySolution, PlanError> {
     }
 }
 
-/// A direct-form bound of eq. 15 with its family and lifted variable.
+/// A bound of eq. 15 in the direct form (a row on Θ), with its family and
+/// the lifted variable it bounds.
 struct DirectBound {
+    family: ConstraintFamily,
     row: LinRow,
     /// Column of the matching variable in the lifted vector.
     lifted_col: usize,
+}
+
+impl DirectBound {
+    /// Whether `v` lies in the outer `1 − θ` fraction of the half-width of
+    /// the bound interval (or outside it): `|v − mid| ≥ θ · half`. A
+    /// one-sided bound is always "near".
+    fn near(&self, v: f64, theta: f64) -> bool {
+        let (lo, hi) = (self.row.lo, self.row.hi);
+        if !(lo.is_finite() && hi.is_finite()) {
+            return true;
+        }
+        let (mid, half) = (0.5 * (lo + hi), 0.5 * (hi - lo));
+        v.is_nan() || (v - mid).abs() >= theta * half
+    }
 }
 
 /// A validated rotary problem with its feedrate-independent parts.
@@ -183,10 +205,8 @@ struct RotaryModel<'p, 'a> {
     n1: usize,
     /// D₁, D₂, D₃ (eq. 12, 21-23).
     derivative_ops: [BandRows; 3],
-    /// E₁, E₂, E₃: one level of eq. 12 each (`D_r = E_r ⋯ E₁`).
-    steps: [BandRows; 3],
-    /// Gram matrix of the jerk basis (`H = D₃ᵀ G D₃`).
-    gram: BandedSym,
+    /// The lifting `Θ → y₁ → y₂ → y₃` and the jerk Gram matrix.
+    chain: JerkChain,
     /// Column offsets of y₁, y₂, y₃ in the lifted vector.
     offsets: [usize; 3],
     /// Lifted objective `y₃ᵀ G y₃` (Clarabel form, P = 2G).
@@ -215,20 +235,12 @@ impl<'p, 'a> RotaryModel<'p, 'a> {
         let n1 = kv.n_coeffs();
         let op = |r| derivative_operator(kv, r).map_err(bs("knots"));
         let derivative_ops = [op(1)?, op(2)?, op(3)?];
-        let dk = |r| derivative_knots(kv, r).map_err(bs("knots"));
-        let knots_r = [dk(1)?, dk(2)?, dk(3)?];
-        let step = |below: &KnotVector| derivative_operator(below, 1).map_err(bs("knots"));
-        let steps = [step(kv)?, step(&knots_r[0])?, step(&knots_r[1])?];
-        let gram = derivative_gram(&knots_r[2], 0).map_err(bs("knots"))?;
-        let offsets = [n1, 2 * n1 - 1, 3 * n1 - 3];
-        let nvars = 4 * n1 - 6;
+        let chain = JerkChain::new(kv).map_err(bs("knots"))?;
+        let offsets = chain.y_offsets(n1);
+        let nvars = n1 + chain.n_aux();
         let lifted_objective = Objective {
             n: nvars,
-            p_upper: gram
-                .upper_triplets()
-                .into_iter()
-                .map(|(i, j, v)| (offsets[2] + i, offsets[2] + j, 2.0 * v))
-                .collect(),
+            p_upper: chain.objective_upper(n1, 1.0),
             q: vec![0.0; nvars],
         };
         let h_scale = p.hessian.max_abs();
@@ -255,7 +267,10 @@ impl<'p, 'a> RotaryModel<'p, 'a> {
             let b = kinematic_bound(&p.limits, p.sigma, d, p.feedrate);
             let scale = if b.is_finite() { b } else { 1.0 };
             equalities.push((ConstraintFamily::Boundary, lin_eq(&row, 0, v, scale)));
-            lifted_boundary.push(basis_row(&knots_r[d - 1], u, 0).map_err(bs("boundary"))?);
+            let kd = chain.derivative_knots(d).ok_or_else(|| {
+                PlanError::invalid(format!("{name} boundary"), "no derivative knots")
+            })?;
+            lifted_boundary.push(basis_row(kd, u, 0).map_err(bs("boundary"))?);
         }
         let l = &p.limits;
         let range = l.min.abs().max(l.max.abs());
@@ -279,8 +294,7 @@ impl<'p, 'a> RotaryModel<'p, 'a> {
             p,
             n1,
             derivative_ops,
-            steps,
-            gram,
+            chain,
             offsets,
             lifted_objective,
             equalities,
@@ -304,6 +318,7 @@ impl<'p, 'a> RotaryModel<'p, 'a> {
         if l.min.is_finite() || l.max.is_finite() {
             for j in 0..self.n1 {
                 out.push(DirectBound {
+                    family: ConstraintFamily::Position,
                     row: LinRow {
                         entries: vec![(j, 1.0)],
                         lo: l.min,
@@ -314,7 +329,12 @@ impl<'p, 'a> RotaryModel<'p, 'a> {
                 });
             }
         }
-        for (r, op) in self.derivative_ops.iter().enumerate() {
+        let families = [
+            ConstraintFamily::Velocity,
+            ConstraintFamily::Acceleration,
+            ConstraintFamily::Jerk,
+        ];
+        for (r, (op, family)) in self.derivative_ops.iter().zip(families).enumerate() {
             let b = self.kinematic_bound(r + 1, f);
             if !b.is_finite() {
                 continue;
@@ -324,6 +344,7 @@ impl<'p, 'a> RotaryModel<'p, 'a> {
                 lr.lo = -b;
                 lr.hi = b;
                 out.push(DirectBound {
+                    family,
                     row: lr,
                     lifted_col: self.offsets[r] + j,
                 });
@@ -332,50 +353,26 @@ impl<'p, 'a> RotaryModel<'p, 'a> {
         out
     }
 
-    /// Every constraint of eq. 61 on the lifted variables at feedrate `f`,
-    /// with the structural rows `E_r y_{r−1} − y_r = 0` (family `None`).
-    fn lifted_constraints(&self, f: f64) -> Result<ConstraintSet, PlanError> {
+    /// The constraints of eq. 61 on the lifted variables at feedrate `f`,
+    /// with the structural rows `E_r y_{r−1} − y_r = 0` (family `None`):
+    /// every equality, and the bounds `ineq[i]` with `include[i]`.
+    fn lifted_constraints(
+        &self,
+        f: f64,
+        ineq: &[DirectBound],
+        include: &[bool],
+    ) -> Result<ConstraintSet, PlanError> {
         let p = self.p;
         let mut set = ConstraintSet::new(self.lifted_objective.n);
         let bounds = [1, 2, 3].map(|r| self.kinematic_bound(r, f));
-        for (r, step) in self.steps.iter().enumerate() {
-            let from = if r == 0 { 0 } else { self.offsets[r - 1] };
-            let to = self.offsets[r];
-            let scale = if bounds[r].is_finite() {
-                bounds[r]
-            } else {
-                1.0
+        let scales = bounds.map(|b| if b.is_finite() { b } else { 1.0 });
+        self.chain.push_structural(&mut set, 0, self.n1, scales)?;
+        for (b, _) in ineq.iter().zip(include).filter(|(_, &inc)| inc) {
+            let bound = Bound::Range {
+                lo: b.row.lo,
+                hi: b.row.hi,
             };
-            for (j, row) in step.rows.iter().enumerate() {
-                let mut entries = lin_eq(row, from, 0.0, 0.0).entries;
-                entries.push((to + j, -1.0));
-                set.push(None, entries, Bound::Eq(0.0), scale)?;
-            }
-        }
-        let l = &p.limits;
-        if l.min.is_finite() || l.max.is_finite() {
-            for j in 0..self.n1 {
-                let bound = Bound::Range {
-                    lo: l.min,
-                    hi: l.max,
-                };
-                set.push(Some(ConstraintFamily::Position), vec![(j, 1.0)], bound, 0.0)?;
-            }
-        }
-        let families = [
-            ConstraintFamily::Velocity,
-            ConstraintFamily::Acceleration,
-            ConstraintFamily::Jerk,
-        ];
-        for (r, family) in families.into_iter().enumerate() {
-            let b = bounds[r];
-            if !b.is_finite() {
-                continue;
-            }
-            for j in 0..self.n1 - (r + 1) {
-                let bound = Bound::Range { lo: -b, hi: b };
-                set.push(Some(family), vec![(self.offsets[r] + j, 1.0)], bound, 0.0)?;
-            }
+            set.push(Some(b.family), vec![(b.lifted_col, 1.0)], bound, 0.0)?;
         }
         for (i, (row, &v)) in self.lifted_boundary.iter().zip(&p.boundary).enumerate() {
             let r = if i < 2 { 0 } else { 1 };
@@ -396,12 +393,14 @@ impl<'p, 'a> RotaryModel<'p, 'a> {
         Ok(set)
     }
 
-    /// The bounds active (slack below [`ACTIVE_REL`]) in a lifted
+    /// The included bounds active (slack below [`ACTIVE_REL`]) in a lifted
     /// interior-point solution.
-    fn active_set(&self, x: &[f64], ineq: &[DirectBound]) -> Vec<(usize, Side)> {
+    fn active_set(&self, x: &[f64], ineq: &[DirectBound], include: &[bool]) -> Vec<(usize, Side)> {
         ineq.iter()
+            .zip(include)
             .enumerate()
-            .filter_map(|(i, b)| {
+            .filter(|(_, (_, &inc))| inc)
+            .filter_map(|(i, (b, _))| {
                 let v = x.get(b.lifted_col).copied()?;
                 let near = |bound: f64| (v - bound).abs() <= ACTIVE_REL * bound.abs().max(1e-9);
                 if b.row.hi.is_finite() && near(b.row.hi) {
@@ -418,52 +417,115 @@ impl<'p, 'a> RotaryModel<'p, 'a> {
     /// `x ↦ 2 D₃ᵀ G D₃ x / max|H|`: the polish Hessian product without the
     /// cancellation of the assembled H.
     fn apply_h(&self, x: &[f64]) -> Vec<f64> {
-        let d3 = &self.derivative_ops[2];
-        let g = self.gram.mul_vec(&d3.mul_vec(x));
-        d3.tr_mul_vec(&g)
+        self.chain
+            .apply_h(x)
             .into_iter()
             .map(|v| 2.0 * v / self.h_scale)
             .collect()
     }
 
-    /// The optimum of eq. 61 from an active-set guess (see
-    /// `qp::active_set`). With `iterate == false` the guess is final: the
-    /// call fails unless its equality-constrained optimum satisfies every
-    /// bound.
-    fn polish(
-        &self,
-        ineq: &[DirectBound],
-        active: Vec<(usize, Side)>,
-        iterate: bool,
-    ) -> Result<Vec<f64>, String> {
+    /// The polish problem: objective `Θᵀ(2H/max|H|)Θ/2` with the accurate
+    /// product, and the equality rows.
+    fn polish_parts(&self) -> (Vec<f64>, Vec<LinRow>) {
+        let eq = self.equalities.iter().map(|(_, r)| r.clone()).collect();
+        (vec![0.0; self.n1], eq)
+    }
+
+    /// The optimum of eq. 19 under the equalities of eq. 45 and 58 alone.
+    fn equality_optimum(&self) -> Result<Vec<f64>, String> {
+        let (q, eq) = self.polish_parts();
         let apply = |x: &[f64]| self.apply_h(x);
         let qp = PolishQp {
             n: self.n1,
             p_upper: &self.polish_p,
             apply_p: Some(&apply),
-            q: &vec![0.0; self.n1],
+            q: &q,
             keys: &self.keys,
         };
-        let eq: Vec<LinRow> = self.equalities.iter().map(|(_, r)| r.clone()).collect();
+        polish(&qp, &eq, &[], Vec::new())
+    }
+
+    /// The optimum of eq. 61 from an active-set guess (see
+    /// `qp::active_set`).
+    fn polish(&self, ineq: &[DirectBound], active: Vec<(usize, Side)>) -> Result<Vec<f64>, String> {
+        let (q, eq) = self.polish_parts();
+        let apply = |x: &[f64]| self.apply_h(x);
+        let qp = PolishQp {
+            n: self.n1,
+            p_upper: &self.polish_p,
+            apply_p: Some(&apply),
+            q: &q,
+            keys: &self.keys,
+        };
         let rows: Vec<LinRow> = ineq.iter().map(|b| b.row.clone()).collect();
-        if iterate {
-            polish(&qp, &eq, &rows, active)
-        } else {
-            let x = polish_once(&qp, &eq, &rows)?;
-            Ok(x)
+        polish(&qp, &eq, &rows, active)
+    }
+
+    /// Clarabel on the lifted form at feedrate `f` without the families
+    /// `dropped`, adding bounds lazily: first those whose value at
+    /// `reference` (coefficients Θ) is in the outer half of their interval,
+    /// then, round after round, every bound the answer violates or comes
+    /// within 10 % of. Far-away bounds never enter, which keeps the problem
+    /// small and well scaled (a loose bound of 10⁸ next to values of 10²
+    /// would otherwise dominate the solver's residual norms). The answer is
+    /// exact: an optimum of a subset of the bounds that satisfies all of
+    /// them is optimal for all; infeasibility of a subset implies
+    /// infeasibility of all.
+    ///
+    /// # Returns
+    /// The verdict of the last round (iterations summed) and the bounds
+    /// included.
+    fn lazy_solve(
+        &self,
+        f: f64,
+        dropped: &[ConstraintFamily],
+        reference: &[f64],
+    ) -> Result<(Verdict, Vec<bool>), PlanError> {
+        let ineq = self.direct_bounds(f);
+        let allowed = |b: &DirectBound| !dropped.contains(&b.family);
+        let mut include: Vec<bool> = ineq
+            .iter()
+            .map(|b| allowed(b) && b.near(b.row.value(reference), 0.5))
+            .collect();
+        let keep = |fam: ConstraintFamily| !dropped.contains(&fam);
+        let mut total = 0;
+        for _ in 0..MAX_LAZY_ROUNDS {
+            let set = self.lifted_constraints(f, &ineq, &include)?;
+            let verdict = solve(self.p.axis_name, &self.lifted_objective, &set, &keep)?;
+            let Verdict::Optimal { x, iterations } = verdict else {
+                return Ok((verdict, include));
+            };
+            total += iterations;
+            let mut added = false;
+            for (b, inc) in ineq.iter().zip(include.iter_mut()) {
+                if !*inc && allowed(b) {
+                    let v = x.get(b.lifted_col).copied().unwrap_or(f64::NAN);
+                    if b.near(v, 0.9) {
+                        *inc = true;
+                        added = true;
+                    }
+                }
+            }
+            if !added {
+                return Ok((
+                    Verdict::Optimal {
+                        x,
+                        iterations: total,
+                    },
+                    include,
+                ));
+            }
         }
+        // Still adding after the round limit: solve with every bound.
+        let include: Vec<bool> = ineq.iter().map(allowed).collect();
+        let set = self.lifted_constraints(f, &ineq, &include)?;
+        let verdict = solve(self.p.axis_name, &self.lifted_objective, &set, &keep)?;
+        Ok((verdict, include))
     }
 
     /// The solution record of coefficients Θ.
     fn solution(&self, coeffs: Vec<f64>, iterations: u32) -> RotarySolution {
-        let y3 = self.derivative_ops[2].mul_vec(&coeffs);
-        let objective = self
-            .gram
-            .mul_vec(&y3)
-            .iter()
-            .zip(&y3)
-            .map(|(a, b)| a * b)
-            .sum();
+        let objective = self.chain.jerk_cost(&coeffs);
         RotarySolution {
             coeffs,
             iterations,
@@ -471,22 +533,22 @@ impl<'p, 'a> RotaryModel<'p, 'a> {
         }
     }
 
-    /// Whether the lifted problem at its feedrate, without the families in
-    /// `dropped`, has an (accepted) optimum.
+    /// Whether the problem at feedrate `f` without the families in
+    /// `dropped` has an (accepted) optimum.
     fn feasible(
         &self,
-        constraints: &ConstraintSet,
+        f: f64,
         dropped: &[ConstraintFamily],
+        reference: &[f64],
     ) -> Result<bool, PlanError> {
-        let keep = |fam: ConstraintFamily| !dropped.contains(&fam);
-        Ok(solve(self.p.axis_name, &self.lifted_objective, constraints, &keep)?.is_feasible())
+        Ok(self.lazy_solve(f, dropped, reference)?.0.is_feasible())
     }
 
     /// The [`PlanError::Infeasible`] of an infeasible problem.
-    fn diagnose(&self, constraints: &ConstraintSet, status: &str) -> Result<PlanError, PlanError> {
+    fn diagnose(&self, reference: &[f64], status: &str) -> Result<PlanError, PlanError> {
         let p = self.p;
         let found = culprit(&ROTARY_DIAGNOSIS_ORDER, &mut |dropped| {
-            self.feasible(constraints, dropped)
+            self.feasible(p.feedrate, dropped, reference)
         })?;
         let Some(c) = found else {
             return Ok(PlanError::Solver {
@@ -517,10 +579,8 @@ impl<'p, 'a> RotaryModel<'p, 'a> {
             for (r, name) in [(1, "|Θ'|"), (2, "|Θ''|"), (3, "|Θ'''|")] {
                 detail += &format!("; {name} ≤ {:.6e}", self.kinematic_bound(r, p.feedrate));
             }
-            max_feasible = max_feasible_feedrate(p.feedrate, &mut |f| {
-                let set = self.lifted_constraints(f)?;
-                self.feasible(&set, &[])
-            })?;
+            max_feasible =
+                max_feasible_feedrate(p.feedrate, &mut |f| self.feasible(f, &[], reference))?;
         } else {
             let l = &p.limits;
             for (i, &(u, q)) in p.via.iter().enumerate() {
@@ -550,17 +610,6 @@ fn kinematic_bound(l: &AxisLimits, sigma: f64, r: usize, f: f64) -> f64 {
         _ => l.jerk,
     };
     limit * (sigma / f).powi(r as i32)
-}
-
-/// One equality-constrained solve: `Ok` only if every row of `ineq` holds.
-fn polish_once(qp: &PolishQp, eq: &[LinRow], ineq: &[LinRow]) -> Result<Vec<f64>, String> {
-    // An empty active set whose optimum violates a bound makes `polish`
-    // add rows; here that means "not optimal without the interior point".
-    let x = polish(qp, eq, &[], Vec::new())?;
-    match ineq.iter().position(|r| r.violated(&x).is_some()) {
-        None => Ok(x),
-        Some(i) => Err(format!("bound row {i} is active")),
-    }
 }
 
 /// A [`LinRow`] equality `row·x = v` with columns shifted by `offset`.
