@@ -130,6 +130,11 @@ fn y_range<'a>(curves: impl Iterator<Item = &'a [(f64, f64)]>) -> (f64, f64) {
     (lo - pad, hi + pad)
 }
 
+/// A limit for a caption: rounded to 4 decimals, without trailing zeros (`-6.2832`, `10`).
+fn short(v: f64) -> String {
+    format!("{}", (v * 1e4).round() / 1e4)
+}
+
 /// `(t, value of joint j)` for every sample with a finite value.
 fn curve(times: &[f64], rows: &[[f64; 6]], j: usize) -> Vec<(f64, f64)> {
     times
@@ -203,7 +208,11 @@ pub fn write_plots(
             let (lo, hi) = y_range([&m[..], &q[..]].into_iter());
             let mut chart = ChartBuilder::on(area)
                 .caption(
-                    format!("{what} ({unit}), limits {} / {}", bounds[0], bounds[1]),
+                    format!(
+                        "{what} ({unit}), limits {} / {}",
+                        short(bounds[0]),
+                        short(bounds[1])
+                    ),
                     ("sans-serif", 16),
                 )
                 .margin(8)
@@ -345,6 +354,11 @@ mod tests {
         // limit 2 m/s is outside [0, 0.2]: no dotted limit line is drawn there.
         let q1 = std::fs::read_to_string(&files[0]).unwrap();
         assert!(q1.contains("limits -2 / 2"), "velocity caption");
+        let q4 = std::fs::read_to_string(&files[3]).unwrap();
+        assert!(
+            q4.contains("position (rad), limits -6.2832 / 6.2832"),
+            "position caption"
+        );
 
         // A q1 velocity beyond its 2 m/s limit brings the +2 line (100 dots) into range, and
         // without QI only the MJTO curves are drawn.
