@@ -144,28 +144,31 @@ impl BandLu {
             b.iter_mut().for_each(|v| *v = f64::NAN);
             return;
         }
-        // L y = P b.
+        let ldab = 2 * kl + ku + 1;
+        // L y = P b: column j of L holds rows j + 1 ..= j + kl contiguously.
         for j in 0..n {
             let p = self.ipiv[j];
             if p != j {
                 b.swap(j, p);
             }
             let bj = b[j];
-            if bj != 0.0 {
-                let last = (j + kl).min(n - 1);
-                for (i, bi) in b.iter_mut().enumerate().take(last + 1).skip(j + 1) {
-                    *bi -= self.ab[self.idx(i, j)] * bj;
+            let len = (j + kl).min(n - 1) - j;
+            if bj != 0.0 && len > 0 {
+                let col = self.idx(j, j) + 1;
+                for (bi, l) in b[j + 1..=j + len].iter_mut().zip(&self.ab[col..col + len]) {
+                    *bi -= l * bj;
                 }
             }
         }
-        // U x = y.
+        // U x = y: column j of U holds rows j − kl − ku ..= j contiguously.
         for j in (0..n).rev() {
             b[j] /= self.ab[self.idx(j, j)];
             let xj = b[j];
-            if xj != 0.0 {
-                let first = j.saturating_sub(kl + ku);
-                for (i, bi) in b.iter_mut().enumerate().take(j).skip(first) {
-                    *bi -= self.ab[self.idx(i, j)] * xj;
+            let first = j.saturating_sub(kl + ku);
+            if xj != 0.0 && first < j {
+                let col = kl + ku + first - j + j * ldab;
+                for (bi, u) in b[first..j].iter_mut().zip(&self.ab[col..col + (j - first)]) {
+                    *bi -= u * xj;
                 }
             }
         }

@@ -19,7 +19,12 @@ mod constraints;
 mod diagnose;
 mod kkt;
 mod lifting;
+pub mod mpath;
 pub mod rotary;
 mod solve;
 
+pub use mpath::{
+    mpath_dense_objective, mpath_tikhonov_weight, solve_mpath, MPathProblem, MPathSolution,
+    MPATH_TIKHONOV,
+};
 pub use rotary::{solve_rotary, RotaryProblem, RotarySolution, ROTARY_DIAGNOSIS_ORDER};
