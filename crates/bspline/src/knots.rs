@@ -66,6 +66,72 @@ impl KnotVector {
         Ok(Self::assemble(degree, interior))
     }
 
+    /// Clamped knot vector for `n_coeffs` coefficients fitted to the
+    /// parameters `params` (strictly increasing, from 0 to 1).
+    ///
+    /// * `n_coeffs == params.len()` (interpolation): de Boor's averaging,
+    ///   t_{j+k} = (u_j + ... + u_{j+k-1}) / k for j = 1..n-k (Piegl &
+    ///   Tiller, *The NURBS Book*, eq. 9.8).
+    /// * `n_coeffs < params.len()` (least squares): Piegl & Tiller eq.
+    ///   9.68-9.69, d = m/(n-k+1), i = ⌊jd⌋, α = jd - i,
+    ///   t_{k+j} = (1-α) u_{i-1} + α u_i (m + 1 = params.len()).
+    ///
+    /// Seed 001 uses a uniform knot vector (section 2.1). With equally
+    /// spaced parameters both rules give nearly uniform knots, but they also
+    /// satisfy the Schoenberg–Whitney condition for uneven parameters (a
+    /// short last segment of a CL path makes the uniform collocation matrix
+    /// numerically singular), so the collocation and fit of eq. 49-52 stay
+    /// well conditioned.
+    ///
+    /// # Errors
+    /// [`BsplineError::TooFewCoefficients`], [`BsplineError::TooFewPoints`]
+    /// (more coefficients than parameters), [`BsplineError::NotFinite`],
+    /// [`BsplineError::InvalidKnots`] (parameters not strictly increasing
+    /// from 0 to 1).
+    pub fn for_parameters(
+        degree: usize,
+        n_coeffs: usize,
+        params: &[f64],
+    ) -> Result<Self, BsplineError> {
+        if n_coeffs < degree + 1 {
+            return Err(BsplineError::TooFewCoefficients { n_coeffs, degree });
+        }
+        if params.len() < n_coeffs {
+            return Err(BsplineError::TooFewPoints {
+                n_points: params.len(),
+                n_coeffs,
+            });
+        }
+        if params.iter().any(|u| !u.is_finite()) {
+            return Err(BsplineError::NotFinite {
+                what: "parameters".into(),
+            });
+        }
+        let m = params.len() - 1;
+        if params[0] != 0.0 || params[m] != 1.0 || params.windows(2).any(|w| w[1] <= w[0]) {
+            return Err(BsplineError::InvalidKnots {
+                detail: "parameters must increase strictly from 0 to 1".into(),
+            });
+        }
+        let n = n_coeffs - 1;
+        let interior: Vec<f64> = if n_coeffs == params.len() {
+            (1..=n - degree)
+                .map(|j| params[j..j + degree].iter().sum::<f64>() / degree as f64)
+                .collect()
+        } else {
+            let d = (m + 1) as f64 / (n - degree + 1) as f64;
+            (1..=n - degree)
+                .map(|j| {
+                    let jd = j as f64 * d;
+                    let i = (jd.floor() as usize).clamp(1, m);
+                    let alpha = jd - i as f64;
+                    (1.0 - alpha) * params[i - 1] + alpha * params[i]
+                })
+                .collect()
+        };
+        Self::clamped_with_interior(degree, &interior)
+    }
+
     fn assemble(degree: usize, interior: &[f64]) -> Self {
         let mut knots = Vec::with_capacity(interior.len() + 2 * degree + 2);
         knots.extend(std::iter::repeat_n(0.0, degree + 1));

@@ -100,6 +100,35 @@ fn centred(centre: f64, half: f64, n: usize) -> Vec<f64> {
         .collect()
 }
 
+/// Half span of the q4 samples around a reference with tilt q̂5.
+///
+/// `q4_half_range` is read as the angle the tool axis sweeps on the unit
+/// sphere; a rotation δ of q4 moves the axis by about δ·sin|q5| (eq. 2), so
+/// the q4 span is `q4_half_range / sin|q̂5|`, at most π. Near the singular
+/// vertical pose (q5 → 0), where q4 is undefined (eq. 3), the grid spans
+/// every q4: the reference q4 there is arbitrary, and the orientation of the
+/// head about the vertical (its fork arms) decides collisions.
+pub fn q4_half_span(q4_half_range: f64, q5_reference: f64) -> f64 {
+    let s = q5_reference.sin().abs();
+    if s * std::f64::consts::PI <= q4_half_range {
+        std::f64::consts::PI
+    } else {
+        q4_half_range / s
+    }
+}
+
+/// The q6 sample range around the reference standoff: symmetric, reaching
+/// the nearer end of the stroke (e.g. [−0.1, −0.04] m for −0.07 m on the
+/// stroke [−0.1, 0.02] m). The samples stay near the preferred standoff
+/// instead of spending most levels where the tilt housing (radius 0.045 m
+/// around M, `urdf/laser_cutter.urdf`) already contains the CL point.
+pub fn q6_span(reference: f64, stroke: &AxisLimits) -> (f64, f64) {
+    let half = (reference - stroke.min)
+        .min(stroke.max - reference)
+        .max(0.0);
+    (reference - half, reference + half)
+}
+
 /// `within(v, l)`: `l.min <= v <= l.max`, false for NaN.
 fn within(v: f64, l: &AxisLimits) -> bool {
     l.min <= v && v <= l.max
@@ -113,10 +142,11 @@ impl Gfd {
     /// * `point` - the CL point C in the machine frame (m).
     /// * `reference` - q̂ = (q4, q5, q6), the IKT (eq. 3) of the nominal
     ///   axis with the preferred standoff.
-    /// * `grid` - q4: `q4_steps` (odd) values over reference ± half range,
-    ///   the reference in the middle; q5 likewise; q6: `q6_steps` values
-    ///   spread evenly over the q6 stroke `[limits[5].min, limits[5].max]`
-    ///   (its midpoint for one step), plus the reference q6.
+    /// * `grid` - q4: `q4_steps` (odd) values over reference ±
+    ///   [`q4_half_span`], the reference in the middle; q5: `q5_steps` over
+    ///   reference ± `q5_half_range`; q6: `q6_steps` values spread evenly
+    ///   over [`q6_span`] (the reference alone for one step), plus the
+    ///   reference q6.
     /// * `weights` - k4, k5, k6 of eq. 55.
     /// * `max_lead`, `max_tilt` - limits on |lead| and |tilt| (rad).
     /// * `lead_tilt` - (lead, tilt) of a unit tool axis against the
@@ -145,10 +175,15 @@ impl Gfd {
         limits: &[AxisLimits; 6],
     ) -> Self {
         let [l1, l2, l3, l4, l5, l6] = limits;
-        let q4s = centred(reference[0], grid.q4_half_range, grid.q4_steps);
+        let q4s = centred(
+            reference[0],
+            q4_half_span(grid.q4_half_range, reference[1]),
+            grid.q4_steps,
+        );
         let q5s = centred(reference[1], grid.q5_half_range, grid.q5_steps);
-        let mut q6s: Vec<f64> = if grid.q6_steps <= 1 {
-            vec![(l6.min + l6.max) / 2.0]
+        let (lo, hi) = q6_span(reference[2], l6);
+        let mut q6s: Vec<f64> = if grid.q6_steps <= 1 || hi <= lo {
+            vec![reference[2]]
         } else {
             let n = grid.q6_steps - 1;
             (0..=n)
@@ -156,9 +191,9 @@ impl Gfd {
                     // Exact end points: rounding must not push them out of
                     // the stroke.
                     if k == n {
-                        l6.max
+                        hi
                     } else {
-                        l6.min + (l6.max - l6.min) * k as f64 / n as f64
+                        lo + (hi - lo) * k as f64 / n as f64
                     }
                 })
                 .collect()

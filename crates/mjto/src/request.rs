@@ -77,7 +77,9 @@ pub struct GfdGrid {
     pub q5_steps: usize,
     /// Samples over q6 (≥ 1), spread over the admissible standoff range.
     pub q6_steps: usize,
-    /// Half width of the q4 range around the reference (rad).
+    /// Half width of the q4 range around the reference, as the angle the
+    /// tool axis sweeps (rad): the q4 span is this over sin|q̂5|, at most π
+    /// (`gfd::q4_half_span`).
     pub q4_half_range: f64,
     /// Half width of the q5 range around the reference (rad).
     pub q5_half_range: f64,
@@ -86,7 +88,7 @@ pub struct GfdGrid {
 impl Default for GfdGrid {
     fn default() -> Self {
         Self {
-            q4_steps: 9,
+            q4_steps: 13,
             q5_steps: 9,
             q6_steps: 5,
             q4_half_range: 0.35,
