@@ -15,41 +15,43 @@ const MAX_HALVINGS: usize = 60;
 /// feasible problem.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub(crate) struct Culprit {
-    /// The family reported: the only one dropped, or the last one of a
-    /// cumulative drop.
+    /// The family reported: the first of the candidate set that worked, or
+    /// the last one of a cumulative drop (callers may refine it).
     pub family: ConstraintFamily,
-    /// Every family dropped (one element when a single family explains it).
+    /// Every family dropped.
     pub dropped: Vec<ConstraintFamily>,
 }
 
-/// Finds the first family of `order` whose removal alone makes the
-/// problem feasible. If none does, drops the families of `order`
-/// cumulatively, in that order, until the problem becomes feasible, and
-/// reports the last one dropped with the whole list.
+/// Finds the first candidate set of families whose removal makes the
+/// problem feasible. If none does, drops the families of `cumulative`
+/// one after the other, in that order, until the problem becomes
+/// feasible, and reports the last one dropped with the whole list.
 ///
 /// `feasible_without(dropped)` re-solves the problem without the given
 /// families and says whether it is feasible.
 ///
 /// # Returns
-/// `None` if the problem stays infeasible with every family of `order`
-/// dropped.
+/// `None` if the problem stays infeasible with every family of
+/// `cumulative` dropped.
 ///
 /// # Errors
 /// Whatever `feasible_without` returns.
 pub(crate) fn culprit(
-    order: &[ConstraintFamily],
+    candidates: &[&[ConstraintFamily]],
+    cumulative: &[ConstraintFamily],
     feasible_without: &mut dyn FnMut(&[ConstraintFamily]) -> Result<bool, PlanError>,
 ) -> Result<Option<Culprit>, PlanError> {
-    for &family in order {
-        if feasible_without(&[family])? {
+    for set in candidates {
+        let Some(&family) = set.first() else { continue };
+        if feasible_without(set)? {
             return Ok(Some(Culprit {
                 family,
-                dropped: vec![family],
+                dropped: set.to_vec(),
             }));
         }
     }
-    let mut dropped = Vec::with_capacity(order.len());
-    for &family in order {
+    let mut dropped = Vec::with_capacity(cumulative.len());
+    for &family in cumulative {
         dropped.push(family);
         if dropped.len() > 1 && feasible_without(&dropped)? {
             return Ok(Some(Culprit { family, dropped }));
@@ -132,23 +134,34 @@ mod tests {
     }
 
     #[test]
-    fn single_then_cumulative_drop() {
+    fn candidate_sets_then_cumulative_drop() {
         let order = [Jerk, Acceleration, Velocity, Position, Rto, Boundary];
+        let sets: [&[ConstraintFamily]; 5] = [
+            &[Jerk],
+            &[Acceleration],
+            &[Velocity],
+            &[Jerk, Acceleration, Velocity],
+            &[Rto],
+        ];
         // Feasible as soon as Velocity is dropped.
-        let c = culprit(&order, &mut |d| Ok(d.contains(&Velocity)))
+        let c = culprit(&sets, &order, &mut |d| Ok(d.contains(&Velocity)))
             .unwrap()
             .unwrap();
         assert_eq!((c.family, c.dropped), (Velocity, vec![Velocity]));
-        // Needs both Jerk and Acceleration dropped.
-        let c = culprit(&order, &mut |d| {
-            Ok(d.contains(&Jerk) && d.contains(&Acceleration))
+        // Needs all three kinematic families dropped (or the RTOs): the
+        // kinematic set comes first.
+        let c = culprit(&sets, &order, &mut |d| Ok(d.len() == 3 || d.contains(&Rto)))
+            .unwrap()
+            .unwrap();
+        assert_eq!(c.dropped, vec![Jerk, Acceleration, Velocity]);
+        // Needs Jerk and Position: only the cumulative drop finds it.
+        let c = culprit(&sets, &order, &mut |d| {
+            Ok(d.contains(&Jerk) && d.contains(&Position))
         })
         .unwrap()
         .unwrap();
-        assert_eq!(
-            (c.family, c.dropped),
-            (Acceleration, vec![Jerk, Acceleration])
-        );
-        assert_eq!(culprit(&order, &mut |_| Ok(false)).unwrap(), None);
+        assert_eq!(c.family, Position);
+        assert_eq!(c.dropped, vec![Jerk, Acceleration, Velocity, Position]);
+        assert_eq!(culprit(&sets, &order, &mut |_| Ok(false)).unwrap(), None);
     }
 }

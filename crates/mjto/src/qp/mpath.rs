@@ -228,6 +228,7 @@ pub fn solve_mpath(p: &MPathProblem) -> Result<MPathSolution, PlanError> {
         }
         Verdict::Infeasible { status } => {
             let found = culprit(
+                &[&[ConstraintFamily::Stroke], &[ConstraintFamily::Rto]],
                 &[ConstraintFamily::Stroke, ConstraintFamily::Rto],
                 &mut |dropped| {
                     let keep = |f: ConstraintFamily| !dropped.contains(&f);

@@ -64,6 +64,11 @@ use crate::PlanError;
 /// Order in which constraint families are dropped to find the cause of an
 /// infeasible rotary QP: the kinematic bounds first (they are the ones a
 /// feedrate change can fix), then position, RTO and boundary equalities.
+/// Each family is tried alone; after the three kinematic families, the
+/// three are also tried together (a feedrate too high for the velocity,
+/// acceleration and jerk limits at once is fixed by none of them alone);
+/// if no single family explains it, they are dropped cumulatively in this
+/// order.
 pub const ROTARY_DIAGNOSIS_ORDER: [ConstraintFamily; 6] = [
     ConstraintFamily::Jerk,
     ConstraintFamily::Acceleration,
@@ -125,11 +130,13 @@ pub struct RotarySolution {
 ///   differs from the number of coefficients, degree below 3;
 /// * [`PlanError::Infeasible`] when Clarabel certifies infeasibility: the
 ///   family is the first of [`ROTARY_DIAGNOSIS_ORDER`] whose removal makes
-///   the problem feasible (or, if no single one does, the last of a
-///   cumulative drop in that order); for the velocity, acceleration and
-///   jerk families, `max_feasible_feedrate` is the largest feasible f found
-///   by bisection to 0.1 % (feasibility is monotone in f because those
-///   bounds scale with `1/f^r`, see `qp::diagnose`);
+///   the problem feasible; when only dropping the three kinematic families
+///   together does, the one closest to its bound at the largest feasible
+///   feedrate; if nothing but a cumulative drop works, the last family
+///   dropped. For the velocity, acceleration and jerk families,
+///   `max_feasible_feedrate` is the largest feasible f found by bisection
+///   to 0.1 % (feasibility is monotone in f because those bounds scale with
+///   `1/f^r`, see `qp::diagnose`);
 /// * [`PlanError::Solver`] for any other Clarabel status (`MaxIterations`,
 ///   `NumericalError`, ...), an `AlmostSolved` answer that fails the
 ///   post-check of every constraint at 1e-6 relative, or a polish that
@@ -544,10 +551,54 @@ impl<'p, 'a> RotaryModel<'p, 'a> {
         Ok(self.lazy_solve(f, dropped, reference)?.0.is_feasible())
     }
 
+    /// The kinematic family whose bound is the most used (largest
+    /// `max |y_r| / b_r`) by the optimum at feedrate `f`, ties to the
+    /// higher derivative.
+    fn tightest_kinematic(
+        &self,
+        f: f64,
+        reference: &[f64],
+    ) -> Result<Option<ConstraintFamily>, PlanError> {
+        let (Verdict::Optimal { x, .. }, _) = self.lazy_solve(f, &[], reference)? else {
+            return Ok(None);
+        };
+        let families = [
+            ConstraintFamily::Velocity,
+            ConstraintFamily::Acceleration,
+            ConstraintFamily::Jerk,
+        ];
+        let mut best: Option<(f64, ConstraintFamily)> = None;
+        for (r, family) in families.into_iter().enumerate() {
+            let b = self.kinematic_bound(r + 1, f);
+            let len = self.n1 - (r + 1);
+            let start = self.offsets[r];
+            let peak = x
+                .get(start..start + len)
+                .unwrap_or(&[])
+                .iter()
+                .fold(0.0_f64, |m, v| m.max(v.abs()));
+            let ratio = peak / b;
+            if best.is_none_or(|(q, _)| ratio >= q * (1.0 - 1e-6)) {
+                best = Some((ratio, family));
+            }
+        }
+        Ok(best.map(|(_, f)| f))
+    }
+
     /// The [`PlanError::Infeasible`] of an infeasible problem.
     fn diagnose(&self, reference: &[f64], status: &str) -> Result<PlanError, PlanError> {
         let p = self.p;
-        let found = culprit(&ROTARY_DIAGNOSIS_ORDER, &mut |dropped| {
+        use ConstraintFamily::{Acceleration, Boundary, Jerk, Position, Rto, Velocity};
+        let candidates: [&[ConstraintFamily]; 7] = [
+            &[Jerk],
+            &[Acceleration],
+            &[Velocity],
+            &[Jerk, Acceleration, Velocity],
+            &[Position],
+            &[Rto],
+            &[Boundary],
+        ];
+        let found = culprit(&candidates, &ROTARY_DIAGNOSIS_ORDER, &mut |dropped| {
             self.feasible(p.feedrate, dropped, reference)
         })?;
         let Some(c) = found else {
@@ -575,12 +626,20 @@ impl<'p, 'a> RotaryModel<'p, 'a> {
             )
         });
         let mut max_feasible = None;
+        let mut family = c.family;
         if kinematic {
             for (r, name) in [(1, "|Θ'|"), (2, "|Θ''|"), (3, "|Θ'''|")] {
                 detail += &format!("; {name} ≤ {:.6e}", self.kinematic_bound(r, p.feedrate));
             }
             max_feasible =
                 max_feasible_feedrate(p.feedrate, &mut |f| self.feasible(f, &[], reference))?;
+            if let (Some(fmax), true) = (max_feasible, c.dropped.len() > 1) {
+                // Several kinematic families bind together: report the one
+                // closest to its bound at the largest feasible feedrate.
+                if let Some(tightest) = self.tightest_kinematic(fmax, reference)? {
+                    family = tightest;
+                }
+            }
         } else {
             let l = &p.limits;
             for (i, &(u, q)) in p.via.iter().enumerate() {
@@ -594,7 +653,7 @@ impl<'p, 'a> RotaryModel<'p, 'a> {
         }
         Ok(PlanError::Infeasible {
             problem: p.axis_name.to_string(),
-            family: c.family,
+            family,
             detail,
             max_feasible_feedrate: max_feasible,
         })
