@@ -1,14 +1,25 @@
 //! The 3D GFD of one RTO (seed 001 section 2.4, eq. 55) on a real sheet.
+//!
+//! The grid of [`GfdGrid::default`]: 13 q4 samples over reference ±
+//! `q4_half_span(0.35, q̂5)` (the full circle, ± π, when |q̂5| is below
+//! asin(0.35 / π) ≈ 0.1116 rad), 9 q5 samples over reference ± 0.3 rad
+//! (0.075 apart) and 5 q6 samples over `q6_span(q̂6, stroke)`.
+
+use std::f64::consts::{FRAC_PI_2, PI};
 
 use kerf_mjto::collision::{CollisionWorld, HeadModel};
-use kerf_mjto::gfd::{tool_axis, weighted_distance, Gfd};
+use kerf_mjto::gfd::{q4_half_span, q6_span, tool_axis, weighted_distance, Gfd};
 use kerf_mjto::mesh::MeshData;
 use kerf_mjto::request::{GfdGrid, Weights};
-use kerf_mjto::LaserMachine;
+use kerf_mjto::{AxisLimits, LaserMachine};
 use nalgebra::{Isometry3, Vector3};
 
 /// CL point on the top face of the sheet.
 const C: [f64; 3] = [0.8, 0.7, 0.3];
+
+/// The preferred standoff of `CutOptions::default()`: on the q6 stroke
+/// [-0.1, 0.02] its q6 span is [-0.1, -0.04], sampled 0.015 apart.
+const STANDOFF: f64 = -0.07;
 
 /// Lead and tilt of a tool axis against the path frame of a straight cut
 /// along +x on a horizontal sheet: t = x, n = z, b = n × t = y;
@@ -47,18 +58,44 @@ fn build(point: [f64; 3], reference: [f64; 3], max_angle: f64) -> Gfd {
     )
 }
 
+/// The distinct values of wrist coordinate `i` among the candidates,
+/// ascending.
+fn distinct(g: &Gfd, i: usize) -> Vec<f64> {
+    let mut v: Vec<f64> = g.candidates.iter().map(|c| c.q[i]).collect();
+    v.sort_by(f64::total_cmp);
+    v.dedup();
+    v
+}
+
+fn stroke(min: f64, max: f64) -> AxisLimits {
+    AxisLimits {
+        min,
+        max,
+        vel: 1.0,
+        acc: 1.0,
+        jerk: 1.0,
+    }
+}
+
 #[test]
 fn candidates_respect_the_lead_and_tilt_limits() {
-    let g = build(C, [0.0, 0.0, -0.08], 0.2);
-    // 9 x 9 q4/q5 samples, q6: 5 over [-0.1, 0.02] plus the reference.
-    assert_eq!(g.total, 9 * 9 * 6);
+    let g = build(C, [0.0, 0.0, STANDOFF], 0.2);
+    // 13 x 9 q4/q5 samples, q6: 5 over [-0.1, -0.04] (the reference is
+    // the middle one, not added again).
+    assert_eq!(g.total, 13 * 9 * 5);
     assert_eq!(
         g.candidates.len() + g.angle_rejected + g.range_rejected + g.stroke_rejected,
         g.total
     );
-    // q5 spans +-0.3 > 0.2: some samples must be rejected.
-    assert!(g.angle_rejected > 0);
-    assert!(!g.candidates.is_empty());
+    assert_eq!((g.range_rejected, g.stroke_rejected), (0, 0));
+    // q̂5 = 0: q4 every 30 deg over [-180, 180] deg. |lead| and |tilt| are
+    // at most |q5|, so |q5| <= 0.15 always passes. At |q5| = 0.225,
+    // tan(lead) = cos q4 tan q5 (tilt: sin q4) <= tan 0.2 needs
+    // |cos q4|, |sin q4| <= 0.8856: q4 = 0, +-90, +-180 deg (5) fail. At
+    // |q5| = 0.3 that needs both <= 0.6553: no multiple of 30 deg passes
+    // (13). (2 * 5 + 2 * 13) pairs of 5 q6 samples each.
+    assert_eq!(g.angle_rejected, (2 * 5 + 2 * 13) * 5);
+    assert_eq!(g.candidates.len(), (13 * 9 - 36) * 5);
     for c in &g.candidates {
         let (lead, tilt) = lead_tilt(&tool_axis(c.q[0], c.q[1]));
         assert!(lead.abs() <= 0.2 && tilt.abs() <= 0.2, "{c:?}");
@@ -66,26 +103,30 @@ fn candidates_respect_the_lead_and_tilt_limits() {
     }
     // Every rejected (q4, q5) really violates a limit: count them.
     let mut rejected = 0;
-    for j in 0..9 {
+    for j in 0..13 {
         for k in 0..9 {
-            let q4 = -0.35 + 0.7 * j as f64 / 8.0;
-            let q5 = -0.3 + 0.6 * k as f64 / 8.0;
+            let q4 = PI * (j as f64 - 6.0) / 6.0;
+            let q5 = 0.3 * (k as f64 - 4.0) / 4.0;
             let (lead, tilt) = lead_tilt(&tool_axis(q4, q5));
             if lead.abs() > 0.2 || tilt.abs() > 0.2 {
-                rejected += 6;
+                rejected += 5;
             }
         }
     }
     assert_eq!(g.angle_rejected, rejected);
-    // With limits wider than the grid nothing is rejected for its angle.
-    assert_eq!(build(C, [0.0, 0.0, -0.08], 1.5).angle_rejected, 0);
+    // With limits wider than the grid (|q5| <= 0.3) nothing is rejected
+    // for its angle.
+    let wide = build(C, [0.0, 0.0, STANDOFF], 1.5);
+    assert_eq!(wide.angle_rejected, 0);
+    assert_eq!(wide.candidates.len(), 13 * 9 * 5);
 }
 
 #[test]
 fn candidates_are_sorted_by_eq55_and_reproduce_the_cl_point() {
-    let reference = [0.1, 0.05, -0.08];
+    let reference = [0.1, 0.05, STANDOFF];
     let g = build(C, reference, 1.0);
     let w = Weights::default();
+    assert_eq!(g.candidates.len(), 13 * 9 * 5);
     // The reference itself is a candidate, at distance 0.
     assert_eq!(g.candidates[0].q, reference);
     assert_eq!(g.candidates[0].distance, 0.0);
@@ -106,52 +147,99 @@ fn candidates_are_sorted_by_eq55_and_reproduce_the_cl_point() {
         let c_fk = Vector3::new(q[0], q[1], q[2]) + q[5] * o;
         assert!((c_fk - Vector3::from(C)).norm() < 1e-14);
     }
-    // q4 samples are 0.0875 apart: the two nearest neighbours of the
-    // reference in q4 (k4 = 1) come right after the q5 ones (0.075).
-    assert!((g.candidates[1].distance - 0.075).abs() < 1e-12);
-    assert!((g.candidates[3].distance - 0.0875).abs() < 1e-12);
+    // q5 neighbours are 0.075 away; q6 samples are 0.015 m apart, i.e.
+    // sqrt(k6) * 0.015 = 0.15, a tie with the second q5 neighbours.
+    for p in [1, 2] {
+        assert!((g.candidates[p].distance - 0.075).abs() < 1e-12);
+    }
+    for p in 3..7 {
+        assert!((g.candidates[p].distance - 0.15).abs() < 1e-12, "{p}");
+    }
+    assert!((g.candidates[7].distance - 0.075 * 5f64.sqrt()).abs() < 1e-12);
+    // sin(0.05) * pi < 0.35: q4 spans the full circle, 30 deg apart. Every
+    // (q5, q6) offset with the reference q4 (0.075 sqrt(a² + 4 b²) with
+    // |a| <= 4, |b| <= 2: at most 0.42) is nearer than the q4 neighbours
+    // at pi / 6 = 0.524: 45 candidates come first.
+    assert!(g.candidates[..45].iter().all(|c| c.q[0] == reference[0]));
+    assert!((g.candidates[45].distance - PI / 6.0).abs() < 1e-12);
+    assert!((g.candidates[45].q[0] - reference[0]).abs() - PI / 6.0 < 1e-12);
+    let q4s = distinct(&g, 0);
+    assert_eq!(q4s.len(), 13);
+    assert!((q4s[0] - (reference[0] - PI)).abs() < 1e-12);
+    assert!((q4s[12] - (reference[0] + PI)).abs() < 1e-12);
+    for pair in q4s.windows(2) {
+        assert!((pair[1] - pair[0] - PI / 6.0).abs() < 1e-12);
+    }
 }
 
 #[test]
 fn translational_stroke_rejects_samples() {
-    // C 1 cm above the lower q3 limit (q3 >= 0): q6 > 0.01 puts M below it.
-    let g = build([0.8, 0.7, 0.01], [0.0, 0.0, -0.08], 1.0);
-    assert!(g.stroke_rejected > 0);
     let limits = *machine().limits();
+    // C 1 cm above the lower q3 limit (q3 >= 0): only q6 > 0.01 would put
+    // M below it, and the q6 span of the preferred standoff, [-0.1, -0.04],
+    // never gets there.
+    let low = build([0.8, 0.7, 0.01], [0.0, 0.0, STANDOFF], 1.0);
+    assert_eq!(low.stroke_rejected, 0);
+    assert_eq!(low.candidates.len(), low.total);
+    // C 7.5 cm below the upper q3 limit (q3 <= 3): M.z = 2.925 + |q6| cos q5
+    // leaves the stroke for |q6| cos q5 > 0.075. |q5| <= 0.3 (cos >= 0.955):
+    // every sample with q6 = -0.1 or -0.085 goes (cos q5 > 0.882), none with
+    // |q6| <= 0.07.
+    let g = build([0.8, 0.7, 2.925], [0.0, 0.0, STANDOFF], 1.0);
+    assert_eq!(g.stroke_rejected, 2 * 13 * 9);
+    assert_eq!(g.candidates.len(), 3 * 13 * 9);
+    assert_eq!(distinct(&g, 2).len(), 3);
+    assert!(g.candidates.iter().all(|c| c.q[2] > -0.08));
     for p in 0..g.candidates.len() {
         let q = g.joint_vector(p);
         for j in 0..6 {
             assert!(limits[j].min <= q[j] && q[j] <= limits[j].max, "{q:?}");
         }
     }
-    // q5 = +-0.3 and q6 = 0.02: M.z = 0.01 - 0.02 cos q5 < 0; every sample
-    // with q6 = 0.02 (9 x 9) goes.
-    assert_eq!(g.stroke_rejected, 81);
+    // The reference standoff 0 spans [-0.02, 0.02] (0.01 apart) on the
+    // stroke [-0.1, 0.02]. With C 1.5 cm above q3 = 0, q6 = 0.02 puts
+    // M.z = 0.015 - 0.02 cos q5 below it for every |q5| <= 0.3 (cos > 0.75):
+    // all 13 x 9 of them go; q6 = 0.01 keeps M.z >= 0.005.
+    let g = build([0.8, 0.7, 0.015], [0.0, 0.0, 0.0], 1.0);
+    assert_eq!(distinct(&g, 2).len(), 4);
+    assert_eq!(g.stroke_rejected, 13 * 9);
+    assert!(g.candidates.iter().all(|c| c.q[2] < 0.015));
 }
 
 #[test]
 fn non_finite_input_gives_an_empty_gfd() {
-    let g = build([f64::NAN, 0.7, 0.3], [0.0, 0.0, -0.08], 0.2);
+    let g = build([f64::NAN, 0.7, 0.3], [0.0, 0.0, STANDOFF], 0.2);
     assert!(g.candidates.is_empty());
-    let g = build(C, [0.0, f64::NAN, -0.08], 0.2);
+    let g = build(C, [0.0, f64::NAN, STANDOFF], 0.2);
     assert!(g.candidates.is_empty());
-    let g = build(C, [0.0, 0.0, -0.08], f64::NAN);
+    let g = build(C, [0.0, 0.0, STANDOFF], f64::NAN);
     assert!(g.candidates.is_empty());
 }
 
 #[test]
 fn collision_status_is_lazy_and_memoised() {
     let world = sheet_world();
-    let mut g = build(C, [0.0, 0.0, -0.08], 0.2);
+    let mut g = build(C, [0.0, 0.0, STANDOFF], 0.2);
     assert_eq!(g.collision_checked(), 0);
-    // The reference (tip 1 mm above the sheet) is free.
+    // The reference (M 7 cm above the sheet, fork arms 1 cm above it) is
+    // free.
+    assert_eq!(g.candidates[0].q, [0.0, 0.0, STANDOFF]);
     assert!(g.is_free(0, &world));
     assert!(g.is_free(0, &world));
     assert_eq!((g.collision_checked(), world.queries()), (1, 1));
-    // A candidate with q6 = 0.02 (M below the surface) collides.
-    let high = g.candidates.iter().position(|c| c.q[2] == 0.02).unwrap();
+    // A candidate with q6 = -0.04 (M 4 cm above C: the tilt housing,
+    // radius 4.5 cm, contains C and the fork arms reach 2 cm into the
+    // sheet) collides.
+    let high = g
+        .candidates
+        .iter()
+        .position(|c| (c.q[2] + 0.04).abs() < 1e-12)
+        .unwrap();
+    assert!(!g.is_free(high, &world));
     assert!(!g.is_free(high, &world));
     assert_eq!(g.known_status(high), Some(false));
+    assert_eq!(g.known_status(1), None);
+    assert_eq!((g.collision_checked(), g.known_colliding()), (2, 1));
     assert_eq!(world.queries(), 2);
 }
 
@@ -160,8 +248,12 @@ fn nearest_free_equals_brute_force() {
     let world = sheet_world();
     let w = Weights::default();
     // Targets that collide (standoff too small, tilted tip) and one free.
-    for target in [[0.0, 0.0, -0.01], [0.2, 0.25, -0.04], [0.0, 0.0, -0.1]] {
-        let mut lazy = build(C, [0.0, 0.0, -0.08], 0.3);
+    let expected = [Some([0.0, 0.0, STANDOFF]), None, Some([0.0, 0.0, -0.1])];
+    for (target, want) in [[0.0, 0.0, -0.01], [0.2, 0.25, -0.04], [0.0, 0.0, -0.1]]
+        .into_iter()
+        .zip(expected)
+    {
+        let mut lazy = build(C, [0.0, 0.0, STANDOFF], 0.3);
         let mut eager = lazy.clone();
         let free: Vec<usize> = (0..eager.candidates.len())
             .filter(|&p| eager.is_free(p, &world))
@@ -174,10 +266,133 @@ fn nearest_free_equals_brute_force() {
         let got = lazy.nearest_free(target, &w, &world);
         assert_eq!(got, brute, "target {target:?}");
         let p = got.unwrap();
-        assert!(
-            lazy.candidates[p].q[2] <= -0.061,
-            "the fork needs q6 < -0.06"
-        );
+        let [_, q5, q6] = lazy.candidates[p].q;
+        // The fork arms (bottom 6 cm below M, not tilted by q5) stay above
+        // the sheet: M.z - C.z = -q6 cos q5 > 0.06. Of the q6 samples
+        // -0.1, -0.085, -0.07, -0.055, -0.04 only the first three can.
+        assert!(-q6 * q5.cos() > 0.06, "the fork needs q6 < -0.06");
+        if let Some(q) = want {
+            assert_eq!(lazy.candidates[p].q, q, "target {target:?}");
+        }
         assert!(lazy.collision_checked() < eager.collision_checked());
+    }
+}
+
+#[test]
+fn q4_half_span_is_the_axis_sweep_over_sin_q5() {
+    // Vertical reference: q4 is undefined, the grid spans the full circle.
+    assert_eq!(q4_half_span(0.35, 0.0), PI);
+    assert_eq!(q4_half_span(0.35, -0.0), PI);
+    // Small tilt: 0.35 / sin(0.05) = 7.0 > pi, capped.
+    assert_eq!(q4_half_span(0.35, 0.05), PI);
+    assert_eq!(q4_half_span(0.35, -0.05), PI);
+    // The cap starts where sin|q5| = 0.35 / pi (q5 = 0.11164): continuous.
+    let edge = (0.35 / PI).asin();
+    assert!((edge - 0.111_640_2).abs() < 1e-7);
+    assert_eq!(q4_half_span(0.35, edge * (1.0 - 1e-9)), PI);
+    assert!((q4_half_span(0.35, edge * (1.0 + 1e-9)) - PI).abs() < 1e-7);
+    assert!(q4_half_span(0.35, edge * (1.0 + 1e-9)) < PI);
+    // Above it: 0.35 / sin|q5|, e.g. 0.35 / sin 0.2 = 1.761721,
+    // 0.35 / sin 0.5 = 0.730040.
+    assert!((q4_half_span(0.35, 0.2) - 1.761_721_3).abs() < 1e-6);
+    assert!((q4_half_span(0.35, 0.5) - 0.730_040_4).abs() < 1e-6);
+    assert_eq!(q4_half_span(0.35, -0.5), q4_half_span(0.35, 0.5));
+    // Horizontal axis: q4 moves the axis at full rate, span = half range.
+    assert_eq!(q4_half_span(0.35, FRAC_PI_2), 0.35);
+    assert_eq!(q4_half_span(0.35, -FRAC_PI_2), 0.35);
+    assert!((q4_half_span(0.1, FRAC_PI_2) - 0.1).abs() < 1e-15);
+    // The axis really sweeps about 2 sin(q5) sin(span / 2) ~ the half range
+    // for small spans: at q5 = pi/2 and 0.5 the chord between the reference
+    // axis and the end of the q4 span.
+    for q5 in [0.5, 1.0, FRAC_PI_2] {
+        let span = q4_half_span(0.1, q5);
+        let chord = (tool_axis(span, q5) - tool_axis(0.0, q5)).norm();
+        assert!((chord - 2.0 * (0.05f64).sin()).abs() < 1e-3, "{q5} {chord}");
+    }
+    // In the GFD: 13 q4 samples over 0.2 +- 0.35 / sin 0.5.
+    let g = build(C, [0.2, 0.5, STANDOFF], 1.0);
+    let q4s = distinct(&g, 0);
+    assert_eq!(q4s.len(), 13);
+    let half = 0.35 / 0.5f64.sin();
+    assert!((q4s[0] - (0.2 - half)).abs() < 1e-12);
+    assert!((q4s[12] - (0.2 + half)).abs() < 1e-12);
+    assert!(q4s.contains(&0.2));
+}
+
+#[test]
+fn q6_span_is_symmetric_and_reaches_the_nearer_stroke_end() {
+    let s = stroke(-0.1, 0.02);
+    let close = |(a, b): (f64, f64), (x, y): (f64, f64)| {
+        assert!((a - x).abs() < 1e-15 && (b - y).abs() < 1e-15, "{a} {b}");
+    };
+    // The doc's example and the middle of the stroke (both ends reached).
+    close(q6_span(-0.07, &s), (-0.1, -0.04));
+    close(q6_span(-0.04, &s), (-0.1, 0.02));
+    // Nearer the upper end.
+    close(q6_span(0.0, &s), (-0.02, 0.02));
+    close(q6_span(-0.08, &s), (-0.1, -0.06));
+    // At an end: a single value.
+    close(q6_span(-0.1, &s), (-0.1, -0.1));
+    close(q6_span(0.02, &s), (0.02, 0.02));
+    // Outside the stroke: zero width at the reference.
+    assert_eq!(q6_span(-0.15, &s), (-0.15, -0.15));
+    assert_eq!(q6_span(0.05, &s), (0.05, 0.05));
+    // Symmetric on another stroke.
+    close(q6_span(0.3, &stroke(0.0, 1.0)), (0.0, 0.6));
+    close(q6_span(0.9, &stroke(0.0, 1.0)), (0.8, 1.0));
+
+    // In the GFD, the q6 samples are q6_span split in 4, the reference the
+    // middle one.
+    let g = build(C, [0.0, 0.0, -0.08], 1.5);
+    let q6s = distinct(&g, 2);
+    assert_eq!(q6s.len(), 5);
+    for (k, v) in q6s.iter().enumerate() {
+        assert!((v - (-0.1 + 0.01 * k as f64)).abs() < 1e-12, "{q6s:?}");
+    }
+    assert_eq!(g.total, 13 * 9 * 5);
+    // At the stroke end the grid has the reference alone.
+    let g = build(C, [0.0, 0.0, -0.1], 1.5);
+    assert_eq!(distinct(&g, 2), vec![-0.1]);
+    assert_eq!((g.total, g.candidates.len()), (13 * 9, 13 * 9));
+    // Outside the stroke: the reference alone, which is out of range.
+    let g = build(C, [0.0, 0.0, -0.15], 1.5);
+    assert_eq!((g.total, g.range_rejected), (13 * 9, 13 * 9));
+    assert!(g.candidates.is_empty());
+}
+
+#[test]
+fn near_the_vertical_q4_spreads_over_the_full_circle() {
+    // q̂5 = 0.02 rad: sin(0.02) pi = 0.063 < 0.35, so q4 spans ref +- pi.
+    let reference = [0.3, 0.02, STANDOFF];
+    assert_eq!(q4_half_span(GfdGrid::default().q4_half_range, 0.02), PI);
+    let g = build(C, reference, 0.3);
+    let q4s = distinct(&g, 0);
+    assert_eq!(q4s.len(), 13);
+    assert!((q4s[0] - (0.3 - PI)).abs() < 1e-12);
+    assert!((q4s[12] - (0.3 + PI)).abs() < 1e-12);
+    // 30 deg apart, so the head's orientation about the vertical (q4 mod
+    // 2 pi) leaves no gap over 30 deg around the circle.
+    let mut around: Vec<f64> = q4s.iter().map(|q| q.rem_euclid(2.0 * PI)).collect();
+    around.sort_by(f64::total_cmp);
+    around.dedup_by(|a, b| (*a - *b).abs() < 1e-9);
+    assert_eq!(around.len(), 12);
+    let mut gaps: Vec<f64> = around.windows(2).map(|p| p[1] - p[0]).collect();
+    gaps.push(around[0] + 2.0 * PI - around[11]);
+    for gap in gaps {
+        assert!((gap - PI / 6.0).abs() < 1e-9, "{gap}");
+    }
+    // Each q4 has candidates at the reference q5 and q6, whose axes stay
+    // within 2 sin(0.02) = 0.04 of the reference axis: the whole circle of
+    // q4 is a small cone of tool axes.
+    let o_ref = tool_axis(reference[0], reference[1]);
+    for &q4 in &q4s {
+        let c = g
+            .candidates
+            .iter()
+            .find(|c| c.q == [q4, reference[1], reference[2]])
+            .unwrap_or_else(|| panic!("q4 = {q4}"));
+        let angle = tool_axis(c.q[0], c.q[1]).angle(&o_ref);
+        assert!(angle <= 0.04 + 1e-12, "{angle}");
+        assert!(c.lead.abs() <= 0.02 + 1e-12 && c.tilt.abs() <= 0.02 + 1e-12);
     }
 }
