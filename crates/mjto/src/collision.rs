@@ -22,17 +22,21 @@
 //!   link whose bounding box misses the workpiece bounding box is skipped
 //!   without any triangle test, then every shape's own box is matched
 //!   against the mesh BVH by parry.
-//! * parry3d 0.31 computes in f32: the mesh and the head poses are
-//!   expressed relative to the centre of the workpiece bounding box before
-//!   conversion, so rounding stays below 1 µm for parts of a few metres.
+//! * The geometry runs on `parry3d-f64` (the f64 build of parry3d 0.31).
+//!   The f32 build's GJK test of a cylinder against a large triangle
+//!   reports contact across a 1 mm gap (the nozzle above a flange at 3°
+//!   tilt) as soon as the triangle is a centimetre off the query origin;
+//!   the f64 build returns the true 0.86 mm (checked in
+//!   `tests/collision.rs`). Coordinates are still taken relative to the
+//!   centre of the workpiece bounding box.
 
 use std::sync::atomic::{AtomicUsize, Ordering};
 
 use nalgebra::{Isometry3, Translation3, UnitQuaternion, Vector3};
-use parry3d::bounding_volume::{Aabb, BoundingVolume};
-use parry3d::math::{Pose, Rotation, Vector};
-use parry3d::query::intersection_test;
-use parry3d::shape::{Ball, Cuboid, Cylinder, RoundShape, Shape, TriMesh, TriMeshFlags};
+use parry3d_f64::bounding_volume::{Aabb, BoundingVolume};
+use parry3d_f64::math::{Pose, Rotation, Vector};
+use parry3d_f64::query::intersection_test;
+use parry3d_f64::shape::{Ball, Cuboid, Cylinder, RoundShape, Shape, TriMesh, TriMeshFlags};
 
 use crate::mesh::MeshData;
 use crate::PlanError;
@@ -399,21 +403,21 @@ fn to_pose(iso: &Isometry3<f64>, origin: &Vector3<f64>) -> Pose {
     let t = iso.translation.vector - origin;
     let q = iso.rotation.quaternion();
     Pose::from_parts(
-        Vector::new(t.x as f32, t.y as f32, t.z as f32),
-        Rotation::from_xyzw(q.i as f32, q.j as f32, q.k as f32, q.w as f32),
+        Vector::new(t.x, t.y, t.z),
+        Rotation::from_xyzw(q.i, q.j, q.k, q.w),
     )
 }
 
 /// The parry shape of a primitive inflated by `clearance` (m, ≥ 0), and
 /// its pose correction (cylinder axis z → y).
-fn parry_shape(p: &Primitive, clearance: f32) -> (Box<dyn Shape>, Isometry3<f64>) {
+fn parry_shape(p: &Primitive, clearance: f64) -> (Box<dyn Shape>, Isometry3<f64>) {
     let z_to_y = Isometry3::from_parts(
         Translation3::identity(),
         UnitQuaternion::from_axis_angle(&Vector3::x_axis(), std::f64::consts::FRAC_PI_2),
     );
     match *p {
         Primitive::Box { half_extents: h } => {
-            let c = Cuboid::new(Vector::new(h[0] as f32, h[1] as f32, h[2] as f32));
+            let c = Cuboid::new(Vector::new(h[0], h[1], h[2]));
             let s: Box<dyn Shape> = if clearance > 0.0 {
                 Box::new(RoundShape {
                     inner_shape: c,
@@ -428,7 +432,7 @@ fn parry_shape(p: &Primitive, clearance: f32) -> (Box<dyn Shape>, Isometry3<f64>
             radius,
             half_length,
         } => {
-            let c = Cylinder::new(half_length as f32, radius as f32);
+            let c = Cylinder::new(half_length, radius);
             let s: Box<dyn Shape> = if clearance > 0.0 {
                 Box::new(RoundShape {
                     inner_shape: c,
@@ -440,7 +444,7 @@ fn parry_shape(p: &Primitive, clearance: f32) -> (Box<dyn Shape>, Isometry3<f64>
             (s, z_to_y)
         }
         Primitive::Sphere { radius } => (
-            Box::new(Ball::new(radius as f32 + clearance)),
+            Box::new(Ball::new(radius + clearance)),
             Isometry3::identity(),
         ),
     }
@@ -503,7 +507,7 @@ impl CollisionWorld {
             .iter()
             .map(|v| {
                 let d = v - origin;
-                Vector::new(d.x as f32, d.y as f32, d.z as f32)
+                Vector::new(d.x, d.y, d.z)
             })
             .collect();
         let trimesh = TriMesh::with_flags(vertices, mesh.triangles, TriMeshFlags::empty())
@@ -512,7 +516,7 @@ impl CollisionWorld {
 
         let mut links: Vec<WorldLink> = Vec::new();
         for s in &head.shapes {
-            let (shape, fix) = parry_shape(&s.primitive, clearance as f32);
+            let (shape, fix) = parry_shape(&s.primitive, clearance);
             let local = to_pose(&(s.origin * fix), &Vector3::zeros());
             let aabb = shape.compute_aabb(&local);
             // Every pair must be supported by parry's dispatcher: probe once.

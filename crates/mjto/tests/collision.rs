@@ -281,3 +281,32 @@ fn unsupported_head_geometry_is_an_error() {
     let err = HeadModel::from_urdf(&robot).unwrap_err().to_string();
     assert!(err.contains("joint q4"), "{err}");
 }
+
+/// Regression: the nozzle tip 0.86 mm above the flange of the committed
+/// case 1 part, tilted 3° (a configuration of a real plan). parry3d's f32
+/// build reported a contact here (its cylinder–triangle GJK fails once the
+/// triangle is a centimetre off the query origin); the f64 build used by
+/// `CollisionWorld` does not.
+#[test]
+fn nozzle_just_above_the_case1_flange_is_free() {
+    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
+    let text = std::fs::read_to_string(dir.join("cases/case1.yaml")).unwrap();
+    let request = kerf_mjto::CutRequest::from_yaml(&text).unwrap();
+    let mesh = kerf_mjto::mesh::load(&request.mesh).unwrap();
+    let machine = kerf_mjto::LaserMachine::default_machine().unwrap();
+    let head = kerf_mjto::collision::HeadModel::from_urdf(machine.robot().urdf()).unwrap();
+    let pose = request.workpiece_pose.isometry().unwrap();
+    let q = [
+        0.4897333565133044,
+        0.6939036470371193,
+        1.0252331286216727,
+        -1.8632834220568073,
+        0.0743563372540371,
+        -0.09611768730387765,
+    ];
+    let free = kerf_mjto::collision::CollisionWorld::new(head.clone(), &mesh, &pose, 0.0).unwrap();
+    assert!(free.is_free(&q), "{:?}", free.colliding_links(&q));
+    // The same pose with 1 mm clearance required touches: the gap is below 1 mm.
+    let tight = kerf_mjto::collision::CollisionWorld::new(head, &mesh, &pose, 0.001).unwrap();
+    assert_eq!(tight.colliding_links(&q), ["nozzle"]);
+}
