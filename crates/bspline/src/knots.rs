@@ -76,12 +76,15 @@ impl KnotVector {
     ///   9.68-9.69, d = m/(n-k+1), i = ⌊jd⌋, α = jd - i,
     ///   t_{k+j} = (1-α) u_{i-1} + α u_i (m + 1 = params.len()).
     ///
-    /// Seed 001 uses a uniform knot vector (section 2.1). With equally
-    /// spaced parameters both rules give nearly uniform knots, but they also
-    /// satisfy the Schoenberg–Whitney condition for uneven parameters (a
-    /// short last segment of a CL path makes the uniform collocation matrix
-    /// numerically singular), so the collocation and fit of eq. 49-52 stay
-    /// well conditioned.
+    /// Seed 001 uses a uniform knot vector (section 2.1). With as many
+    /// coefficients as parameters that is already numerically singular for
+    /// a few hundred *equally spaced* parameters (they drift half a knot span
+    /// against uniform knots, where odd-degree interpolation breaks down;
+    /// condition number ∞ for 241 points against about 15 with averaged
+    /// knots), and uneven parameters (a short last segment) make it worse.
+    /// Both rules here place every parameter inside its basis function's
+    /// support (Schoenberg–Whitney), so the collocation and fit of eq. 49-52
+    /// stay well conditioned (`tests/knots_for_parameters.rs`).
     ///
     /// # Errors
     /// [`BsplineError::TooFewCoefficients`], [`BsplineError::TooFewPoints`]
