@@ -64,6 +64,14 @@ impl LinRow {
         PRIMAL_TOL * b.abs().max(self.scale) + 64.0 * f64::EPSILON * self.magnitude(x) + ABS_FLOOR
     }
 
+    /// By how much `x` exceeds the given side (positive when violated).
+    fn excess(&self, x: &[f64], side: Side) -> f64 {
+        match side {
+            Side::Upper => self.value(x) - self.hi,
+            Side::Lower => self.lo - self.value(x),
+        }
+    }
+
     /// Whether the equality `aᵀx = lo` holds (to [`LinRow::tol`]).
     pub fn holds_as_equality(&self, x: &[f64]) -> bool {
         (self.value(x) - self.lo).abs() <= self.tol(self.lo, x)
@@ -168,17 +176,50 @@ pub(crate) fn polish(
             })
             .map(|(&(i, _), _)| i)
             .collect();
-        let violated: Vec<(usize, Side)> = ineq
+        let mut violated: Vec<(usize, Side, f64)> = ineq
             .iter()
             .enumerate()
             .filter(|(i, _)| !active.iter().any(|&(a, _)| a == *i))
-            .filter_map(|(i, r)| r.violated(&x).map(|s| (i, s)))
+            .filter_map(|(i, r)| r.violated(&x).map(|s| (i, s, r.excess(&x, s))))
             .collect();
         if wrong.is_empty() && violated.is_empty() {
             return Ok(x);
         }
+        // Add one violated row per cluster: the most violated of each group
+        // of violated rows chained by shared variables. Bounds on a densely
+        // sampled smooth function (a spline at many parameters) are touched
+        // at isolated points; holding a whole violated run at once makes the
+        // multipliers of neighbouring rows alternate in sign and the active
+        // set oscillate.
         active.retain(|(i, _)| !wrong.contains(i));
-        active.extend(violated);
+        let span = |i: usize| {
+            let cols = ineq[i].entries.iter().map(|&(c, _)| c);
+            (cols.clone().min().unwrap_or(0), cols.max().unwrap_or(0))
+        };
+        violated.sort_by_key(|&(i, _, _)| (span(i), i));
+        let mut best: Option<(usize, Side, f64)> = None;
+        let mut reach = 0usize;
+        for (i, side, excess) in violated {
+            let (lo, hi) = span(i);
+            match best {
+                Some(b) if lo <= reach => {
+                    if excess > b.2 {
+                        best = Some((i, side, excess));
+                    }
+                    reach = reach.max(hi);
+                }
+                _ => {
+                    if let Some((bi, bs, _)) = best {
+                        active.push((bi, bs));
+                    }
+                    best = Some((i, side, excess));
+                    reach = hi;
+                }
+            }
+        }
+        if let Some((bi, bs, _)) = best {
+            active.push((bi, bs));
+        }
         active.sort_by_key(|&(i, _)| i);
     }
     Err(format!(

@@ -214,17 +214,18 @@ pub fn solve_mpath(p: &MPathProblem) -> Result<MPathSolution, PlanError> {
     // The active-set loop alone did not settle: Clarabel finds the active
     // stroke bounds, then the polish certifies.
     let lifted = model.lifted_constraints()?;
-    match solve(PROBLEM, &model.lifted_objective, &lifted, &|_| true)? {
-        Verdict::Optimal { x, iterations } => {
-            let active = model.active_set(&x);
-            let x = model.polish(active).map_err(|e| PlanError::Solver {
+    let (x, iterations, status) = match solve(PROBLEM, &model.lifted_objective, &lifted, &|_| true)?
+    {
+        Verdict::Optimal { x, iterations } => (x, iterations, "solved".to_string()),
+        Verdict::Failed {
+            detail,
+            last: Some((x, iterations)),
+        } => (x, iterations, detail),
+        Verdict::Failed { detail, last: None } => {
+            return Err(PlanError::Solver {
                 problem: PROBLEM.into(),
-                detail: format!(
-                    "active-set solve: {first}; Clarabel solved in {iterations} iterations \
-                     but the polish failed: {e}"
-                ),
-            })?;
-            model.solution(x, iterations)
+                detail: format!("active-set solve: {first}; Clarabel: {detail}"),
+            })
         }
         Verdict::Infeasible { status } => {
             let found = culprit(
@@ -232,21 +233,27 @@ pub fn solve_mpath(p: &MPathProblem) -> Result<MPathSolution, PlanError> {
                 &[ConstraintFamily::Stroke, ConstraintFamily::Rto],
                 &mut |dropped| {
                     let keep = |f: ConstraintFamily| !dropped.contains(&f);
-                    Ok(solve(PROBLEM, &model.lifted_objective, &lifted, &keep)?.is_feasible())
+                    let v = solve(PROBLEM, &model.lifted_objective, &lifted, &keep)?;
+                    Ok(v.is_feasible())
                 },
             )?;
-            Err(PlanError::Infeasible {
+            return Err(PlanError::Infeasible {
                 problem: PROBLEM.into(),
                 family: found.map_or(ConstraintFamily::Stroke, |c| c.family),
                 detail: format!("Clarabel reports {status:?}"),
                 max_feasible_feedrate: None,
-            })
+            });
         }
-        Verdict::Failed { detail } => Err(PlanError::Solver {
-            problem: PROBLEM.into(),
-            detail: format!("active-set solve: {first}; Clarabel: {detail}"),
-        }),
-    }
+    };
+    let active = model.active_set(&x);
+    let x = model.polish(active).map_err(|e| PlanError::Solver {
+        problem: PROBLEM.into(),
+        detail: format!(
+            "active-set solve: {first}; Clarabel: {status} ({iterations} iterations); \
+             the polish failed: {e}"
+        ),
+    })?;
+    model.solution(x, iterations)
 }
 
 /// A validated M-path problem in the lifted variables `(s, P_x, P_y, P_z)`

@@ -160,26 +160,35 @@ pub fn solve_rotary(p: &RotaryProblem) -> Result<RotarySolution, PlanError> {
     let reference = reference.unwrap_or_else(|| vec![0.0; model.n1]);
     // Step 2: interior point on the lifted form, with lazily added bounds.
     let (verdict, included) = model.lazy_solve(p.feedrate, &[], &reference)?;
-    match verdict {
-        Verdict::Optimal { x, iterations } => {
-            // Step 3: polish from the active bounds of the interior point.
-            let active = model.active_set(&x, &ineq, &included);
-            let theta = model
-                .polish(&ineq, active)
-                .map_err(|detail| PlanError::Solver {
-                    problem: p.axis_name.to_string(),
-                    detail: format!(
-                        "Clarabel solved in {iterations} iterations but the polish failed: {detail}"
-                    ),
-                })?;
-            Ok(model.solution(theta, iterations))
+    let (x, iterations, status) = match verdict {
+        Verdict::Optimal { x, iterations } => (x, iterations, "solved".to_string()),
+        Verdict::Infeasible { status } => {
+            return Err(model.diagnose(&reference, &format!("{status:?}"))?)
         }
-        Verdict::Infeasible { status } => Err(model.diagnose(&reference, &format!("{status:?}"))?),
-        Verdict::Failed { detail } => Err(PlanError::Solver {
-            problem: p.axis_name.to_string(),
+        // An uncertified answer may still show the active bounds; the
+        // polish below certifies or rejects the result.
+        Verdict::Failed {
             detail,
-        }),
-    }
+            last: Some((x, iterations)),
+        } => (x, iterations, detail),
+        Verdict::Failed { detail, last: None } => {
+            return Err(PlanError::Solver {
+                problem: p.axis_name.to_string(),
+                detail,
+            })
+        }
+    };
+    // Step 3: polish from the active bounds of the interior point.
+    let active = model.active_set(&x, &ineq, &included);
+    let theta = model
+        .polish(&ineq, active)
+        .map_err(|detail| PlanError::Solver {
+            problem: p.axis_name.to_string(),
+            detail: format!(
+                "Clarabel: {status} ({iterations} iterations); the polish failed: {detail}"
+            ),
+        })?;
+    Ok(model.solution(theta, iterations))
 }
 
 /// A bound of eq. 15 in the direct form (a row on Θ), with its family and

@@ -43,10 +43,15 @@ pub(crate) enum Verdict {
         /// `PrimalInfeasible` or `AlmostPrimalInfeasible`.
         status: SolverStatus,
     },
-    /// Anything else: no usable answer.
+    /// Anything else: no certified answer.
     Failed {
         /// Status name, iteration count and what went wrong.
         detail: String,
+        /// The last finite iterate and the iteration count, if any: an
+        /// `AlmostSolved` answer that failed the post-check, or where the
+        /// solver stopped. Not an optimum, but a starting guess of the
+        /// active bounds for a polish that certifies its own result.
+        last: Option<(Vec<f64>, u32)>,
     },
 }
 
@@ -131,6 +136,7 @@ pub(crate) fn solve(
                         "AlmostSolved after {iterations} iterations, but {}",
                         describe(&v)
                     ),
+                    last: Some((sol.x.clone(), iterations)),
                 },
             }
         }
@@ -142,6 +148,7 @@ pub(crate) fn solve(
                 "{s:?} after {iterations} iterations{}",
                 if finite { "" } else { " (non-finite solution)" }
             ),
+            last: finite.then(|| (sol.x.clone(), iterations)),
         },
     })
 }
