@@ -434,6 +434,8 @@ fn invalid_inputs_are_rejected() {
     let mut singular = Setup::new(200, 200);
     singular.params = (0..200).map(|i| i as f64 / 199.0).collect();
     let far_via = [(12, 0.0)];
+    let mut wrong_h = Setup::new(12, 12);
+    wrong_h.h = wrong_h.h.scaled(0.5);
     let cases = [
         bad_axis.problem((-0.1, 0.02), &via),
         decreasing.problem((-0.1, 0.02), &via),
@@ -443,6 +445,7 @@ fn invalid_inputs_are_rejected() {
         setup.problem((-0.1, 0.02), &far_via),
         setup.problem((0.02, -0.1), &via),
         setup.problem((-0.1, f64::NAN), &via),
+        wrong_h.problem((-0.1, 0.02), &via),
     ];
     for (i, p) in cases.iter().enumerate() {
         match solve_mpath(p) {

@@ -452,6 +452,7 @@ fn invalid_inputs_are_rejected() {
     let kv = KnotVector::clamped_uniform(5, 12).unwrap();
     let h = jerk_hessian(&kv).unwrap();
     let h_small = jerk_hessian(&KnotVector::clamped_uniform(5, 10).unwrap()).unwrap();
+    let h_scaled = h.scaled(2.0);
     let nan_via = [(0.5, f64::NAN)];
     let far_via = [(1.5, 0.0)];
     let ok_via = [(0.5, 0.0)];
@@ -472,6 +473,7 @@ fn invalid_inputs_are_rejected() {
         problem(&kv, &h, loose(), (0.0, 0.5), &ok_via),
         problem(&kv, &h, loose(), (1.0, -0.5), &ok_via),
         problem(&kv, &h_small, loose(), (1.0, 0.5), &ok_via),
+        problem(&kv, &h_scaled, loose(), (1.0, 0.5), &ok_via),
         problem(&kv, &h, bad_range, (1.0, 0.5), &ok_via),
         problem(&kv, &h, nan_jerk, (1.0, 0.5), &ok_via),
         nan_boundary,

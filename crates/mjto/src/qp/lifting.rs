@@ -132,6 +132,42 @@ impl JerkChain {
         y
     }
 
+    /// Checks that `h` is the jerk Hessian of these knots (eq. 18): `h x`
+    /// must equal `D₃ᵀ G D₃ x` for two probe vectors (a smooth and an
+    /// oscillating one) to 1e-6 relative.
+    ///
+    /// # Errors
+    /// A description of the mismatch.
+    pub fn check_hessian(&self, h: &BandedSym) -> Result<(), String> {
+        if h.n() != self.n1 {
+            return Err(format!("size {} for {} coefficients", h.n(), self.n1));
+        }
+        let n = self.n1 as f64;
+        let probes = [
+            (0..self.n1)
+                .map(|j| (j as f64 / n).powi(4))
+                .collect::<Vec<_>>(),
+            (0..self.n1)
+                .map(|j| (0.9 * j as f64).sin() + (j % 3) as f64)
+                .collect(),
+        ];
+        for x in probes {
+            let (a, b) = (h.mul_vec(&x), self.apply_h(&x));
+            let scale = b.iter().fold(0.0_f64, |m, v| m.max(v.abs()));
+            let diff = a
+                .iter()
+                .zip(&b)
+                .fold(0.0_f64, |m, (p, q)| m.max((p - q).abs()));
+            if !(diff <= 1e-6 * scale) {
+                return Err(format!(
+                    "it is not the jerk Hessian of these knots (H x differs by {diff:.3e} \
+                     from ∫N'''N''' x, scale {scale:.3e})"
+                ));
+            }
+        }
+        Ok(())
+    }
+
     /// `H x = D₃ᵀ G D₃ x` through the chain.
     pub fn apply_h(&self, x: &[f64]) -> Vec<f64> {
         let mut z = self.gram.mul_vec(&self.apply_d3(x));
@@ -163,6 +199,10 @@ mod tests {
             assert!((a - b).abs() < 1e-9 * hx.iter().fold(0.0_f64, |m, v| m.max(v.abs())));
         }
         assert_eq!(chain.n_aux(), 14 + 13 + 12);
+        assert!(chain.check_hessian(&h).is_ok());
+        assert!(chain.check_hessian(&h.scaled(1.01)).is_err());
+        let other = jerk_hessian(&KnotVector::clamped_uniform(4, 15).unwrap()).unwrap();
+        assert!(chain.check_hessian(&other).is_err());
         assert_eq!(chain.y_offsets(15), [15, 29, 42]);
     }
 }

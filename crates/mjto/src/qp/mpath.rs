@@ -303,6 +303,9 @@ impl<'p, 'a> MPathModel<'p, 'a> {
         let nmat = collocation(kv, p.params).map_err(|e| bad("params", e))?;
         let ntn = normal_matrix(&nmat, k);
         let chain = JerkChain::new(kv).map_err(|e| bad("knots", e))?;
+        chain
+            .check_hessian(p.hessian)
+            .map_err(|why| PlanError::invalid("M path hessian", why))?;
         let h_scale = p.hessian.max_abs();
         if !(h_scale.is_finite() && h_scale > 0.0) {
             return Err(PlanError::invalid(
