@@ -158,7 +158,7 @@ impl JerkChain {
                 .iter()
                 .zip(&b)
                 .fold(0.0_f64, |m, (p, q)| m.max((p - q).abs()));
-            if !(diff <= 1e-6 * scale) {
+            if diff.is_nan() || diff > 1e-6 * scale {
                 return Err(format!(
                     "it is not the jerk Hessian of these knots (H x differs by {diff:.3e} \
                      from ∫N'''N''' x, scale {scale:.3e})"
