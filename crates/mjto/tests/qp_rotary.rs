@@ -393,6 +393,26 @@ fn rto_outside_the_position_range_is_named() {
     }
 }
 
+/// Two RTOs asking different angles at the same parameter contradict each
+/// other: the RTO equalities are named.
+#[test]
+fn contradicting_rtos_are_named() {
+    let kv = KnotVector::clamped_uniform(5, 30).unwrap();
+    let h = jerk_hessian(&kv).unwrap();
+    let via = [(0.0, 0.0), (0.5, 0.3), (0.5, 0.4), (1.0, 0.2)];
+    match solve_rotary(&problem(&kv, &h, q4_limits(), (0.5, 0.1), &via)) {
+        Err(PlanError::Infeasible {
+            family,
+            max_feasible_feedrate,
+            ..
+        }) => {
+            assert_eq!(family, ConstraintFamily::Rto);
+            assert_eq!(max_feasible_feedrate, None);
+        }
+        other => panic!("expected Infeasible, got {other:?}"),
+    }
+}
+
 /// 628 coefficients (one per CL point of the paper's case, 4 ms × 628 =
 /// 2.51 s at f = 0.5 m/s): loose and tight-velocity cases solve, meet the
 /// vias, eq. 45 and the limits. Timings are printed, not asserted.
