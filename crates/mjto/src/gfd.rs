@@ -175,6 +175,18 @@ impl Gfd {
         limits: &[AxisLimits; 6],
     ) -> Self {
         let [l1, l2, l3, l4, l5, l6] = limits;
+        // Eq. 55 measures q4 against the IKT reference, which eq. 3 leaves
+        // undefined at q5 = 0 and ill-defined near it (the nominal q4 of a
+        // near-vertical axis swings with noise). A q4 offset δ moves the tool
+        // axis by δ·sin|q5| (eq. 2), so the q4 term is weighted by sin²q̂5:
+        // the distance to the reference is the axis displacement, and near
+        // the vertical the choice of q4 is left to the RTO-change term of
+        // eq. 56 and to collisions. Elsewhere (sin²q̂5 ≈ 1 on walls) eq. 55
+        // is unchanged.
+        let reference_weights = Weights {
+            k4: weights.k4 * reference[1].sin().powi(2),
+            ..*weights
+        };
         let q4s = centred(
             reference[0],
             q4_half_span(grid.q4_half_range, reference[1]),
@@ -240,7 +252,7 @@ impl Gfd {
                     let q = [q4, q5, q6];
                     gfd.candidates.push(Candidate {
                         q,
-                        distance: weighted_distance(&q, &reference, weights),
+                        distance: weighted_distance(&q, &reference, &reference_weights),
                         lead,
                         tilt,
                     });

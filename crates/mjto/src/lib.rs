@@ -9,9 +9,9 @@
 //!    representative tool orientations (RTO) ([`gfd`], section 2.4);
 //! 2. initial RTO selection by a shortest path over the layered candidate
 //!    graph ([`selection`], eq. 56);
-//! 3. the rotary-axis jerk QP ([`qp::rotary`], eq. 15-45, 57-61) and the
-//!    M-path QP of the standoff axis ([`qp::mpath`], eq. 46-54, 62, App. A),
-//!    both solved with Clarabel;
+//! 3. the rotary-axis jerk QP ([`rotary`], eq. 15-45, 57-61) and the
+//!    M-path QP of the standoff axis ([`standoff`], eq. 46-54, 62, App. A),
+//!    both solved with Clarabel as second-order cone programs;
 //! 4. a collision check of the whole trajectory at every controller sample,
 //!    RTO insertion and repetition (Figure 6; [`planner`]);
 //! 5. metrics beside the quaternion-interpolation baseline ([`baseline`],
@@ -32,9 +32,10 @@ pub mod metrics;
 pub mod orientation;
 pub mod plan;
 pub mod planner;
-pub mod qp;
 pub mod request;
+pub mod rotary;
 pub mod selection;
+pub mod standoff;
 pub mod timelaw;
 
 pub use error::PlanError;

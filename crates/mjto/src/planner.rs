@@ -24,7 +24,7 @@
 
 use std::time::Instant;
 
-use kerf_bspline::{jerk_hessian, BSpline, KnotVector};
+use kerf_bspline::{BSpline, KnotVector};
 use nalgebra::Vector3;
 
 use crate::baseline::{quaternion_interpolation, Rto};
@@ -37,10 +37,10 @@ use crate::mesh::MeshCache;
 use crate::metrics::{finite_differences, kinematic_metrics, limit_violations};
 use crate::orientation::PathFrames;
 use crate::plan::{Metrics, RtoRecord, StageTimes};
-use crate::qp::mpath::{solve_mpath, MPathProblem};
-use crate::qp::rotary::{solve_rotary, RotaryProblem};
 use crate::request::ValidatedRequest;
+use crate::rotary::{JerkFactor, RotaryQp};
 use crate::selection::select_rtos;
+use crate::standoff::{solve_standoff, MPathProblem};
 use crate::timelaw::{chain_rule, TimeLaw, MAX_SAMPLES};
 use crate::{CutPlan, CutRequest, LaserMachine, PlanError};
 
@@ -147,15 +147,37 @@ impl Planner {
 
         let t = Instant::now();
         let n_coeffs = match request.options.control_points {
-            0 => v.points.len(),
+            0 => automatic_control_points(v.sigma, v.points.len()),
             c => c,
         };
         let knots = KnotVector::for_parameters(DEGREE, n_coeffs, &v.u).map_err(bspline_error)?;
-        let hessian = jerk_hessian(&knots).map_err(bspline_error)?;
+        let factor = JerkFactor::new(&knots)?;
         times.hessian = t.elapsed().as_secs_f64();
 
-        ctx.run(&world, &knots, &hessian, times, start)
+        ctx.run(&world, &knots, &factor, times, start)
     }
+}
+
+/// Path length per control coefficient of the automatic choice (m).
+pub const AUTO_SPACING: f64 = 0.01;
+
+/// The automatic number of control coefficients: one per
+/// [`AUTO_SPACING`] of path, at least 12 and at most 100 (and never more
+/// than the CL points).
+///
+/// Seed 001 uses one coefficient per CL point (n + 1 = 628 in its case 2;
+/// `options.control_points` = the CL count reproduces that). Its cost grows
+/// with n² in the M-path problem while the CL error it buys is small: on
+/// the committed cases 1 cm per coefficient reproduces the CL points
+/// to 0.02-0.1 mm (BENCHMARKS.md).
+pub fn automatic_control_points(sigma: f64, n_points: usize) -> usize {
+    let n = (sigma / AUTO_SPACING).ceil();
+    let n = if n.is_finite() {
+        n.clamp(12.0, 100.0) as usize
+    } else {
+        12
+    };
+    n.min(n_points)
 }
 
 fn bspline_error(e: kerf_bspline::BsplineError) -> PlanError {
@@ -312,7 +334,7 @@ impl<'a> Context<'a> {
         &self,
         world: &CollisionWorld,
         knots: &KnotVector,
-        hessian: &kerf_bspline::BandedSym,
+        factor: &JerkFactor,
         mut times: StageTimes,
         start: Instant,
     ) -> Result<CutPlan, PlanError> {
@@ -347,7 +369,7 @@ impl<'a> Context<'a> {
         let mut iteration = 0;
         let (iterate, samples) = loop {
             iteration += 1;
-            let iterate = self.solve(knots, hessian, &rtos, &mut times)?;
+            let iterate = self.solve(knots, factor, &rtos, &mut times)?;
             let samples = self.sample(&iterate);
             let t = Instant::now();
             let violations = self.check(world, &samples);
@@ -455,7 +477,7 @@ impl<'a> Context<'a> {
     fn solve(
         &self,
         knots: &KnotVector,
-        hessian: &kerf_bspline::BandedSym,
+        factor: &JerkFactor,
         rtos: &[RtoState],
         times: &mut StageTimes,
     ) -> Result<Iterate, PlanError> {
@@ -464,18 +486,18 @@ impl<'a> Context<'a> {
         let mut rotary = Vec::with_capacity(2);
         for (k, name) in [(3usize, "q4"), (4usize, "q5")] {
             let via: Vec<(f64, f64)> = rtos.iter().map(|r| (r.u, r.q[k - 3])).collect();
-            let problem = RotaryProblem {
+            let problem = RotaryQp {
                 axis_name: name,
                 knots,
-                hessian,
+                factor,
                 limits: limits[k],
                 sigma: self.v.sigma,
                 feedrate: self.request.feedrate,
                 boundary: [0.0; 4],
                 via: &via,
             };
-            let sol = solve_rotary(&problem)?;
-            rotary.push(BSpline::new(knots.clone(), sol.coeffs).map_err(bspline_error)?);
+            let (coeffs, _) = problem.solve()?;
+            rotary.push(BSpline::new(knots.clone(), coeffs).map_err(bspline_error)?);
         }
         times.rotary_qp += t.elapsed().as_secs_f64();
         let q5 = rotary
@@ -495,7 +517,7 @@ impl<'a> Context<'a> {
         let via: Vec<(usize, f64)> = rtos.iter().map(|r| (r.cl_index, r.q[2])).collect();
         let problem = MPathProblem {
             knots,
-            hessian,
+            factor,
             params: &self.v.u,
             points: &self.v.points,
             axes: &axes,
@@ -503,7 +525,7 @@ impl<'a> Context<'a> {
             via: &via,
             reference: self.request.options.reference_standoff,
         };
-        let sol = solve_mpath(&problem)?;
+        let sol = solve_standoff(&problem)?;
         let [px, py, pz] = sol.control_points;
         let m = [
             BSpline::new(knots.clone(), px).map_err(bspline_error)?,

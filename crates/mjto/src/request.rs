@@ -117,7 +117,7 @@ impl Default for Weights {
     fn default() -> Self {
         Self {
             k1: 1.0,
-            k2: 0.05,
+            k2: 0.5,
             k4: 1.0,
             k5: 1.0,
             k6: 100.0,
@@ -129,8 +129,10 @@ impl Default for Weights {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct CutOptions {
-    /// Number of B-spline control coefficients n + 1; 0 = one per CL point
-    /// (the paper's choice). Otherwise 6 ≤ n + 1 ≤ number of CL points.
+    /// Number of B-spline control coefficients n + 1; 0 = automatic (one
+    /// per 10 mm of path, 12 to 100: `planner::automatic_control_points`).
+    /// Otherwise 6 ≤ n + 1 ≤ number of CL points; the CL count is the
+    /// paper's choice.
     pub control_points: usize,
     /// Maximum iterations of the loop of Figure 6 (≥ 1).
     pub max_iterations: usize,
