@@ -121,23 +121,35 @@ fn candidates_respect_the_lead_and_tilt_limits() {
     assert_eq!(wide.candidates.len(), 13 * 9 * 5);
 }
 
+/// Eq. 55 as `Gfd::build` applies it: the q4 term weighted by sin²q̂5 (the
+/// q4 offset δ moves the tool axis by about δ sin|q̂5|, eq. 2).
+fn eq55(q: &[f64; 3], reference: &[f64; 3], w: &Weights) -> f64 {
+    let k4 = w.k4 * reference[1].sin().powi(2);
+    (k4 * (q[0] - reference[0]).powi(2)
+        + w.k5 * (q[1] - reference[1]).powi(2)
+        + w.k6 * (q[2] - reference[2]).powi(2))
+    .sqrt()
+}
+
 #[test]
 fn candidates_are_sorted_by_eq55_and_reproduce_the_cl_point() {
     let reference = [0.1, 0.05, STANDOFF];
     let g = build(C, reference, 1.0);
     let w = Weights::default();
+    let reference_weights = Weights {
+        k4: w.k4 * 0.05f64.sin().powi(2),
+        ..w
+    };
     assert_eq!(g.candidates.len(), 13 * 9 * 5);
     // The reference itself is a candidate, at distance 0.
     assert_eq!(g.candidates[0].q, reference);
     assert_eq!(g.candidates[0].distance, 0.0);
     for (p, c) in g.candidates.iter().enumerate() {
-        let d = reference;
-        let expected = (w.k4 * (c.q[0] - d[0]).powi(2)
-            + w.k5 * (c.q[1] - d[1]).powi(2)
-            + w.k6 * (c.q[2] - d[2]).powi(2))
-        .sqrt();
-        assert!((c.distance - expected).abs() < 1e-15);
-        assert_eq!(c.distance, weighted_distance(&c.q, &reference, &w));
+        assert!((c.distance - eq55(&c.q, &reference, &w)).abs() < 1e-15);
+        assert_eq!(
+            c.distance,
+            weighted_distance(&c.q, &reference, &reference_weights)
+        );
         if p > 0 {
             assert!(g.candidates[p - 1].distance <= c.distance);
         }
@@ -147,28 +159,199 @@ fn candidates_are_sorted_by_eq55_and_reproduce_the_cl_point() {
         let c_fk = Vector3::new(q[0], q[1], q[2]) + q[5] * o;
         assert!((c_fk - Vector3::from(C)).norm() < 1e-14);
     }
-    // q5 neighbours are 0.075 away; q6 samples are 0.015 m apart, i.e.
-    // sqrt(k6) * 0.015 = 0.15, a tie with the second q5 neighbours.
-    for p in [1, 2] {
-        assert!((g.candidates[p].distance - 0.075).abs() < 1e-12);
+    // The whole sorted list of distances, from the grid enumerated here:
+    // q4 = 0.1 + j pi/6 (|j| <= 6), q5 = 0.05 + 0.075 a (|a| <= 4), q6 =
+    // -0.1 + 0.015 b (b = 0..4).
+    let mut expected: Vec<f64> = Vec::new();
+    for j in -6..=6 {
+        for a in -4..=4 {
+            for b in 0..5 {
+                let q = [
+                    0.1 + PI * j as f64 / 6.0,
+                    0.05 + 0.075 * a as f64,
+                    -0.1 + 0.015 * b as f64,
+                ];
+                expected.push(eq55(&q, &reference, &w));
+            }
+        }
     }
-    for p in 3..7 {
-        assert!((g.candidates[p].distance - 0.15).abs() < 1e-12, "{p}");
+    expected.sort_by(f64::total_cmp);
+    for (c, e) in g.candidates.iter().zip(&expected) {
+        assert!((c.distance - e).abs() < 1e-12, "{} {e}", c.distance);
     }
-    assert!((g.candidates[7].distance - 0.075 * 5f64.sqrt()).abs() < 1e-12);
-    // sin(0.05) * pi < 0.35: q4 spans the full circle, 30 deg apart. Every
-    // (q5, q6) offset with the reference q4 (0.075 sqrt(a² + 4 b²) with
-    // |a| <= 4, |b| <= 2: at most 0.42) is nearer than the q4 neighbours
-    // at pi / 6 = 0.524: 45 candidates come first.
-    assert!(g.candidates[..45].iter().all(|c| c.q[0] == reference[0]));
-    assert!((g.candidates[45].distance - PI / 6.0).abs() < 1e-12);
-    assert!((g.candidates[45].q[0] - reference[0]).abs() - PI / 6.0 < 1e-12);
+    // sin(0.05) * pi < 0.35: q4 spans the full circle, 30 deg apart, and a
+    // q4 step of pi/6 costs sin(0.05) pi/6 = 0.026169 only: the q4
+    // neighbours come before the q5 neighbours (0.075 away; q6 samples,
+    // 0.015 m apart, cost sqrt(k6) 0.015 = 0.15). The order (ties in grid
+    // order, q4 ascending):
+    //   1, 2: q4 -+ pi/6 (0.026169); 3, 4: q4 -+ pi/3 (0.052338);
+    //   5, 6: q5 -+ 0.075; 7, 8: q4 -+ pi/2 (0.078507);
+    //   9..12: q4 -+ pi/6 with q5 -+ 0.075 (0.079434);
+    //   13..16: q4 -+ pi/3 with q5 -+ 0.075 (0.091457).
+    let step = 0.05f64.sin() * PI / 6.0;
+    assert!((step - 0.026_169).abs() < 1e-6);
+    let offsets = |p: usize| {
+        let q = g.candidates[p].q;
+        (
+            ((q[0] - reference[0]) / (PI / 6.0)).round() as i32,
+            ((q[1] - reference[1]) / 0.075).round() as i32,
+            ((q[2] - reference[2]) / 0.015).round() as i32,
+        )
+    };
+    let order: Vec<(i32, i32, i32)> = (0..17).map(offsets).collect();
+    assert_eq!(
+        order,
+        vec![
+            (0, 0, 0),
+            (-1, 0, 0),
+            (1, 0, 0),
+            (-2, 0, 0),
+            (2, 0, 0),
+            (0, -1, 0),
+            (0, 1, 0),
+            (-3, 0, 0),
+            (3, 0, 0),
+            (-1, -1, 0),
+            (-1, 1, 0),
+            (1, -1, 0),
+            (1, 1, 0),
+            (-2, -1, 0),
+            (-2, 1, 0),
+            (2, -1, 0),
+            (2, 1, 0),
+        ]
+    );
+    let want = [
+        0.0,
+        step,
+        step,
+        2.0 * step,
+        2.0 * step,
+        0.075,
+        0.075,
+        3.0 * step,
+        3.0 * step,
+    ];
+    for (p, d) in want.iter().enumerate() {
+        assert!((g.candidates[p].distance - d).abs() < 1e-12, "{p}");
+    }
+    assert!((3.0 * step - 0.078_507).abs() < 1e-6);
+    for p in 9..13 {
+        let d = (step * step + 0.075 * 0.075).sqrt();
+        assert!((g.candidates[p].distance - d).abs() < 1e-12, "{p}");
+        assert!((d - 0.079_434).abs() < 1e-6);
+    }
+    for p in 13..17 {
+        let d = (4.0 * step * step + 0.075 * 0.075).sqrt();
+        assert!((g.candidates[p].distance - d).abs() < 1e-12, "{p}");
+        assert!((d - 0.091_457).abs() < 1e-6);
+    }
+    // The q4 term is the tool-axis displacement: the axes of the q4
+    // neighbours are 2 asin(sin(0.05) sin(pi/12)) = 0.025872 rad from the
+    // reference axis, 1.2 % below the weighted q4 step.
+    let o_ref = tool_axis(reference[0], reference[1]);
+    let angle = tool_axis(g.candidates[1].q[0], g.candidates[1].q[1]).angle(&o_ref);
+    assert!((angle - 0.025_872).abs() < 1e-6, "{angle}");
+    assert!((g.candidates[1].distance / angle - 1.0).abs() < 0.013);
     let q4s = distinct(&g, 0);
     assert_eq!(q4s.len(), 13);
     assert!((q4s[0] - (reference[0] - PI)).abs() < 1e-12);
     assert!((q4s[12] - (reference[0] + PI)).abs() < 1e-12);
     for pair in q4s.windows(2) {
         assert!((pair[1] - pair[0] - PI / 6.0).abs() < 1e-12);
+    }
+}
+
+#[test]
+fn eq55_q4_weight_is_sin_squared_of_the_reference_q5() {
+    let w = Weights::default();
+    // Vertical reference (q̂5 = 0): q4 is undefined (eq. 3) and costs
+    // nothing; candidates differing only in q4 have the same distance,
+    // sqrt(k5 dq5² + k6 dq6²).
+    for q5_ref in [0.0, -0.0] {
+        let reference = [0.4, q5_ref, STANDOFF];
+        let g = build(C, reference, 0.3);
+        assert_eq!(distinct(&g, 0).len(), 13);
+        let mut groups = 0;
+        for c in &g.candidates {
+            let same: Vec<_> = g
+                .candidates
+                .iter()
+                .filter(|d| d.q[1] == c.q[1] && d.q[2] == c.q[2])
+                .collect();
+            if same.len() > 1 {
+                groups += 1;
+            }
+            for d in &same {
+                assert_eq!(d.distance, c.distance, "{:?} {:?}", c.q, d.q);
+            }
+            let plain =
+                (w.k5 * (c.q[1] - q5_ref).powi(2) + w.k6 * (c.q[2] - STANDOFF).powi(2)).sqrt();
+            assert!((c.distance - plain).abs() < 1e-15);
+        }
+        assert!(groups > 0);
+        // So the 13 q4 samples at the reference q5, q6 all tie at 0 and
+        // keep grid order (q4 ascending, from 0.4 - pi).
+        for (j, c) in g.candidates[..13].iter().enumerate() {
+            assert_eq!(c.distance, 0.0);
+            assert_eq!((c.q[1], c.q[2]), (q5_ref, STANDOFF));
+            assert!((c.q[0] - (0.4 - PI + PI * j as f64 / 6.0)).abs() < 1e-12);
+        }
+        assert!(g.candidates[13].distance > 0.0);
+    }
+
+    // A horizontal reference axis (q̂5 = pi/2, sin² = 1): the plain k4 of
+    // eq. 55, here a non-default k4 = 2.5. The lead/tilt test is switched
+    // off (every axis accepted) to keep the whole grid.
+    let m = machine();
+    let weights = Weights { k4: 2.5, ..w };
+    let accept = |_: &Vector3<f64>| (0.0, 0.0);
+    let build_with = |reference: [f64; 3]| {
+        Gfd::build(
+            2,
+            0.5,
+            &Vector3::from(C),
+            reference,
+            &GfdGrid::default(),
+            &weights,
+            0.2,
+            0.2,
+            &accept,
+            m.limits(),
+        )
+    };
+    let reference = [0.2, FRAC_PI_2, STANDOFF];
+    let g = build_with(reference);
+    // q5 above pi/2 is out of range: 4 of the 9 q5 samples.
+    assert_eq!(g.range_rejected, 13 * 4 * 5);
+    assert_eq!(g.candidates.len(), 13 * 5 * 5);
+    for c in &g.candidates {
+        assert_eq!(c.distance, weighted_distance(&c.q, &reference, &weights));
+    }
+    // q4 samples 0.35 / 6 apart (q4_half_span(0.35, pi/2) = 0.35): the
+    // two q4 neighbours, sqrt(2.5) 0.35 / 6 = 0.092233, come right after
+    // the single q5 neighbour at 0.075 (the other one is above pi/2).
+    assert_eq!(g.candidates[0].q, reference);
+    assert_eq!(g.candidates[1].q[0], reference[0]);
+    assert!((g.candidates[1].q[1] - (FRAC_PI_2 - 0.075)).abs() < 1e-12);
+    assert!((g.candidates[1].distance - 0.075).abs() < 1e-12);
+    for p in [2, 3] {
+        let c = g.candidates[p];
+        assert_eq!((c.q[1], c.q[2]), (reference[1], reference[2]));
+        assert!(((c.q[0] - reference[0]).abs() - 0.35 / 6.0).abs() < 1e-12);
+        assert!((c.distance - 2.5f64.sqrt() * 0.35 / 6.0).abs() < 1e-12);
+    }
+    // In between: k4 sin²(q̂5), e.g. q̂5 = 0.5: 2.5 * 0.229849 = 0.574623.
+    let reference = [0.2, 0.5, STANDOFF];
+    let g = build_with(reference);
+    let k4 = 2.5 * 0.5f64.sin().powi(2);
+    assert!((k4 - 0.574_623).abs() < 1e-6);
+    for c in &g.candidates {
+        let expected = (k4 * (c.q[0] - 0.2).powi(2)
+            + (c.q[1] - 0.5).powi(2)
+            + 100.0 * (c.q[2] - STANDOFF).powi(2))
+        .sqrt();
+        assert!((c.distance - expected).abs() < 1e-15, "{:?}", c.q);
     }
 }
 
@@ -221,11 +404,16 @@ fn collision_status_is_lazy_and_memoised() {
     let world = sheet_world();
     let mut g = build(C, [0.0, 0.0, STANDOFF], 0.2);
     assert_eq!(g.collision_checked(), 0);
-    // The reference (M 7 cm above the sheet, fork arms 1 cm above it) is
+    // q̂5 = 0: the q4 term of eq. 55 has weight sin²(0) = 0, so the 13 q4
+    // samples at the reference q5, q6 tie at distance 0 in grid order
+    // (q4 = -pi, -5 pi/6, ..., pi); the reference itself (q4 = 0) is the
+    // seventh. It (M 7 cm above the sheet, fork arms 1 cm above it) is
     // free.
-    assert_eq!(g.candidates[0].q, [0.0, 0.0, STANDOFF]);
-    assert!(g.is_free(0, &world));
-    assert!(g.is_free(0, &world));
+    assert!(g.candidates[..13].iter().all(|c| c.distance == 0.0));
+    assert_eq!(g.candidates[0].q, [-PI, 0.0, STANDOFF]);
+    assert_eq!(g.candidates[6].q, [0.0, 0.0, STANDOFF]);
+    assert!(g.is_free(6, &world));
+    assert!(g.is_free(6, &world));
     assert_eq!((g.collision_checked(), world.queries()), (1, 1));
     // A candidate with q6 = -0.04 (M 4 cm above C: the tilt housing,
     // radius 4.5 cm, contains C and the fork arms reach 2 cm into the
