@@ -112,6 +112,8 @@ struct Pieces {
     k2: [DMatrix<f64>; 3],
     /// Lᵀ D₃ (rows: third-derivative coefficients).
     ltd3: DMatrix<f64>,
+    /// Lower Cholesky factor of NᵀN.
+    ntn_l: DMatrix<f64>,
 }
 
 fn pieces(p: &MPathProblem) -> Result<Pieces, PlanError> {
@@ -155,7 +157,14 @@ fn pieces(p: &MPathProblem) -> Result<Pieces, PlanError> {
             ltd3[(i, j)] = v;
         }
     }
-    Ok(Pieces { n, k1, k2, ltd3 })
+    let ntn_l = chol.l();
+    Ok(Pieces {
+        n,
+        k1,
+        k2,
+        ltd3,
+        ntn_l,
+    })
 }
 
 /// D and f of eq. 53 / Appendix A (A4, A5), per axis: `J_M(s) = ½ sᵀ D s +
@@ -229,7 +238,29 @@ pub fn solve_standoff(p: &MPathProblem) -> Result<MPathSolution, PlanError> {
     r_vec /= scale;
     let sqrt_tau =
         (TIKHONOV * r_mat.norm_squared() / pc.n.norm_squared().max(f64::MIN_POSITIVE)).sqrt();
+    let nt_w = pc.n.transpose() * DVector::from_element(m, p.reference);
+    let tik_c = pc
+        .ntn_l
+        .solve_lower_triangular(&nt_w)
+        .ok_or_else(|| solver_error("NᵀN factor is singular"))?;
 
+    // The cone rows ‖R s + r‖² + τ‖Lᵀ s − c‖² = ‖M s − y‖², compressed by a
+    // QR factorisation M = Q R̃ to ‖R̃ s − Q₁ᵀ y‖ (+ a constant, which does
+    // not move the minimiser): n + 1 rows, and R̃ keeps the conditioning
+    // of M (no normal equations).
+    let mut stacked = DMatrix::zeros(3 * rows + nc, nc);
+    let mut target = DVector::zeros(3 * rows + nc);
+    stacked.rows_mut(0, 3 * rows).copy_from(&r_mat);
+    target.rows_mut(0, 3 * rows).copy_from(&(-&r_vec));
+    stacked
+        .rows_mut(3 * rows, nc)
+        .copy_from(&(pc.ntn_l.transpose() * sqrt_tau));
+    target
+        .rows_mut(3 * rows, nc)
+        .copy_from(&(&tik_c * sqrt_tau));
+    let qr = stacked.qr();
+    let r_tilde = qr.r();
+    let y_tilde = qr.q().transpose() * &target;
     let try_solve = |with_stroke: bool| -> Result<Option<(DVector<f64>, u32)>, PlanError> {
         let nx = nc + 1;
         let (mut ii, mut jj, mut vv) = (Vec::new(), Vec::new(), Vec::new());
@@ -257,35 +288,30 @@ pub fn solve_standoff(p: &MPathProblem) -> Result<MPathSolution, PlanError> {
         }
         cones.push(SupportedConeT::ZeroConeT(p.via.len()));
         if with_stroke {
-            for i in 0..m {
-                let c: Vec<(usize, f64)> = (0..nc).map(|j| (j, pc.n[(i, j)])).collect();
-                push_row(&mut ii, &mut jj, &mut vv, row, &c);
+            // Convex hull (as eq. 15 for the rotary axes): bounds on the
+            // coefficients of q6(u) keep the whole curve, not only the CL
+            // points of eq. 54, inside the stroke.
+            for j in 0..nc {
+                push_row(&mut ii, &mut jj, &mut vv, row, &[(j, 1.0)]);
                 b.push(hi);
                 row += 1;
-                let c: Vec<(usize, f64)> = (0..nc).map(|j| (j, -pc.n[(i, j)])).collect();
-                push_row(&mut ii, &mut jj, &mut vv, row, &c);
+                push_row(&mut ii, &mut jj, &mut vv, row, &[(j, -1.0)]);
                 b.push(-lo);
                 row += 1;
             }
-            cones.push(SupportedConeT::NonnegativeConeT(2 * m));
+            cones.push(SupportedConeT::NonnegativeConeT(2 * nc));
         }
-        // SOC: (t, −(R s + r), −√τ (N s − w_ref)).
+        // SOC: (t, R̃ s − ỹ).
         push_row(&mut ii, &mut jj, &mut vv, row, &[(nc, -1.0)]);
         b.push(0.0);
         row += 1;
-        for k in 0..3 * rows {
-            let c: Vec<(usize, f64)> = (0..nc).map(|j| (j, r_mat[(k, j)])).collect();
+        for k in 0..nc {
+            let c: Vec<(usize, f64)> = (k..nc).map(|j| (j, -r_tilde[(k, j)])).collect();
             push_row(&mut ii, &mut jj, &mut vv, row, &c);
-            b.push(-r_vec[k]);
+            b.push(-y_tilde[k]);
             row += 1;
         }
-        for i in 0..m {
-            let c: Vec<(usize, f64)> = (0..nc).map(|j| (j, sqrt_tau * pc.n[(i, j)])).collect();
-            push_row(&mut ii, &mut jj, &mut vv, row, &c);
-            b.push(sqrt_tau * p.reference);
-            row += 1;
-        }
-        cones.push(SupportedConeT::SecondOrderConeT(1 + 3 * rows + m));
+        cones.push(SupportedConeT::SecondOrderConeT(1 + nc));
         let a = CscMatrix::new_from_triplets(row, nx, ii, jj, vv);
         let pm = CscMatrix::zeros((nx, nx));
         let mut q = vec![0.0; nx];
