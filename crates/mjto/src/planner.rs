@@ -693,7 +693,16 @@ impl<'a> Context<'a> {
             };
             let u = self.v.u[i];
             let target = [it.q4.eval(u)[0], it.q5.eval(u)[0], it.w[i]];
-            let mut gfd = self.build_gfd(i, target);
+            // The grid is centred on the trajectory's orientation and spans
+            // the usual q6 range around the preferred standoff (a q6 at a
+            // stroke end would leave no q6 span); the candidate taken is the
+            // free one nearest (eq. 55) to the trajectory's (q4, q5, q6).
+            let centre = [
+                target[0],
+                target[1],
+                self.request.options.reference_standoff,
+            ];
+            let mut gfd = self.build_gfd(i, centre);
             let weights = &self.request.options.weights;
             let Some(p) = gfd.nearest_free(target, weights, world) else {
                 return Err(PlanError::NoFeasibleOrientation {

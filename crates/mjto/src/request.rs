@@ -376,7 +376,7 @@ impl CutRequest {
             return Err(PlanError::invalid(
                 "options.control_points",
                 format!(
-                    "{} must be 0 (one per CL point) or in [6, {n}]",
+                    "{} must be 0 (automatic) or in [6, {n}] (the CL count is seed 001's choice)",
                     o.control_points
                 ),
             ));
