@@ -97,7 +97,7 @@ pub struct CutRequest {
     pub mesh: String,
     /// Pose of the workpiece frame in the machine frame; a unit quaternion (w = 1 = identity).
     pub workpiece_pose: Pose,
-    /// B-spline control coefficients n + 1; 0 = default (one per CL point).
+    /// B-spline control coefficients n + 1; 0 = automatic (one per 10 mm of path, 12 to 100).
     pub control_points: u32,
     /// Maximum iterations of the collision loop; 0 = default 10.
     pub max_iterations: u32,
