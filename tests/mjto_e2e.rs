@@ -567,16 +567,17 @@ fn case1_runs_from_planner_through_executor() {
             start.position
         );
     }
-    // The planner's trajectory publisher must be matched with the executor before planning.
+    // The planner's (remapped) trajectory publisher is the only writer on the executor's
+    // input; it must be discovered before planning.
     let deadline = Instant::now() + QUICK;
     while !watch
         .discovered_topics()
         .iter()
-        .any(|(t, _)| t == "/mjto_planner/joint_trajectory")
+        .any(|(t, _)| t == "/trajectory_executor/joint_trajectory")
     {
         assert!(
             Instant::now() < deadline,
-            "planner's trajectory topic not discovered"
+            "the planner's remapped trajectory writer was not discovered"
         );
         std::thread::sleep(Duration::from_millis(20));
     }
