@@ -786,11 +786,17 @@ impl<'a> Context<'a> {
             let (lead, tilt) = self.frames.lead_tilt(u, &o);
             m.max_lead_angle = m.max_lead_angle.max(lead.abs());
             m.max_tilt_angle = m.max_tilt_angle.max(tilt.abs());
-            if let Some(w) = world {
-                if !w.is_free(q) {
-                    m.colliding_samples += 1;
-                }
-            }
+        }
+        if let Some(w) = world {
+            // Two threads, as the dense check of the plan itself.
+            let half = q.len() / 2;
+            let count = |part: &[[f64; 6]]| part.iter().filter(|q| !w.is_free(q)).count();
+            m.colliding_samples = std::thread::scope(|scope| {
+                let second = scope.spawn(|| count(&q[half..]));
+                let first = count(&q[..half]);
+                // A panicking check thread counts every sample of its half.
+                first + second.join().unwrap_or(q.len() - half)
+            });
         }
     }
 }
