@@ -666,8 +666,13 @@ fn case1_runs_from_planner_through_executor() {
         moved > 0.5 * (last[0] - first[0]).abs(),
         "q1 moved only {moved} m"
     );
-    // After the end: at rest on the last point.
-    let end = PlannerClient::take(&states, QUICK, "joint state after the cut");
+    // After the end: at rest on the last point (the newest state, read after a short hold;
+    // states queued before SUCCEEDED was seen may still be decelerating).
+    std::thread::sleep(Duration::from_millis(200));
+    let mut end = PlannerClient::take(&states, QUICK, "joint state after the cut");
+    while let Ok(Some((s, _))) = states.take() {
+        end = s;
+    }
     for (j, (got, want)) in end.position.iter().zip(last).enumerate() {
         assert!(
             (got - want).abs() < 1e-4,
@@ -805,8 +810,11 @@ fn planned_trajectory_format_runs_on_the_executor() {
         outcome,
         [TrajectoryStatus::ACCEPTED, TrajectoryStatus::SUCCEEDED]
     );
-    while let Ok(Some(_)) = states.take() {}
-    let end = PlannerClient::take(&states, QUICK, "joint state after the motion");
+    std::thread::sleep(Duration::from_millis(200));
+    let mut end = PlannerClient::take(&states, QUICK, "joint state after the motion");
+    while let Ok(Some((s, _))) = states.take() {
+        end = s;
+    }
     for j in 0..6 {
         let want = start[j] + delta[j];
         assert!(
