@@ -14,6 +14,8 @@ use std::time::{Duration, Instant};
 use kerf_msgs::{msg::CutPlan, std_msgs::StringMsg, RosType};
 use kerf_ros::{qos, ros2_client::ServiceMapping};
 
+// Shared with the end-to-end tests; spawn_executor is not used here.
+#[allow(dead_code)]
 #[path = "../tests/support/mod.rs"]
 mod support;
 
