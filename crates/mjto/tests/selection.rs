@@ -147,7 +147,12 @@ fn single_layer_is_the_nearest_free_candidate() {
     let w = Weights::default();
     let choice = select_rtos(&mut gfds, &sigma, &w, &world).unwrap();
     let mut g = gfds[0].clone();
-    let nearest = g.nearest_free(g.reference, &w, &world).unwrap();
+    // The GFD's distances (eq. 55 to the reference) weight q4 by sin²q̂5.
+    let reference_w = Weights {
+        k4: w.k4 * g.reference[1].sin().powi(2),
+        ..w
+    };
+    let nearest = g.nearest_free(g.reference, &reference_w, &world).unwrap();
     assert_eq!(choice, vec![nearest]);
 }
 
@@ -235,7 +240,7 @@ fn empty_layer_and_bad_inputs() {
             index: 0, reason, ..
         }) => {
             assert!(
-                reason.starts_with("486 grid samples: 486 outside the lead/tilt limits"),
+                reason.starts_with("585 grid samples: 585 outside the lead/tilt limits"),
                 "{reason}"
             );
         }
