@@ -18,7 +18,11 @@ fn case_files_become_equivalent_cut_request_messages() {
             .arg(&path)
             .output()
             .expect("python3 runs");
-        assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
         let message: msg::CutRequest =
             serde_json::from_slice(&out.stdout).expect("the output is a CutRequest message");
         let from_msg = kerf_mjto_planner::convert::request_from_msg(&message).expect("converts");
