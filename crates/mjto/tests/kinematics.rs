@@ -10,20 +10,8 @@ use kerf_mjto::kinematics::{
 use kerf_mjto::{LaserMachine, PlanError};
 use nalgebra::Vector3;
 
-/// Deterministic xorshift64* generator in [0, 1).
-struct Rng(u64);
-
-impl Rng {
-    fn next(&mut self) -> f64 {
-        self.0 ^= self.0 >> 12;
-        self.0 ^= self.0 << 25;
-        self.0 ^= self.0 >> 27;
-        (self.0.wrapping_mul(0x2545_F491_4F6C_DD1D) >> 11) as f64 / (1u64 << 53) as f64
-    }
-    fn range(&mut self, lo: f64, hi: f64) -> f64 {
-        lo + (hi - lo) * self.next()
-    }
-}
+mod common;
+use common::Rng;
 
 fn machine() -> LaserMachine {
     LaserMachine::default_machine().expect("the repository's laser cutter loads")

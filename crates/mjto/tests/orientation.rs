@@ -7,20 +7,8 @@ use kerf_mjto::orientation::{any_perpendicular, axis_from_lead_tilt, slerp_unit,
 use kerf_mjto::PlanError;
 use nalgebra::Vector3;
 
-/// Deterministic xorshift64* generator in [0, 1).
-struct Rng(u64);
-
-impl Rng {
-    fn next(&mut self) -> f64 {
-        self.0 ^= self.0 >> 12;
-        self.0 ^= self.0 << 25;
-        self.0 ^= self.0 >> 27;
-        (self.0.wrapping_mul(0x2545_F491_4F6C_DD1D) >> 11) as f64 / (1u64 << 53) as f64
-    }
-    fn range(&mut self, lo: f64, hi: f64) -> f64 {
-        lo + (hi - lo) * self.next()
-    }
-}
+mod common;
+use common::Rng;
 
 /// Normalised arc length of a polyline.
 fn arc_u(points: &[Vector3<f64>]) -> Vec<f64> {

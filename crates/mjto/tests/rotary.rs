@@ -13,18 +13,8 @@ use nalgebra::{DMatrix, DVector};
 
 const K: usize = 5;
 
-/// Deterministic uniform numbers in [-1, 1) (xorshift64*).
-struct Rng(u64);
-
-impl Rng {
-    fn next(&mut self) -> f64 {
-        self.0 ^= self.0 >> 12;
-        self.0 ^= self.0 << 25;
-        self.0 ^= self.0 >> 27;
-        let x = self.0.wrapping_mul(0x2545_f491_4f6c_dd1d) >> 11;
-        2.0 * (x as f64 / (1u64 << 53) as f64) - 1.0
-    }
-}
+mod common;
+use common::Rng;
 
 /// Limits that never bind here (positions ±10 rad, 100 rad/s, 10³ rad/s²,
 /// 10⁴ rad/s³; the curves below stay an order of magnitude inside).
@@ -180,7 +170,7 @@ fn jerk_cost_equals_the_banded_hessian_and_a_quadrature() {
         assert_eq!(factor.n_coeffs, 12);
         let h = dense_h(knots);
         for trial in 0..5 {
-            let theta: Vec<f64> = (0..12).map(|_| rng.next()).collect();
+            let theta: Vec<f64> = (0..12).map(|_| rng.signed()).collect();
             let cost = factor.jerk_cost(&theta);
             let t = DVector::from_column_slice(&theta);
             let banded = (t.transpose() * &h * &t)[(0, 0)];

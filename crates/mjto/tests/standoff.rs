@@ -17,18 +17,8 @@ const K: usize = 5;
 const STROKE: (f64, f64) = (-0.1, 0.02);
 const REFERENCE: f64 = -0.07;
 
-/// Deterministic uniform numbers in [-1, 1) (xorshift64*).
-struct Rng(u64);
-
-impl Rng {
-    fn next(&mut self) -> f64 {
-        self.0 ^= self.0 >> 12;
-        self.0 ^= self.0 << 25;
-        self.0 ^= self.0 >> 27;
-        let x = self.0.wrapping_mul(0x2545_f491_4f6c_dd1d) >> 11;
-        2.0 * (x as f64 / (1u64 << 53) as f64) - 1.0
-    }
-}
+mod common;
+use common::Rng;
 
 /// A path of `m` CL points with `nc` spline coefficients.
 struct Path {
@@ -187,7 +177,7 @@ fn dense_objective_is_the_jerk_of_the_fitted_m_path() {
         assert!(eig.min() >= -1e-9 * eig.max(), "{}", eig.min());
         let c = path.jerk(&vec![0.0; m]);
         for trial in 0..5 {
-            let s: Vec<f64> = (0..nc).map(|_| REFERENCE + 0.04 * rng.next()).collect();
+            let s: Vec<f64> = (0..nc).map(|_| REFERENCE + 0.04 * rng.signed()).collect();
             let sv = DVector::from_column_slice(&s);
             let quad = 0.5 * (sv.transpose() * &d * &sv)[(0, 0)] + f.dot(&sv) + c;
             let direct = path.jerk(&path.w_of(&s));
