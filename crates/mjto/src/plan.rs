@@ -41,7 +41,10 @@ pub struct Metrics {
     pub max_lead_angle: f64,
     /// Largest |tilt angle| against the nominal tool axis (rad).
     pub max_tilt_angle: f64,
-    /// Samples at which the head touches the workpiece.
+    /// Samples at which the head touches the workpiece. For the MJTO
+    /// plan this is the result of the loop's last dense check, which must
+    /// be clean for a plan to exist (so 0); for QI it is counted on its own
+    /// samples.
     pub colliding_samples: usize,
 }
 
