@@ -25,3 +25,15 @@ pub use model::{
     chip_direction, force_direction, DdeSample, DelayTerm, MillingProcess, Modal2, Mode,
     PeriodicDde,
 };
+pub use directional::{
+    constant_delay_dde, constant_delay_dde_unit_depth, directional_averages,
+    mean_directional_matrix, scale_dde,
+};
+pub use fdm::{CompiledDde, Discretization, DEFAULT_STEPS};
+pub use lobes::{critical_depth, stability_lobes, LobeOptions, LobePoint};
+pub use spectral::{
+    eigenvalues_dense, spectral_radius_arnoldi, spectral_radius_dense, ArnoldiOptions,
+};
+pub use timedomain::{
+    classify, simulate, Growth, PeriodSample, Simulation, SimulationSettings, StepSample, Verdict,
+};
