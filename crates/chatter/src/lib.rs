@@ -34,3 +34,6 @@ pub use lobes::{critical_depth, stability_lobes, LobeOptions, LobePoint};
 pub use spectral::{
     eigenvalues_dense, spectral_radius_arnoldi, spectral_radius_dense, ArnoldiOptions,
 };
+pub use timedomain::{
+    classify, simulate, Growth, PeriodSample, Simulation, SimulationSettings, StepSample, Verdict,
+};

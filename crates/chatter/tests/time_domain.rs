@@ -1,0 +1,260 @@
+//! Cross-checks of the nonlinear time-domain simulation
+//! ([`kerf_chatter::timedomain`], seed 004 eq. 1-4) against things it was
+//! not built from: the free vibration of the structure, the analytic chip
+//! and mean force of a rigid tool, and (issue 4 section 5) the stability
+//! boundary of the semi/full-discretization and of the state-dependent
+//! indicator.
+
+use std::f64::consts::PI;
+
+use kerf_chatter::{
+    classify, force_direction, simulate, ChatterError, MillingProcess, Modal2, Mode,
+    SimulationSettings, Verdict,
+};
+
+/// The 2-DOF textbook system of Insperger & Stépán (2004, Int. J. Numer.
+/// Meth. Eng. 61:117, section 5): f_n = 922 Hz, ζ = 0.011, m = 0.03993 kg
+/// in x and y.
+fn textbook_modal() -> Result<Modal2, ChatterError> {
+    let mode = Mode {
+        natural_frequency_hz: 922.0,
+        damping_ratio: 0.011,
+        modal_mass: 0.03993,
+    };
+    Modal2::from_modes(mode, mode)
+}
+
+/// Its cut: 2 teeth, K_t = 6e8, K_n = 2e8 N/m², a/D = 0.05 down milling;
+/// the radius (not needed by the constant-delay model) is R = 10 mm.
+fn textbook_process(depth: f64) -> Result<MillingProcess, ChatterError> {
+    let (entry, exit) = MillingProcess::down_milling_angles(0.05)?;
+    Ok(MillingProcess {
+        teeth: 2,
+        radius: 0.01,
+        axial_depth: depth,
+        kt: 6e8,
+        kn: 2e8,
+        entry_angle: entry,
+        exit_angle: exit,
+    })
+}
+
+/// The cut of seed 004 Table 1: 2 teeth, R = 0.04 m, a_p = 3 mm,
+/// K_t = 6.44e8, K_n = 2.37e8 N/m², engagement [0.75π, π].
+fn seed_process(depth: f64) -> MillingProcess {
+    MillingProcess {
+        teeth: 2,
+        radius: 0.04,
+        axial_depth: depth,
+        kt: 6.44e8,
+        kn: 2.37e8,
+        entry_angle: 0.75 * PI,
+        exit_angle: PI,
+    }
+}
+
+/// (c) Zero cutting force (K_t = K_n = 0, the same as zero depth): the
+/// deviation from periodicity is a free vibration, which decays by
+/// exp(−ζ ω_n T) per period.
+#[test]
+fn free_vibration_decays_at_the_modal_rate() -> Result<(), ChatterError> {
+    let modal = textbook_modal()?;
+    let process = MillingProcess {
+        kt: 0.0,
+        kn: 0.0,
+        ..textbook_process(1e-3)?
+    };
+    let rpm = 10_000.0;
+    let period = process.tooth_period(rpm)?;
+    let sim = simulate(
+        &modal,
+        &process,
+        rpm,
+        1e-4 / period,
+        &SimulationSettings::default(),
+    )?;
+    assert_eq!(sim.orbit_iterations, 1);
+    assert!(sim.orbit.iter().all(|s| s.position.norm() == 0.0));
+    let expected = (-0.011 * 2.0 * PI * 922.0 * period).exp();
+    let growth = classify(&sim)?;
+    println!("free decay: factor {} expected {expected}", growth.factor);
+    // From period 1 on: period 0 compares the perturbed start with the
+    // unperturbed history, not two perturbed periods.
+    for w in sim.periods[1..].windows(2) {
+        let r = w[1].deviation / w[0].deviation;
+        // The energy norm of a damped mode ripples by O(ζ) within a cycle.
+        assert!((r - expected).abs() < 1.5e-2, "ratio {r} vs {expected}");
+    }
+    assert!((growth.factor - expected).abs() < 1e-3, "{growth:?}");
+    assert_eq!(growth.verdict, Verdict::Stable);
+    Ok(())
+}
+
+/// (c) A stiff tool (m = 1e4 kg, f_n = 500 Hz: k ≈ 1e11 N/m, deflection
+/// ~ 1e-8 m) cuts the rigid-tool trochoid: chip = f_z sin φ to first order
+/// in f/(RΩ) and f_z/R (0.3 % and 1 % here); to second order (eq. 3:
+/// R sin δ = −f τ cos φ, τ = T + δ/Ω; eq. 4: h = R (1 − cos δ) + f τ sin φ)
+/// `h = f_z sin φ + f_z² cos² φ / (2R) − f f_z sin φ cos φ / (R Ω)`;
+/// and the mean force over a
+/// period is the analytic
+/// `F̄ = a_p f_z N_t / (2π) ∫ sin φ (K_t (cos φ, −sin φ) + K_n (sin φ, cos φ)) dφ`
+/// over [φ_en, φ_ex], with ∫ sin φ cos φ = sin²φ / 2 and
+/// ∫ sin² φ = φ/2 − sin 2φ / 4.
+#[test]
+fn stiff_tool_cuts_the_trochoid_with_the_analytic_mean_force() -> Result<(), ChatterError> {
+    let stiff = Mode {
+        natural_frequency_hz: 500.0,
+        damping_ratio: 0.05,
+        modal_mass: 1e4,
+    };
+    let modal = Modal2::from_modes(stiff, stiff)?;
+    let process = seed_process(3e-3);
+    let (rpm, feed) = (3000.0, 0.04);
+    let settings = SimulationSettings {
+        periods: 8,
+        record_steps: true,
+        // A perturbation far below the chip, so that the chip is the
+        // trochoid's.
+        perturbation: nalgebra::Vector2::new(1e-12, 1e-12),
+        ..Default::default()
+    };
+    let sim = simulate(&modal, &process, rpm, feed, &settings)?;
+    let fz = feed * sim.period;
+    let omega = rpm * PI / 30.0;
+    let mut engaged = 0;
+    for s in &sim.steps {
+        // Exactly one of the two teeth can be inside [0.75π, π]; a sample
+        // on a window edge belongs to the side after it (the simulator
+        // decides membership on each RK4 sub-step, edges are sub-step ends).
+        let after = s.time + 1e-3 * sim.period / settings.steps_per_period as f64;
+        let tooth = (0..2).find(|&j| {
+            let p = (omega * after + PI * j as f64).rem_euclid(2.0 * PI);
+            (process.entry_angle..=process.exit_angle).contains(&p)
+        });
+        match tooth.map(|j| omega * s.time + PI * j as f64) {
+            Some(phi) => {
+                engaged += 1;
+                let (sp, cp) = phi.sin_cos();
+                let nominal = fz * sp;
+                assert!(
+                    (s.chip - nominal).abs() < 1e-2 * fz,
+                    "t {}: chip {} vs f_z sin phi {nominal}",
+                    s.time,
+                    s.chip
+                );
+                let second = nominal + fz * fz * cp * cp / (2.0 * process.radius)
+                    - feed * fz * sp * cp / (process.radius * omega);
+                assert!(
+                    (s.chip - second).abs() < 2e-4 * fz,
+                    "t {}: chip {} vs second order {second}",
+                    s.time,
+                    s.chip
+                );
+                let f = process.axial_depth * s.chip * force_direction(phi, process.kt, process.kn);
+                assert!((s.force - f).norm() <= 1e-9 * f.norm().max(1.0));
+            }
+            None => {
+                assert_eq!(s.chip, 0.0);
+                assert_eq!(s.force.norm(), 0.0);
+            }
+        }
+    }
+    assert!(engaged > 0);
+    // Mean force over the last period. The force jumps at the entry angle,
+    // so its sample mean carries an O(h) window-edge error; the position is
+    // C¹ and periodic, so its sample mean is accurate, and for a periodic
+    // response mean(F) = K mean(o).
+    let n = settings.steps_per_period;
+    let last = &sim.steps[sim.steps.len() - n..];
+    let mean_o = last
+        .iter()
+        .map(|s| s.position)
+        .sum::<nalgebra::Vector2<f64>>()
+        / n as f64;
+    let mean = modal.stiffness * mean_o;
+    let (a, b) = (process.entry_angle, process.exit_angle);
+    let isc = 0.5 * (b.sin().powi(2) - a.sin().powi(2));
+    let iss = 0.5 * (b - a) - 0.25 * ((2.0 * b).sin() - (2.0 * a).sin());
+    let scale = process.axial_depth * fz * 2.0 / (2.0 * PI);
+    let analytic = nalgebra::Vector2::new(
+        scale * (process.kt * isc + process.kn * iss),
+        scale * (-process.kt * iss + process.kn * isc),
+    );
+    // Second order: the chip expansion above integrated by composite
+    // Simpson (1000 panels).
+    let chip2 = |phi: f64| {
+        let (sp, cp) = phi.sin_cos();
+        fz * sp + fz * fz * cp * cp / (2.0 * process.radius)
+            - feed * fz * sp * cp / (process.radius * omega)
+    };
+    let panels = 1000;
+    let dphi = (b - a) / panels as f64;
+    let mut second = nalgebra::Vector2::zeros();
+    for i in 0..=panels {
+        let phi = a + i as f64 * dphi;
+        let w = if i == 0 || i == panels {
+            1.0
+        } else if i % 2 == 1 {
+            4.0
+        } else {
+            2.0
+        };
+        second += w * chip2(phi) * force_direction(phi, process.kt, process.kn);
+    }
+    let second = second * (dphi / 3.0) * process.axial_depth * 2.0 / (2.0 * PI);
+    println!("mean force {mean:?} first order {analytic:?} second order {second:?}");
+    // First order: the second-order chip terms (f_z/2R, f/(RΩ)) shift the
+    // mean by ~1.6 % here.
+    assert!(
+        (mean - analytic).norm() < 2.5e-2 * analytic.norm(),
+        "mean {mean:?} vs first order {analytic:?}"
+    );
+    assert!(
+        (mean - second).norm() < 1e-3 * second.norm(),
+        "mean {mean:?} vs second order {second:?}"
+    );
+    Ok(())
+}
+
+/// Bad inputs are errors, never panics or NaN; a vibration comparable to
+/// the tool radius (no root of eq. 3 in its bracket) is an error too.
+#[test]
+fn invalid_inputs_are_errors() -> Result<(), ChatterError> {
+    let modal = textbook_modal()?;
+    let process = textbook_process(1e-3)?;
+    let ok = SimulationSettings::default();
+    let invalid =
+        |r: Result<_, ChatterError>| matches!(r, Err(ChatterError::InvalidParameter { .. }));
+    assert!(invalid(simulate(&modal, &process, f64::NAN, 0.01, &ok)));
+    assert!(invalid(simulate(&modal, &process, 10_000.0, -1.0, &ok)));
+    let coarse = SimulationSettings {
+        steps_per_period: 100,
+        ..ok
+    };
+    assert!(invalid(simulate(&modal, &process, 10_000.0, 0.03, &coarse)));
+    let still = SimulationSettings {
+        perturbation: nalgebra::Vector2::zeros(),
+        ..ok
+    };
+    assert!(invalid(simulate(&modal, &process, 10_000.0, 0.03, &still)));
+    let no_regeneration = SimulationSettings {
+        max_regeneration: 0,
+        ..ok
+    };
+    assert!(invalid(simulate(
+        &modal,
+        &process,
+        10_000.0,
+        0.03,
+        &no_regeneration
+    )));
+    // A 5 mm kick on a 10 mm cutter: the earlier tooth path no longer
+    // crosses the current radial line inside the bracket.
+    let kick = SimulationSettings {
+        perturbation: nalgebra::Vector2::new(5e-3, 5e-3),
+        ..ok
+    };
+    let r = simulate(&modal, &process, 10_000.0, 0.03, &kick);
+    assert!(matches!(r, Err(ChatterError::NotConverged { .. })), "{r:?}");
+    Ok(())
+}
