@@ -116,8 +116,53 @@ const GL_W: [f64; 5] = [
     0.236_926_885_056_189_1,
 ];
 
-/// The gain `W_j(t)` (module documentation) of tooth j at time t, with the
-/// order of its regeneration, or `None` when the tooth does not cut.
+/// First-order chip sensitivity of tooth j at time t (module
+/// documentation): `δh = direction · (p(t − delay) − p(t))`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ChipSensitivity {
+    /// `c(φ) − κ w(φ)` [-].
+    pub direction: Vector2<f64>,
+    /// κ = h_τ / g_τ [-].
+    pub kappa: f64,
+    /// The delay τ̃ of the cut's regeneration order [s].
+    pub delay: f64,
+    /// That order m.
+    pub order: usize,
+    /// Equilibrium chip h̃ [m].
+    pub chip: f64,
+    /// Immersion angle φ [rad] in [0, 2π).
+    pub phi: f64,
+}
+
+/// [`ChipSensitivity`] of tooth j at time t, or `None` when the tooth does
+/// not cut there in the equilibrium.
+///
+/// # Errors
+/// As [`Equilibrium::chip_state`].
+pub fn chip_sensitivity(
+    eq: &Equilibrium,
+    tooth: usize,
+    t: f64,
+) -> Result<Option<ChipSensitivity>, ChatterError> {
+    let cs = eq.chip_state(tooth, t)?;
+    if !cs.in_contact {
+        return Ok(None);
+    }
+    let kappa = cs.h_tau / cs.g_tau;
+    let w = Vector2::new(cs.phi.cos(), -cs.phi.sin());
+    Ok(Some(ChipSensitivity {
+        direction: chip_direction(cs.phi) - w * kappa,
+        kappa,
+        delay: cs.delay,
+        order: cs.order,
+        chip: cs.chip,
+        phi: cs.phi,
+    }))
+}
+
+/// The gain `W_j(t) = a_p F'(h̃) b (c − κ w)ᵀ` [N/m] (module documentation)
+/// of tooth j at time t, with the order of its regeneration, or `None`
+/// when the tooth does not cut.
 ///
 /// # Errors
 /// As [`Equilibrium::chip_state`].
@@ -126,17 +171,13 @@ pub fn tooth_gain(
     tooth: usize,
     t: f64,
 ) -> Result<Option<(Matrix2<f64>, usize)>, ChatterError> {
-    let cs = eq.chip_state(tooth, t)?;
-    if !cs.in_contact {
+    let Some(sens) = chip_sensitivity(eq, tooth, t)? else {
         return Ok(None);
-    }
+    };
     let p = eq.process();
-    let kappa = cs.h_tau / cs.g_tau;
-    let w = Vector2::new(cs.phi.cos(), -cs.phi.sin());
-    let dir = chip_direction(cs.phi) - w * kappa;
-    let slope = eq.settings().force_law.slope(cs.chip);
-    let b = force_direction(cs.phi, p.kt, p.kn) * (p.axial_depth * slope);
-    Ok(Some((b * dir.transpose(), cs.order)))
+    let slope = eq.settings().force_law.slope(sens.chip);
+    let b = force_direction(sens.phi, p.kt, p.kn) * (p.axial_depth * slope);
+    Ok(Some((b * sens.direction.transpose(), sens.order)))
 }
 
 /// Linearizes the state-dependent model about `eq` (seed 004 eq. 8) and
