@@ -363,8 +363,9 @@ pub fn simulate(
 /// `d_k` leaves `[1e-5, 10] × d_0` (noise floor / saturation by loss of
 /// contact). Verdict: unstable if the factor exceeds 1 + 2e-3 or the run
 /// ends saturated (mean deviation of the last fifth > 10 d_0); stable if
-/// the factor is below 1 − 2e-3 and the run ends below d_0; otherwise
-/// indeterminate.
+/// the factor is below 1 − 2e-3 (the fit then runs to the end of the run
+/// or to the noise floor, so the deviation decays up to the end);
+/// otherwise indeterminate.
 ///
 /// # Errors
 /// [`ChatterError::InvalidParameter`] for a run shorter than 8 periods or a
@@ -410,7 +411,7 @@ pub fn classify(sim: &Simulation) -> Result<Growth, ChatterError> {
     let amplification = d.iter().fold(0.0_f64, |a, &v| a.max(v)) / d0;
     let verdict = if factor > 1.0 + FACTOR_TOLERANCE || final_ratio > SATURATION_RATIO {
         Verdict::Unstable
-    } else if factor < 1.0 - FACTOR_TOLERANCE && final_ratio < 1.0 {
+    } else if factor < 1.0 - FACTOR_TOLERANCE {
         Verdict::Stable
     } else {
         Verdict::Indeterminate
