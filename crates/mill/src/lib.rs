@@ -3,6 +3,7 @@
 //! angle about the tool axis, its condition number, the milling path and
 //! the pose-dependent tool-tip dynamics fed to `kerf_chatter`.
 
+pub mod cell;
 pub mod dynamics;
 pub mod error;
 pub mod ik;
@@ -10,6 +11,7 @@ pub mod jacobian;
 pub mod mdh;
 pub mod path;
 
+pub use cell::{CellState, MillCell, StateLimits};
 pub use dynamics::{ComplianceModel, ToolTipDynamics};
 pub use error::MillError;
 pub use ik::{BranchJump, IkPath, IkSolution, JointRange, Kinematics};

@@ -1,0 +1,457 @@
+//! The robotic milling cell file `urdf/irb6660_milling.yaml`: robot, TCP,
+//! path, characteristic length, tool-tip dynamics and the milling process
+//! of seed 004 Table 1 in one validated description.
+//!
+//! File paths inside the YAML (`robot.urdf`, `robot.limits`) are relative to
+//! the YAML file's directory. Every field is validated on load; an error
+//! names the field (e.g. `process.spindle_rpm[1]`), the value and the
+//! reason.
+
+use std::path::{Path, PathBuf};
+
+use kerf_chatter::{MillingProcess, Modal2, Mode};
+use kerf_robot::RobotModel;
+use nalgebra::{Isometry3, Matrix3, Rotation3, Translation3, UnitQuaternion, Vector3};
+use serde::Deserialize;
+
+use crate::dynamics::{ComplianceModel, ToolTipDynamics};
+use crate::error::{check_finite, check_positive, MillError};
+use crate::ik::Kinematics;
+use crate::jacobian::condition_number;
+use crate::path::{MillingPath, PathSpec};
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct CellFile {
+    robot: RobotSection,
+    #[serde(default)]
+    tcp: Option<TcpSection>,
+    path: PathSection,
+    condition: ConditionSection,
+    dynamics: DynamicsSection,
+    process: ProcessSection,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RobotSection {
+    urdf: String,
+    #[serde(default)]
+    limits: Option<String>,
+    reference_joints: [f64; 6],
+    joint_weights: [f64; 6],
+    branch_jump_threshold: f64,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct TcpSection {
+    position: [f64; 3],
+    z_axis: [f64; 3],
+    x_axis: [f64; 3],
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct PathSection {
+    points: Vec<[f64; 3]>,
+    segments: usize,
+    approach_from_above: bool,
+    up: [f64; 3],
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct ConditionSection {
+    characteristic_length: f64,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct DynamicsSection {
+    model: String,
+    joint_stiffness: [f64; 6],
+    modal_mass: [f64; 2],
+    damping_ratio: f64,
+    #[serde(default)]
+    measured: Option<MeasuredSection>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct MeasuredSection {
+    x: Mode,
+    y: Mode,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct StepSection {
+    feed: f64,
+    spindle_rpm: f64,
+    redundancy_angle: f64,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct ProcessSection {
+    teeth: usize,
+    tool_radius: f64,
+    axial_depth: f64,
+    kt: f64,
+    kn: f64,
+    engagement_over_pi: [f64; 2],
+    spindle_rpm: [f64; 2],
+    feed: [f64; 2],
+    redundancy_angle: [f64; 2],
+    step_bounds: StepSection,
+}
+
+/// Ranges and per-step bounds of the planning state (seed 004 Table 1,
+/// "State range" and the action bounds of eq. 9-11).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct StateLimits {
+    /// Spindle speed range [rpm] (rpm at the API boundary, as named).
+    pub spindle_rpm: [f64; 2],
+    /// Feed range [m/s].
+    pub feed: [f64; 2],
+    /// Redundancy angle range [rad].
+    pub redundancy_angle: [f64; 2],
+    /// Largest feed change per step |Δf| [m/s].
+    pub max_feed_step: f64,
+    /// Largest spindle-speed change per step |ΔΩ| [rpm].
+    pub max_spindle_step_rpm: f64,
+    /// Largest redundancy-angle change per step |Δg| [rad].
+    pub max_redundancy_step: f64,
+}
+
+/// What the cell gives for one (segment, g).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct CellState {
+    /// Joint vector [rad] (nearest valid IK solution to the reference).
+    pub joints: [f64; 6],
+    /// The normalized condition number K of seed 004 eq. 14 (≥ 1, ∞ at a
+    /// singularity).
+    pub condition_number: f64,
+    /// The singularity indicator 1/K ∈ [0, 1].
+    pub condition_indicator: f64,
+    /// The 2-DOF tool-tip dynamics in the segment's cutting frame.
+    pub modal: Modal2,
+}
+
+/// The robotic milling cell (module documentation).
+#[derive(Debug, Clone)]
+pub struct MillCell {
+    robot: RobotModel,
+    kinematics: Kinematics,
+    path: MillingPath,
+    characteristic_length: f64,
+    dynamics: ToolTipDynamics,
+    process: MillingProcess,
+    limits: StateLimits,
+    reference: [f64; 6],
+    jump_threshold: f64,
+}
+
+impl MillCell {
+    /// The default cell file, `urdf/irb6660_milling.yaml` of the repository.
+    pub fn default_path() -> PathBuf {
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("../../urdf/irb6660_milling.yaml")
+    }
+
+    /// Loads [`MillCell::default_path`] (with `urdf/irb6660.urdf` and
+    /// `urdf/irb6660_limits.yaml`).
+    ///
+    /// # Errors
+    /// As [`MillCell::load`].
+    pub fn default_cell() -> Result<Self, MillError> {
+        Self::load(&Self::default_path())
+    }
+
+    /// Loads and validates a cell file.
+    ///
+    /// # Errors
+    /// [`MillError::FileRead`], [`MillError::Yaml`] (syntax, unknown or
+    /// missing field), [`MillError::Robot`], and every validation error of
+    /// [`MillCell::from_yaml_str`].
+    pub fn load(path: &Path) -> Result<Self, MillError> {
+        let text = std::fs::read_to_string(path).map_err(|e| MillError::FileRead {
+            path: path.to_path_buf(),
+            message: e.to_string(),
+        })?;
+        let dir = path.parent().unwrap_or(Path::new("."));
+        Self::from_yaml_str(&text, dir, path)
+    }
+
+    /// Parses and validates cell YAML text.
+    ///
+    /// # Arguments
+    /// * `yaml` - the document;
+    /// * `base_dir` - directory the robot file paths are relative to;
+    /// * `name` - the file name used in error messages.
+    ///
+    /// # Errors
+    /// [`MillError::Yaml`], [`MillError::Robot`], [`MillError::InvalidParameter`]
+    /// / [`MillError::InvalidConfig`] naming the field,
+    /// [`MillError::NotCoplanar`], [`MillError::Chatter`].
+    pub fn from_yaml_str(yaml: &str, base_dir: &Path, name: &Path) -> Result<Self, MillError> {
+        let file: CellFile = serde_yaml_ng::from_str(yaml).map_err(|e| MillError::Yaml {
+            path: name.to_path_buf(),
+            message: e.to_string(),
+        })?;
+        let urdf = base_dir.join(&file.robot.urdf);
+        let limits = file.robot.limits.as_ref().map(|l| base_dir.join(l));
+        let robot = RobotModel::from_files(&urdf, limits.as_deref())?;
+        let tcp = match &file.tcp {
+            None => Isometry3::identity(),
+            Some(t) => tcp_from_axes(t)?,
+        };
+        let kinematics = Kinematics::from_robot(&robot, tcp, file.robot.joint_weights)?;
+        for (i, v) in file.robot.reference_joints.iter().enumerate() {
+            check_finite(&format!("robot.reference_joints[{i}] [rad]"), *v)?;
+        }
+        let jump_threshold = check_positive(
+            "robot.branch_jump_threshold [rad]",
+            file.robot.branch_jump_threshold,
+        )?;
+        let path = MillingPath::new(&PathSpec {
+            points: file.path.points.clone(),
+            segments: file.path.segments,
+            approach_from_above: file.path.approach_from_above,
+            up: file.path.up,
+        })?;
+        let characteristic_length = check_positive(
+            "condition.characteristic_length [m]",
+            file.condition.characteristic_length,
+        )?;
+        let compliance = ComplianceModel {
+            joint_stiffness: file.dynamics.joint_stiffness,
+            modal_mass: file.dynamics.modal_mass,
+            damping_ratio: file.dynamics.damping_ratio,
+        };
+        compliance.validate()?;
+        let dynamics = match (file.dynamics.model.as_str(), &file.dynamics.measured) {
+            ("compliance", _) => ToolTipDynamics::Compliance(compliance),
+            ("measured", Some(m)) => ToolTipDynamics::Measured { x: m.x, y: m.y },
+            ("measured", None) => {
+                return Err(MillError::InvalidConfig {
+                    name: "dynamics.measured".to_string(),
+                    reason: "model is `measured` but no measured modes are given".to_string(),
+                })
+            }
+            (other, _) => {
+                return Err(MillError::InvalidConfig {
+                    name: "dynamics.model".to_string(),
+                    reason: format!("`{other}`: must be `compliance` or `measured`"),
+                })
+            }
+        };
+        dynamics.validate()?;
+        let (process, limits) = process_from(&file.process)?;
+        Ok(Self {
+            robot,
+            kinematics,
+            path,
+            characteristic_length,
+            dynamics,
+            process,
+            limits,
+            reference: file.robot.reference_joints,
+            jump_threshold,
+        })
+    }
+
+    /// The robot model (URDF + limits).
+    pub fn robot(&self) -> &RobotModel {
+        &self.robot
+    }
+
+    /// The kinematics (with the TCP offset).
+    pub fn kinematics(&self) -> &Kinematics {
+        &self.kinematics
+    }
+
+    /// The milling path.
+    pub fn path(&self) -> &MillingPath {
+        &self.path
+    }
+
+    /// The characteristic length L of eq. 14 [m].
+    pub fn characteristic_length(&self) -> f64 {
+        self.characteristic_length
+    }
+
+    /// The tool-tip dynamics model.
+    pub fn dynamics(&self) -> &ToolTipDynamics {
+        &self.dynamics
+    }
+
+    /// The milling process (seed 004 Table 1), for `kerf_chatter`.
+    pub fn milling_process(&self) -> MillingProcess {
+        self.process
+    }
+
+    /// State ranges and step bounds.
+    pub fn state_limits(&self) -> &StateLimits {
+        &self.limits
+    }
+
+    /// The reference joint vector of the YAML (`robot.reference_joints`).
+    pub fn reference_joints(&self) -> &[f64; 6] {
+        &self.reference
+    }
+
+    /// The branch-jump threshold [rad].
+    pub fn branch_jump_threshold(&self) -> f64 {
+        self.jump_threshold
+    }
+
+    /// Joint vector, condition number/indicator and 2-DOF dynamics at
+    /// segment `segment` and redundancy angle `g`.
+    ///
+    /// The tool tip is at the segment's arc-length midpoint with the
+    /// orientation `R0 · RotZ(g)` of [`MillingPath::tool_pose`]; the joint
+    /// vector is the valid IK solution nearest to `reference` (the previous
+    /// state's joints, for branch continuity), or to the YAML's
+    /// `robot.reference_joints` when `None`.
+    ///
+    /// # Errors
+    /// [`MillError::Unreachable`] / [`MillError::JointLimit`] with the segment
+    /// and g; [`MillError::InvalidParameter`] for a bad index or g outside
+    /// the configured range; the errors of the dynamics model.
+    ///
+    /// # Performance
+    /// One IK (≤ 8 solutions), one Jacobian, one 6×6 eigen-decomposition:
+    /// a few µs.
+    pub fn evaluate(
+        &self,
+        segment: usize,
+        g: f64,
+        reference: Option<&[f64; 6]>,
+    ) -> Result<CellState, MillError> {
+        let [lo, hi] = self.limits.redundancy_angle;
+        if !(g >= lo - 1e-12 && g <= hi + 1e-12) {
+            return Err(MillError::InvalidParameter {
+                name: "redundancy angle g [rad]".to_string(),
+                value: g,
+                reason: format!("must be in [{lo}, {hi}]"),
+            });
+        }
+        let pose = self.path.tool_pose(segment, g)?;
+        let reference = reference.unwrap_or(&self.reference);
+        let joints = self
+            .kinematics
+            .ik_nearest(&pose, reference)
+            .map_err(|e| e.with_context(Some(segment), Some(g)))?;
+        let j = self.kinematics.jacobian(&joints)?;
+        let k = condition_number(&j, self.characteristic_length)?;
+        let frame = self.path.segment(segment)?.cutting_frame;
+        let modal = self.dynamics.modal2(&j, &frame)?;
+        Ok(CellState {
+            joints,
+            condition_number: k,
+            condition_indicator: 1.0 / k,
+            modal,
+        })
+    }
+}
+
+/// The TCP isometry from a position and the tool's z and x axes in `tool0`.
+fn tcp_from_axes(t: &TcpSection) -> Result<Isometry3<f64>, MillError> {
+    for (name, v) in [
+        ("tcp.position", t.position),
+        ("tcp.z_axis", t.z_axis),
+        ("tcp.x_axis", t.x_axis),
+    ] {
+        for (i, c) in v.iter().enumerate() {
+            check_finite(&format!("{name}[{i}]"), *c)?;
+        }
+    }
+    let z = Vector3::from(t.z_axis);
+    let x = Vector3::from(t.x_axis);
+    for (name, v) in [("tcp.z_axis", &z), ("tcp.x_axis", &x)] {
+        if (v.norm() - 1.0).abs() > 1e-9 {
+            return Err(MillError::InvalidParameter {
+                name: format!("{name} (norm)"),
+                value: v.norm(),
+                reason: "must be a unit vector".to_string(),
+            });
+        }
+    }
+    if x.dot(&z).abs() > 1e-9 {
+        return Err(MillError::InvalidParameter {
+            name: "tcp.x_axis . tcp.z_axis".to_string(),
+            value: x.dot(&z),
+            reason: "the axes must be perpendicular".to_string(),
+        });
+    }
+    let r = Matrix3::from_columns(&[x, z.cross(&x), z]);
+    Ok(Isometry3::from_parts(
+        Translation3::from(Vector3::from(t.position)),
+        UnitQuaternion::from_rotation_matrix(&Rotation3::from_matrix_unchecked(r)),
+    ))
+}
+
+fn process_from(p: &ProcessSection) -> Result<(MillingProcess, StateLimits), MillError> {
+    use std::f64::consts::PI;
+    for (i, v) in p.engagement_over_pi.iter().enumerate() {
+        if !(v.is_finite() && (0.0..=1.0).contains(v)) {
+            return Err(MillError::InvalidParameter {
+                name: format!("process.engagement_over_pi[{i}]"),
+                value: *v,
+                reason: "must be in [0, 1] (fraction of pi)".to_string(),
+            });
+        }
+    }
+    let process = MillingProcess {
+        teeth: p.teeth,
+        radius: p.tool_radius,
+        axial_depth: p.axial_depth,
+        kt: p.kt,
+        kn: p.kn,
+        entry_angle: p.engagement_over_pi[0] * PI,
+        exit_angle: p.engagement_over_pi[1] * PI,
+    };
+    process.validate()?;
+    let range = |name: &str, r: [f64; 2], min: f64| -> Result<[f64; 2], MillError> {
+        for (i, v) in r.iter().enumerate() {
+            check_finite(&format!("{name}[{i}]"), *v)?;
+        }
+        if r[0] < min || r[1] <= r[0] {
+            return Err(MillError::InvalidParameter {
+                name: format!("{name}[1]"),
+                value: r[1],
+                reason: format!(
+                    "the range must satisfy {min} <= [0] < [1] (got [0] = {})",
+                    r[0]
+                ),
+            });
+        }
+        Ok(r)
+    };
+    let spindle_rpm = range("process.spindle_rpm", p.spindle_rpm, f64::MIN_POSITIVE)?;
+    let feed = range("process.feed", p.feed, 0.0)?;
+    let redundancy_angle = range("process.redundancy_angle", p.redundancy_angle, -PI - 1e-12)?;
+    if redundancy_angle[1] > PI + 1e-12 {
+        return Err(MillError::InvalidParameter {
+            name: "process.redundancy_angle[1]".to_string(),
+            value: redundancy_angle[1],
+            reason: "must be <= pi".to_string(),
+        });
+    }
+    let limits = StateLimits {
+        spindle_rpm,
+        feed,
+        redundancy_angle,
+        max_feed_step: check_positive("process.step_bounds.feed [m/s]", p.step_bounds.feed)?,
+        max_spindle_step_rpm: check_positive(
+            "process.step_bounds.spindle_rpm [rpm]",
+            p.step_bounds.spindle_rpm,
+        )?,
+        max_redundancy_step: check_positive(
+            "process.step_bounds.redundancy_angle [rad]",
+            p.step_bounds.redundancy_angle,
+        )?,
+    };
+    Ok((process, limits))
+}
