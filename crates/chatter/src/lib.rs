@@ -37,3 +37,10 @@ pub use spectral::{
 pub use timedomain::{
     classify, simulate, Growth, PeriodSample, Simulation, SimulationSettings, StepSample, Verdict,
 };
+pub use equilibrium::{
+    ChipState, Equilibrium, EquilibriumDiagnostics, EquilibriumSettings, ForceLaw,
+};
+pub use indicator::{
+    chatter_indicator, indicator_dde, indicator_map, DelayModel, Indicator, IndicatorSettings,
+};
+pub use linearize::{chip_sensitivity, linearize, tooth_gain, ChipSensitivity, LinearizeSettings};
