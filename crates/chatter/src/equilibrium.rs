@@ -816,6 +816,23 @@ impl Equilibrium {
             .newton(&self.traj(), tooth, order, t, order as f64 * self.period)
     }
 
+    /// Delay τ_j^m (Newton on eq. 3) and chip h_j^m (eq. 4) [s, m] of one
+    /// regeneration order m: the surface left by the tooth m positions
+    /// earlier (seed 004 Fig. 1b).
+    ///
+    /// # Errors
+    /// As [`Equilibrium::solve_delay`].
+    pub fn chip_of_order(
+        &self,
+        tooth: usize,
+        order: usize,
+        t: f64,
+    ) -> Result<(f64, f64), ChatterError> {
+        let tau = self.solve_delay(tooth, order, t)?;
+        let geo = self.ctx().geometry(&self.traj(), tooth, order, t, tau);
+        Ok((tau, geo.h))
+    }
+
     /// The cut of tooth j at time t (module documentation): order-1 delay
     /// from the RK4 track, higher orders by Newton, chip = minimum.
     /// Outside the nominal engagement `in_contact` is false. At zero feed

@@ -9,8 +9,10 @@ use std::f64::consts::PI;
 use kerf_chatter::equilibrium::{Equilibrium, EquilibriumSettings, ForceLaw};
 use kerf_chatter::linearize::{chip_sensitivity, linearize, LinearizeSettings};
 use kerf_chatter::trochoid::{chip_thickness, tangential_residual};
-use kerf_chatter::{force_direction, ChatterError, MillingProcess, Modal2, Mode};
-use nalgebra::{Vector2, Vector4};
+use kerf_chatter::{
+    constant_delay_dde, force_direction, ChatterError, Discretization, MillingProcess, Modal2, Mode,
+};
+use nalgebra::{Matrix2, Vector2, Vector4};
 
 /// Seed 004 Table 1: 2 teeth, R 0.04 m, a_p 3 mm, down milling [0.75π, π].
 fn seed_process() -> MillingProcess {
@@ -96,6 +98,32 @@ fn rk4_delays_satisfy_eq3_and_match_newton() {
     // where t − τ crosses the entry, just after each track starts)
     assert!(worst_res < 5e-9, "eq. 3 residual {worst_res:e} m");
     assert!(worst_diff < 5e-8, "RK4 vs Newton {worst_diff:e} T");
+    // Older surfaces (multiple regeneration, seed 004 Fig. 1b): the tooth
+    // two back left a surface 2 f_z sin φ deep with twice the delay shift,
+    // so the chip min_m h^m is the order-1 chip here.
+    let fz = eq.feed_per_tooth();
+    for frac in [0.8, 0.9, 0.97] {
+        let t = frac * period;
+        let (tau1, h1) = eq.chip_of_order(0, 1, t).unwrap();
+        let (tau2, h2) = eq.chip_of_order(0, 2, t).unwrap();
+        let (tau3, h3) = eq.chip_of_order(0, 3, t).unwrap();
+        let s = eq.angle(0, t).sin();
+        assert!(
+            (h2 - 2.0 * fz * s).abs() < 0.05 * fz,
+            "h2 {h2:e} vs {:e}",
+            2.0 * fz * s
+        );
+        assert!((h3 - 3.0 * fz * s).abs() < 0.1 * fz);
+        assert!(
+            ((tau2 - 2.0 * period) - 2.0 * (tau1 - period)).abs() < 0.05 * (tau1 - period).abs()
+        );
+        assert!(
+            ((tau3 - 3.0 * period) - 3.0 * (tau1 - period)).abs() < 0.1 * (tau1 - period).abs()
+        );
+        let cs = eq.chip_state(0, t).unwrap();
+        assert_eq!(cs.order, 1);
+        assert!((cs.chip - h1).abs() < 1e-7 * fz); // RK4 vs Newton delay
+    }
     // The delay does differ from T: it is state dependent.
     let tau = eq.solve_delay(0, 1, 0.9 * period).unwrap();
     assert!((tau - period).abs() > 1e-4 * period);
@@ -475,4 +503,59 @@ fn bad_inputs_are_errors() {
         }
     )
     .is_err());
+}
+
+/// As f → 0 (no forced response) the linearized state-dependent model is
+/// the constant-delay model of directional.rs (computed there by exact
+/// antiderivatives, here by Gauss–Legendre quadrature of W_j): same gains,
+/// delays → T, same |μ|max.
+#[test]
+fn reduces_to_the_constant_delay_model_as_feed_vanishes() {
+    let modal = robot();
+    let process = seed_process();
+    let rpm = 2700.0;
+    for steps in [40, 57] {
+        let reference = constant_delay_dde(&process, rpm, steps).unwrap();
+        let eq = Equilibrium::compute(&modal, &process, rpm, 1e-8, &EquilibriumSettings::default())
+            .unwrap();
+        let sd = linearize(
+            &eq,
+            &LinearizeSettings {
+                steps,
+                wall_term: true,
+            },
+        )
+        .unwrap();
+        let scale = reference
+            .samples
+            .iter()
+            .map(|s| s.present.abs().max())
+            .fold(0.0, f64::max);
+        let mut worst: f64 = 0.0;
+        let mut worst_delay: f64 = 0.0;
+        for (a, b) in sd.samples.iter().zip(&reference.samples) {
+            worst = worst.max((a.present - b.present).abs().max() / scale);
+            let sum = a
+                .delayed
+                .iter()
+                .fold(Matrix2::zeros(), |acc, d| acc + d.gain);
+            let refsum = b
+                .delayed
+                .iter()
+                .fold(Matrix2::zeros(), |acc, d| acc + d.gain);
+            worst = worst.max((sum - refsum).abs().max() / scale);
+            for d in &a.delayed {
+                worst_delay = worst_delay.max((d.delay - eq.period()).abs() / eq.period());
+            }
+        }
+        println!("m {steps}: gains {worst:e} (relative), delays {worst_delay:e} T");
+        assert!(worst < 1e-6, "gains differ by {worst:e}");
+        assert!(worst_delay < 1e-6, "delays differ by {worst_delay:e} T");
+        let disc = Discretization::new(&modal, eq.period(), steps, sd.max_delay().max(eq.period()))
+            .unwrap();
+        let mu_sd = disc.spectral_radius(&sd).unwrap();
+        let mu_c = disc.spectral_radius(&reference).unwrap();
+        println!("m {steps}: |mu| {mu_sd} vs {mu_c}");
+        assert!((mu_sd - mu_c).abs() < 1e-6 * mu_c);
+    }
 }
