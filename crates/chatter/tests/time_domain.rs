@@ -7,6 +7,8 @@
 
 use std::f64::consts::PI;
 
+use kerf_chatter::equilibrium::{Equilibrium, EquilibriumSettings};
+use kerf_chatter::indicator::{chatter_indicator, DelayModel, IndicatorSettings};
 use kerf_chatter::{
     classify, constant_delay_dde, eigenvalues_dense, force_direction, simulate, stability_lobes,
     ChatterError, Discretization, LobeOptions, MillingProcess, Modal2, Mode, SimulationSettings,
@@ -360,6 +362,138 @@ fn textbook_boundary_splits_decay_from_growth() -> Result<(), ChatterError> {
                     "{flips} of {pairs} alternate"
                 );
             }
+        }
+    }
+    Ok(())
+}
+
+/// A representative robot tool tip (seed 004 gives no modal data): one
+/// mode per direction, m = 50 kg, f_n = 25 Hz, ζ = 0.05 (k ≈ 1.2e6 N/m,
+/// the order of an IRB-6660-class arm at its flange).
+fn robot_modal() -> Result<Modal2, ChatterError> {
+    let mode = Mode {
+        natural_frequency_hz: 25.0,
+        damping_ratio: 0.05,
+        modal_mass: 50.0,
+    };
+    Modal2::from_modes(mode, mode)
+}
+
+/// The periodic forced response the simulation starts from (its own
+/// fixed-point iteration on the RK4 grid) is the equilibrium õ of
+/// [`Equilibrium::compute`] (a separate implementation: Newton/RK4 delay
+/// tracks, Hermite nodes, its own periodic solve), at the paper's cut
+/// (seed 004 Table 1: a_p = 3 mm, 2000 and 4000 rpm, 0.04 m/s).
+#[test]
+fn periodic_response_matches_the_equilibrium() -> Result<(), ChatterError> {
+    let modal = robot_modal()?;
+    let process = seed_process(3e-3);
+    for rpm in [2000.0, 4000.0] {
+        let feed = 0.04;
+        let settings = SimulationSettings {
+            periods: 8,
+            ..Default::default()
+        };
+        let sim = simulate(&modal, &process, rpm, feed, &settings)?;
+        let eq =
+            Equilibrium::compute(&modal, &process, rpm, feed, &EquilibriumSettings::default())?;
+        let dp = sim
+            .orbit
+            .iter()
+            .map(|s| (s.position - eq.position(s.time)).norm())
+            .fold(0.0, f64::max);
+        let dv = sim
+            .orbit
+            .iter()
+            .map(|s| (s.velocity - eq.velocity(s.time)).norm())
+            .fold(0.0, f64::max);
+        let vmax = sim
+            .orbit
+            .iter()
+            .map(|s| s.velocity.norm())
+            .fold(0.0, f64::max);
+        let amplitude = eq.forced_amplitude();
+        println!(
+            "{rpm} rpm: orbit vs equilibrium {dp:.3e} m (forced amplitude {amplitude:.3e} m, \
+             static {:.3e} m), velocity {dv:.3e} m/s of {vmax:.3e}",
+            sim.orbit[0].position.norm()
+        );
+        assert!(amplitude > 1e-6);
+        assert!(dp < 1e-4 * amplitude, "{dp} vs {amplitude}");
+        assert!(dv < 1e-4 * vmax, "{dv} vs {vmax}");
+        assert!(sim.orbit_contact_fraction > 0.99);
+    }
+    Ok(())
+}
+
+/// (b) Issue 4 section 5 on the seed 004 cut (Table 1: 2 teeth, R 0.04 m,
+/// K_t 6.44e8, K_n 2.37e8 N/m², engagement [0.75π, π]) and the robot tool
+/// tip of [`robot_modal`]: the critical depth of the STATE-DEPENDENT
+/// indicator ([`chatter_indicator`], bisection on a_p) splits the simulated
+/// nonlinear model at 0.8 and 1.2 times it.
+///
+/// The simulation keeps the engagement window fixed in tool angle (seed 004
+/// Table 1); the indicator adds by default a workpiece-wall term (the entry
+/// angle moving with the vibration, `crate::linearize`), which the
+/// simulation does not model. Hence two factor checks: against the
+/// indicator without that term the measured factor agrees tightly (within
+/// 0.005; 4e-4 when written), against the default indicator loosely
+/// (within 0.03; its term shifts |μ| by up to 0.02 here).
+#[test]
+fn state_dependent_boundary_splits_decay_from_growth() -> Result<(), ChatterError> {
+    let modal = robot_modal()?;
+    let sd = IndicatorSettings::default();
+    assert_eq!(sd.model, DelayModel::StateDependent);
+    let no_wall = IndicatorSettings {
+        wall_term: false,
+        ..sd
+    };
+    for (rpm, feed) in [(2000.0, 0.05), (2500.0, 0.04)] {
+        let mu = |depth: f64, s: &IndicatorSettings| {
+            chatter_indicator(&modal, &seed_process(depth), rpm, feed, s).map(|i| i.spectral_radius)
+        };
+        let (mut lo, mut hi) = (1e-3, 30e-3);
+        if !(mu(lo, &sd)? < 1.0 && mu(hi, &sd)? > 1.0) {
+            return Err(ChatterError::Unsupported {
+                reason: format!("no boundary in [1, 30] mm at {rpm} rpm"),
+            });
+        }
+        while hi - lo > 1e-6 {
+            let mid = 0.5 * (lo + hi);
+            if mu(mid, &sd)? < 1.0 {
+                lo = mid;
+            } else {
+                hi = mid;
+            }
+        }
+        let a_crit = 0.5 * (lo + hi);
+        for (fraction, expected) in [(0.8, Verdict::Stable), (1.2, Verdict::Unstable)] {
+            let process = seed_process(fraction * a_crit);
+            let (mu_sd, mu_nw) = (
+                mu(process.axial_depth, &sd)?,
+                mu(process.axial_depth, &no_wall)?,
+            );
+            let sim = simulate(&modal, &process, rpm, feed, &SimulationSettings::default())?;
+            let growth = classify(&sim)?;
+            println!(
+                "{rpm} rpm, {feed} m/s, a_crit {:.3} mm, {fraction} a_crit: |mu| {mu_sd:.4} \
+                 (no wall term {mu_nw:.4}), simulated factor {:.4}, amplification {:.1}, \
+                 late contact {:.3}, {:?}",
+                a_crit * 1e3,
+                growth.factor,
+                growth.amplification,
+                growth.late_contact_fraction,
+                growth.verdict
+            );
+            assert_eq!(growth.verdict, expected, "{rpm} rpm {fraction}: {growth:?}");
+            assert!(
+                (growth.factor - mu_nw).abs() < 5e-3,
+                "{growth:?} vs {mu_nw}"
+            );
+            assert!(
+                (growth.factor - mu_sd).abs() < 3e-2,
+                "{growth:?} vs {mu_sd}"
+            );
         }
     }
     Ok(())
