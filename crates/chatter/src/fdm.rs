@@ -12,7 +12,7 @@
 //! A₀ = [0, I; −M⁻¹K, −M⁻¹C],   L = [0; M⁻¹]   (4×2).
 //! ```
 //!
-//! # The discretization (Ding, Zhu, Zhang & Ding 2010, IJMTM 50:502, eq. 5–15)
+//! # The discretization (Ding, Zhu, Zhang & Ding 2010, IJMTM 50:502, eq. 5–15, with a cubic delayed-state interpolation)
 //!
 //! The period is cut into m sub-intervals `[t_i, t_{i+1}]`, `t_i = i Δt`,
 //! `Δt = T/m`. The variation-of-constants formula over one sub-interval is
@@ -22,44 +22,61 @@
 //! x_{i+1} = Φ₀ x_i + ∫₀^Δt e^{A₀(Δt−s)} L f(t_i + s) ds,   Φ₀ = e^{A₀Δt}.
 //! ```
 //!
-//! Full discretization keeps `A₀` exact and approximates the forcing `f`:
-//! the gains are the sub-interval averages carried by the [`DdeSample`]s
-//! (as in first-order semi-discretization, Insperger & Stépán 2004 IJNME
-//! 61:117 §3, which keeps interrupted cutting accurate), and the states are
-//! interpolated linearly between grid points (Ding 2010 eq. 8–9):
-//! `p(t_i + s) ≈ (1 − s/Δt) p_i + (s/Δt) p_{i+1}`, and the delayed value
-//! `p(t − τ)` is itself a linear interpolation between the two grid points
-//! around `t − τ` (first-order SDM's treatment of a delay that is not a
-//! multiple of Δt, Insperger & Stépán 2004 eq. 19). With
+//! Full discretization keeps `A₀` exact and approximates the forcing `f`
+//! by polynomials in `u = s/Δt ∈ [0, 1]`, so that only the moments
 //!
 //! ```text
-//! Φ₁ = ∫₀^Δt e^{A₀u} du,    Φ₂ = (1/Δt) ∫₀^Δt e^{A₀u} (Δt − u) du
+//! Ψ_n = ∫₀^Δt e^{A₀(Δt−s)} (s/Δt)ⁿ ds,   n = 0 … 3
 //! ```
 //!
-//! (so `∫ e^{A₀(Δt−s)} (1 − s/Δt) ds = Φ₁ − Φ₂` and `∫ e^{A₀(Δt−s)} s/Δt ds = Φ₂`,
-//! substituting u = Δt − s) the step becomes, with `G₁ = (Φ₁ − Φ₂) L`,
-//! `G₂ = Φ₂ L` (4×2),
+//! are needed (`Ψ₀ = Φ₁`, `Ψ₁ = Φ₂` in Ding's notation); they depend on the
+//! modal model and Δt only. The gains are the sub-interval averages carried
+//! by the [`DdeSample`]s (as in first-order semi-discretization, Insperger &
+//! Stépán 2004 IJNME 61:117 §3, which keeps interrupted cutting accurate).
+//!
+//! * Present term `−A_i p(t)`: linear interpolation between `p_i` and
+//!   `p_{i+1}` (Ding 2010 eq. 8), weights `Ψ₀ − Ψ₁` and `Ψ₁`. (A quadratic
+//!   interpolation through `p_{i−1}, p_i, p_{i+1}` as in the second-order
+//!   FDM of Ding et al. 2010, IJMTM 50:926, was tried: for the textbook
+//!   oscillator at ω_n Δt ≈ 0.9 it made |μ| worse, 5 % instead of 0.2 %
+//!   (presumably a parasitic root of the multistep formula), so it is not
+//!   used.)
+//! * Delayed terms `B_k p(t − τ_k)`: `t_i + s − τ` is grid coordinate
+//!   `σ = i − q + u` (`q = τ/Δt`, any positive real ≥ 1, not only m).
+//!   `p` is interpolated by the cubic Lagrange polynomial through the four
+//!   consecutive past grid points `n₀ … n₀+3` around `[i − q, i + 1 − q]`
+//!   (`n₀ = ⌊i − q⌋ − 1`, moved back if `n₀ + 3 > i` so that only known
+//!   values are used). Writing each Lagrange basis polynomial in monomials,
+//!   `ℓ_k(u) = Σ_n a_{kn} uⁿ`, its weight matrix is `Σ_n a_{kn} Ψ_n`.
+//!   This generalizes the linear interpolation of first-order SDM
+//!   (Insperger & Stépán 2004 eq. 19) and of Ding 2010 eq. 9; with linear
+//!   interpolation the delayed term dominated the error (2 % in |μ| at
+//!   ω_n Δt ≈ 0.9, against 0.2 % for the present term).
+//!
+//! With `L Ψ = Ψ[:, 2..4] M⁻¹` the step is
 //!
 //! ```text
-//! x_{i+1} = Φ₀ x_i − G₁ A_i p_i − G₂ A_i p_{i+1}
-//!           + Σ_k [G₁ B_{k,i} p(t_i − τ_k) + G₂ B_{k,i} p(t_{i+1} − τ_k)].
+//! x_{i+1} = Φ₀ x_i − L(Ψ₀ − Ψ₁) A_i p_i − LΨ₁ A_i p_{i+1}
+//!           + Σ_k Σ_{l=0}^{3} LΨ_{(k,l)} B_{k,i} p_{n₀+l}.
 //! ```
 //!
 //! `p_{i+1}` appears on both sides (Ding 2010 eq. 13, the `(I − F₀,₁)⁻¹`
-//! factor). Because `G₂ A_i` only acts on the displacement, the implicit
-//! part reduces to a 2×2 solve: writing `W = G₂ A_i = [W₁; W₂]` (two 2×2
-//! blocks), `p_{i+1} = (I + W₁)⁻¹ r_p` and `ṗ_{i+1} = r_v − W₂ p_{i+1}`
+//! factor). Because it only enters through the displacement, the implicit
+//! part reduces to a 2×2 solve: writing `W = LΨ₁ A_i = [W₁; W₂]` (two
+//! 2×2 blocks), `p_{i+1} = (I + W₁)⁻¹ r_p` and `ṗ_{i+1} = r_v − W₂ p_{i+1}`
 //! where `(r_p, r_v)` is the explicit right-hand side.
 //!
-//! # Φ₀, Φ₁, Φ₂ by one matrix exponential (Van Loan 1978)
+//! # The moments by one matrix exponential (Van Loan 1978)
 //!
-//! `exp([[A₀Δt, I, 0], [0, 0, I], [0, 0, 0]])` (12×12) has the blocks
-//! `[e^{A₀Δt}, Φ₁/Δt, Φ₂/Δt]` in its first block row. Derivation: for
-//! `C = [[A, I, 0], [0, 0, I], [0, 0, 0]]`, `e^{Cs}` has first block row
-//! `[e^{As}, F₁(s), F₂(s)]` with `F₁' = A F₁ + I`, `F₂' = A F₂ + s I`,
-//! `F₁(0) = F₂(0) = 0`, whose solutions are `F₁ = ∫₀^s e^{Au} du` and
-//! `F₂ = ∫₀^s e^{Au}(s − u) du`; with `A = A₀Δt` and s = 1 the substitution
-//! u → u/Δt gives `F₁ = Φ₁/Δt`, `F₂ = Φ₂/Δt`. The exponential is nalgebra's
+//! For the 20×20 block matrix `C = [[A₀Δt, I, 0, 0, 0], [0, 0, I, 0, 0],
+//! [0, 0, 0, I, 0], [0, 0, 0, 0, I], 0]`, `e^{C}` has the first block row
+//! `[e^{A₀Δt}, G₁, G₂, G₃, G₄]` with `G_{n+1} = ∫₀¹ e^{A₀Δtσ} (1 − σ)ⁿ/n! dσ`.
+//! Derivation: `(e^{Cs})' = e^{Cs} C`, so the first block row
+//! `[E, F₁, …, F₄](s)` satisfies `E' = E A`, `F₁' = E`, `F_{n+1}' = F_n`
+//! with zero initial values: `F₁(s) = ∫₀^s e^{Av} dv` and, by Cauchy's
+//! repeated-integration formula, `F_{n+1}(s) = ∫₀^s e^{Av} (s − v)ⁿ/n! dv`;
+//! s = 1 with `A = A₀Δt` gives `G_{n+1}`. Substituting `s = Δt(1 − σ)` in
+//! `Ψ_n` gives `Ψ_n = Δt · n! · G_{n+1}`. The exponential is nalgebra's
 //! scaling-and-squaring Padé approximant (Higham 2005). Everything here
 //! depends on the modal model and the spindle speed only, so it is computed
 //! once per speed ([`Discretization::new`]); the cutting depth and the
@@ -68,9 +85,10 @@
 //! # The monodromy map
 //!
 //! The discrete state at grid point i is `z_i = (x_i, p_{i−1}, …, p_{i−r})`
-//! (dimension 4 + 2r) with r = ⌈τ_max/Δt⌉ past displacements. One period
-//! maps `z_0 ↦ z_m = Φ z_0` (Ding 2010 eq. 15); the spectral radius of Φ
-//! decides stability (Floquet theory, seed 004 section 2).
+//! (dimension 4 + 2r) with `r = max(⌈τ_max/Δt⌉ + 1, 3)` past displacements
+//! (one more than the delay needs, for the cubic stencil). One period maps
+//! `z_0 ↦ z_m = Φ z_0` (Ding 2010 eq. 15); the spectral radius of Φ decides
+//! stability (Floquet theory, seed 004 section 2).
 
 use nalgebra::{DMatrix, DVector, Matrix2, Matrix4, Matrix4x2, SMatrix, Vector2, Vector4};
 
@@ -88,6 +106,12 @@ pub const DENSE_MAX_ITERATIONS: usize = 10_000;
 /// time steps (so that τ = T is exactly m steps despite rounding).
 const SNAP: f64 = 1e-9;
 
+/// Number of interpolation nodes of a delayed term (cubic).
+const NODES: usize = 4;
+
+/// `[Φ₀, Ψ₀, Ψ₁, Ψ₂, Ψ₃]` of the module documentation.
+pub type ExpMoments = [Matrix4<f64>; 5];
+
 /// Precomputed full discretization of one modal model at one spindle
 /// speed (Ding et al. 2010; see the module documentation).
 #[derive(Debug, Clone)]
@@ -97,26 +121,17 @@ pub struct Discretization {
     dt: f64,
     max_delay: f64,
     history: usize,
-    phi0: Matrix4<f64>,
-    phi1: Matrix4<f64>,
-    phi2: Matrix4<f64>,
-    g1: Matrix4x2<f64>,
-    g2: Matrix4x2<f64>,
+    moments: ExpMoments,
+    /// `LΨ_n = Ψ_n[:, 2..4] M⁻¹`, n = 0 … 3.
+    l_psi: [Matrix4x2<f64>; 4],
 }
 
-/// One delayed term compiled for the stepping loop: the interpolation
-/// stencils of `p(t_i − τ)` and `p(t_{i+1} − τ)` and the two 4×2 gains.
+/// One delayed term compiled for the stepping loop: buffer index of its
+/// first interpolation node and the four node gains `LΨ_(k,l) B`.
 #[derive(Debug, Clone, Copy)]
 struct CompiledDelay {
-    /// Buffer index of the left grid point of `t_i − τ`, and its weight on
-    /// the right neighbour.
-    j0: usize,
-    w0: f64,
-    /// Same for `t_{i+1} − τ`.
-    j1: usize,
-    w1: f64,
-    c1: Matrix4x2<f64>,
-    c2: Matrix4x2<f64>,
+    first_node: usize,
+    gains: [Matrix4x2<f64>; NODES],
 }
 
 /// One sub-interval compiled for the stepping loop.
@@ -126,8 +141,8 @@ struct CompiledStep {
     inv_top: Matrix2<f64>,
     /// `W₂`.
     w_bottom: Matrix2<f64>,
-    /// `G₁ A_i`.
-    present: Matrix4x2<f64>,
+    /// `LΨ_(0) A_i` (weight of `p_i`).
+    present_now: Matrix4x2<f64>,
     /// Range of this step's delayed terms in the flat list.
     first_delay: usize,
     end_delay: usize,
@@ -144,8 +159,8 @@ pub struct CompiledDde {
 }
 
 impl Discretization {
-    /// Precomputes `Φ₀ = e^{A₀Δt}`, `Φ₁`, `Φ₂` (module documentation) for
-    /// one modal model and one period.
+    /// Precomputes `Φ₀ = e^{A₀Δt}` and the moments `Ψ₀ … Ψ₃` (module
+    /// documentation) for one modal model and one period.
     ///
     /// # Arguments
     /// * `modal` — the tool-tip dynamics (validated here).
@@ -153,7 +168,7 @@ impl Discretization {
     /// * `steps` — number m of sub-intervals per period, ≥ 2 (use ≥ 40).
     /// * `max_delay` — the largest delay any equation used with this
     ///   discretization may have [s], ≥ T/m; fixes the state dimension
-    ///   `4 + 2⌈max_delay/Δt⌉`.
+    ///   `4 + 2 max(⌈max_delay/Δt⌉ + 1, 3)`.
     ///
     /// # Errors
     /// [`ChatterError::InvalidParameter`] for an invalid modal model,
@@ -191,7 +206,7 @@ impl Discretization {
                 reason: "needs more than 1e6 history steps".to_string(),
             });
         }
-        let history = q_max.ceil() as usize;
+        let history = (q_max.ceil() as usize + 1).max(3);
         let minv = modal
             .mass
             .try_inverse()
@@ -201,24 +216,25 @@ impl Discretization {
                 reason: "is singular".to_string(),
             })?;
         let a0 = state_matrix(modal, &minv);
-        let (phi0, phi1, phi2) = exponential_integrals(&a0, dt)?;
-        let l_map = |phi: &Matrix4<f64>| -> Matrix4x2<f64> {
-            let cols: Matrix4x2<f64> = phi.fixed_view::<4, 2>(0, 2).into_owned();
+        let moments = exponential_moments(&a0, dt)?;
+        let l_map = |psi: &Matrix4<f64>| -> Matrix4x2<f64> {
+            let cols: Matrix4x2<f64> = psi.fixed_view::<4, 2>(0, 2).into_owned();
             cols * minv
         };
-        let g1 = l_map(&(phi1 - phi2));
-        let g2 = l_map(&phi2);
+        let l_psi = [
+            l_map(&moments[1]),
+            l_map(&moments[2]),
+            l_map(&moments[3]),
+            l_map(&moments[4]),
+        ];
         Ok(Self {
             period,
             steps,
             dt,
             max_delay,
             history,
-            phi0,
-            phi1,
-            phi2,
-            g1,
-            g2,
+            moments,
+            l_psi,
         })
     }
 
@@ -254,17 +270,27 @@ impl Discretization {
 
     /// `Φ₀ = e^{A₀Δt}`, the free-vibration transition over one step.
     pub fn phi0(&self) -> &Matrix4<f64> {
-        &self.phi0
+        &self.moments[0]
     }
 
-    /// `Φ₁ = ∫₀^Δt e^{A₀u} du`.
+    /// `Φ₁ = Ψ₀ = ∫₀^Δt e^{A₀u} du`.
     pub fn phi1(&self) -> &Matrix4<f64> {
-        &self.phi1
+        &self.moments[1]
     }
 
-    /// `Φ₂ = (1/Δt) ∫₀^Δt e^{A₀u} (Δt − u) du`.
+    /// `Φ₂ = Ψ₁ = (1/Δt) ∫₀^Δt e^{A₀u} (Δt − u) du`.
     pub fn phi2(&self) -> &Matrix4<f64> {
-        &self.phi2
+        &self.moments[2]
+    }
+
+    /// The moment `Ψ_n = ∫₀^Δt e^{A₀(Δt−s)} (s/Δt)ⁿ ds`, n = 0 … 3 (`None`
+    /// for larger n).
+    pub fn moment(&self, n: usize) -> Option<&Matrix4<f64>> {
+        if n < 4 {
+            self.moments.get(n + 1)
+        } else {
+            None
+        }
     }
 
     /// Validates `dde` against this discretization and compiles its
@@ -296,10 +322,15 @@ impl Discretization {
             });
         }
         let r = self.history;
+        let [lp0, lp1, _, _] = self.l_psi;
+        // Linear present-term weights (module documentation).
+        let w_now = lp0 - lp1;
+        let w_next = lp1;
+        let q_limit = snap(self.max_delay / self.dt);
         let mut steps = Vec::with_capacity(self.steps);
         let mut delays = Vec::new();
         for (i, sample) in dde.samples.iter().enumerate() {
-            let w = self.g2 * sample.present;
+            let w = w_next * sample.present;
             let top: Matrix2<f64> = Matrix2::identity() + w.fixed_view::<2, 2>(0, 0);
             let inv_top = top.try_inverse().ok_or_else(|| ChatterError::Unsupported {
                 reason: format!("implicit step {i} is singular (present gain too large)"),
@@ -307,7 +338,7 @@ impl Discretization {
             let first_delay = delays.len();
             for d in &sample.delayed {
                 let q = snap(d.delay / self.dt);
-                if q < 1.0 || q > r as f64 {
+                if q < 1.0 || q > q_limit {
                     return Err(ChatterError::Unsupported {
                         reason: format!(
                             "delay {} s of sub-interval {i} is outside [T/m, max_delay] = [{}, {}] s",
@@ -315,21 +346,16 @@ impl Discretization {
                         ),
                     });
                 }
-                let (j0, w0) = stencil(i as f64 - q, r, i);
-                let (j1, w1) = stencil(i as f64 + 1.0 - q, r, i);
+                let (first_node, weights) = self.delay_stencil(i, q);
                 delays.push(CompiledDelay {
-                    j0,
-                    w0,
-                    j1,
-                    w1,
-                    c1: self.g1 * d.gain,
-                    c2: self.g2 * d.gain,
+                    first_node,
+                    gains: weights.map(|w| w * d.gain),
                 });
             }
             steps.push(CompiledStep {
                 inv_top,
                 w_bottom: w.fixed_view::<2, 2>(2, 0).into_owned(),
-                present: self.g1 * sample.present,
+                present_now: w_now * sample.present,
                 first_delay,
                 end_delay: delays.len(),
             });
@@ -338,8 +364,41 @@ impl Discretization {
             steps,
             delays,
             history: r,
-            phi0: self.phi0,
+            phi0: self.moments[0],
         })
+    }
+
+    /// Cubic interpolation stencil of `p(t_i + s − τ)`, `τ = q Δt`: buffer
+    /// index of the first of four consecutive nodes, and the four weights
+    /// `Σ_n a_{kn} LΨ_n` (module documentation).
+    fn delay_stencil(&self, i: usize, q: f64) -> (usize, [Matrix4x2<f64>; NODES]) {
+        let r = self.history as f64;
+        let s0 = i as f64 - q; // grid coordinate of u = 0
+        let n0 = (s0.floor() - 1.0).min(i as f64 - 3.0).max(-r);
+        let nodes: [f64; NODES] = [0.0, 1.0, 2.0, 3.0].map(|k| n0 + k - s0);
+        let mut weights = [Matrix4x2::zeros(); NODES];
+        for (k, weight) in weights.iter_mut().enumerate() {
+            // Monomial coefficients of ℓ_k(u) = Π_{l≠k} (u − u_l)/(u_k − u_l).
+            let mut poly = [1.0, 0.0, 0.0, 0.0];
+            let mut denom = 1.0;
+            for (l, &ul) in nodes.iter().enumerate() {
+                if l == k {
+                    continue;
+                }
+                let mut next = [0.0; 4];
+                for deg in 0..3 {
+                    next[deg + 1] += poly[deg];
+                    next[deg] -= ul * poly[deg];
+                }
+                poly = next;
+                denom *= nodes[k] - ul;
+            }
+            *weight = poly
+                .iter()
+                .zip(&self.l_psi)
+                .fold(Matrix4x2::zeros(), |acc, (a, lp)| acc + lp * (a / denom));
+        }
+        ((n0 + r) as usize, weights)
     }
 
     /// The monodromy matrix Φ (dense, `(4+2r)×(4+2r)`), built column by
@@ -366,6 +425,9 @@ impl Discretization {
     /// As [`Discretization::compile`]; [`ChatterError::NotConverged`] if
     /// the dense fallback also hits its iteration cap;
     /// [`ChatterError::NonFinite`] on overflow.
+    ///
+    /// # Performance
+    /// ≈ 0.15 ms at m = 40 (release build; see `benches/indicator.rs`).
     pub fn spectral_radius(&self, dde: &PeriodicDde) -> Result<f64, ChatterError> {
         self.compile(dde)?.spectral_radius()
     }
@@ -410,12 +472,12 @@ impl CompiledDde {
         let mut x = Vector4::new(input[0], input[1], input[2], input[3]);
         buffer[r] = x.fixed_rows::<2>(0).into_owned();
         for (i, step) in self.steps.iter().enumerate() {
-            let p = buffer[r + i];
-            let mut rhs = self.phi0 * x - step.present * p;
+            let mut rhs = self.phi0 * x - step.present_now * buffer[r + i];
             for d in &self.delays[step.first_delay..step.end_delay] {
-                let pd0 = interpolate(buffer, d.j0, d.w0);
-                let pd1 = interpolate(buffer, d.j1, d.w1);
-                rhs += d.c1 * pd0 + d.c2 * pd1;
+                let nodes = &buffer[d.first_node..d.first_node + NODES];
+                for (g, p) in d.gains.iter().zip(nodes) {
+                    rhs += g * p;
+                }
             }
             let p_next = step.inv_top * rhs.fixed_rows::<2>(0);
             let v_next = rhs.fixed_rows::<2>(2) - step.w_bottom * p_next;
@@ -493,37 +555,40 @@ fn state_matrix(modal: &Modal2, minv: &Matrix2<f64>) -> Matrix4<f64> {
     a0
 }
 
-/// `(Φ₀, Φ₁, Φ₂)` of the module documentation.
-pub type ExpIntegrals = (Matrix4<f64>, Matrix4<f64>, Matrix4<f64>);
-
-/// `(e^{AΔt}, ∫₀^Δt e^{Au} du, (1/Δt)∫₀^Δt e^{Au}(Δt − u) du)` by the
-/// 12×12 block exponential of the module documentation (Van Loan 1978).
+/// `[e^{AΔt}, Ψ₀, Ψ₁, Ψ₂, Ψ₃]` with `Ψ_n = ∫₀^Δt e^{A(Δt−s)} (s/Δt)ⁿ ds`,
+/// by the 20×20 block exponential of the module documentation (Van Loan
+/// 1978): `Ψ_n = Δt n! G_{n+1}`.
 ///
 /// # Errors
-/// [`ChatterError::NonFinite`] if the exponential is not finite.
-pub fn exponential_integrals(a: &Matrix4<f64>, dt: f64) -> Result<ExpIntegrals, ChatterError> {
+/// [`ChatterError::InvalidParameter`] for a bad Δt,
+/// [`ChatterError::NonFinite`] if `a` or the exponential is not finite.
+pub fn exponential_moments(a: &Matrix4<f64>, dt: f64) -> Result<ExpMoments, ChatterError> {
     check_positive("time step [s]", dt)?;
     if a.iter().any(|v| !v.is_finite()) {
         return Err(ChatterError::NonFinite {
             what: "state matrix".to_string(),
         });
     }
-    let mut c = SMatrix::<f64, 12, 12>::zeros();
+    let mut c = SMatrix::<f64, 20, 20>::zeros();
     c.fixed_view_mut::<4, 4>(0, 0).copy_from(&(a * dt));
-    c.fixed_view_mut::<4, 4>(0, 4)
-        .copy_from(&Matrix4::identity());
-    c.fixed_view_mut::<4, 4>(4, 8)
-        .copy_from(&Matrix4::identity());
+    for b in 0..4 {
+        c.fixed_view_mut::<4, 4>(4 * b, 4 * (b + 1))
+            .copy_from(&Matrix4::identity());
+    }
     let e = c.exp();
     if e.iter().any(|v| !v.is_finite()) {
         return Err(ChatterError::NonFinite {
             what: "matrix exponential of the state matrix".to_string(),
         });
     }
-    let phi0 = e.fixed_view::<4, 4>(0, 0).into_owned();
-    let phi1 = e.fixed_view::<4, 4>(0, 4).into_owned() * dt;
-    let phi2 = e.fixed_view::<4, 4>(0, 8).into_owned() * dt;
-    Ok((phi0, phi1, phi2))
+    let block = |b: usize| -> Matrix4<f64> { e.fixed_view::<4, 4>(0, 4 * b).into_owned() };
+    Ok([
+        block(0),
+        block(1) * dt,
+        block(2) * dt,
+        block(3) * (2.0 * dt),
+        block(4) * (6.0 * dt),
+    ])
 }
 
 /// Rounds `q` to the nearest integer when it is within [`SNAP`] of it.
@@ -533,30 +598,5 @@ fn snap(q: f64) -> f64 {
         rq
     } else {
         q
-    }
-}
-
-/// Interpolation stencil of grid coordinate `s` (time `s Δt`, s ≥ −r, at
-/// most `i`): buffer index of the left neighbour and weight of the right.
-fn stencil(s: f64, r: usize, i: usize) -> (usize, f64) {
-    let fl = s.floor();
-    let w = s - fl;
-    // Buffer index of grid point fl is fl + r, clamped into the valid range
-    // (the caller guarantees −r ≤ s ≤ i up to the snapping tolerance).
-    let j = (fl + r as f64).max(0.0) as usize;
-    let j = j.min(r + i);
-    if j == r + i {
-        (j, 0.0)
-    } else {
-        (j, w)
-    }
-}
-
-#[inline]
-fn interpolate(buffer: &[Vector2<f64>], j: usize, w: f64) -> Vector2<f64> {
-    if w == 0.0 {
-        buffer[j]
-    } else {
-        buffer[j] * (1.0 - w) + buffer[j + 1] * w
     }
 }

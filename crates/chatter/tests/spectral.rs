@@ -307,7 +307,7 @@ fn fast_path_matches_dense_with_multiple_fractional_delays() {
                 .collect(),
         };
         let disc = Discretization::new(&modal, t, 40, 2.02 * t).unwrap();
-        assert_eq!(disc.dimension(), 4 + 2 * 81);
+        assert_eq!(disc.dimension(), 4 + 2 * 82);
         let dense = spectral_radius_dense(&disc.monodromy(&dde).unwrap(), 10_000).unwrap();
         let fast = disc.spectral_radius(&dde).unwrap();
         assert!(
