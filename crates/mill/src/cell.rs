@@ -429,7 +429,8 @@ fn process_from(p: &ProcessSection) -> Result<(MillingProcess, StateLimits), Mil
         }
         Ok(r)
     };
-    let spindle_rpm = range("process.spindle_rpm", p.spindle_rpm, f64::MIN_POSITIVE)?;
+    let spindle_rpm = range("process.spindle_rpm", p.spindle_rpm, 0.0)?;
+    check_positive("process.spindle_rpm[0] [rpm]", spindle_rpm[0])?;
     let feed = range("process.feed", p.feed, 0.0)?;
     let redundancy_angle = range("process.redundancy_angle", p.redundancy_angle, -PI - 1e-12)?;
     if redundancy_angle[1] > PI + 1e-12 {
