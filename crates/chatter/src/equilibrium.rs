@@ -429,9 +429,21 @@ impl Ctx<'_> {
         let mut last = f64::NAN;
         for _ in 0..50 {
             let geo = self.geometry(traj, tooth, order, t, tau);
-            if !(geo.g_tau.is_finite() && geo.g_tau > 0.0 && geo.g.is_finite()) {
+            if !(geo.g_tau.is_finite() && geo.g.is_finite()) {
                 return Err(ChatterError::NonFinite {
                     what: format!("eq. 3 Newton step (tooth {tooth}, order {order}, t = {t:e} s)"),
+                });
+            }
+            if geo.g_tau <= 0.0 {
+                // off the branch |δ| < π/2 (or the vibration velocity
+                // exceeds the cutting speed): no delay to follow
+                return Err(ChatterError::NotConverged {
+                    what: format!(
+                        "eq. 3 delay by Newton (tooth {tooth}, order {order}, t = {t:e} s): dg/dtau = {:e} <= 0",
+                        geo.g_tau
+                    ),
+                    iterations: 50,
+                    residual: geo.g,
                 });
             }
             let step = geo.g / geo.g_tau;
@@ -1017,7 +1029,8 @@ fn chip_at(
     };
     let mut best = (ctx.geometry(traj, tooth, 1, t, tau1), 1usize, tau1);
     for order in 2..=settings.max_regeneration {
-        let guess = tau1 + (order - 1) as f64 * ctx.period;
+        // no-vibration scaling: τ^m − mT ≈ m (τ^1 − T), i.e. τ^m ≈ m τ^1
+        let guess = order as f64 * tau1;
         let tau = ctx.newton(traj, tooth, order, t, guess)?;
         let geo = ctx.geometry(traj, tooth, order, t, tau);
         if geo.h < best.0.h {
