@@ -9,8 +9,8 @@ use std::f64::consts::PI;
 use approx::assert_relative_eq;
 use kerf_chatter::{
     chip_direction, constant_delay_dde, constant_delay_dde_unit_depth, directional_averages,
-    force_direction, scale_dde, spectral_radius_dense, ChatterError, DdeSample, DelayTerm,
-    Discretization, MillingProcess, Modal2, Mode, PeriodicDde,
+    force_direction, scale_dde, spectral_radius_dense, stability_lobes, ChatterError, DdeSample,
+    DelayTerm, Discretization, LobeOptions, MillingProcess, Modal2, Mode, PeriodicDde,
 };
 use nalgebra::{Complex, Matrix2, Matrix4};
 
@@ -326,7 +326,9 @@ fn fractional_delay_matches_the_characteristic_equation() {
         let rho_exact = (best.re * period).exp();
         let rho = disc.spectral_radius(&dde).unwrap();
         let error = (rho - rho_exact).abs() / rho_exact;
-        eprintln!("m = {m}: |mu| = {rho:.9}, characteristic root gives {rho_exact:.9}, error {error:.2e}");
+        eprintln!(
+            "m = {m}: |mu| = {rho:.9}, characteristic root gives {rho_exact:.9}, error {error:.2e}"
+        );
         assert!(
             error < 2e-3,
             "m = {m}: |mu| = {rho}, exact {rho_exact}, error {error:e}"
@@ -426,4 +428,24 @@ fn bad_inputs_are_errors() {
     assert!(scale_dde(&dde, f64::NAN).is_err());
     assert!(constant_delay_dde(&textbook_process(1e-3), -5.0, 40).is_err());
     assert!(directional_averages(&textbook_process(1e-3), 0).is_err());
+
+    // Lobe options and speeds.
+    let process = textbook_process(1e-3);
+    let bad_range = LobeOptions {
+        min_depth: 0.01,
+        max_depth: 0.005,
+        ..LobeOptions::default()
+    };
+    assert!(stability_lobes(&modal, &process, &[10_000.0], &bad_range).is_err());
+    let no_scan = LobeOptions {
+        scan_points: 0,
+        ..LobeOptions::default()
+    };
+    assert!(stability_lobes(&modal, &process, &[10_000.0], &no_scan).is_err());
+    let few_steps = LobeOptions {
+        steps: 1,
+        ..LobeOptions::default()
+    };
+    assert!(stability_lobes(&modal, &process, &[10_000.0], &few_steps).is_err());
+    assert!(stability_lobes(&modal, &process, &[f64::NAN], &LobeOptions::default()).is_err());
 }
