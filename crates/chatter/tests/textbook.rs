@@ -125,6 +125,31 @@ fn boundary_matches_the_published_fdm_script() {
 }
 
 #[test]
+fn converged_boundary_matches_the_script_at_m_160() {
+    // The script refined to m = 160 (bisection to 1e-6 m) at two speeds:
+    // 7500 rpm → 1.484912 mm, 17 500 rpm → 2.648535 mm. Both methods
+    // converged, the boundaries agree to 1 %.
+    let opts = LobeOptions {
+        steps: 200,
+        min_depth: 0.0,
+        max_depth: 0.01,
+        scan_points: 100,
+        tolerance: 1e-7,
+    };
+    let reference = [(7_500.0, 1.484912), (17_500.0, 2.648535)];
+    let rpms: Vec<f64> = reference.iter().map(|r| r.0).collect();
+    let ours = stability_lobes(&textbook_modal(), &textbook_process(0.05), &rpms, &opts).unwrap();
+    for (point, (rpm, mm)) in ours.iter().zip(reference) {
+        let value = point.critical_depth.expect("unstable below 10 mm") * 1e3;
+        eprintln!("{rpm} rpm: ours (m = 200) {value} mm, script (m = 160) {mm} mm");
+        assert!(
+            (value - mm).abs() <= 0.01 * mm,
+            "{rpm} rpm: {value} vs {mm}"
+        );
+    }
+}
+
+#[test]
 fn boundary_converges_with_m() {
     let coarse = lobes_mm(0.05, 40, 0.01);
     let fine = lobes_mm(0.05, 200, 0.01);
