@@ -111,24 +111,24 @@ struct ProcessSection {
 /// "State range" and the action bounds of eq. 9-11).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct StateLimits {
-    /// Spindle speed range [rpm] (rpm at the API boundary, as named).
+    /// Spindle speed range \[rpm\] (rpm at the API boundary, as named).
     pub spindle_rpm: [f64; 2],
     /// Feed range [m/s].
     pub feed: [f64; 2],
-    /// Redundancy angle range [rad].
+    /// Redundancy angle range \[rad\].
     pub redundancy_angle: [f64; 2],
     /// Largest feed change per step |Δf| [m/s].
     pub max_feed_step: f64,
-    /// Largest spindle-speed change per step |ΔΩ| [rpm].
+    /// Largest spindle-speed change per step |ΔΩ| \[rpm\].
     pub max_spindle_step_rpm: f64,
-    /// Largest redundancy-angle change per step |Δg| [rad].
+    /// Largest redundancy-angle change per step |Δg| \[rad\].
     pub max_redundancy_step: f64,
 }
 
 /// What the cell gives for one (segment, g).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct CellState {
-    /// Joint vector [rad] (nearest valid IK solution to the reference).
+    /// Joint vector \[rad\] (nearest valid IK solution to the reference).
     pub joints: [f64; 6],
     /// The normalized condition number K of seed 004 eq. 14 (≥ 1, ∞ at a
     /// singularity).
@@ -276,7 +276,7 @@ impl MillCell {
         &self.path
     }
 
-    /// The characteristic length L of eq. 14 [m].
+    /// The characteristic length L of eq. 14 \[m\].
     pub fn characteristic_length(&self) -> f64 {
         self.characteristic_length
     }
@@ -301,7 +301,7 @@ impl MillCell {
         &self.reference
     }
 
-    /// The branch-jump threshold [rad].
+    /// The branch-jump threshold \[rad\].
     pub fn branch_jump_threshold(&self) -> f64 {
         self.jump_threshold
     }

@@ -17,7 +17,7 @@
 //!   `C₂ = Eᵀ C_tt E`, and the 2-DOF stiffness is `K₂ = C₂⁻¹` (coupled,
 //!   symmetric). The out-of-plane (axial) compliance is neglected, as in the
 //!   2-DOF model of seed 004 eq. 1.
-//! * **Mass.** `M₂ = diag(m_x, m_y)` [kg], modal masses from the cell YAML.
+//! * **Mass.** `M₂ = diag(m_x, m_y)` \[kg\], modal masses from the cell YAML.
 //! * **Damping.** A modal damping ratio ζ on each mode of (M₂, K₂): with
 //!   mass-normalized eigenvectors Φ (`Φᵀ M₂ Φ = I`, `Φᵀ K₂ Φ = diag(ω_i²)`),
 //!   `Φᵀ C Φ = diag(2 ζ ω_i)`, hence `C = M₂ Φ diag(2 ζ ω_i) Φᵀ M₂` (since
@@ -43,7 +43,7 @@ use crate::ik::Kinematics;
 pub struct ComplianceModel {
     /// Joint stiffnesses k_1..k_6 [N m/rad].
     pub joint_stiffness: [f64; 6],
-    /// Modal masses [m_x, m_y] along x_c and y_c [kg].
+    /// Modal masses [m_x, m_y] along x_c and y_c \[kg\].
     pub modal_mass: [f64; 2],
     /// Modal damping ratio ζ of both modes [-], 0 ≤ ζ < 1.
     pub damping_ratio: f64,

@@ -40,9 +40,9 @@ pub enum MillError {
     NotCoplanar {
         /// Index of the point farthest from the best-fit plane.
         worst_point: usize,
-        /// Its distance from the plane [m].
+        /// Its distance from the plane \[m\].
         distance: f64,
-        /// The tolerance [m].
+        /// The tolerance \[m\].
         tolerance: f64,
     },
     /// The wrist centre of a target lies outside the arm's reach.
@@ -54,9 +54,9 @@ pub enum MillError {
     Unreachable {
         /// Path segment index, when the target belongs to a path.
         segment: Option<usize>,
-        /// Redundancy angle [rad], when the target was built from one.
+        /// Redundancy angle \[rad\], when the target was built from one.
         g: Option<f64>,
-        /// Distance [m] from the wrist centre to the nearest reachable
+        /// Distance \[m\] from the wrist centre to the nearest reachable
         /// wrist-centre position of the shoulder/elbow chain (> 0).
         distance_beyond_reach: f64,
     },
@@ -70,17 +70,17 @@ pub enum MillError {
     JointLimit {
         /// Path segment index, when the target belongs to a path.
         segment: Option<usize>,
-        /// Redundancy angle [rad], when the target was built from one.
+        /// Redundancy angle \[rad\], when the target was built from one.
         g: Option<f64>,
         /// Joint name (URDF).
         joint: String,
-        /// The joint value of the best solution [rad].
+        /// The joint value of the best solution \[rad\].
         value: f64,
-        /// Lower limit [rad].
+        /// Lower limit \[rad\].
         lower: f64,
-        /// Upper limit [rad].
+        /// Upper limit \[rad\].
         upper: f64,
-        /// How far the value lies outside the limits [rad] (> 0).
+        /// How far the value lies outside the limits \[rad\] (> 0).
         excess: f64,
     },
     /// A computation produced NaN or an infinity.

@@ -53,30 +53,30 @@ use nalgebra::{Isometry3, Matrix3, Rotation3, Vector3};
 use crate::error::MillError;
 use crate::mdh::ArmGeometry;
 
-/// Tolerance of the limit checks [rad] (rounding only).
+/// Tolerance of the limit checks \[rad\] (rounding only).
 const LIMIT_TOL: f64 = 1e-12;
 /// Below this |sin q5| the wrist is treated as singular.
 const WRIST_SINGULAR: f64 = 1e-10;
-/// Below this distance [m] the wrist centre is on the joint-1 axis.
+/// Below this distance \[m\] the wrist centre is on the joint-1 axis.
 const SHOULDER_SINGULAR: f64 = 1e-12;
-/// Self-check tolerance of every IK solution (position [m], angle [rad]).
+/// Self-check tolerance of every IK solution (position \[m\], angle \[rad\]).
 const VERIFY_TOL: f64 = 1e-8;
 
-/// Name and position limits of one joint [rad].
+/// Name and position limits of one joint \[rad\].
 #[derive(Debug, Clone, PartialEq)]
 pub struct JointRange {
     /// Joint name (URDF).
     pub name: String,
-    /// Lower limit [rad].
+    /// Lower limit \[rad\].
     pub lower: f64,
-    /// Upper limit [rad].
+    /// Upper limit \[rad\].
     pub upper: f64,
 }
 
 /// One closed-form IK solution, before limits are applied.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct IkSolution {
-    /// Joint angles [rad], each wrapped to (−π, π].
+    /// Joint angles \[rad\], each wrapped to (−π, π].
     pub q: [f64; 6],
     /// Shoulder back: q1 = atan2(p_wy, p_wx) + π.
     pub shoulder_back: bool,
@@ -93,7 +93,7 @@ pub struct BranchJump {
     pub index: usize,
     /// The joint with the largest step.
     pub joint: String,
-    /// Its step [rad] (absolute value).
+    /// Its step \[rad\] (absolute value).
     pub step: f64,
 }
 
@@ -101,7 +101,7 @@ pub struct BranchJump {
 /// every branch jump found (nothing is hidden).
 #[derive(Debug, Clone, PartialEq)]
 pub struct IkPath {
-    /// Joint vectors [rad], one per pose.
+    /// Joint vectors \[rad\], one per pose.
     pub joints: Vec<[f64; 6]>,
     /// Steps above the threshold, in path order.
     pub jumps: Vec<BranchJump>,
@@ -217,7 +217,7 @@ impl Kinematics {
         &self.weights
     }
 
-    /// Weighted joint distance `√(Σ w_i (a_i − b_i)²)` [rad].
+    /// Weighted joint distance `√(Σ w_i (a_i − b_i)²)` \[rad\].
     pub fn joint_distance(&self, a: &[f64; 6], b: &[f64; 6]) -> f64 {
         a.iter()
             .zip(b)
@@ -454,7 +454,7 @@ impl Kinematics {
     /// # Arguments
     /// * `poses` - tool-tip poses, in path order;
     /// * `reference` - the joint vector the first pose is chosen against;
-    /// * `jump_threshold` - a step of any joint above this [rad] between
+    /// * `jump_threshold` - a step of any joint above this \[rad\] between
     ///   consecutive poses is reported as a [`BranchJump`] (the reference
     ///   itself is not a path pose: its step to pose 0 is not checked).
     ///
@@ -541,7 +541,7 @@ pub fn nearest_equivalent(v: f64, reference: f64, lower: f64, upper: f64) -> Opt
 }
 
 /// The equivalent `v + 2πk` closest to `[lower, upper]` and its distance
-/// outside it [rad].
+/// outside it \[rad\].
 fn smallest_excess(v: f64, lower: f64, upper: f64) -> (f64, f64) {
     let w = wrap(v);
     [-TAU, 0.0, TAU]

@@ -16,7 +16,11 @@
 //! [`characteristic_length`] computes it (golden-section search); the value
 //! stored in `urdf/irb6660_milling.yaml` (`condition.characteristic_length`)
 //! is its result, and `tests/condition.rs` recomputes it and checks the
-//! stored value. Any other value can be configured there.
+//! stored value: **L = 1.2896 m**, mean K = 2.440 over the 500 reachable
+//! (segment, g) samples (K = 3.05 at L/2 and at 2L). It is of the order of
+//! the arm's reach from the wrist to the tool (a2 ≈ 1.28 m, d4 ≈ 1.51 m),
+//! as Angeles' length typically is. Any other value can be configured
+//! (`condition.characteristic_length`).
 
 use nalgebra::{Matrix6, Vector3};
 
@@ -68,7 +72,7 @@ impl Kinematics {
 ///
 /// # Arguments
 /// * `j` - the Jacobian, linear rows first ([`Kinematics::jacobian`]);
-/// * `length` - the characteristic length L [m] (module documentation).
+/// * `length` - the characteristic length L \[m\] (module documentation).
 ///
 /// # Returns
 /// K ≥ 1, or `f64::INFINITY` when J is singular (smallest eigenvalue of A

@@ -35,13 +35,13 @@ use crate::error::{check_positive, MillError};
 /// One row of an MDH table (Craig convention).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct MdhRow {
-    /// Link twist α(i−1) [rad].
+    /// Link twist α(i−1) \[rad\].
     pub alpha: f64,
-    /// Link length a(i−1) [m].
+    /// Link length a(i−1) \[m\].
     pub a: f64,
-    /// Link offset d(i) [m].
+    /// Link offset d(i) \[m\].
     pub d: f64,
-    /// Joint angle offset: θ(i) = q(i) + `theta_offset` [rad].
+    /// Joint angle offset: θ(i) = q(i) + `theta_offset` \[rad\].
     pub theta_offset: f64,
 }
 
@@ -74,17 +74,17 @@ pub fn frame6_to_tool0() -> Isometry3<f64> {
 /// offset a1, forearm offset a3) that fill the MDH table.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ArmGeometry {
-    /// Shoulder height d1 [m].
+    /// Shoulder height d1 \[m\].
     pub d1: f64,
-    /// Shoulder offset a1 (joint 1 axis to joint 2 axis) [m].
+    /// Shoulder offset a1 (joint 1 axis to joint 2 axis) \[m\].
     pub a1: f64,
-    /// Lower-arm length a2 (joint 2 to joint 3) [m].
+    /// Lower-arm length a2 (joint 2 to joint 3) \[m\].
     pub a2: f64,
-    /// Forearm offset a3 (perpendicular to the forearm) [m].
+    /// Forearm offset a3 (perpendicular to the forearm) \[m\].
     pub a3: f64,
-    /// Forearm length d4 (joint 4 axis, up to the wrist centre) [m].
+    /// Forearm length d4 (joint 4 axis, up to the wrist centre) \[m\].
     pub d4: f64,
-    /// Wrist centre to flange d6 [m].
+    /// Wrist centre to flange d6 \[m\].
     pub d6: f64,
 }
 
@@ -135,7 +135,7 @@ impl ArmGeometry {
     /// Poses of the MDH frames 1..6 in the base frame.
     ///
     /// # Arguments
-    /// * `q` - joint angles [rad] (not checked: NaN propagates; use
+    /// * `q` - joint angles \[rad\] (not checked: NaN propagates; use
     ///   [`crate::Kinematics`] for validated evaluation).
     ///
     /// # Performance

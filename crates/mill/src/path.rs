@@ -9,7 +9,7 @@
 //! line), the parameters are chord-length `u_i = Σ_{l≤i} |p_l − p_{l−1}| / Σ |…|`
 //! (Piegl & Tiller, *The NURBS Book*, eq. 9.5), the knots are de Boor's
 //! averages of them ([`KnotVector::for_parameters`], eq. 9.8), and each
-//! coordinate is the interpolating fit of [`kerf_bspline::fit`]. For the
+//! coordinate is the interpolating fit of [`kerf_bspline::fit()`]. For the
 //! four points of seed 004 Table 1 this is the cubic Bézier through them.
 //! The spline is an affine combination of the points, so it stays in their
 //! plane.
@@ -54,19 +54,19 @@ use crate::error::{check_finite, MillError};
 
 /// Gauss–Legendre order per panel.
 const GL_ORDER: usize = 10;
-/// Panel doubling cap (P ≤ 2^14 panels per knot span).
+/// Panel doubling cap (P from 4 up to 4 · 2^13 panels per knot span).
 const MAX_DOUBLINGS: usize = 14;
 /// Newton/bisection cap of the arc-length inversion.
 const INVERT_MAX_ITER: usize = 100;
-/// Coplanarity tolerance [m].
+/// Coplanarity tolerance \[m\].
 pub const COPLANAR_TOL: f64 = 1e-6;
-/// Two consecutive points closer than this [m] are "repeated".
+/// Two consecutive points closer than this \[m\] are "repeated".
 pub const REPEAT_TOL: f64 = 1e-9;
 
 /// What the path is built from (every field configurable in the cell YAML).
 #[derive(Debug, Clone, PartialEq)]
 pub struct PathSpec {
-    /// The coplanar points the spline interpolates, in the base frame [m].
+    /// The coplanar points the spline interpolates, in the base frame \[m\].
     pub points: Vec<[f64; 3]>,
     /// Number of equal-arc-length segments N.
     pub segments: usize,
@@ -113,13 +113,13 @@ pub struct CuttingFrame {
 pub struct Segment {
     /// Index, 0-based.
     pub index: usize,
-    /// Start point [m].
+    /// Start point \[m\].
     pub start: Vector3<f64>,
-    /// End point [m].
+    /// End point \[m\].
     pub end: Vector3<f64>,
-    /// Arc-length midpoint [m] (where the tool is placed for this segment).
+    /// Arc-length midpoint \[m\] (where the tool is placed for this segment).
     pub mid: Vector3<f64>,
-    /// Arc length [m].
+    /// Arc length \[m\].
     pub length: f64,
     /// Unit tangent (feed direction) at the midpoint.
     pub tangent: Vector3<f64>,
@@ -201,12 +201,12 @@ impl MillingPath {
         self.approach
     }
 
-    /// Largest distance of an input point from the best-fit plane [m].
+    /// Largest distance of an input point from the best-fit plane \[m\].
     pub fn plane_deviation(&self) -> f64 {
         self.plane_deviation
     }
 
-    /// Total arc length [m].
+    /// Total arc length \[m\].
     pub fn total_length(&self) -> f64 {
         self.cumulative.last().copied().unwrap_or(0.0)
     }
@@ -230,7 +230,7 @@ impl MillingPath {
             })
     }
 
-    /// Point P(u) [m].
+    /// Point P(u) \[m\].
     ///
     /// # Errors
     /// [`MillError::Bspline`] for u outside [0, 1] or NaN.
@@ -254,7 +254,7 @@ impl MillingPath {
         Ok(p)
     }
 
-    /// Arc length s(u) from u = 0 [m].
+    /// Arc length s(u) from u = 0 \[m\].
     ///
     /// # Errors
     /// [`MillError::InvalidParameter`] for u outside [0, 1] or NaN.
