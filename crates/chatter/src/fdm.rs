@@ -31,7 +31,7 @@
 //!
 //! are needed (`Ψ₀ = Φ₁`, `Ψ₁ = Φ₂` in Ding's notation); they depend on the
 //! modal model and Δt only. The gains are the sub-interval averages carried
-//! by the [`DdeSample`]s (as in first-order semi-discretization, Insperger &
+//! by the [`DdeSample`](crate::model::DdeSample)s (as in first-order semi-discretization, Insperger &
 //! Stépán 2004 IJNME 61:117 §3, which keeps interrupted cutting accurate).
 //!
 //! * Present term `−A_i p(t)`: linear interpolation between `p_i` and
