@@ -70,7 +70,8 @@
 //!
 //! On sub-interval i of `[i T/m, (i+1) T/m)` the gains are averaged by
 //! 5-point Gauss–Legendre quadrature on each piece between engagement
-//! breakpoints (exact cut boundaries); one delayed term per (tooth, order)
+//! breakpoints (exact cut boundaries) and loss-of-contact switches of the
+//! equilibrium (located by bisection); one delayed term per (tooth, order)
 //! with a nonzero gain, its delay taken at the sub-interval midpoint (Newton
 //! on eq. 3 there).
 
@@ -220,18 +221,21 @@ pub fn linearize(
         let mut groups: BTreeMap<(usize, usize), Matrix2<f64>> = BTreeMap::new();
         for w in cuts.windows(2) {
             let (pa, pb) = (w[0], w[1]);
-            let half = 0.5 * (pb - pa);
             let mid = 0.5 * (pa + pb);
             for j in 0..process.teeth {
                 if !engaged(&process, eq.angle(j, mid)) {
                     continue;
                 }
-                for (x, wq) in GL_X.iter().zip(GL_W) {
-                    let t = mid + half * x;
-                    if let Some((gain, order)) = tooth_gain(eq, j, t)? {
-                        let g = gain * (wq * half / dt);
-                        present += g;
-                        *groups.entry((j, order)).or_insert_with(Matrix2::zeros) += g;
+                for (ca, cb) in contact_pieces(eq, j, pa, pb)? {
+                    let half = 0.5 * (cb - ca);
+                    let mid = 0.5 * (ca + cb);
+                    for (x, wq) in GL_X.iter().zip(GL_W) {
+                        let t = mid + half * x;
+                        if let Some((gain, order)) = tooth_gain(eq, j, t)? {
+                            let g = gain * (wq * half / dt);
+                            present += g;
+                            *groups.entry((j, order)).or_insert_with(Matrix2::zeros) += g;
+                        }
                     }
                 }
             }
@@ -250,6 +254,60 @@ pub fn linearize(
     let dde = PeriodicDde { period, samples };
     dde.validate()?;
     Ok(dde)
+}
+
+/// Sub-intervals of `[pa, pb]` (inside the engagement of tooth j) where
+/// the tooth is in contact in the equilibrium: the contact state is
+/// sampled at 9 points and every change is located by bisection (50
+/// steps), so that a loss-of-contact window changes the gains continuously
+/// with the parameters instead of by quadrature-point jumps (the
+/// linearized gain does not vanish at h̃ = 0⁺: W ∝ b cᵀ).
+fn contact_pieces(
+    eq: &Equilibrium,
+    tooth: usize,
+    pa: f64,
+    pb: f64,
+) -> Result<Vec<(f64, f64)>, ChatterError> {
+    const SAMPLES: usize = 8;
+    let inset = 1e-9 * (pb - pa);
+    let at = |i: usize| {
+        let t = pa + (pb - pa) * i as f64 / SAMPLES as f64;
+        t.clamp(pa + inset, pb - inset)
+    };
+    let contact =
+        |t: f64| -> Result<bool, ChatterError> { Ok(eq.chip_state(tooth, t)?.in_contact) };
+    let mut pieces = Vec::new();
+    let mut start = if contact(at(0))? { Some(pa) } else { None };
+    let mut prev_t = at(0);
+    let mut prev_c = start.is_some();
+    for i in 1..=SAMPLES {
+        let t = at(i);
+        let c = contact(t)?;
+        if c != prev_c {
+            // bisection for the switch in (prev_t, t)
+            let (mut lo, mut hi) = (prev_t, t);
+            for _ in 0..50 {
+                let m = 0.5 * (lo + hi);
+                if contact(m)? == prev_c {
+                    lo = m;
+                } else {
+                    hi = m;
+                }
+            }
+            let switch = 0.5 * (lo + hi);
+            if c {
+                start = Some(switch);
+            } else if let Some(s0) = start.take() {
+                pieces.push((s0, switch));
+            }
+        }
+        prev_t = t;
+        prev_c = c;
+    }
+    if let Some(s0) = start {
+        pieces.push((s0, pb));
+    }
+    Ok(pieces)
 }
 
 /// Adds the entry/exit wall impulses (module documentation) to `samples`.
