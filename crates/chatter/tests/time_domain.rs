@@ -288,7 +288,11 @@ fn constant_delay_multiplier(
 /// period-doubling (flip) lobe (19 000 rpm; the type is checked from the
 /// dominant multiplier), the critical depth of the constant-delay full
 /// discretization ([`stability_lobes`], m = 40) splits the simulated
-/// nonlinear model: 0.8 a_lim decays, 1.2 a_lim grows. ±20 % rather than
+/// nonlinear model: 0.8 a_lim decays, 1.2 a_lim grows. The constant-delay
+/// model keeps its engagement window fixed in tool angle, so the factors
+/// are compared with the simulation run likewise (`workpiece_wall:
+/// false`); the verdicts must also hold with the moving workpiece wall (the
+/// default, which shifts the factor by up to ~0.025 here). ±20 % rather than
 /// nearer: within ±5 % the per-period factor is within 1e-2 of 1 and the
 /// exact-trochoid model differs from the constant-delay one by about that
 /// much (at 10 000 rpm, 1.05 a_lim: |μ| = 1.007 but the simulation grows by
@@ -328,8 +332,18 @@ fn textbook_boundary_splits_decay_from_growth() -> Result<(), ChatterError> {
             let process = textbook_process(fraction * a_lim)?;
             let (mu, _) = constant_delay_multiplier(&modal, &process, rpm)?;
             let feed = 1e-4 / process.tooth_period(rpm)?;
-            let sim = simulate(&modal, &process, rpm, feed, &SimulationSettings::default())?;
+            let settings = SimulationSettings {
+                workpiece_wall: false,
+                ..Default::default()
+            };
+            let sim = simulate(&modal, &process, rpm, feed, &settings)?;
             let growth = classify(&sim)?;
+            let wall = classify(&simulate(&modal, &process, rpm, feed, &Default::default())?)?;
+            println!(
+                "{rpm} rpm, {fraction} a_lim, with the workpiece wall: factor {:.4}, {:?}",
+                wall.factor, wall.verdict
+            );
+            assert_eq!(wall.verdict, expected, "with the workpiece wall: {wall:?}");
             println!(
                 "{rpm} rpm, a_lim {:.4} mm, {fraction} a_lim: |mu| {mu:.4}, simulated factor \
                  {:.4}, amplification {:.1}, late contact {:.3}, {:?}",
@@ -432,13 +446,14 @@ fn periodic_response_matches_the_equilibrium() -> Result<(), ChatterError> {
 /// indicator ([`chatter_indicator`], bisection on a_p) splits the simulated
 /// nonlinear model at 0.8 and 1.2 times it.
 ///
-/// The simulation keeps the engagement window fixed in tool angle (seed 004
-/// Table 1); the indicator adds by default a workpiece-wall term (the entry
-/// angle moving with the vibration, `crate::linearize`), which the
-/// simulation does not model. Hence two factor checks: against the
-/// indicator without that term the measured factor agrees tightly (within
-/// 0.005; 4e-4 when written), against the default indicator loosely
-/// (within 0.03; its term shifts |μ| by up to 0.02 here).
+/// Two variants of the same physics, each modelled independently in both
+/// codes: with the workpiece wall (the entry moves with the vibration: the
+/// simulator locates the tooth tip's crossing of the wall line, the
+/// linearization adds the entry impulse of `crate::linearize`; the default
+/// of both), and with the engagement window fixed in tool angle
+/// (`workpiece_wall: false` / `wall_term: false`). The wall shifts |μ| by
+/// about 0.01 here; in each variant the measured per-period factor must
+/// match |μ|max within 0.005.
 #[test]
 fn state_dependent_boundary_splits_decay_from_growth() -> Result<(), ChatterError> {
     let modal = robot_modal()?;
@@ -475,25 +490,30 @@ fn state_dependent_boundary_splits_decay_from_growth() -> Result<(), ChatterErro
             );
             let sim = simulate(&modal, &process, rpm, feed, &SimulationSettings::default())?;
             let growth = classify(&sim)?;
+            let fixed = SimulationSettings {
+                workpiece_wall: false,
+                ..Default::default()
+            };
+            let fixed = classify(&simulate(&modal, &process, rpm, feed, &fixed)?)?;
             println!(
-                "{rpm} rpm, {feed} m/s, a_crit {:.3} mm, {fraction} a_crit: |mu| {mu_sd:.4} \
-                 (no wall term {mu_nw:.4}), simulated factor {:.4}, amplification {:.1}, \
-                 late contact {:.3}, {:?}",
+                "{rpm} rpm, {feed} m/s, a_crit {:.3} mm, {fraction} a_crit: |mu| {mu_sd:.4}, \
+                 simulated factor {:.4} (amplification {:.1}, late contact {:.3}, {:?}); \
+                 fixed window: |mu| {mu_nw:.4}, simulated {:.4} ({:?})",
                 a_crit * 1e3,
                 growth.factor,
                 growth.amplification,
                 growth.late_contact_fraction,
-                growth.verdict
+                growth.verdict,
+                fixed.factor,
+                fixed.verdict
             );
             assert_eq!(growth.verdict, expected, "{rpm} rpm {fraction}: {growth:?}");
+            assert_eq!(fixed.verdict, expected, "{rpm} rpm {fraction}: {fixed:?}");
             assert!(
-                (growth.factor - mu_nw).abs() < 5e-3,
-                "{growth:?} vs {mu_nw}"
-            );
-            assert!(
-                (growth.factor - mu_sd).abs() < 3e-2,
+                (growth.factor - mu_sd).abs() < 5e-3,
                 "{growth:?} vs {mu_sd}"
             );
+            assert!((fixed.factor - mu_nw).abs() < 5e-3, "{fixed:?} vs {mu_nw}");
         }
     }
     Ok(())
