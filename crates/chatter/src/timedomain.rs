@@ -137,6 +137,10 @@ pub struct StepSample {
     /// Largest chip thickness of the teeth inside the engagement window
     /// \[m\] (0 when none is inside or none is in contact).
     pub chip: f64,
+    /// Regeneration order m of that chip: the earlier tooth whose path is
+    /// the surface being cut (1 = the previous tooth; ≥ 2 = multiple
+    /// regeneration, the teeth in between left the cut); 0 without a chip.
+    pub order: usize,
 }
 
 /// The state at the start of one tooth period (Poincaré section) and what
@@ -350,6 +354,7 @@ pub fn simulate(
                 velocity: vel,
                 force: cut.force,
                 chip: cut.chip,
+                order: cut.order,
             });
         }
         let (mut p1, mut v1) = (pos, vel);
@@ -807,6 +812,7 @@ struct Edge {
 struct Cut {
     force: Vector2<f64>,
     chip: f64,
+    order: usize,
     engaged: usize,
     contact: usize,
 }
@@ -951,6 +957,7 @@ impl Cutter {
         let mut cut = Cut {
             force: Vector2::zeros(),
             chip: 0.0,
+            order: 0,
             engaged: 0,
             contact: 0,
         };
@@ -962,16 +969,22 @@ impl Cutter {
             }
             let phi = self.omega * t + self.phase + offset;
             cut.engaged += 1;
-            let mut h = f64::INFINITY;
+            let (mut h, mut order) = (f64::INFINITY, 0);
             for m in 1..=self.regen {
                 let slot = warm.get_mut(j * self.regen + m - 1).ok_or_else(internal)?;
                 let (tau, hm) = self.solve_delay(t, phi, o, m, hist, *slot)?;
                 *slot = tau;
-                h = h.min(hm);
+                if hm < h {
+                    h = hm;
+                    order = m;
+                }
             }
             if h > 0.0 {
                 cut.contact += 1;
-                cut.chip = cut.chip.max(h);
+                if h > cut.chip {
+                    cut.chip = h;
+                    cut.order = order;
+                }
                 cut.force += self.depth * h * force_direction(phi, self.kt, self.kn);
             }
         }
@@ -1122,7 +1135,7 @@ fn periodic_response(
         .iter()
         .map(|b| vec![[Vector2::zeros(); 4]; b.len().saturating_sub(1)])
         .collect();
-    let mut chips = vec![0.0; n];
+    let mut chips = vec![(0.0, 0usize); n];
     let mut change = f64::NAN;
     for iteration in 1..=settings.orbit_max_iterations {
         let (mut engaged, mut contact) = (0usize, 0usize);
@@ -1143,7 +1156,7 @@ fn periodic_response(
                 if i == 0 {
                     engaged += c0.engaged;
                     contact += c0.contact;
-                    *ck = c0.chip;
+                    *ck = (c0.chip, c0.order);
                 }
                 let mut stage = [c0.force; 4];
                 let mut next = 1;
@@ -1211,7 +1224,8 @@ fn periodic_response(
                         .and_then(|f| f.first())
                         .map(|f| f[0])
                         .unwrap_or_default(),
-                    chip: chips.get(k).copied().unwrap_or_default(),
+                    chip: chips.get(k).map(|c| c.0).unwrap_or_default(),
+                    order: chips.get(k).map(|c| c.1).unwrap_or_default(),
                 })
                 .collect();
             return Ok(Orbit {

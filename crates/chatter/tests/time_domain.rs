@@ -518,3 +518,61 @@ fn state_dependent_boundary_splits_decay_from_growth() -> Result<(), ChatterErro
     }
     Ok(())
 }
+
+/// Loss of contact and multiple regeneration (seed 004 Fig. 1b): far above
+/// the boundary (textbook system, 10 000 rpm, a_p = 3 mm ≈ 2 a_lim) the
+/// linear growth (|μ|max ≈ 1.12 per period) stops once the teeth leave the
+/// cut: the deviation saturates instead of growing by orders of magnitude,
+/// the contact fraction drops, the chip is never negative and gives no
+/// force when zero, and teeth cut surfaces left two or more teeth earlier.
+/// Below the boundary every chip is cut from the previous tooth's path.
+#[test]
+fn loss_of_contact_saturates_chatter() -> Result<(), ChatterError> {
+    let modal = textbook_modal()?;
+    let rpm = 10_000.0;
+    let settings = SimulationSettings {
+        periods: 120,
+        record_steps: true,
+        ..Default::default()
+    };
+    let process = textbook_process(3e-3)?;
+    let (mu, _) = constant_delay_multiplier(&modal, &process, rpm)?;
+    let feed = 1e-4 / process.tooth_period(rpm)?;
+    let sim = simulate(&modal, &process, rpm, feed, &settings)?;
+    let growth = classify(&sim)?;
+    let d: Vec<f64> = sim.periods.iter().map(|p| p.deviation).collect();
+    let mean = |r: std::ops::Range<usize>| d[r.clone()].iter().sum::<f64>() / r.len() as f64;
+    let (middle, late) = (mean(72..96), mean(96..120));
+    let multiple = sim.steps[sim.steps.len() / 2..]
+        .iter()
+        .filter(|s| s.order >= 2)
+        .count();
+    let max_chip = sim.steps.iter().map(|s| s.chip).fold(0.0, f64::max);
+    println!(
+        "saturated: |mu| {mu:.3}, {growth:?}, mean deviation {middle:.3e} then {late:.3e} m, \
+         {multiple} late steps with multiple regeneration, max chip {max_chip:.3e} m"
+    );
+    assert!(mu > 1.1);
+    assert_eq!(growth.verdict, Verdict::Unstable);
+    assert!(growth.amplification > 10.0 && growth.final_ratio > 10.0);
+    // 24 periods of linear growth would multiply by mu^24 > 9.
+    assert!(
+        late < 2.0 * middle && late > 0.5 * middle,
+        "{middle} -> {late}"
+    );
+    assert!(growth.late_contact_fraction < 0.9);
+    assert!(multiple > 0);
+    for s in &sim.steps {
+        assert!(s.chip >= 0.0);
+        if s.chip == 0.0 {
+            assert_eq!(s.force.norm(), 0.0);
+            assert_eq!(s.order, 0);
+        }
+    }
+
+    let stable = simulate(&modal, &textbook_process(0.5e-3)?, rpm, feed, &settings)?;
+    assert_eq!(classify(&stable)?.verdict, Verdict::Stable);
+    assert!(stable.steps.iter().all(|s| s.order <= 1));
+    assert!(stable.steps.iter().any(|s| s.order == 1));
+    Ok(())
+}
