@@ -603,20 +603,29 @@ impl Equilibrium {
             };
             tracks = build_tracks(&ctx, &traj, &times, &engaged_steps)?;
             // Forces at step start, midpoint, end.
-            let mut forces = Vec::with_capacity(nsteps);
-            for (k, teeth) in engaged_steps.iter().enumerate() {
-                let tm = 0.5 * (times[k] + times[k + 1]);
-                let mut fk = [zero; 3];
-                for (slot, t) in [times[k], tm, times[k + 1]].into_iter().enumerate() {
-                    for &j in teeth {
-                        let cs = chip_at(&ctx, &traj, &tracks, settings, &times, j, t)?;
-                        if cs.in_contact {
-                            fk[slot] += force_direction(cs.phi, process.kt, process.kn)
-                                * (process.axial_depth * settings.force_law.value(cs.chip));
-                        }
+            // Force of the teeth engaged on the step (the step's engaged set
+            // decides, so a jump sitting on a node gets its one-sided value);
+            // the end force of a step is the start force of the next unless
+            // the engaged set changes there.
+            let force_at = |teeth: &[usize], t: f64| -> Result<Vector2<f64>, ChatterError> {
+                let mut f = zero;
+                for &j in teeth {
+                    let cs = chip_at(&ctx, &traj, &tracks, settings, &times, j, t)?;
+                    if cs.chip > 0.0 {
+                        f += force_direction(cs.phi, process.kt, process.kn)
+                            * (process.axial_depth * settings.force_law.value(cs.chip));
                     }
                 }
-                forces.push(fk);
+                Ok(f)
+            };
+            let mut forces: Vec<[Vector2<f64>; 3]> = Vec::with_capacity(nsteps);
+            for (k, teeth) in engaged_steps.iter().enumerate() {
+                let tm = 0.5 * (times[k] + times[k + 1]);
+                let fa = match (k.checked_sub(1), forces.last()) {
+                    (Some(prev), Some(last)) if engaged_steps[prev] == *teeth => last[2],
+                    _ => force_at(teeth, times[k])?,
+                };
+                forces.push([fa, force_at(teeth, tm)?, force_at(teeth, times[k + 1])?]);
             }
             // Shooting: particular solution from z = 0, then periodicity.
             let step = |z: Vector4<f64>, k: usize, f: &[Vector2<f64>; 3]| {
