@@ -61,11 +61,19 @@
 //!
 //! With a T-periodic õ the regenerative terms nearly cancel:
 //! `õ(t − τ) − õ(t) ≈ −õ̇(t) (τ − T)` and `τ − T = O(f T/(R Ω))`, so the
-//! equilibrium chip is `h̃ ≈ f_z sin φ (1 + O(f/(RΩ), õ̇/(RΩ)))` whatever
-//! the size of the forced response: loss of contact in the equilibrium
-//! happens only where `f_z sin φ` itself vanishes (at φ = 0 or π) unless
-//! the vibration velocity approaches the cutting speed RΩ. The fixed point
-//! map is therefore a strong contraction (2-4 iterations).
+//! equilibrium chip is `h̃ ≈ f_z sin φ + O(f_z f/(RΩ), f_z õ̇/(RΩ))`
+//! whatever the size of the forced response: loss of contact in the
+//! equilibrium happens only where `f_z sin φ` itself is small (near φ = 0
+//! or π) unless the vibration velocity becomes a sizeable fraction of the
+//! cutting speed RΩ. Measured (2 teeth, [0.75π, π], a_p 3 mm): a 25 Hz /
+//! 50 kg tool tip at 2000-4000 rpm keeps full contact (min chip ≈ 0.017
+//! f_z, at the last grid midpoint before φ = π); at the resonance speed
+//! 750 rpm (forced amplitude 2-11 f_z) contact is lost over 2-14 % of the
+//! engagement, always next to the exit. The fixed-point map is a strong
+//! contraction: 4-6 iterations, up to ~20 at resonance. When the vibration
+//! velocity reaches the cutting speed, eq. 3 loses its regular root
+//! (`g_τ ≤ 0`) and [`Equilibrium::compute`] reports
+//! [`ChatterError::NotConverged`] rather than following a spurious branch.
 //!
 //! Neglected: the shift of the entry/exit angle at a fixed workpiece wall
 //! by the equilibrium's own y-vibration (relative size (ỹ − mean ỹ)/R,
@@ -508,12 +516,14 @@ impl Equilibrium {
     /// [`ChatterError::InvalidParameter`] for bad inputs (also feed = 0 with
     /// a force exponent < 1, whose stiffness is infinite at h = 0);
     /// [`ChatterError::NotConverged`] when the fixed-point iteration or a
-    /// delay's Newton iteration hits its cap; [`ChatterError::NonFinite`];
+    /// delay's Newton iteration hits its cap, or eq. 3 has no regular root
+    /// (`g_τ ≤ 0`: vibration velocity comparable to the cutting speed); [`ChatterError::NonFinite`];
     /// [`ChatterError::Unsupported`] when `I − Φ_T` is singular (undamped
     /// resonance with a harmonic of the tooth frequency).
     ///
     /// # Performance
-    /// About 1 ms for 200 nodes and 2-4 iterations (2 teeth, 25 % immersion).
+    /// About 0.8 ms (dev profile, opt-level 1) for 200 nodes and 4
+    /// iterations (2 teeth, quarter-turn engagement, 3 regeneration orders).
     pub fn compute(
         modal: &Modal2,
         process: &MillingProcess,
@@ -888,7 +898,8 @@ pub struct EquilibriumDiagnostics {
     /// Smallest equilibrium chip h̃ over the engagement [m] (≤ 0: loss of
     /// contact somewhere).
     pub min_chip: f64,
-    /// Fraction of the nominal engagement time with h̃ > 0 [-].
+    /// Fraction of the nominal engagement time with h̃ > 0 [-] (sampled at
+    /// the grid-step midpoints, so resolved to about 1/(engaged steps)).
     pub contact_fraction: f64,
     /// max |τ_j(t) − m T| / T over the engagement (order m of the cut) [-].
     pub max_delay_deviation: f64,
