@@ -126,7 +126,10 @@ impl Default for SimulationSettings {
 /// The state at one instant, with the cutting force acting on it.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct StepSample {
-    /// Time t \[s\] from the start.
+    /// Time t \[s\] in the angle convention of [`crate::model`]
+    /// (φ_j = Ω t + 2π j / N_t). The step grid starts at t = 0, or, with a
+    /// workpiece wall, up to one step later (it is offset so that the
+    /// nominal wall crossings fall mid-step).
     pub time: f64,
     /// Tool-centre displacement o(t) \[m\].
     pub position: Vector2<f64>,
@@ -147,7 +150,7 @@ pub struct StepSample {
 /// happened during that period.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct PeriodSample {
-    /// Time k T \[s\].
+    /// Time k T (plus the grid offset of [`StepSample::time`]) \[s\].
     pub time: f64,
     /// Tool-centre displacement at k T \[m\].
     pub position: Vector2<f64>,
