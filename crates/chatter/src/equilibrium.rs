@@ -66,7 +66,7 @@
 //! equilibrium happens only where `f_z sin φ` itself is small (near φ = 0
 //! or π) unless the vibration velocity becomes a sizeable fraction of the
 //! cutting speed RΩ. Measured (2 teeth, [0.75π, π], a_p 3 mm): a 25 Hz /
-//! 50 kg tool tip at 2000-4000 rpm keeps full contact (min chip ≈ 0.017
+//! 50 kg tool tip at 2000-4000 rpm keeps full contact (min chip 0.01-0.02
 //! f_z, at the last grid midpoint before φ = π); at the resonance speed
 //! 750 rpm (forced amplitude 2-11 f_z) contact is lost over 2-14 % of the
 //! engagement, always next to the exit. The fixed-point map is a strong
