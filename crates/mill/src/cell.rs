@@ -9,6 +9,7 @@
 
 use std::path::{Path, PathBuf};
 
+use kerf_chatter::indicator::{DelayModel, IndicatorSettings};
 use kerf_chatter::{MillingProcess, Modal2, Mode};
 use kerf_robot::RobotModel;
 use nalgebra::{Isometry3, Matrix3, Rotation3, Translation3, UnitQuaternion, Vector3};
@@ -30,6 +31,21 @@ struct CellFile {
     condition: ConditionSection,
     dynamics: DynamicsSection,
     process: ProcessSection,
+    #[serde(default)]
+    chatter: Option<ChatterSection>,
+}
+
+/// The `chatter` section: how the chatter indicator is evaluated for this
+/// cell (absent: the paper's model, state-dependent delays, linear force
+/// law, m = 40).
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct ChatterSection {
+    model: String,
+    steps: usize,
+    force_exponent: f64,
+    reference_chip: f64,
+    wall_term: bool,
 }
 
 #[derive(Debug, Deserialize)]
@@ -149,6 +165,7 @@ pub struct MillCell {
     dynamics: ToolTipDynamics,
     process: MillingProcess,
     limits: StateLimits,
+    indicator: IndicatorSettings,
     reference: [f64; 6],
     jump_threshold: f64,
 }
@@ -248,6 +265,7 @@ impl MillCell {
         };
         dynamics.validate()?;
         let (process, limits) = process_from(&file.process)?;
+        let indicator = indicator_from(file.chatter.as_ref())?;
         Ok(Self {
             robot,
             kinematics,
@@ -256,6 +274,7 @@ impl MillCell {
             dynamics,
             process,
             limits,
+            indicator,
             reference: file.robot.reference_joints,
             jump_threshold,
         })
@@ -289,6 +308,12 @@ impl MillCell {
     /// The milling process (seed 004 Table 1), for `kerf_chatter`.
     pub fn milling_process(&self) -> MillingProcess {
         self.process
+    }
+
+    /// How the chatter indicator is evaluated for this cell (the YAML's
+    /// `chatter` section: delay model, m, force law, wall term).
+    pub fn indicator_settings(&self) -> &IndicatorSettings {
+        &self.indicator
     }
 
     /// State ranges and step bounds.
@@ -390,6 +415,39 @@ fn tcp_from_axes(t: &TcpSection) -> Result<Isometry3<f64>, MillError> {
         Translation3::from(Vector3::from(t.position)),
         UnitQuaternion::from_rotation_matrix(&Rotation3::from_matrix_unchecked(r)),
     ))
+}
+
+/// The indicator settings of the `chatter` section (module documentation
+/// of `kerf_chatter::indicator`); the paper's model when it is absent.
+fn indicator_from(c: Option<&ChatterSection>) -> Result<IndicatorSettings, MillError> {
+    let Some(c) = c else {
+        return Ok(IndicatorSettings::default());
+    };
+    let model = match c.model.as_str() {
+        "state_dependent" => DelayModel::StateDependent,
+        "constant" => DelayModel::Constant,
+        other => {
+            return Err(MillError::InvalidConfig {
+                name: "chatter.model".to_string(),
+                reason: format!("`{other}`: must be `state_dependent` or `constant`"),
+            })
+        }
+    };
+    if !(c.force_exponent.is_finite() && c.force_exponent > 0.0 && c.force_exponent <= 1.0) {
+        return Err(MillError::InvalidParameter {
+            name: "chatter.force_exponent [-]".to_string(),
+            value: c.force_exponent,
+            reason: "must be in (0, 1]".to_string(),
+        });
+    }
+    check_positive("chatter.reference_chip [m]", c.reference_chip)?;
+    let settings = IndicatorSettings::default()
+        .model(model)
+        .steps(c.steps)
+        .force_law(c.force_exponent, c.reference_chip)
+        .wall_term(c.wall_term);
+    settings.validate()?;
+    Ok(settings)
 }
 
 fn process_from(p: &ProcessSection) -> Result<(MillingProcess, StateLimits), MillError> {
