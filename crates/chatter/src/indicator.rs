@@ -226,10 +226,10 @@ fn finite(rho: f64) -> Result<f64, ChatterError> {
 /// [`ChatterError::NonFinite`]; [`ChatterError::Unsupported`].
 ///
 /// # Performance
-/// State-dependent, m = 40, 200 equilibrium nodes, dev profile (opt-level
-/// 1) on the 2-core build machine: ≈ 1.4 ms (equilibrium 0.8 ms,
-/// linearization 0.2 ms, diagnostics 0.06 ms, discretization + Arnoldi
-/// 0.2-0.3 ms); constant delay ≈ 0.25 ms.
+/// State-dependent, m = 40, 200 equilibrium nodes, dev profile
+/// (opt-level 1) on the 2-core build machine: about 1.4 ms (equilibrium 0.8 ms,
+/// linearization 0.2 ms, diagnostics 0.06 ms, discretization and Arnoldi
+/// 0.2-0.3 ms); constant delay about 0.25 ms. Release figures: BENCHMARKS.md.
 pub fn chatter_indicator(
     modal: &Modal2,
     process: &MillingProcess,
