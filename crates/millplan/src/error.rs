@@ -1,0 +1,53 @@
+//! The one error type of `kerf_millplan`.
+
+use kerf_chatter::ChatterError;
+use kerf_mill::MillError;
+use thiserror::Error;
+
+/// Everything that can go wrong while planning a milling path.
+#[derive(Debug, Error)]
+pub enum MillPlanError {
+    /// A parameter or input is NaN, infinite or out of its range.
+    #[error("invalid {name} = {value}: {reason}")]
+    InvalidParameter {
+        /// Name with unit.
+        name: String,
+        /// The value given.
+        value: f64,
+        /// Why it is refused.
+        reason: String,
+    },
+    /// A configuration or file content is inconsistent (not a single number).
+    #[error("invalid {name}: {reason}")]
+    InvalidConfig {
+        /// What is wrong (field, file).
+        name: String,
+        /// Why.
+        reason: String,
+    },
+    /// The robot/cell model failed (unreachable, joint limit, bad cell file).
+    #[error(transparent)]
+    Mill(#[from] MillError),
+    /// The chatter model failed (non-convergence, bad parameters).
+    #[error(transparent)]
+    Chatter(#[from] ChatterError),
+    /// A policy file is missing, unreadable or incompatible.
+    #[error("policy {path}: {reason}")]
+    Policy {
+        /// File path.
+        path: String,
+        /// What is wrong (missing, wrong sizes, settings mismatch).
+        reason: String,
+    },
+    /// File input/output failed.
+    #[error("{path}: {message}")]
+    Io {
+        /// File path.
+        path: String,
+        /// The OS or parser message.
+        message: String,
+    },
+    /// The learning backend (candle) failed.
+    #[error("learning backend: {0}")]
+    Backend(String),
+}

@@ -1,0 +1,28 @@
+//! The milling planner of kerf (seed 004, `../shared/seeds/004_*.txt`):
+//! chooses spindle speed Ω, feed f and the redundancy angle g per path
+//! segment under the chatter constraint, with DDPG, and measures it against
+//! a dynamic-programming optimum and naive baselines on the same model.
+//!
+//! * [`rl`] — the agent/environment interface.
+//! * [`error`] — [`MillPlanError`].
+
+pub mod error;
+pub mod rl;
+
+// The environment of seed 004 section 3 and the baselines.
+pub mod cache;
+pub mod dp;
+pub mod env;
+pub mod naive;
+pub mod plan;
+pub mod reward;
+
+// DDPG (seed 004 Algorithm 1, Table 2) on candle.
+pub mod ddpg;
+pub mod nets;
+pub mod policy;
+pub mod replay;
+pub mod rng;
+
+pub use error::MillPlanError;
+pub use rl::{Environment, Transition};
