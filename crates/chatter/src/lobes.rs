@@ -181,3 +181,135 @@ pub fn stability_lobes(
         })
         .collect()
 }
+
+/// Critical axial depth of the **state-dependent** model (or of whatever
+/// [`DelayModel`](crate::indicator::DelayModel) `settings` selects) at one
+/// spindle speed and one feed: the smallest depth at which the chatter
+/// indicator [`chatter_indicator`](crate::indicator::chatter_indicator)
+/// reaches |μ|max = 1 (Floquet: the boundary of seed 004 eq. 8; Bachrathy,
+/// Insperger & Stépán 2011 draw the same |μ| = 1 contour in the depth–speed
+/// plane).
+///
+/// # Method
+///
+/// Unlike the constant-delay model, the state-dependent variational
+/// system is not linear in the depth: the periodic equilibrium (seed 004
+/// eq. 3-6: the forced vibration, its feed-dependent delays and
+/// loss-of-contact windows) scales with `a_p`, and with a nonlinear force
+/// law `F ∝ a_p h^x_F` the cutting stiffness depends on the equilibrium
+/// chip. So there is no per-unit-depth equation to scale
+/// ([`scale_dde`] does not apply); every depth is a full evaluation
+/// (equilibrium + linearization + discretization + spectral radius) with
+/// `process.axial_depth` set to that depth. The search is the one of
+/// [`critical_depth`]: a coarse scan from `min_depth` upward brackets the
+/// FIRST crossing (stability pockets exist), then bisection to
+/// `opts.tolerance`. A depth of exactly 0 has no cutting force (and the
+/// process check refuses it), so a zero `min_depth` is evaluated at
+/// `opts.tolerance` instead.
+///
+/// # Arguments
+/// * `modal` — tool-tip dynamics.
+/// * `process` — milling process; its `axial_depth` is ignored (it is the
+///   unknown).
+/// * `rpm` — spindle speed [rev/min].
+/// * `feed` — feed [m/s] (≥ 0).
+/// * `settings` — delay model, force law, wall term; `opts.steps`
+///   replaces `settings.steps` so one m governs the search.
+/// * `opts` — depth range, scan intervals, tolerance.
+///
+/// # Returns
+/// `Some(a_lim)` [m] (midpoint of the final bracket, within
+/// `opts.tolerance`; the first examined depth if already unstable there),
+/// `None` if |μ| < 1 up to `opts.max_depth`.
+///
+/// # Errors
+/// Invalid options or inputs ([`ChatterError::InvalidParameter`]); every
+/// error of [`chatter_indicator`](crate::indicator::chatter_indicator) at
+/// any examined depth (an equilibrium that does not converge is reported,
+/// never skipped).
+///
+/// # Performance
+/// About `scan_points + log₂(scan step / tolerance)` indicator evaluations
+/// (≈ 30 for the defaults), each ≈ 0.5–1.5 ms at m = 40.
+pub fn state_dependent_critical_depth(
+    modal: &Modal2,
+    process: &MillingProcess,
+    rpm: f64,
+    feed: f64,
+    settings: &crate::indicator::IndicatorSettings,
+    opts: &LobeOptions,
+) -> Result<Option<f64>, ChatterError> {
+    opts.validate()?;
+    check_positive("spindle speed [rpm]", rpm)?;
+    check_non_negative("feed [m/s]", feed)?;
+    let settings = settings.steps(opts.steps);
+    settings.validate()?;
+    let first = if opts.min_depth > 0.0 {
+        opts.min_depth
+    } else {
+        opts.tolerance.min(opts.max_depth)
+    };
+    let rho_at = |depth: f64| -> Result<f64, ChatterError> {
+        let p = MillingProcess {
+            axial_depth: depth,
+            ..*process
+        };
+        crate::indicator::chatter_indicator(modal, &p, rpm, feed, &settings)
+            .map(|ind| ind.spectral_radius)
+    };
+    first_crossing(rho_at, first, opts)
+}
+
+/// The scan + bisection of [`critical_depth`] over an arbitrary |μ|(depth)
+/// starting at `first` (≥ `opts.min_depth`): `Some(first)` if unstable
+/// there, `None` if stable up to `opts.max_depth`, else the midpoint of
+/// the final bracket. The bisection is capped by the number of halvings
+/// the tolerance needs (at most 200).
+fn first_crossing(
+    mut rho_at: impl FnMut(f64) -> Result<f64, ChatterError>,
+    first: f64,
+    opts: &LobeOptions,
+) -> Result<Option<f64>, ChatterError> {
+    let finite = |rho: f64| -> Result<f64, ChatterError> {
+        if rho.is_finite() {
+            Ok(rho)
+        } else {
+            Err(ChatterError::NonFinite {
+                what: "chatter indicator |mu|max in the depth search".to_string(),
+            })
+        }
+    };
+    if finite(rho_at(first)?)? >= 1.0 {
+        return Ok(Some(first));
+    }
+    let span = opts.max_depth - opts.min_depth;
+    let mut lo = first;
+    let mut hi = None;
+    for k in 1..=opts.scan_points {
+        let d = opts.min_depth + span * k as f64 / opts.scan_points as f64;
+        if d <= lo {
+            continue;
+        }
+        if finite(rho_at(d)?)? >= 1.0 {
+            hi = Some(d);
+            break;
+        }
+        lo = d;
+    }
+    let Some(mut hi) = hi else {
+        return Ok(None);
+    };
+    let cap = ((hi - lo) / opts.tolerance).log2().ceil().max(0.0) as usize + 1;
+    for _ in 0..cap.min(200) {
+        if hi - lo <= opts.tolerance {
+            break;
+        }
+        let mid = 0.5 * (lo + hi);
+        if finite(rho_at(mid)?)? >= 1.0 {
+            hi = mid;
+        } else {
+            lo = mid;
+        }
+    }
+    Ok(Some(0.5 * (lo + hi)))
+}
