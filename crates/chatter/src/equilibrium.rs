@@ -576,14 +576,7 @@ impl Equilibrium {
             })
             .collect();
 
-        let minv = modal
-            .mass
-            .try_inverse()
-            .ok_or_else(|| ChatterError::InvalidParameter {
-                name: "mass matrix [kg]".to_string(),
-                value: modal.mass.determinant(),
-                reason: "is singular".to_string(),
-            })?;
+        let minv = modal.mass_inverse()?;
         let a = system_matrix(&minv, modal);
         // Monodromy of the RK4 map of the homogeneous system.
         let mut phi_t = Matrix4::<f64>::identity();

@@ -207,14 +207,7 @@ impl Discretization {
             });
         }
         let history = (q_max.ceil() as usize + 1).max(3);
-        let minv = modal
-            .mass
-            .try_inverse()
-            .ok_or(ChatterError::InvalidParameter {
-                name: "mass matrix [kg]".to_string(),
-                value: modal.mass.determinant(),
-                reason: "is singular".to_string(),
-            })?;
+        let minv = modal.mass_inverse()?;
         let a0 = state_matrix(modal, &minv);
         let moments = exponential_moments(&a0, dt)?;
         let l_map = |psi: &Matrix4<f64>| -> Matrix4x2<f64> {

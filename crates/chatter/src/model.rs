@@ -90,6 +90,21 @@ impl Modal2 {
         })
     }
 
+    /// The inverse mass matrix M⁻¹ [1/kg].
+    ///
+    /// # Errors
+    /// [`ChatterError::InvalidParameter`] when M is singular (its
+    /// determinant is reported).
+    pub fn mass_inverse(&self) -> Result<Matrix2<f64>, ChatterError> {
+        self.mass
+            .try_inverse()
+            .ok_or_else(|| ChatterError::InvalidParameter {
+                name: "mass matrix [kg]".to_string(),
+                value: self.mass.determinant(),
+                reason: "is singular".to_string(),
+            })
+    }
+
     /// Checks that every entry is finite, M and K are symmetric positive
     /// definite and C is symmetric positive semidefinite (relative symmetry
     /// tolerance 1e-9).

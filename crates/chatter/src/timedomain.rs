@@ -586,14 +586,7 @@ struct Structure {
 
 impl Structure {
     fn new(modal: &Modal2) -> Result<Self, ChatterError> {
-        let minv = modal
-            .mass
-            .try_inverse()
-            .ok_or(ChatterError::InvalidParameter {
-                name: "mass matrix [kg]".to_string(),
-                value: modal.mass.determinant(),
-                reason: "is singular".to_string(),
-            })?;
+        let minv = modal.mass_inverse()?;
         let minv_c = minv * modal.damping;
         let minv_k = minv * modal.stiffness;
         let mut a = Matrix4::zeros();
