@@ -4,6 +4,8 @@
 //! quadrature, the characteristic equation of an autonomous DDE, and
 //! self-consistency under re-expressions of the same equation.
 
+mod common;
+
 use std::f64::consts::PI;
 
 use approx::assert_relative_eq;
@@ -15,25 +17,11 @@ use kerf_chatter::{
 use nalgebra::{Complex, Matrix2, Matrix4};
 
 fn textbook_modal() -> Modal2 {
-    let mode = Mode {
-        natural_frequency_hz: 922.0,
-        damping_ratio: 0.011,
-        modal_mass: 0.03993,
-    };
-    Modal2::from_modes(mode, mode).unwrap()
+    common::textbook_modal()
 }
 
 fn textbook_process(axial_depth: f64) -> MillingProcess {
-    let (entry_angle, exit_angle) = MillingProcess::down_milling_angles(0.05).unwrap();
-    MillingProcess {
-        teeth: 2,
-        radius: 0.005,
-        axial_depth,
-        kt: 6e8,
-        kn: 2e8,
-        entry_angle,
-        exit_angle,
-    }
+    common::textbook_process(0.05, 0.005, axial_depth)
 }
 
 /// Closed-form free response of `ẍ + 2ζω ẋ + ω² x = 0` over `t`:
@@ -143,15 +131,7 @@ fn directional_averages_match_brute_force_quadrature() {
 }
 
 fn seed_process() -> MillingProcess {
-    MillingProcess {
-        teeth: 2,
-        radius: 0.04,
-        axial_depth: 3e-3,
-        kt: 6.44e8,
-        kn: 2.37e8,
-        entry_angle: 0.75 * PI,
-        exit_angle: PI,
-    }
+    common::seed004_process(3e-3)
 }
 
 #[test]

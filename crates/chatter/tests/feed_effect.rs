@@ -52,39 +52,21 @@
 //! the decrease with feed is strong at every speed (robot A at a_lim:
 //! 2000 rpm 1.046 → 0.948, 3000 rpm 1.152 → 0.948 from 0.005 to 0.06 m/s).
 
-use std::f64::consts::PI;
+mod common;
 
 use kerf_chatter::indicator::{chatter_indicator, indicator_map, DelayModel, IndicatorSettings};
-use kerf_chatter::{MillingProcess, Modal2, Mode};
+use kerf_chatter::{MillingProcess, Modal2};
 
 fn process(ap: f64) -> MillingProcess {
-    MillingProcess {
-        teeth: 2,
-        radius: 0.04,
-        axial_depth: ap,
-        kt: 6.44e8,
-        kn: 2.37e8,
-        entry_angle: 0.75 * PI,
-        exit_angle: PI,
-    }
+    common::seed004_process(ap)
 }
 
 fn robot() -> Modal2 {
-    let m = Mode {
-        natural_frequency_hz: 25.0,
-        damping_ratio: 0.05,
-        modal_mass: 50.0,
-    };
-    Modal2::from_modes(m, m).unwrap()
+    common::symmetric_modal(25.0, 0.05, 50.0)
 }
 
 fn robot_b() -> Modal2 {
-    let m = Mode {
-        natural_frequency_hz: 80.0,
-        damping_ratio: 0.03,
-        modal_mass: 6.0,
-    };
-    Modal2::from_modes(m, m).unwrap()
+    common::symmetric_modal(80.0, 0.03, 6.0)
 }
 
 /// Constant-delay critical depth a_lim by bisection of |μ| = 1.

@@ -5,6 +5,8 @@
 //! stability boundary, with single and multiple (fractional) delays; and
 //! the iteration caps.
 
+mod common;
+
 use std::f64::consts::PI;
 
 use kerf_chatter::{
@@ -154,12 +156,7 @@ fn fit(mut real: Vec<f64>, pairs: Vec<(f64, f64)>, n: usize) -> (Vec<f64>, Vec<(
 }
 
 fn textbook_modal() -> Modal2 {
-    let mode = Mode {
-        natural_frequency_hz: 922.0,
-        damping_ratio: 0.011,
-        modal_mass: 0.03993,
-    };
-    Modal2::from_modes(mode, mode).unwrap()
+    common::textbook_modal()
 }
 
 fn robot_modal(rng: &mut Rng) -> Modal2 {

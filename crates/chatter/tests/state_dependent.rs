@@ -4,47 +4,31 @@
 //! integration, finite differences of the exact tooth-path geometry of
 //! `trochoid.rs`).
 
+mod common;
+
 use std::f64::consts::PI;
 
 use kerf_chatter::equilibrium::{Equilibrium, EquilibriumSettings, ForceLaw};
 use kerf_chatter::linearize::{chip_sensitivity, linearize, LinearizeSettings};
 use kerf_chatter::trochoid::{chip_thickness, tangential_residual};
 use kerf_chatter::{
-    constant_delay_dde, force_direction, ChatterError, Discretization, MillingProcess, Modal2, Mode,
+    constant_delay_dde, force_direction, ChatterError, Discretization, MillingProcess, Modal2,
 };
 use nalgebra::{Matrix2, Vector2, Vector4};
 
 /// Seed 004 Table 1: 2 teeth, R 0.04 m, a_p 3 mm, down milling [0.75π, π].
 fn seed_process() -> MillingProcess {
-    MillingProcess {
-        teeth: 2,
-        radius: 0.04,
-        axial_depth: 3e-3,
-        kt: 6.44e8,
-        kn: 2.37e8,
-        entry_angle: 0.75 * PI,
-        exit_angle: PI,
-    }
+    common::seed004_process(3e-3)
 }
 
 /// A representative robot tool tip: 25 Hz, ζ 0.05, 50 kg per direction.
 fn robot() -> Modal2 {
-    let m = Mode {
-        natural_frequency_hz: 25.0,
-        damping_ratio: 0.05,
-        modal_mass: 50.0,
-    };
-    Modal2::from_modes(m, m).unwrap()
+    common::symmetric_modal(25.0, 0.05, 50.0)
 }
 
 /// A near-rigid tool: 3 kHz, 20 kg.
 fn stiff() -> Modal2 {
-    let m = Mode {
-        natural_frequency_hz: 3000.0,
-        damping_ratio: 0.05,
-        modal_mass: 20.0,
-    };
-    Modal2::from_modes(m, m).unwrap()
+    common::symmetric_modal(3000.0, 0.05, 20.0)
 }
 
 fn engaged_times(eq: &Equilibrium, tooth: usize) -> Vec<f64> {

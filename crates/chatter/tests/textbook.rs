@@ -27,11 +27,11 @@
 //!    The same script also gives the slot-milling boundary, peaks included.
 //! 3. **Convergence** of our own method: m = 40 against m = 200.
 
+mod common;
+
 use std::f64::consts::PI;
 
-use kerf_chatter::{
-    mean_directional_matrix, stability_lobes, LobeOptions, MillingProcess, Modal2, Mode,
-};
+use kerf_chatter::{mean_directional_matrix, stability_lobes, LobeOptions, MillingProcess, Modal2};
 use nalgebra::Complex;
 
 const SPEEDS: [f64; 9] = [
@@ -59,25 +59,12 @@ const PUBLISHED_SLOT_MM: [f64; 9] = [
 ];
 
 fn textbook_modal() -> Modal2 {
-    let mode = Mode {
-        natural_frequency_hz: 922.0,
-        damping_ratio: 0.011,
-        modal_mass: 0.03993,
-    };
-    Modal2::from_modes(mode, mode).unwrap()
+    common::textbook_modal()
 }
 
 fn textbook_process(radial_immersion: f64) -> MillingProcess {
-    let (entry_angle, exit_angle) = MillingProcess::down_milling_angles(radial_immersion).unwrap();
-    MillingProcess {
-        teeth: 2,
-        radius: 0.005,
-        axial_depth: 1e-3, // unused by the lobes (depth is the unknown)
-        kt: 6e8,
-        kn: 2e8,
-        entry_angle,
-        exit_angle,
-    }
+    // The depth is the unknown of the lobes; 1 mm is a placeholder.
+    common::textbook_process(radial_immersion, 0.005, 1e-3)
 }
 
 fn lobes_mm(radial_immersion: f64, steps: usize, max_depth: f64) -> Vec<Option<f64>> {

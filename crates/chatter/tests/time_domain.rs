@@ -5,6 +5,8 @@
 //! boundary of the semi/full-discretization and of the state-dependent
 //! indicator.
 
+mod common;
+
 use std::f64::consts::PI;
 
 use kerf_chatter::equilibrium::{Equilibrium, EquilibriumSettings};
@@ -19,41 +21,19 @@ use kerf_chatter::{
 /// Meth. Eng. 61:117, section 5): f_n = 922 Hz, ζ = 0.011, m = 0.03993 kg
 /// in x and y.
 fn textbook_modal() -> Result<Modal2, ChatterError> {
-    let mode = Mode {
-        natural_frequency_hz: 922.0,
-        damping_ratio: 0.011,
-        modal_mass: 0.03993,
-    };
-    Modal2::from_modes(mode, mode)
+    Ok(common::textbook_modal())
 }
 
 /// Its cut: 2 teeth, K_t = 6e8, K_n = 2e8 N/m², a/D = 0.05 down milling;
 /// the radius (not needed by the constant-delay model) is R = 10 mm.
 fn textbook_process(depth: f64) -> Result<MillingProcess, ChatterError> {
-    let (entry, exit) = MillingProcess::down_milling_angles(0.05)?;
-    Ok(MillingProcess {
-        teeth: 2,
-        radius: 0.01,
-        axial_depth: depth,
-        kt: 6e8,
-        kn: 2e8,
-        entry_angle: entry,
-        exit_angle: exit,
-    })
+    Ok(common::textbook_process(0.05, 0.01, depth))
 }
 
 /// The cut of seed 004 Table 1: 2 teeth, R = 0.04 m, a_p = 3 mm,
 /// K_t = 6.44e8, K_n = 2.37e8 N/m², engagement [0.75π, π].
 fn seed_process(depth: f64) -> MillingProcess {
-    MillingProcess {
-        teeth: 2,
-        radius: 0.04,
-        axial_depth: depth,
-        kt: 6.44e8,
-        kn: 2.37e8,
-        entry_angle: 0.75 * PI,
-        exit_angle: PI,
-    }
+    common::seed004_process(depth)
 }
 
 /// (c) Zero cutting force (K_t = K_n = 0, the same as zero depth): the
@@ -385,12 +365,7 @@ fn textbook_boundary_splits_decay_from_growth() -> Result<(), ChatterError> {
 /// mode per direction, m = 50 kg, f_n = 25 Hz, ζ = 0.05 (k ≈ 1.2e6 N/m,
 /// the order of an IRB-6660-class arm at its flange).
 fn robot_modal() -> Result<Modal2, ChatterError> {
-    let mode = Mode {
-        natural_frequency_hz: 25.0,
-        damping_ratio: 0.05,
-        modal_mass: 50.0,
-    };
-    Modal2::from_modes(mode, mode)
+    Ok(common::symmetric_modal(25.0, 0.05, 50.0))
 }
 
 /// The periodic forced response the simulation starts from (its own
