@@ -4,9 +4,12 @@
 //!   process (today: the trajectory executor).
 //! * `kerf echo TOPIC` prints a kerf or standard topic as YAML, with no ROS install.
 //! * `kerf plan cut --request FILE` plans a laser cut offline (exit code 2 on failure).
+//! * `kerf lobes --segment N --g RAD` draws the stability lobes and the feed × speed chatter
+//!   map of a milling state (issue 4) and prints a table (exit code 2 on failure).
 
 mod echo;
 mod launch;
+mod lobes;
 mod plan_cut;
 
 use std::process::ExitCode;
@@ -32,6 +35,8 @@ enum Command {
     Echo(echo::EchoArgs),
     /// Plan offline, without ROS (`kerf plan cut --request cut.yaml`).
     Plan(plan_cut::PlanArgs),
+    /// Stability lobes and feed map of a milling state (`kerf lobes --segment 50 --g 0`).
+    Lobes(lobes::LobesArgs),
 }
 
 fn main() -> ExitCode {
@@ -40,6 +45,7 @@ fn main() -> ExitCode {
         Command::Launch(a) => (launch::run(a), ExitCode::FAILURE),
         Command::Echo(a) => (echo::run(a), ExitCode::FAILURE),
         Command::Plan(a) => (plan_cut::run(a), ExitCode::from(plan_cut::EXIT_FAILURE)),
+        Command::Lobes(a) => (lobes::run(a), ExitCode::from(lobes::EXIT_FAILURE)),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
