@@ -95,7 +95,7 @@ pub struct LobesArgs {
     #[arg(long)]
     rpm: Option<String>,
     /// Largest axial depth searched [m] (default 0.02 = 20 mm).
-    #[arg(long, default_value_t = 0.02)]
+    #[arg(long, default_value_t = 0.02, allow_hyphen_values = true)]
     max_depth: f64,
     /// Feeds MIN:MAX:COUNT [m/s] of the map (default: the cell's range, 25 feeds; 0 allowed).
     #[arg(long)]

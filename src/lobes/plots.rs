@@ -56,6 +56,26 @@ pub fn lobe_diagram(path: &Path, r: &LobesReport) -> Result<(), String> {
         r.rpms.last().copied().unwrap_or(1.0),
     );
     let top = r.options.max_depth * 1e3;
+    // y range: up to 1.3 × the largest finite depth drawn (critical depths, cell depth),
+    // never above the searched range (stable-to-max speeds are drawn at `top`).
+    let any_stable = r.constant.iter().any(|p| p.critical_depth.is_none())
+        || r.state_dependent
+            .as_ref()
+            .is_some_and(|v| v.iter().any(|d| d.is_none()));
+    let drawn = r
+        .constant
+        .iter()
+        .filter_map(|p| p.critical_depth)
+        .chain(r.state_dependent.iter().flatten().flatten().copied())
+        .chain(std::iter::once(r.process.axial_depth))
+        .map(|d| d * 1e3)
+        .filter(|d| d.is_finite())
+        .fold(0.0_f64, f64::max);
+    let y_top = if any_stable {
+        top * 1.05
+    } else {
+        (1.3 * drawn).clamp(1e-3, top * 1.05)
+    };
     let root = SVGBackend::new(path, (1000, 650)).into_drawing_area();
     root.fill(&WHITE).map_err(&err)?;
     let mut chart = ChartBuilder::on(&root)
@@ -69,7 +89,7 @@ pub fn lobe_diagram(path: &Path, r: &LobesReport) -> Result<(), String> {
         .margin(15)
         .x_label_area_size(50)
         .y_label_area_size(70)
-        .build_cartesian_2d(x0..x1, 0.0..top * 1.05)
+        .build_cartesian_2d(x0..x1, 0.0..y_top)
         .map_err(&err)?;
     chart
         .configure_mesh()
