@@ -8,15 +8,19 @@
 //!   (`Discretization::new` + the directional averages) and the evaluation
 //!   given it (fast Arnoldi path), with the dense reference for comparison;
 //! * a lobe diagram of 100 speeds (2000–4000 rpm) × coarse scan and
-//!   bisection on depth (0–20 mm, 20 scan intervals, 1 µm tolerance).
+//!   bisection on depth (0–20 mm, 20 scan intervals, 1 µm tolerance);
+//! * the state-dependent indicator (seed 004 eq. 1-8: periodic equilibrium,
+//!   linearization, discretization, spectral radius; nothing precomputed) on
+//!   the same modes at 3000 rpm, 0.04 m/s, with the default cell's force law
+//!   (x_F = 0.75 at h_ref = 0.224 mm) and wall term.
 
 use std::f64::consts::PI;
 use std::hint::black_box;
 
 use criterion::{criterion_group, criterion_main, Criterion};
 use kerf_chatter::{
-    constant_delay_dde, spectral_radius_dense, stability_lobes, Discretization, LobeOptions,
-    MillingProcess, Modal2, Mode,
+    chatter_indicator, constant_delay_dde, spectral_radius_dense, stability_lobes, DelayModel,
+    Discretization, IndicatorSettings, LobeOptions, MillingProcess, Modal2, Mode,
 };
 
 fn robot_modal() -> Modal2 {
@@ -87,5 +91,28 @@ fn bench(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, bench);
+fn bench_state_dependent(c: &mut Criterion) {
+    let modal = robot_modal();
+    let process = seed_process();
+    let settings = IndicatorSettings::default()
+        .model(DelayModel::StateDependent)
+        .force_law(0.75, 2.24e-4);
+    let (rpm, feed) = (3000.0, 0.04);
+    let ind = chatter_indicator(&modal, &process, rpm, feed, &settings).expect("indicator");
+    eprintln!(
+        "state-dependent |mu|max = {} ({} equilibrium iterations)",
+        ind.spectral_radius, ind.equilibrium_iterations
+    );
+    c.bench_function(
+        "indicator m=40: state-dependent (equilibrium + linearization + eigen)",
+        |b| {
+            b.iter(|| {
+                chatter_indicator(&modal, &process, black_box(rpm), black_box(feed), &settings)
+                    .expect("indicator")
+            })
+        },
+    );
+}
+
+criterion_group!(benches, bench, bench_state_dependent);
 criterion_main!(benches);
