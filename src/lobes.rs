@@ -656,3 +656,76 @@ pub fn run(a: LobesArgs) -> Result<(), String> {
     );
     Ok(())
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn grid_parses_and_refuses_bad_ranges() {
+        let g = Grid::parse("rpm", "2000:4000:5", 0.0, true).expect("grid");
+        assert_eq!(g.values(), vec![2000.0, 2500.0, 3000.0, 3500.0, 4000.0]);
+        assert_eq!(
+            Grid::parse("feed", "0:0:1", 0.0, false)
+                .expect("single")
+                .values(),
+            vec![0.0]
+        );
+        for bad in [
+            "4000:2000:5",
+            "NaN:4000:5",
+            "2000:inf:5",
+            "2000:4000:0",
+            "2000:4000",
+        ] {
+            assert!(Grid::parse("rpm", bad, 0.0, true).is_err(), "{bad}");
+        }
+        assert!(Grid::parse("rpm", "0:4000:5", 0.0, true).is_err());
+        assert!(Grid::parse("feed", "-0.01:0.06:5", 0.0, false).is_err());
+        assert!(Grid::parse("feed", "0.01:0.06:1", 0.0, false).is_err());
+    }
+
+    #[test]
+    fn feed_lower_bound_cases() {
+        let f = [0.0, 0.02, 0.04, 0.06];
+        let b = |row: [Option<f64>; 4]| feed_lower_bound(&f, &row);
+        assert_eq!(b([Some(0.9), Some(0.9), Some(0.9), Some(0.9)]), Bound::All);
+        assert_eq!(
+            b([Some(1.2), Some(1.1), Some(0.99), Some(0.9)]),
+            Bound::Feed(0.04)
+        );
+        // Stable, unstable, stable: the bound is the start of the stable tail.
+        assert_eq!(
+            b([Some(0.9), Some(1.1), Some(0.9), Some(0.9)]),
+            Bound::Feed(0.04)
+        );
+        assert_eq!(b([Some(0.9), Some(0.9), Some(0.9), Some(1.0)]), Bound::None);
+        // Undefined (f = 0, sublinear law) counts as not stable.
+        assert_eq!(
+            b([None, Some(0.9), Some(0.9), Some(0.9)]),
+            Bound::Feed(0.02)
+        );
+    }
+
+    #[test]
+    fn closed_forms_match_uncoupled_modes() {
+        use kerf_chatter::Mode;
+        let x = Mode {
+            natural_frequency_hz: 15.0,
+            damping_ratio: 0.05,
+            modal_mass: 60.0,
+        };
+        let y = Mode {
+            natural_frequency_hz: 28.0,
+            ..x
+        };
+        let modal = Modal2::from_modes(y, x).expect("modes");
+        let f = natural_frequencies(&modal).expect("frequencies");
+        assert!(
+            (f[0] - 15.0).abs() < 1e-9 && (f[1] - 28.0).abs() < 1e-9,
+            "{f:?}"
+        );
+        // [[2, 1], [1, 2]] has eigenvalues 1 and 3.
+        assert_eq!(sym_eigen(2.0, 1.0, 2.0), [1.0, 3.0]);
+    }
+}

@@ -420,6 +420,8 @@ pub fn feed_map(path: &Path, r: &LobesReport) -> Result<(), String> {
         .disable_mesh()
         .disable_x_axis()
         .y_desc("|mu|max")
+        .y_label_style(("sans-serif", 14))
+        .axis_desc_style(("sans-serif", 16))
         .draw()
         .map_err(&err)?;
     let n = 100;
