@@ -1,1 +1,884 @@
-//! (being written; see the crate documentation)
+//! A grid cache of the chatter indicator |μ|max over (segment, Ω, f, g)
+//! with multilinear interpolation — the chatter indicator (seed 004
+//! section 2, `kerf_chatter::indicator::chatter_indicator`) costs about
+//! 0.5 ms per evaluation in release and dominates every planner.
+//!
+//! # Grid
+//!
+//! [`GridSpec`]: explicit, strictly increasing node lists per axis — path
+//! segment indices (usually every k-th segment and the last, [`GridSpec::uniform`]),
+//! spindle speed \[rpm\], feed [m/s] and redundancy angle g \[rad\]. At each
+//! (segment, g) node the cell state (IK with the cell's reference joints,
+//! `MillCell::evaluate(segment, g, None)`) is computed once; when it is
+//! infeasible (IK unreachable, joint limit, singular) — or the indicator
+//! itself fails — every node of that (segment, g) column is marked
+//! infeasible (stored as NaN, never returned as a number).
+//!
+//! # Interpolation and infeasible nodes
+//!
+//! Multilinear in the four coordinates (the segment index as a real
+//! number). Corners whose weight is exactly 0 are skipped, so a query ON a
+//! node returns the stored value exactly, whatever its neighbours. A query
+//! whose interpolation cell has an infeasible corner with a non-zero weight
+//! is REPORTED (`Ok(None)` from [`IndicatorCache::try_query`], an error from
+//! [`IndicatorCache::query`]); it is never mixed in. The environment
+//! ([`crate::env`]) then evaluates directly; the DP treats the state as
+//! infeasible (documented in [`crate::dp`]). A query outside the node range
+//! of an axis is also reported (`None`).
+//!
+//! # Error bound
+//!
+//! Two numbers: the a-priori estimate [`IndicatorCache::curvature_bound`]
+//! (the multilinear error `Σ_i h_i²/8 · max|∂²μ/∂x_i²|` with the second
+//! derivatives taken from second divided differences of the nodes, times a
+//! safety factor 2), and the measured error against direct evaluation at
+//! random points ([`IndicatorCache::measure_error`]). The default cache
+//! (`examples/build_cache.rs`, `data/indicator_cache.bin`) stores the
+//! measured statistics and its stated bound in the file header
+//! ([`CacheHeader`]); `tests/cache.rs` re-checks it at new random points.
+//!
+//! # File format
+//!
+//! `kerf-indicator-cache 1\n`, one line of JSON ([`CacheHeader`]: grid,
+//! cell fingerprint, error statistics, build command, data checksum), then
+//! the values as little-endian f64 (NaN = infeasible). A wrong magic line,
+//! truncated data, a checksum mismatch, or a fingerprint that differs from
+//! the cell's (a stale cache: the cell file was edited) is an error.
+
+use std::path::Path;
+use std::sync::Mutex;
+
+use kerf_chatter::indicator::chatter_indicator;
+use kerf_mill::{MillCell, MillError};
+use serde::{Deserialize, Serialize};
+
+use crate::error::MillPlanError;
+
+/// First line of a cache file.
+pub const CACHE_MAGIC: &str = "kerf-indicator-cache 1";
+
+/// Node lists of the cache grid (each strictly increasing, ≥ 2 nodes, except
+/// that a single segment node is allowed for a one-segment cache).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct GridSpec {
+    /// Path segment indices (0-based).
+    pub segments: Vec<usize>,
+    /// Spindle speeds \[rpm\].
+    pub rpm: Vec<f64>,
+    /// Feeds [m/s] (> 0: the indicator of a zero feed is not a cutting
+    /// state of a plan, [`crate::env`]).
+    pub feed: Vec<f64>,
+    /// Redundancy angles \[rad\].
+    pub g: Vec<f64>,
+}
+
+/// `count` equally spaced values from `min` to `max` (both included).
+fn linspace(min: f64, max: f64, count: usize) -> Vec<f64> {
+    if count <= 1 {
+        return vec![min];
+    }
+    (0..count)
+        .map(|i| min + (max - min) * i as f64 / (count - 1) as f64)
+        .collect()
+}
+
+impl GridSpec {
+    /// A grid with every `stride`-th segment of `0..segment_count` plus the
+    /// last, and equally spaced Ω, f and g nodes.
+    ///
+    /// # Arguments
+    /// * `segment_count`, `stride` — segments 0, k, 2k, …, and N − 1;
+    /// * `rpm`, `feed`, `g` — (min, max, count) per axis.
+    ///
+    /// # Errors
+    /// As [`GridSpec::validate`]; `stride` or `segment_count` 0.
+    pub fn uniform(
+        segment_count: usize,
+        stride: usize,
+        rpm: (f64, f64, usize),
+        feed: (f64, f64, usize),
+        g: (f64, f64, usize),
+    ) -> Result<Self, MillPlanError> {
+        if stride == 0 || segment_count == 0 {
+            return Err(MillPlanError::InvalidConfig {
+                name: "cache grid segments".to_string(),
+                reason: format!("segment count {segment_count} and stride {stride} must be >= 1"),
+            });
+        }
+        let mut segments: Vec<usize> = (0..segment_count).step_by(stride).collect();
+        if segments.last() != Some(&(segment_count - 1)) {
+            segments.push(segment_count - 1);
+        }
+        let spec = Self {
+            segments,
+            rpm: linspace(rpm.0, rpm.1, rpm.2),
+            feed: linspace(feed.0, feed.1, feed.2),
+            g: linspace(g.0, g.1, g.2),
+        };
+        spec.validate()?;
+        Ok(spec)
+    }
+
+    /// Checks the node lists.
+    ///
+    /// # Errors
+    /// [`MillPlanError::InvalidConfig`] for an axis that is empty, not
+    /// strictly increasing, non-finite, or has fewer than 2 nodes (Ω, f, g);
+    /// feeds ≤ 0 or spindle speeds ≤ 0.
+    pub fn validate(&self) -> Result<(), MillPlanError> {
+        let bad = |name: &str, reason: &str| MillPlanError::InvalidConfig {
+            name: format!("cache grid {name}"),
+            reason: reason.to_string(),
+        };
+        if self.segments.is_empty() {
+            return Err(bad("segments", "no nodes"));
+        }
+        if self.segments.windows(2).any(|w| w[1] <= w[0]) {
+            return Err(bad("segments", "must be strictly increasing"));
+        }
+        for (name, axis, positive) in [
+            ("rpm", &self.rpm, true),
+            ("feed", &self.feed, true),
+            ("g", &self.g, false),
+        ] {
+            if axis.len() < 2 {
+                return Err(bad(name, "needs at least 2 nodes"));
+            }
+            if axis.iter().any(|v| !v.is_finite()) {
+                return Err(bad(name, "non-finite node"));
+            }
+            if axis.windows(2).any(|w| w[1] <= w[0]) {
+                return Err(bad(name, "must be strictly increasing"));
+            }
+            if positive && axis.first().is_some_and(|v| *v <= 0.0) {
+                return Err(bad(name, "nodes must be > 0"));
+            }
+        }
+        Ok(())
+    }
+
+    /// Number of nodes (segments × Ω × f × g).
+    pub fn node_count(&self) -> usize {
+        self.segments.len() * self.rpm.len() * self.feed.len() * self.g.len()
+    }
+
+    fn index(&self, s: usize, r: usize, f: usize, g: usize) -> usize {
+        ((s * self.rpm.len() + r) * self.feed.len() + f) * self.g.len() + g
+    }
+}
+
+/// Error of the cache against direct evaluation at random points.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct ErrorStats {
+    /// Points compared (both the cache and the direct evaluation feasible).
+    pub points: usize,
+    /// Random points skipped (infeasible state, or reported by the cache).
+    pub skipped: usize,
+    /// Largest absolute error of |μ|max.
+    pub max_abs: f64,
+    /// 99th percentile of the absolute error.
+    pub p99_abs: f64,
+    /// Mean absolute error.
+    pub mean_abs: f64,
+    /// Seed of the random points.
+    pub seed: u64,
+    /// The random g were snapped to the nearest g node (the queries of the
+    /// DP, whose g grid is the cache's), so only segment, Ω and f were
+    /// interpolated.
+    #[serde(default)]
+    pub g_on_nodes: bool,
+}
+
+/// The JSON header line of a cache file.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct CacheHeader {
+    /// The grid.
+    pub grid: GridSpec,
+    /// FNV-1a hash (hex) of the cell's parameters ([`cell_fingerprint`]).
+    pub cell_fingerprint: String,
+    /// Infeasible nodes (NaN).
+    pub infeasible_nodes: usize,
+    /// Build time \[s\] (wall clock).
+    pub build_seconds: f64,
+    /// Threads used for the build.
+    pub threads: usize,
+    /// Measured interpolation error, when measured.
+    pub error: Option<ErrorStats>,
+    /// The stated bound on |cache − direct| for feasible queries, when set.
+    pub error_bound: Option<f64>,
+    /// Measured error with g on the g nodes (the DP's queries).
+    #[serde(default)]
+    pub error_g_nodes: Option<ErrorStats>,
+    /// The stated bound for queries with g on a g node.
+    #[serde(default)]
+    pub error_bound_g_nodes: Option<f64>,
+    /// The command that produced the file.
+    pub command: String,
+    /// FNV-1a hash (hex) of the value bytes.
+    pub data_checksum: String,
+}
+
+/// The cached indicator (module documentation).
+#[derive(Debug, Clone, PartialEq)]
+pub struct IndicatorCache {
+    header: CacheHeader,
+    values: Vec<f64>,
+}
+
+/// FNV-1a 64-bit hash.
+fn fnv1a(bytes: &[u8]) -> u64 {
+    let mut h: u64 = 0xcbf2_9ce4_8422_2325;
+    for b in bytes {
+        h ^= u64::from(*b);
+        h = h.wrapping_mul(0x0000_0100_0000_01b3);
+    }
+    h
+}
+
+/// A fingerprint of everything in the cell that the indicator depends on:
+/// the milling process, the indicator settings, the state limits, the
+/// dynamics model, the characteristic length, the reference joints, every
+/// segment's geometry, and the cell state (joints, K, modal matrices) at
+/// g = 0 of the first, middle and last segments (which catches a changed
+/// URDF or TCP). FNV-1a over the exact `Debug` texts (f64 `Debug` is
+/// round-trip exact), as 16 hex digits.
+pub fn cell_fingerprint(cell: &MillCell) -> String {
+    let mut text = String::new();
+    text.push_str(&format!("{:?}", cell.milling_process()));
+    text.push_str(&format!("{:?}", cell.indicator_settings()));
+    text.push_str(&format!("{:?}", cell.state_limits()));
+    text.push_str(&format!("{:?}", cell.dynamics()));
+    text.push_str(&format!("{:?}", cell.characteristic_length()));
+    text.push_str(&format!("{:?}", cell.reference_joints()));
+    for s in cell.path().segments() {
+        text.push_str(&format!("{:?}{:?}{:?}", s.length, s.mid, s.cutting_frame));
+    }
+    let n = cell.path().segments().len();
+    for seg in [0, n / 2, n.saturating_sub(1)] {
+        match cell.evaluate(seg, 0.0, None) {
+            Ok(state) => text.push_str(&format!("{state:?}")),
+            Err(e) => text.push_str(&e.to_string()),
+        }
+    }
+    format!("{:016x}", fnv1a(text.as_bytes()))
+}
+
+/// Whether a cell-model error means "this (segment, g) is not a feasible
+/// state" (unreachable, joint limit, singular) rather than a failure.
+pub fn is_infeasible(e: &MillError) -> bool {
+    matches!(
+        e,
+        MillError::Unreachable { .. } | MillError::JointLimit { .. } | MillError::Singular { .. }
+    )
+}
+
+/// |μ|max evaluated directly (no cache): the cell state at (segment, g)
+/// with IK nearest `reference` (the cell's reference joints for `None`),
+/// then `chatter_indicator` with the cell's process and settings.
+///
+/// # Returns
+/// `Ok(None)` when the cell state is infeasible ([`is_infeasible`]).
+///
+/// # Errors
+/// Other cell-model errors, and every chatter-model error (NaN, non
+/// convergence) as [`MillPlanError::Chatter`].
+pub fn direct_indicator(
+    cell: &MillCell,
+    segment: usize,
+    rpm: f64,
+    feed: f64,
+    g: f64,
+    reference: Option<&[f64; 6]>,
+) -> Result<Option<f64>, MillPlanError> {
+    let state = match cell.evaluate(segment, g, reference) {
+        Ok(s) => s,
+        Err(e) if is_infeasible(&e) => return Ok(None),
+        Err(e) => return Err(e.into()),
+    };
+    let ind = chatter_indicator(
+        &state.modal,
+        &cell.milling_process(),
+        rpm,
+        feed,
+        cell.indicator_settings(),
+    )?;
+    Ok(Some(ind.spectral_radius))
+}
+
+/// Bracketing interval of `x` in `nodes`: (lower index, weight of the
+/// upper node); `None` outside [first, last].
+fn bracket(nodes: &[f64], x: f64) -> Option<(usize, f64)> {
+    let (first, last) = (*nodes.first()?, *nodes.last()?);
+    if !(x >= first && x <= last) {
+        return None;
+    }
+    let n = nodes.len();
+    if n == 1 {
+        return Some((0, 0.0));
+    }
+    // First node > x, minus one, kept in 0..n-1.
+    let upper = nodes.partition_point(|v| *v <= x);
+    let lo = upper.saturating_sub(1).min(n - 2);
+    let (a, b) = (nodes[lo], nodes[lo + 1]);
+    let w = ((x - a) / (b - a)).clamp(0.0, 1.0);
+    Some((lo, w))
+}
+
+/// A small deterministic generator (SplitMix64) for the random test points.
+#[derive(Debug, Clone)]
+pub struct SplitMix64(u64);
+
+impl SplitMix64 {
+    /// Seeded generator.
+    pub fn new(seed: u64) -> Self {
+        Self(seed)
+    }
+
+    /// Next 64 random bits.
+    pub fn next_u64(&mut self) -> u64 {
+        self.0 = self.0.wrapping_add(0x9e37_79b9_7f4a_7c15);
+        let mut z = self.0;
+        z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
+        z ^ (z >> 31)
+    }
+
+    /// Uniform in [0, 1).
+    pub fn next_f64(&mut self) -> f64 {
+        (self.next_u64() >> 11) as f64 / (1u64 << 53) as f64
+    }
+
+    /// Uniform in [lo, hi).
+    pub fn uniform(&mut self, lo: f64, hi: f64) -> f64 {
+        lo + (hi - lo) * self.next_f64()
+    }
+
+    /// Uniform integer in lo..=hi.
+    pub fn integer(&mut self, lo: usize, hi: usize) -> usize {
+        if hi <= lo {
+            return lo;
+        }
+        lo + (self.next_u64() % (hi - lo + 1) as u64) as usize
+    }
+}
+
+/// The outcome of one column: its values, `None` when infeasible.
+type ColumnResult = Result<Option<Vec<f64>>, MillPlanError>;
+
+/// One (segment, g) column of the grid: the indicator at every (Ω, f), or
+/// None (infeasible).
+fn build_column(
+    cell: &MillCell,
+    spec: &GridSpec,
+    segment: usize,
+    g: f64,
+) -> Result<Option<Vec<f64>>, MillPlanError> {
+    let state = match cell.evaluate(segment, g, None) {
+        Ok(s) => s,
+        Err(e) if is_infeasible(&e) => return Ok(None),
+        Err(e) => return Err(e.into()),
+    };
+    let process = cell.milling_process();
+    let mut out = Vec::with_capacity(spec.rpm.len() * spec.feed.len());
+    for &rpm in &spec.rpm {
+        for &feed in &spec.feed {
+            let v = chatter_indicator(&state.modal, &process, rpm, feed, cell.indicator_settings())
+                .map(|i| i.spectral_radius)
+                // A failed indicator marks the node infeasible (NaN), never
+                // a number; it is counted in the header.
+                .unwrap_or(f64::NAN);
+            out.push(v);
+        }
+    }
+    Ok(Some(out))
+}
+
+impl IndicatorCache {
+    /// Evaluates the indicator at every node.
+    ///
+    /// # Arguments
+    /// * `cell` — the milling cell; `spec` — the grid;
+    /// * `threads` — worker threads (1 or 2; more is refused: the build
+    ///   machine has 2 cores). The result does not depend on it: every
+    ///   (segment, g) column is computed independently and stored at its
+    ///   index.
+    ///
+    /// # Errors
+    /// [`MillPlanError::InvalidConfig`] for a bad grid, a segment node
+    /// beyond the path, or a thread count outside 1..=2; cell-model errors
+    /// other than infeasibility.
+    ///
+    /// # Performance
+    /// One indicator evaluation per feasible node (≈ 0.5 ms release).
+    pub fn build(cell: &MillCell, spec: &GridSpec, threads: usize) -> Result<Self, MillPlanError> {
+        spec.validate()?;
+        if !(1..=2).contains(&threads) {
+            return Err(MillPlanError::InvalidConfig {
+                name: "cache build threads".to_string(),
+                reason: format!("{threads}: must be 1 or 2"),
+            });
+        }
+        let n_seg = cell.path().segments().len();
+        if spec.segments.last().is_some_and(|s| *s >= n_seg) {
+            return Err(MillPlanError::InvalidConfig {
+                name: "cache grid segments".to_string(),
+                reason: format!("the path has {n_seg} segments"),
+            });
+        }
+        let start = std::time::Instant::now();
+        let columns: Vec<(usize, usize)> = (0..spec.segments.len())
+            .flat_map(|s| (0..spec.g.len()).map(move |g| (s, g)))
+            .collect();
+        let results: Mutex<Vec<Option<ColumnResult>>> =
+            Mutex::new((0..columns.len()).map(|_| None).collect());
+        std::thread::scope(|scope| {
+            for t in 0..threads {
+                let (columns, results) = (&columns, &results);
+                scope.spawn(move || {
+                    for (k, (s, g)) in columns.iter().enumerate() {
+                        if k % threads != t {
+                            continue;
+                        }
+                        let (Some(seg), Some(gv)) = (spec.segments.get(*s), spec.g.get(*g)) else {
+                            continue;
+                        };
+                        let col = build_column(cell, spec, *seg, *gv);
+                        if let Ok(mut r) = results.lock() {
+                            if let Some(slot) = r.get_mut(k) {
+                                *slot = Some(col);
+                            }
+                        }
+                    }
+                });
+            }
+        });
+        let results = results
+            .into_inner()
+            .map_err(|_| MillPlanError::InvalidConfig {
+                name: "cache build".to_string(),
+                reason: "a worker thread panicked".to_string(),
+            })?;
+        let mut values = vec![f64::NAN; spec.node_count()];
+        for ((s, g), res) in columns.iter().zip(results) {
+            let col = res.ok_or_else(|| MillPlanError::InvalidConfig {
+                name: "cache build".to_string(),
+                reason: "a column was not computed".to_string(),
+            })??;
+            if let Some(col) = col {
+                for r in 0..spec.rpm.len() {
+                    for f in 0..spec.feed.len() {
+                        let v = col
+                            .get(r * spec.feed.len() + f)
+                            .copied()
+                            .unwrap_or(f64::NAN);
+                        if let Some(slot) = values.get_mut(spec.index(*s, r, f, *g)) {
+                            *slot = v;
+                        }
+                    }
+                }
+            }
+        }
+        let infeasible_nodes = values.iter().filter(|v| v.is_nan()).count();
+        let bytes: Vec<u8> = values.iter().flat_map(|v| v.to_le_bytes()).collect();
+        let header = CacheHeader {
+            grid: spec.clone(),
+            cell_fingerprint: cell_fingerprint(cell),
+            infeasible_nodes,
+            build_seconds: start.elapsed().as_secs_f64(),
+            threads,
+            error: None,
+            error_bound: None,
+            error_g_nodes: None,
+            error_bound_g_nodes: None,
+            command: String::new(),
+            data_checksum: format!("{:016x}", fnv1a(&bytes)),
+        };
+        Ok(Self { header, values })
+    }
+
+    /// The header (grid, fingerprint, error statistics, bound).
+    pub fn header(&self) -> &CacheHeader {
+        &self.header
+    }
+
+    /// The grid.
+    pub fn grid(&self) -> &GridSpec {
+        &self.header.grid
+    }
+
+    /// The stored value at a node (`None` for an infeasible node or an
+    /// index out of range).
+    pub fn node_value(&self, s: usize, r: usize, f: usize, g: usize) -> Option<f64> {
+        let grid = &self.header.grid;
+        if s >= grid.segments.len()
+            || r >= grid.rpm.len()
+            || f >= grid.feed.len()
+            || g >= grid.g.len()
+        {
+            return None;
+        }
+        self.values
+            .get(grid.index(s, r, f, g))
+            .copied()
+            .filter(|v| !v.is_nan())
+    }
+
+    /// Sets the measured error statistics and stated bounds (general
+    /// queries, and queries with g on a node) and the build command
+    /// (written to the header by [`IndicatorCache::save`]).
+    ///
+    /// # Errors
+    /// [`MillPlanError::InvalidParameter`] for a NaN or negative bound.
+    pub fn set_error(
+        &mut self,
+        general: (Option<ErrorStats>, Option<f64>),
+        g_nodes: (Option<ErrorStats>, Option<f64>),
+        command: &str,
+    ) -> Result<(), MillPlanError> {
+        for b in [general.1, g_nodes.1].into_iter().flatten() {
+            if !(b.is_finite() && b >= 0.0) {
+                return Err(MillPlanError::InvalidParameter {
+                    name: "cache error bound [-]".to_string(),
+                    value: b,
+                    reason: "must be finite and >= 0".to_string(),
+                });
+            }
+        }
+        self.header.error = general.0;
+        self.header.error_bound = general.1;
+        self.header.error_g_nodes = g_nodes.0;
+        self.header.error_bound_g_nodes = g_nodes.1;
+        self.header.command = command.to_string();
+        Ok(())
+    }
+
+    /// Interpolated |μ|max, or `None` when the query is outside the grid or
+    /// its interpolation cell has an infeasible corner with non-zero weight
+    /// (module documentation).
+    ///
+    /// # Errors
+    /// [`MillPlanError::InvalidParameter`] for NaN inputs.
+    pub fn try_query(
+        &self,
+        segment: usize,
+        rpm: f64,
+        feed: f64,
+        g: f64,
+    ) -> Result<Option<f64>, MillPlanError> {
+        for (name, v) in [
+            ("spindle speed [rpm]", rpm),
+            ("feed [m/s]", feed),
+            ("g [rad]", g),
+        ] {
+            if v.is_nan() {
+                return Err(MillPlanError::InvalidParameter {
+                    name: name.to_string(),
+                    value: v,
+                    reason: "is NaN".to_string(),
+                });
+            }
+        }
+        let grid = &self.header.grid;
+        let seg_nodes: Vec<f64> = grid.segments.iter().map(|s| *s as f64).collect();
+        let Some(bs) = bracket(&seg_nodes, segment as f64) else {
+            return Ok(None);
+        };
+        let (Some(br), Some(bf), Some(bg)) = (
+            bracket(&grid.rpm, rpm),
+            bracket(&grid.feed, feed),
+            bracket(&grid.g, g),
+        ) else {
+            return Ok(None);
+        };
+        let mut acc = 0.0;
+        for cs in 0..2usize {
+            let ws = if cs == 0 { 1.0 - bs.1 } else { bs.1 };
+            if ws == 0.0 {
+                continue;
+            }
+            for cr in 0..2usize {
+                let wr = if cr == 0 { 1.0 - br.1 } else { br.1 };
+                if wr == 0.0 {
+                    continue;
+                }
+                for cf in 0..2usize {
+                    let wf = if cf == 0 { 1.0 - bf.1 } else { bf.1 };
+                    if wf == 0.0 {
+                        continue;
+                    }
+                    for cg in 0..2usize {
+                        let wg = if cg == 0 { 1.0 - bg.1 } else { bg.1 };
+                        if wg == 0.0 {
+                            continue;
+                        }
+                        let idx = grid.index(bs.0 + cs, br.0 + cr, bf.0 + cf, bg.0 + cg);
+                        match self.values.get(idx) {
+                            Some(v) if !v.is_nan() => acc += ws * wr * wf * wg * v,
+                            _ => return Ok(None),
+                        }
+                    }
+                }
+            }
+        }
+        Ok(Some(acc))
+    }
+
+    /// Interpolated |μ|max ([`IndicatorCache::try_query`]).
+    ///
+    /// # Errors
+    /// [`MillPlanError::InvalidParameter`] for NaN inputs, or when the query
+    /// is outside the grid or next to an infeasible node (the message says
+    /// which; evaluate directly with [`direct_indicator`] instead).
+    pub fn query(&self, segment: usize, rpm: f64, feed: f64, g: f64) -> Result<f64, MillPlanError> {
+        self.try_query(segment, rpm, feed, g)?
+            .ok_or_else(|| MillPlanError::InvalidConfig {
+                name: "indicator cache query".to_string(),
+                reason: format!(
+                    "(segment {segment}, {rpm} rpm, {feed} m/s, g = {g} rad) is outside the grid \
+                     or next to an infeasible node: evaluate it directly"
+                ),
+            })
+    }
+
+    /// A-priori interpolation error estimate: for multilinear interpolation
+    /// `|e| ≤ Σ_i h_i²/8 · max|∂²μ/∂x_i²|` (tensor-product linear
+    /// interpolation, e.g. Davis, "Interpolation and Approximation", §3.1);
+    /// each second derivative is estimated by the second divided difference
+    /// `2[(u₂−u₁)/h₂ − (u₁−u₀)/h₁]/(h₁+h₂)` over all feasible node triples,
+    /// and the sum is multiplied by a safety factor 2 (the largest
+    /// curvature between nodes can exceed the sampled one). An axis with 2
+    /// nodes has no triple and contributes nothing: use ≥ 3 nodes per axis
+    /// for a meaningful bound.
+    pub fn curvature_bound(&self) -> f64 {
+        let grid = &self.header.grid;
+        let seg: Vec<f64> = grid.segments.iter().map(|s| *s as f64).collect();
+        let axes: [&[f64]; 4] = [&seg, &grid.rpm, &grid.feed, &grid.g];
+        let dims = [seg.len(), grid.rpm.len(), grid.feed.len(), grid.g.len()];
+        let mut total = 0.0;
+        for (axis, nodes) in axes.iter().enumerate() {
+            let hmax = nodes.windows(2).map(|w| w[1] - w[0]).fold(0.0, f64::max);
+            let mut dmax: f64 = 0.0;
+            for s in 0..dims[0] {
+                for r in 0..dims[1] {
+                    for f in 0..dims[2] {
+                        for g in 0..dims[3] {
+                            let mut idx = [s, r, f, g];
+                            let i = idx[axis];
+                            if i + 2 >= dims[axis] {
+                                continue;
+                            }
+                            let mut u = [0.0; 3];
+                            let mut ok = true;
+                            for (k, uk) in u.iter_mut().enumerate() {
+                                idx[axis] = i + k;
+                                match self.node_value(idx[0], idx[1], idx[2], idx[3]) {
+                                    Some(v) => *uk = v,
+                                    None => ok = false,
+                                }
+                            }
+                            if !ok {
+                                continue;
+                            }
+                            let (x0, x1, x2) = (nodes[i], nodes[i + 1], nodes[i + 2]);
+                            let (h1, h2) = (x1 - x0, x2 - x1);
+                            let d2 = 2.0 * ((u[2] - u[1]) / h2 - (u[1] - u[0]) / h1) / (h1 + h2);
+                            dmax = dmax.max(d2.abs());
+                        }
+                    }
+                }
+            }
+            total += hmax * hmax / 8.0 * dmax;
+        }
+        2.0 * total
+    }
+
+    /// Measures |cache − direct| at `count` random points (uniform segment
+    /// index, Ω, f, g over the grid's range; direct evaluation with the
+    /// cell's reference joints, as the nodes), skipping points where either
+    /// is infeasible. With `g_on_nodes` each g is snapped to its nearest g
+    /// node (the DP's queries).
+    ///
+    /// # Errors
+    /// [`MillPlanError::InvalidConfig`] when no point could be compared;
+    /// model errors of [`direct_indicator`].
+    pub fn measure_error(
+        &self,
+        cell: &MillCell,
+        count: usize,
+        seed: u64,
+        g_on_nodes: bool,
+    ) -> Result<ErrorStats, MillPlanError> {
+        let grid = &self.header.grid;
+        let mut rng = SplitMix64::new(seed);
+        let mut errors = Vec::with_capacity(count);
+        let mut skipped = 0;
+        let (s0, s1) = (
+            grid.segments.first().copied().unwrap_or(0),
+            grid.segments.last().copied().unwrap_or(0),
+        );
+        let span = |a: &[f64]| {
+            (
+                a.first().copied().unwrap_or(0.0),
+                a.last().copied().unwrap_or(0.0),
+            )
+        };
+        let (r0, r1) = span(&grid.rpm);
+        let (f0, f1) = span(&grid.feed);
+        let (g0, g1) = span(&grid.g);
+        for _ in 0..count {
+            let seg = rng.integer(s0, s1);
+            let rpm = rng.uniform(r0, r1);
+            let feed = rng.uniform(f0, f1);
+            let mut g = rng.uniform(g0, g1);
+            if g_on_nodes {
+                g = grid
+                    .g
+                    .iter()
+                    .copied()
+                    .min_by(|a, b| (a - g).abs().total_cmp(&(b - g).abs()))
+                    .unwrap_or(g);
+            }
+            let cached = self.try_query(seg, rpm, feed, g)?;
+            let direct = match direct_indicator(cell, seg, rpm, feed, g, None) {
+                Ok(d) => d,
+                Err(MillPlanError::Chatter(_)) => None,
+                Err(e) => return Err(e),
+            };
+            match (cached, direct) {
+                (Some(c), Some(d)) => errors.push((c - d).abs()),
+                _ => skipped += 1,
+            }
+        }
+        if errors.is_empty() {
+            return Err(MillPlanError::InvalidConfig {
+                name: "cache error measurement".to_string(),
+                reason: format!("none of the {count} random points was feasible"),
+            });
+        }
+        errors.sort_by(f64::total_cmp);
+        let n = errors.len();
+        let p99_index = ((0.99 * n as f64).ceil() as usize).clamp(1, n) - 1;
+        Ok(ErrorStats {
+            points: n,
+            skipped,
+            max_abs: errors.last().copied().unwrap_or(0.0),
+            p99_abs: errors.get(p99_index).copied().unwrap_or(0.0),
+            mean_abs: errors.iter().sum::<f64>() / n as f64,
+            seed,
+            g_on_nodes,
+        })
+    }
+
+    /// Writes the cache file (module documentation).
+    ///
+    /// # Errors
+    /// [`MillPlanError::Io`].
+    pub fn save(&self, path: &Path) -> Result<(), MillPlanError> {
+        let bytes: Vec<u8> = self.values.iter().flat_map(|v| v.to_le_bytes()).collect();
+        let mut header = self.header.clone();
+        header.data_checksum = format!("{:016x}", fnv1a(&bytes));
+        let json = serde_json::to_string(&header).map_err(|e| MillPlanError::Io {
+            path: path.display().to_string(),
+            message: e.to_string(),
+        })?;
+        let mut out = Vec::with_capacity(bytes.len() + json.len() + 64);
+        out.extend_from_slice(CACHE_MAGIC.as_bytes());
+        out.push(b'\n');
+        out.extend_from_slice(json.as_bytes());
+        out.push(b'\n');
+        out.extend_from_slice(&bytes);
+        std::fs::write(path, out).map_err(|e| MillPlanError::Io {
+            path: path.display().to_string(),
+            message: e.to_string(),
+        })
+    }
+
+    /// Reads a cache file and checks it against `cell`.
+    ///
+    /// # Errors
+    /// [`MillPlanError::Io`] (unreadable file); [`MillPlanError::InvalidConfig`]
+    /// for a wrong magic line, bad header, truncated/extra data, a checksum
+    /// mismatch (corrupt file), or a fingerprint that differs from
+    /// [`cell_fingerprint`]`(cell)` (stale cache: rebuild it with
+    /// `cargo run --release -p kerf_millplan --example build_cache`).
+    pub fn load(path: &Path, cell: &MillCell) -> Result<Self, MillPlanError> {
+        let bytes = std::fs::read(path).map_err(|e| MillPlanError::Io {
+            path: path.display().to_string(),
+            message: e.to_string(),
+        })?;
+        let cache = Self::from_bytes(&bytes, &path.display().to_string())?;
+        let expected = cell_fingerprint(cell);
+        if cache.header.cell_fingerprint != expected {
+            return Err(MillPlanError::InvalidConfig {
+                name: format!("indicator cache {}", path.display()),
+                reason: format!(
+                    "stale: built for cell fingerprint {} but the cell's is {expected} (the cell \
+                     file changed); rebuild with `cargo run --release -p kerf_millplan --example \
+                     build_cache`",
+                    cache.header.cell_fingerprint
+                ),
+            });
+        }
+        Ok(cache)
+    }
+
+    /// Parses the bytes of a cache file (no fingerprint check).
+    ///
+    /// # Errors
+    /// As [`IndicatorCache::load`], except the fingerprint.
+    pub fn from_bytes(bytes: &[u8], name: &str) -> Result<Self, MillPlanError> {
+        let corrupt = |reason: String| MillPlanError::InvalidConfig {
+            name: format!("indicator cache {name}"),
+            reason,
+        };
+        let magic_end = bytes
+            .iter()
+            .position(|b| *b == b'\n')
+            .ok_or_else(|| corrupt("no header line".to_string()))?;
+        if bytes.get(..magic_end) != Some(CACHE_MAGIC.as_bytes()) {
+            return Err(corrupt(format!(
+                "not a cache file (first line must be `{CACHE_MAGIC}`)"
+            )));
+        }
+        let rest = bytes.get(magic_end + 1..).unwrap_or(&[]);
+        let json_end = rest
+            .iter()
+            .position(|b| *b == b'\n')
+            .ok_or_else(|| corrupt("no JSON header line".to_string()))?;
+        let json = std::str::from_utf8(rest.get(..json_end).unwrap_or(&[]))
+            .map_err(|e| corrupt(format!("header is not UTF-8: {e}")))?;
+        let header: CacheHeader =
+            serde_json::from_str(json).map_err(|e| corrupt(format!("bad header: {e}")))?;
+        header.grid.validate()?;
+        let data = rest.get(json_end + 1..).unwrap_or(&[]);
+        let expected = header.grid.node_count() * 8;
+        if data.len() != expected {
+            return Err(corrupt(format!(
+                "{} data bytes, expected {expected} for the grid (truncated or extra data)",
+                data.len()
+            )));
+        }
+        let checksum = format!("{:016x}", fnv1a(data));
+        if checksum != header.data_checksum {
+            return Err(corrupt(format!(
+                "data checksum {checksum} differs from the header's {} (corrupt file)",
+                header.data_checksum
+            )));
+        }
+        let values = data
+            .chunks_exact(8)
+            .map(|c| {
+                let mut b = [0u8; 8];
+                b.copy_from_slice(c);
+                f64::from_le_bytes(b)
+            })
+            .collect();
+        Ok(Self { header, values })
+    }
+
+    /// The default cache file of the default cell,
+    /// `crates/millplan/data/indicator_cache.bin`.
+    pub fn default_path() -> std::path::PathBuf {
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("data/indicator_cache.bin")
+    }
+}

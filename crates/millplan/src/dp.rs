@@ -1,1 +1,384 @@
-//! (being written; see the crate documentation)
+//! The deterministic optimum: dynamic programming over a discretized
+//! (Ω, f, g) grid whose spacing equals the per-step bounds (20 rpm,
+//! 1e-3 m/s, 0.2 rad on the default cell), so that the moves of −1/0/+1
+//! grid steps per segment (27 moves) are exactly the moves the step bounds
+//! allow between grid points.
+//!
+//! # Problem
+//!
+//! Maximize `Σ_{t=0}^{N−1} r(t, x_t)` (r of seed 004 eq. 12, undiscounted,
+//! all N segments as in [`crate::plan`]) over grid sequences with
+//! `x_0` = the IVP (2000 rpm, 0.04 m/s, 0 rad) and `x_{t+1} − x_t` ∈
+//! {−1, 0, 1}³ grid steps. Bellman backward recursion
+//! `V_t(x) = r(t, x) + max_m V_{t+1}(x + m)`, `V_{N−1} = r(N−1, ·)`, with
+//! f32 value layers and a u8 backpointer (move code) per (t, x); the plan
+//! is read forward from x_0. Moves that would leave the grid are not
+//! offered (in the environment, the clip turns them into a smaller move
+//! that is also on offer).
+//!
+//! # What the value means
+//!
+//! * With α = 1 (no inertial filter) and grid-aligned actions the DP is
+//!   exact for the environment on its grid: every DP plan is an action
+//!   sequence of [`crate::env::MillEnv`] (normalized actions −1/0/+1).
+//! * With α < 1 the filtered moves â are convex combinations of bounded
+//!   actions, still within the step bounds: the set of state sequences a
+//!   filtered policy can produce is (up to the grid) a SUBSET of the
+//!   unfiltered one, so the DP value is an UPPER BOUND of what any policy
+//!   of the filtered environment can reach (exactly so on the grid; off
+//!   the grid the interpolation error of the cache and the grid spacing
+//!   add a small slack).
+//! * Feasible set: (t, g) pairs where the cell state is infeasible (IK,
+//!   joint limit, singular; a precomputed table) are forbidden, and so are
+//!   states whose |μ| the cache cannot give (outside its grid — f below
+//!   its lowest feed node, 0.01 m/s on the default cache — or next to an
+//!   infeasible node). Excluding f < 0.01 m/s does not lower the optimum on
+//!   the default cell: a lower feed lowers r_e and raises |μ| (the feed
+//!   lower bound), so it is never optimal. The forbidden count is
+//!   reported ([`DpResult::forbidden_states`]).
+//! * |μ| comes from the cache (its stated error bound applies); the plan
+//!   is then re-evaluated directly by [`crate::plan::Plan::evaluate`].
+//!   K (eq. 14) uses the cell's reference joints per (t, g), as the cache.
+
+use std::time::Instant;
+
+use kerf_mill::MillCell;
+
+use crate::cache::{is_infeasible, IndicatorCache};
+use crate::env::PhysicalState;
+use crate::error::MillPlanError;
+use crate::reward::{efficiency_reward, operational_reward, stability_reward, RewardWeights};
+
+/// The DP grid: node ranges on each axis, in multiples of the step bound
+/// from the initial state (so the IVP is a node).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct DpSpec {
+    /// Initial state (Ω0 \[rpm\], f0 [m/s], g0 \[rad\]).
+    pub initial: [f64; 3],
+    /// Ω range \[rpm\] (clipped to the cell's range, aligned to Ω0 + k·ΔΩ).
+    pub rpm_range: [f64; 2],
+    /// Feed range [m/s].
+    pub feed_range: [f64; 2],
+    /// g range \[rad\]; `[g0, g0]` is the paper's fixed-g ablation.
+    pub g_range: [f64; 2],
+    /// Reward weights.
+    pub weights: RewardWeights,
+    /// Optional hard chatter constraint `(limit, from_segment)`: states with
+    /// cached |μ| ≥ limit are forbidden at segments ≥ from_segment. `None`
+    /// (default) optimizes eq. 12 alone, the objective of DDPG: eq. 17 has
+    /// no jump at |μ| = 1, so that optimum may ride marginally above 1
+    /// where the efficiency gain outweighs w_p (e^(|μ|−1) − 1).
+    pub chatter_limit: Option<(f64, usize)>,
+}
+
+impl DpSpec {
+    /// The full state ranges of the cell from the IVP (2000 rpm, 0.04 m/s,
+    /// 0 rad); `fixed_g` restricts g to g0 = 0.
+    pub fn full(cell: &MillCell, weights: RewardWeights, fixed_g: bool) -> Self {
+        let lim = cell.state_limits();
+        Self {
+            initial: [2000.0, 0.04, 0.0],
+            rpm_range: lim.spindle_rpm,
+            feed_range: lim.feed,
+            g_range: if fixed_g {
+                [0.0, 0.0]
+            } else {
+                lim.redundancy_angle
+            },
+            weights,
+            chatter_limit: None,
+        }
+    }
+}
+
+/// Grid nodes `x0 + k h` within [lo, hi] (with a 1e-9 relative tolerance),
+/// and the index of x0.
+fn axis(x0: f64, h: f64, lo: f64, hi: f64) -> Result<(Vec<f64>, usize), MillPlanError> {
+    if !(h > 0.0 && x0.is_finite() && lo <= x0 + 1e-9 * h && x0 <= hi + 1e-9 * h) {
+        return Err(MillPlanError::InvalidParameter {
+            name: "DP initial state".to_string(),
+            value: x0,
+            reason: format!("must be inside its range [{lo}, {hi}]"),
+        });
+    }
+    let below = ((x0 - lo) / h + 1e-9).floor() as usize;
+    let above = ((hi - x0) / h + 1e-9).floor() as usize;
+    let nodes = (0..=below + above)
+        .map(|k| x0 + (k as f64 - below as f64) * h)
+        .collect();
+    Ok((nodes, below))
+}
+
+/// Result of the generic DP.
+#[derive(Debug, Clone, PartialEq)]
+pub struct GridPath {
+    /// The value (Σ stage rewards, f64 re-summed along the path).
+    pub value: f64,
+    /// Node indices (i, j, k) per stage.
+    pub nodes: Vec<[usize; 3]>,
+}
+
+/// The generic DP on a 3-D grid (module documentation): `stages` stages,
+/// grid `dims`, start node `start`, moves of −1/0/+1 per axis, stage
+/// reward `stage(t, [i, j, k])` (`None` = forbidden state).
+///
+/// # Returns
+/// `Ok(None)` when no feasible sequence exists (the start is forbidden or
+/// every continuation dies).
+///
+/// # Errors
+/// [`MillPlanError::InvalidConfig`] for zero stages, empty dimensions, a
+/// start outside the grid, or a grid too large (> 2^31 nodes × stages).
+pub fn solve_grid<F>(
+    stages: usize,
+    dims: [usize; 3],
+    start: [usize; 3],
+    mut stage: F,
+) -> Result<Option<GridPath>, MillPlanError>
+where
+    F: FnMut(usize, [usize; 3]) -> Option<f64>,
+{
+    let nodes = dims[0] * dims[1] * dims[2];
+    if stages == 0 || nodes == 0 || (0..3).any(|a| start[a] >= dims[a]) {
+        return Err(MillPlanError::InvalidConfig {
+            name: "DP grid".to_string(),
+            reason: format!("stages {stages}, dims {dims:?}, start {start:?}"),
+        });
+    }
+    if nodes.checked_mul(stages).is_none_or(|v| v > (1usize << 31)) {
+        return Err(MillPlanError::InvalidConfig {
+            name: "DP grid".to_string(),
+            reason: "too many states".to_string(),
+        });
+    }
+    let index = |i: usize, j: usize, k: usize| (i * dims[1] + j) * dims[2] + k;
+    let stage_table = |t: usize, stage: &mut F| -> Vec<f32> {
+        let mut out = vec![f32::NEG_INFINITY; nodes];
+        for i in 0..dims[0] {
+            for j in 0..dims[1] {
+                for k in 0..dims[2] {
+                    if let Some(r) = stage(t, [i, j, k]) {
+                        if r.is_finite() {
+                            out[index(i, j, k)] = r as f32;
+                        }
+                    }
+                }
+            }
+        }
+        out
+    };
+    // Backward pass.
+    let mut next = stage_table(stages - 1, &mut stage);
+    let mut back: Vec<u8> = vec![u8::MAX; nodes * (stages - 1)];
+    for t in (0..stages - 1).rev() {
+        let r = stage_table(t, &mut stage);
+        let mut value = vec![f32::NEG_INFINITY; nodes];
+        let bt = &mut back[t * nodes..(t + 1) * nodes];
+        for i in 0..dims[0] {
+            for j in 0..dims[1] {
+                for k in 0..dims[2] {
+                    let here = index(i, j, k);
+                    let rv = r[here];
+                    if rv == f32::NEG_INFINITY {
+                        continue;
+                    }
+                    let mut best = f32::NEG_INFINITY;
+                    let mut best_m = u8::MAX;
+                    for di in 0..3usize {
+                        let Some(ni) = (i + di).checked_sub(1).filter(|v| *v < dims[0]) else {
+                            continue;
+                        };
+                        for dj in 0..3usize {
+                            let Some(nj) = (j + dj).checked_sub(1).filter(|v| *v < dims[1]) else {
+                                continue;
+                            };
+                            for dk in 0..3usize {
+                                let Some(nk) = (k + dk).checked_sub(1).filter(|v| *v < dims[2])
+                                else {
+                                    continue;
+                                };
+                                let v = next[index(ni, nj, nk)];
+                                if v > best {
+                                    best = v;
+                                    best_m = (di * 9 + dj * 3 + dk) as u8;
+                                }
+                            }
+                        }
+                    }
+                    if best > f32::NEG_INFINITY {
+                        value[here] = rv + best;
+                        bt[here] = best_m;
+                    }
+                }
+            }
+        }
+        next = value;
+    }
+    let s0 = index(start[0], start[1], start[2]);
+    if next.get(s0).is_none_or(|v| *v == f32::NEG_INFINITY) {
+        return Ok(None);
+    }
+    // Forward pass, re-summing the stage rewards in f64.
+    let mut path = Vec::with_capacity(stages);
+    let mut x = start;
+    let mut total = 0.0;
+    for t in 0..stages {
+        path.push(x);
+        total += stage(t, x).unwrap_or(f64::NEG_INFINITY);
+        if t + 1 == stages {
+            break;
+        }
+        let m = back[t * nodes + index(x[0], x[1], x[2])];
+        if m == u8::MAX {
+            return Ok(None);
+        }
+        let m = m as usize;
+        x = [x[0] + m / 9 - 1, x[1] + (m / 3) % 3 - 1, x[2] + m % 3 - 1];
+    }
+    Ok(Some(GridPath {
+        value: total,
+        nodes: path,
+    }))
+}
+
+/// The DP plan on a cell.
+#[derive(Debug, Clone, PartialEq)]
+pub struct DpResult {
+    /// Optimal state sequence (one per segment).
+    pub states: Vec<PhysicalState>,
+    /// Optimal total reward on the grid (cache |μ|).
+    pub value: f64,
+    /// Grid sizes (Ω, f, g).
+    pub dims: [usize; 3],
+    /// States excluded (infeasible cell state or not given by the cache),
+    /// over all segments.
+    pub forbidden_states: usize,
+    /// Wall-clock time \[s\] (tables and DP).
+    pub seconds: f64,
+}
+
+/// Solves the DP of the module documentation on `cell` with |μ| from
+/// `cache`.
+///
+/// # Errors
+/// [`MillPlanError::InvalidParameter`] for an initial state outside its
+/// range; [`MillPlanError::InvalidConfig`] when the initial state is
+/// forbidden or no feasible plan exists; cell-model errors other than
+/// infeasibility.
+///
+/// # Performance
+/// Default cell, full grid (101 × 61 × 31 nodes × 100 segments × 27 moves):
+/// measured in the crate's BENCHMARKS entry (a few seconds in release).
+pub fn solve(
+    cell: &MillCell,
+    cache: &IndicatorCache,
+    spec: &DpSpec,
+) -> Result<DpResult, MillPlanError> {
+    let start_time = Instant::now();
+    spec.weights.validate()?;
+    let lim = *cell.state_limits();
+    let clip = |r: [f64; 2], l: [f64; 2]| [r[0].max(l[0]), r[1].min(l[1])];
+    let (rpm, i0) = axis(
+        spec.initial[0],
+        lim.max_spindle_step_rpm,
+        clip(spec.rpm_range, lim.spindle_rpm)[0],
+        clip(spec.rpm_range, lim.spindle_rpm)[1],
+    )?;
+    let (feed, j0) = axis(
+        spec.initial[1],
+        lim.max_feed_step,
+        clip(spec.feed_range, lim.feed)[0],
+        clip(spec.feed_range, lim.feed)[1],
+    )?;
+    let (g, k0) = axis(
+        spec.initial[2],
+        lim.max_redundancy_step,
+        clip(spec.g_range, lim.redundancy_angle)[0],
+        clip(spec.g_range, lim.redundancy_angle)[1],
+    )?;
+    let n = cell.path().segments().len();
+    // (segment, g) table of r_o = 1/(K + ε); None = infeasible.
+    let mut ro: Vec<Option<f64>> = Vec::with_capacity(n * g.len());
+    for t in 0..n {
+        for gv in &g {
+            match cell.evaluate(t, *gv, None) {
+                Ok(cs) => ro.push(Some(operational_reward(cs.condition_number)?)),
+                Err(e) if is_infeasible(&e) => ro.push(None),
+                Err(e) => return Err(e.into()),
+            }
+        }
+    }
+    let re: Vec<f64> = feed
+        .iter()
+        .map(|f| efficiency_reward(*f, lim.feed[1]))
+        .collect::<Result<_, _>>()?;
+    let w = spec.weights;
+    let mut forbidden = 0usize;
+    let mut error: Option<MillPlanError> = None;
+    let path = solve_grid(
+        n,
+        [rpm.len(), feed.len(), g.len()],
+        [i0, j0, k0],
+        |t, [i, j, k]| {
+            let ro = ro.get(t * g.len() + k).copied().flatten();
+            let (Some(ro), Some(re)) = (ro, re.get(j)) else {
+                forbidden += 1;
+                return None;
+            };
+            if feed[j] <= 0.0 {
+                forbidden += 1;
+                return None;
+            }
+            match cache.try_query(t, rpm[i], feed[j], g[k]) {
+                Ok(Some(mu))
+                    if spec
+                        .chatter_limit
+                        .is_some_and(|(l, from)| t >= from && mu >= l) =>
+                {
+                    forbidden += 1;
+                    None
+                }
+                Ok(Some(mu)) => match stability_reward(mu) {
+                    Ok(rs) => Some(w.operational * ro + w.efficiency * re + w.stability * rs),
+                    Err(e) => {
+                        error.get_or_insert(e);
+                        None
+                    }
+                },
+                Ok(None) => {
+                    forbidden += 1;
+                    None
+                }
+                Err(e) => {
+                    error.get_or_insert(e);
+                    None
+                }
+            }
+        },
+    )?;
+    if let Some(e) = error {
+        return Err(e);
+    }
+    let path = path.ok_or_else(|| MillPlanError::InvalidConfig {
+        name: "DP".to_string(),
+        reason: "no feasible plan from the initial state on this grid".to_string(),
+    })?;
+    let states = path
+        .nodes
+        .iter()
+        .enumerate()
+        .map(|(t, [i, j, k])| PhysicalState {
+            segment: t,
+            rpm: rpm[*i],
+            feed: feed[*j],
+            g: g[*k],
+        })
+        .collect();
+    Ok(DpResult {
+        states,
+        value: path.value,
+        dims: [rpm.len(), feed.len(), g.len()],
+        forbidden_states: forbidden,
+        seconds: start_time.elapsed().as_secs_f64(),
+    })
+}

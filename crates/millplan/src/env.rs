@@ -1,1 +1,583 @@
-//! (being written; see the crate documentation)
+//! The milling environment of seed 004 section 3: [`MillEnv`] implements
+//! [`Environment`] for DDPG and is the reference simulator of every planner.
+//!
+//! # State, action, transition
+//!
+//! * **State** `s_t = (t, Ω_t, f_t, g_t)` (seed 004 section 3,
+//!   `S = (s_pa, Ω, f, g)`): segment `t` (0-based) is machined at spindle
+//!   speed Ω_t, feed f_t and redundancy angle g_t.
+//! * **Initial value problem** (seed 004 section 2 end, Algorithm 1
+//!   "initial point s_0 = (1, Ω0, f0, g0)"): s_0 = (0, 2000 rpm, 0.04 m/s,
+//!   0 rad) by default ([`EnvConfig`]). Segment 0 is machined at the IVP.
+//! * **Action** `a = (ΔΩ, Δf, Δg)` normalized to [−1, 1]³ and scaled by the
+//!   cell's per-step bounds (|ΔΩ| ≤ 20 rpm, |Δf| ≤ 1e-3 m/s, |Δg| ≤ 0.2
+//!   rad, `kerf_mill::StateLimits`). A NaN or an entry outside [−1, 1] is an
+//!   error, never clamped. With [`EnvConfig::fixed_g`] (the paper's
+//!   ablation) the action is (ΔΩ, Δf) and g stays at g0.
+//! * **Transition**, seed 004 eq. 11 (garbled in the extraction; read as
+//!   the inertial filter of the brief): `â_{t+1} = α a_{t+1} + (1 − α) â_t`
+//!   (â_0 = 0), then `p_{t+1} = clip(p_t + â_{t+1}, p_min, p_max)` for
+//!   p = (Ω, f, g), and `t → t + 1`. The clip to the state RANGE is the
+//!   paper's (it keeps Ω in [2000, 4000] rpm, f in [0, 0.06] m/s, g in
+//!   [−π, π]); since |â| ≤ the step bound (a convex combination of bounded
+//!   actions), the per-step bounds hold for the filtered moves too.
+//!   Default α = 0.5 (kerf's choice; the paper says α ∈ (0, 1) only): a
+//!   reversal of the command takes effect over about two steps, a constant
+//!   command reaches 97 % of its step within 5 steps; α = 1 switches the
+//!   filter off (then the DP of [`crate::dp`] is exact for this
+//!   environment; with α < 1 the DP value is an upper bound).
+//! * **Reward of step t** (Algorithm 1: from s_t, action a_t, observe
+//!   r_{t+1} and s_{t+1}): `r_{t+1} = r(s_{t+1})` of seed 004 eq. 12,
+//!   evaluated on segment t + 1 with the new parameters (the segment the
+//!   new state machines). An episode therefore has N − 1 = 99 steps for the
+//!   N = 100 segments; segment 0 is machined at the IVP, its reward
+//!   r(s_0) is the same for every policy and is reported by
+//!   [`MillEnv::initial_info`]. Plan totals ([`Rollout::total_reward`],
+//!   [`crate::plan`]) sum all N segments, r(s_0) included.
+//! * **Observation** (4 entries, each in [−1, 1]): `2t/(N−1) − 1`, and Ω, f,
+//!   g mapped linearly from their ranges to [−1, 1].
+//! * **Segment time** `l_t / f_t` (the segment's arc length over its feed).
+//!   A zero feed (reachable through the clip at f_min = 0) would take
+//!   infinitely long: it is a terminal constraint violation, like an
+//!   infeasible g.
+//! * **Infeasible state** — IK unreachable, a joint limit or a singular
+//!   Jacobian at (segment t + 1, g_{t+1}), or a zero feed: the step returns
+//!   `done = true` with the reward [`EnvConfig::violation_penalty`]
+//!   (default −100) instead of eq. 12. −100 is worse than any continuation
+//!   of the remaining ≤ 99 steps whose |μ|max stays below 1.7 (the step
+//!   reward is ≥ −w_p e^(|μ|−1) ≥ −1.01 there with the default weights),
+//!   so ending an episode on purpose never pays; the default cell's
+//!   measured |μ| stays below 1.2.
+//! * **IK branch continuity**: each state's joints are the IK solution
+//!   nearest the previous state's joints (`MillCell::evaluate` with the
+//!   previous joints as reference).
+//! * **|μ|max**: from the [`IndicatorCache`] when one is given and the query
+//!   is inside its grid and away from infeasible nodes; evaluated directly
+//!   otherwise ([`Evaluation::from_cache`] says which).
+
+use std::sync::Arc;
+
+use kerf_mill::MillCell;
+
+use crate::cache::{is_infeasible, IndicatorCache};
+use crate::error::MillPlanError;
+use crate::reward::{step_reward, RewardParts, RewardWeights};
+use crate::rl::{Environment, Transition};
+
+/// Settings of [`MillEnv`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct EnvConfig {
+    /// Reward weights (seed 004 eq. 12).
+    pub weights: RewardWeights,
+    /// Inertia coefficient α ∈ (0, 1] of the filter (seed 004 eq. 11).
+    pub alpha: f64,
+    /// Ω0 \[rpm\] of the initial value problem.
+    pub initial_rpm: f64,
+    /// f0 [m/s].
+    pub initial_feed: f64,
+    /// g0 \[rad\].
+    pub initial_g: f64,
+    /// Reward of a terminal constraint violation (< 0).
+    pub violation_penalty: f64,
+    /// The paper's ablation: g fixed at g0, action (ΔΩ, Δf).
+    pub fixed_g: bool,
+}
+
+impl Default for EnvConfig {
+    /// Seed 004's IVP (2000 rpm, 0.04 m/s, 0 rad), α = 0.5, penalty −100,
+    /// default weights, g free (module documentation).
+    fn default() -> Self {
+        Self {
+            weights: RewardWeights::default(),
+            alpha: 0.5,
+            initial_rpm: 2000.0,
+            initial_feed: 0.04,
+            initial_g: 0.0,
+            violation_penalty: -100.0,
+            fixed_g: false,
+        }
+    }
+}
+
+/// The physical state (segment, Ω, f, g).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PhysicalState {
+    /// Segment index (0-based).
+    pub segment: usize,
+    /// Spindle speed \[rpm\].
+    pub rpm: f64,
+    /// Feed [m/s].
+    pub feed: f64,
+    /// Redundancy angle \[rad\].
+    pub g: f64,
+}
+
+/// What the model gives for a feasible state.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Evaluation {
+    /// Joint vector \[rad\].
+    pub joints: [f64; 6],
+    /// Condition number K (seed 004 eq. 14).
+    pub condition_number: f64,
+    /// Condition indicator 1/K.
+    pub condition_indicator: f64,
+    /// |μ|max.
+    pub spectral_radius: f64,
+    /// Whether |μ|max came from the cache (else direct evaluation).
+    pub from_cache: bool,
+    /// Segment length / feed \[s\].
+    pub segment_time: f64,
+    /// Reward parts (eq. 12, 15-17).
+    pub reward: RewardParts,
+}
+
+/// Diagnostics of one state (the initial state or the result of a step).
+#[derive(Debug, Clone, PartialEq)]
+pub struct StepInfo {
+    /// The state.
+    pub state: PhysicalState,
+    /// The filtered move â that led to it (ΔΩ \[rpm\], Δf [m/s], Δg \[rad\];
+    /// zero for the initial state).
+    pub filtered_action: [f64; 3],
+    /// The reward (eq. 12, or the violation penalty).
+    pub reward: f64,
+    /// The model's values; `None` for a constraint violation.
+    pub evaluation: Option<Evaluation>,
+    /// Why the state violates a constraint (terminal), if it does.
+    pub violation: Option<String>,
+}
+
+/// One episode: the initial state and every step.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Rollout {
+    /// s_0 (the IVP on segment 0).
+    pub initial: StepInfo,
+    /// s_1 … (one per step).
+    pub steps: Vec<StepInfo>,
+    /// r(s_0) + Σ step rewards (all machined segments).
+    pub total_reward: f64,
+    /// All N segments were machined without a violation.
+    pub completed: bool,
+}
+
+impl Rollout {
+    /// The state sequence s_0, s_1, ….
+    pub fn states(&self) -> Vec<PhysicalState> {
+        std::iter::once(self.initial.state)
+            .chain(self.steps.iter().map(|s| s.state))
+            .collect()
+    }
+}
+
+/// The environment (module documentation).
+#[derive(Debug, Clone)]
+pub struct MillEnv {
+    cell: Arc<MillCell>,
+    cache: Option<Arc<IndicatorCache>>,
+    config: EnvConfig,
+    current: Option<StepInfo>,
+    initial: Option<StepInfo>,
+    filter: [f64; 3],
+    joints: [f64; 6],
+    done: bool,
+}
+
+fn check_range(name: &str, v: f64, lo: f64, hi: f64) -> Result<f64, MillPlanError> {
+    if !(v.is_finite() && v >= lo && v <= hi) {
+        return Err(MillPlanError::InvalidParameter {
+            name: name.to_string(),
+            value: v,
+            reason: format!("must be in [{lo}, {hi}]"),
+        });
+    }
+    Ok(v)
+}
+
+/// Maps `v` in [lo, hi] to [−1, 1].
+fn normalize(v: f64, lo: f64, hi: f64) -> f32 {
+    ((2.0 * (v - lo) / (hi - lo) - 1.0).clamp(-1.0, 1.0)) as f32
+}
+
+impl MillEnv {
+    /// A new environment (call [`Environment::reset`] before stepping).
+    ///
+    /// # Arguments
+    /// * `cell` — the milling cell; `cache` — optional indicator cache (it
+    ///   must have been built for this cell: [`IndicatorCache::load`]
+    ///   checks that); `config` — settings.
+    ///
+    /// # Errors
+    /// [`MillPlanError::InvalidParameter`] for α ∉ (0, 1], an IVP outside
+    /// the state ranges, a zero initial feed, a non-negative or NaN
+    /// penalty, bad weights; [`MillPlanError::InvalidConfig`] for a path of
+    /// fewer than 2 segments.
+    pub fn new(
+        cell: Arc<MillCell>,
+        cache: Option<Arc<IndicatorCache>>,
+        config: EnvConfig,
+    ) -> Result<Self, MillPlanError> {
+        config.weights.validate()?;
+        if !(config.alpha > 0.0 && config.alpha <= 1.0) {
+            return Err(MillPlanError::InvalidParameter {
+                name: "inertia coefficient alpha [-]".to_string(),
+                value: config.alpha,
+                reason: "must be in (0, 1] (seed 004 eq. 11)".to_string(),
+            });
+        }
+        let lim = *cell.state_limits();
+        check_range(
+            "initial spindle speed [rpm]",
+            config.initial_rpm,
+            lim.spindle_rpm[0],
+            lim.spindle_rpm[1],
+        )?;
+        check_range(
+            "initial feed [m/s]",
+            config.initial_feed,
+            lim.feed[0],
+            lim.feed[1],
+        )?;
+        if config.initial_feed <= 0.0 {
+            return Err(MillPlanError::InvalidParameter {
+                name: "initial feed [m/s]".to_string(),
+                value: config.initial_feed,
+                reason: "must be > 0 (a zero feed never finishes a segment)".to_string(),
+            });
+        }
+        check_range(
+            "initial redundancy angle [rad]",
+            config.initial_g,
+            lim.redundancy_angle[0],
+            lim.redundancy_angle[1],
+        )?;
+        if !(config.violation_penalty.is_finite() && config.violation_penalty < 0.0) {
+            return Err(MillPlanError::InvalidParameter {
+                name: "violation penalty [-]".to_string(),
+                value: config.violation_penalty,
+                reason: "must be finite and < 0".to_string(),
+            });
+        }
+        if cell.path().segments().len() < 2 {
+            return Err(MillPlanError::InvalidConfig {
+                name: "milling path".to_string(),
+                reason: "needs at least 2 segments".to_string(),
+            });
+        }
+        Ok(Self {
+            cell,
+            cache,
+            config,
+            current: None,
+            initial: None,
+            filter: [0.0; 3],
+            joints: [0.0; 6],
+            done: false,
+        })
+    }
+
+    /// The cell.
+    pub fn cell(&self) -> &MillCell {
+        &self.cell
+    }
+
+    /// The settings.
+    pub fn config(&self) -> &EnvConfig {
+        &self.config
+    }
+
+    /// Number of path segments N.
+    pub fn segment_count(&self) -> usize {
+        self.cell.path().segments().len()
+    }
+
+    /// The current physical state (`None` before the first reset).
+    pub fn state(&self) -> Option<PhysicalState> {
+        self.current.as_ref().map(|c| c.state)
+    }
+
+    /// Diagnostics of the current state (the last step's, or the initial
+    /// state's after a reset).
+    pub fn last_info(&self) -> Option<&StepInfo> {
+        self.current.as_ref()
+    }
+
+    /// Diagnostics of s_0 (its reward r(s_0) is not part of any step).
+    pub fn initial_info(&self) -> Option<&StepInfo> {
+        self.initial.as_ref()
+    }
+
+    /// The filter state â_t (physical units: rpm, m/s, rad).
+    pub fn filter_state(&self) -> [f64; 3] {
+        self.filter
+    }
+
+    /// Whether the episode has ended.
+    pub fn is_done(&self) -> bool {
+        self.done
+    }
+
+    /// Evaluates a state: `Ok(Ok(evaluation))`, `Ok(Err(reason))` for a
+    /// constraint violation, `Err` for a model failure.
+    ///
+    /// # Errors
+    /// Cell-model errors other than infeasibility; chatter-model errors.
+    pub fn evaluate_state(
+        &self,
+        state: &PhysicalState,
+        reference: Option<&[f64; 6]>,
+    ) -> Result<Result<Evaluation, String>, MillPlanError> {
+        let segment = self.cell.path().segment(state.segment)?;
+        if state.feed.is_nan() || state.feed <= 0.0 {
+            return Ok(Err(format!(
+                "zero feed at segment {}: the segment would take infinitely long",
+                state.segment
+            )));
+        }
+        let cs = match self.cell.evaluate(state.segment, state.g, reference) {
+            Ok(cs) => cs,
+            Err(e) if is_infeasible(&e) => return Ok(Err(e.to_string())),
+            Err(e) => return Err(e.into()),
+        };
+        let cached = match &self.cache {
+            Some(c) => c.try_query(state.segment, state.rpm, state.feed, state.g)?,
+            None => None,
+        };
+        let (mu, from_cache) = match cached {
+            Some(mu) => (mu, true),
+            None => {
+                let ind = kerf_chatter::indicator::chatter_indicator(
+                    &cs.modal,
+                    &self.cell.milling_process(),
+                    state.rpm,
+                    state.feed,
+                    self.cell.indicator_settings(),
+                )?;
+                (ind.spectral_radius, false)
+            }
+        };
+        let max_feed = self.cell.state_limits().feed[1];
+        let reward = step_reward(
+            &self.config.weights,
+            cs.condition_number,
+            state.feed,
+            max_feed,
+            mu,
+        )?;
+        Ok(Ok(Evaluation {
+            joints: cs.joints,
+            condition_number: cs.condition_number,
+            condition_indicator: cs.condition_indicator,
+            spectral_radius: mu,
+            from_cache,
+            segment_time: segment.length / state.feed,
+            reward,
+        }))
+    }
+
+    /// The normalized observation of a state (module documentation).
+    pub fn observe(&self, state: &PhysicalState) -> Vec<f32> {
+        let lim = self.cell.state_limits();
+        let n = self.segment_count();
+        vec![
+            normalize(state.segment as f64, 0.0, (n - 1).max(1) as f64),
+            normalize(state.rpm, lim.spindle_rpm[0], lim.spindle_rpm[1]),
+            normalize(state.feed, lim.feed[0], lim.feed[1]),
+            normalize(state.g, lim.redundancy_angle[0], lim.redundancy_angle[1]),
+        ]
+    }
+
+    fn info_from(
+        &self,
+        state: PhysicalState,
+        filtered_action: [f64; 3],
+        eval: Result<Evaluation, String>,
+    ) -> StepInfo {
+        match eval {
+            Ok(e) => StepInfo {
+                state,
+                filtered_action,
+                reward: e.reward.total,
+                evaluation: Some(e),
+                violation: None,
+            },
+            Err(reason) => StepInfo {
+                state,
+                filtered_action,
+                reward: self.config.violation_penalty,
+                evaluation: None,
+                violation: Some(reason),
+            },
+        }
+    }
+
+    /// Runs one episode from the IVP with a policy.
+    ///
+    /// # Arguments
+    /// * `policy` — maps (observation, physical state) to a normalized
+    ///   action.
+    ///
+    /// # Returns
+    /// The [`Rollout`]; it ends at the last segment or the first violation.
+    ///
+    /// # Errors
+    /// Those of [`Environment::reset`] and [`Environment::step`], and the
+    /// policy's.
+    pub fn rollout<P>(&mut self, mut policy: P) -> Result<Rollout, MillPlanError>
+    where
+        P: FnMut(&[f32], &PhysicalState) -> Result<Vec<f32>, MillPlanError>,
+    {
+        let mut obs = self.reset()?;
+        let initial = self
+            .current
+            .clone()
+            .ok_or_else(|| MillPlanError::InvalidConfig {
+                name: "environment".to_string(),
+                reason: "no state after reset".to_string(),
+            })?;
+        let mut steps = Vec::with_capacity(self.max_steps());
+        let mut total = initial.reward;
+        while !self.done {
+            let state = self.state().ok_or_else(|| MillPlanError::InvalidConfig {
+                name: "environment".to_string(),
+                reason: "no state".to_string(),
+            })?;
+            let action = policy(&obs, &state)?;
+            let tr = self.step(&action)?;
+            obs = tr.observation;
+            total += tr.reward;
+            if let Some(info) = &self.current {
+                steps.push(info.clone());
+            }
+        }
+        let completed =
+            steps.len() == self.max_steps() && steps.iter().all(|s| s.violation.is_none());
+        Ok(Rollout {
+            initial,
+            steps,
+            total_reward: total,
+            completed,
+        })
+    }
+
+    /// Runs one episode with a fixed action sequence; when the sequence is
+    /// shorter than the episode, the remaining actions are zero.
+    ///
+    /// # Errors
+    /// As [`MillEnv::rollout`] (a bad action is an error).
+    pub fn rollout_actions(&mut self, actions: &[Vec<f32>]) -> Result<Rollout, MillPlanError> {
+        let dim = self.action_dim();
+        let mut t = 0usize;
+        self.rollout(|_, _| {
+            let a = actions.get(t).cloned().unwrap_or_else(|| vec![0.0; dim]);
+            t += 1;
+            Ok(a)
+        })
+    }
+}
+
+impl Environment for MillEnv {
+    fn observation_dim(&self) -> usize {
+        4
+    }
+
+    fn action_dim(&self) -> usize {
+        if self.config.fixed_g {
+            2
+        } else {
+            3
+        }
+    }
+
+    fn max_steps(&self) -> usize {
+        self.segment_count() - 1
+    }
+
+    fn reset(&mut self) -> Result<Vec<f32>, MillPlanError> {
+        let state = PhysicalState {
+            segment: 0,
+            rpm: self.config.initial_rpm,
+            feed: self.config.initial_feed,
+            g: self.config.initial_g,
+        };
+        let eval = self.evaluate_state(&state, None)?;
+        let eval = eval.map_err(|reason| MillPlanError::InvalidConfig {
+            name: "initial state (segment 0, Omega0, f0, g0)".to_string(),
+            reason,
+        })?;
+        self.joints = eval.joints;
+        let info = self.info_from(state, [0.0; 3], Ok(eval));
+        self.initial = Some(info.clone());
+        self.current = Some(info);
+        self.filter = [0.0; 3];
+        self.done = false;
+        Ok(self.observe(&state))
+    }
+
+    fn step(&mut self, action: &[f32]) -> Result<Transition, MillPlanError> {
+        let Some(current) = self.current.as_ref().map(|c| c.state) else {
+            return Err(MillPlanError::InvalidConfig {
+                name: "environment".to_string(),
+                reason: "step before reset".to_string(),
+            });
+        };
+        if self.done {
+            return Err(MillPlanError::InvalidConfig {
+                name: "environment".to_string(),
+                reason: "the episode is over: call reset".to_string(),
+            });
+        }
+        if action.len() != self.action_dim() {
+            return Err(MillPlanError::InvalidConfig {
+                name: "action".to_string(),
+                reason: format!("{} entries, expected {}", action.len(), self.action_dim()),
+            });
+        }
+        for (i, a) in action.iter().enumerate() {
+            if !(a.is_finite() && (-1.0..=1.0).contains(a)) {
+                return Err(MillPlanError::InvalidParameter {
+                    name: format!("action[{i}] [-]"),
+                    value: f64::from(*a),
+                    reason: "must be in [-1, 1] (normalized action; NaN is refused)".to_string(),
+                });
+            }
+        }
+        let lim = *self.cell.state_limits();
+        let bounds = [
+            lim.max_spindle_step_rpm,
+            lim.max_feed_step,
+            lim.max_redundancy_step,
+        ];
+        let mut raw = [0.0; 3];
+        for (k, r) in raw.iter_mut().enumerate() {
+            *r = action.get(k).map(|a| f64::from(*a)).unwrap_or(0.0) * bounds[k];
+        }
+        if self.config.fixed_g {
+            raw[2] = 0.0;
+        }
+        // Seed 004 eq. 11: inertial filter, then the clip to the state range.
+        let alpha = self.config.alpha;
+        for (f, r) in self.filter.iter_mut().zip(raw) {
+            *f = alpha * r + (1.0 - alpha) * *f;
+        }
+        let next = PhysicalState {
+            segment: current.segment + 1,
+            rpm: (current.rpm + self.filter[0]).clamp(lim.spindle_rpm[0], lim.spindle_rpm[1]),
+            feed: (current.feed + self.filter[1]).clamp(lim.feed[0], lim.feed[1]),
+            g: (current.g + self.filter[2]).clamp(lim.redundancy_angle[0], lim.redundancy_angle[1]),
+        };
+        let eval = self.evaluate_state(&next, Some(&self.joints))?;
+        let violated = eval.is_err();
+        if let Ok(e) = &eval {
+            self.joints = e.joints;
+        }
+        let info = self.info_from(next, self.filter, eval);
+        let reward = info.reward;
+        self.current = Some(info);
+        self.done = violated || next.segment + 1 >= self.segment_count();
+        Ok(Transition {
+            observation: self.observe(&next),
+            reward,
+            done: self.done,
+        })
+    }
+}
