@@ -1,0 +1,334 @@
+//! MillEnv (seed 004 section 3, eq. 11-17) and plan evaluation on the
+//! default cell, without the cache (direct evaluation), against hand
+//! computations and the model itself.
+
+use std::sync::Arc;
+
+use approx::assert_relative_eq;
+use kerf_chatter::indicator::chatter_indicator;
+use kerf_mill::MillCell;
+use kerf_millplan::env::{EnvConfig, MillEnv, PhysicalState};
+use kerf_millplan::plan::{comparison_table, Plan};
+use kerf_millplan::reward::{step_reward, RewardWeights};
+use kerf_millplan::{Environment, MillPlanError};
+
+fn cell() -> Arc<MillCell> {
+    Arc::new(MillCell::default_cell().expect("default cell"))
+}
+
+fn env(config: EnvConfig) -> MillEnv {
+    MillEnv::new(cell(), None, config).expect("env")
+}
+
+#[test]
+fn initial_value_problem_observation_and_reward() {
+    let mut e = env(EnvConfig::default());
+    assert_eq!(e.observation_dim(), 4);
+    assert_eq!(e.action_dim(), 3);
+    assert_eq!(e.max_steps(), 99);
+    let obs = e.reset().unwrap();
+    // (segment 0, 2000 rpm in [2000, 4000], 0.04 m/s in [0, 0.06], g = 0 in [-pi, pi]).
+    assert_eq!(obs, vec![-1.0, -1.0, (2.0 * 0.04 / 0.06 - 1.0) as f32, 0.0]);
+    let s = e.state().unwrap();
+    assert_eq!(
+        s,
+        PhysicalState {
+            segment: 0,
+            rpm: 2000.0,
+            feed: 0.04,
+            g: 0.0
+        }
+    );
+    // r(s_0) from the model directly.
+    let c = e.cell();
+    let cs = c.evaluate(0, 0.0, None).unwrap();
+    let mu = chatter_indicator(
+        &cs.modal,
+        &c.milling_process(),
+        2000.0,
+        0.04,
+        c.indicator_settings(),
+    )
+    .unwrap()
+    .spectral_radius;
+    let r = step_reward(
+        &RewardWeights::default(),
+        cs.condition_number,
+        0.04,
+        0.06,
+        mu,
+    )
+    .unwrap();
+    let info = e.initial_info().unwrap();
+    let ev = info.evaluation.unwrap();
+    assert_eq!(ev.spectral_radius, mu);
+    assert!(!ev.from_cache);
+    assert_relative_eq!(info.reward, r.total, epsilon = 1e-15);
+    assert_relative_eq!(
+        ev.segment_time,
+        c.path().segments()[0].length / 0.04,
+        epsilon = 1e-15
+    );
+}
+
+#[test]
+fn inertial_filter_and_clip_by_hand() {
+    // alpha = 0.5: a_hat_{t+1} = 0.5 a_{t+1} + 0.5 a_hat_t (eq. 11).
+    let mut e = env(EnvConfig::default());
+    e.reset().unwrap();
+    e.step(&[1.0, 1.0, 0.5]).unwrap();
+    // a = (20 rpm, 1e-3 m/s, 0.1 rad): a_hat_1 = (10, 5e-4, 0.05).
+    let s1 = e.state().unwrap();
+    assert_eq!(s1.segment, 1);
+    assert_relative_eq!(s1.rpm, 2010.0, epsilon = 1e-9);
+    assert_relative_eq!(s1.feed, 0.0405, epsilon = 1e-12);
+    assert_relative_eq!(s1.g, 0.05, epsilon = 1e-12);
+    e.step(&[1.0, -1.0, 0.5]).unwrap();
+    // a_hat_2 = (0.5*20 + 0.5*10, 0.5*(-1e-3) + 0.5*5e-4, 0.5*0.1 + 0.5*0.05)
+    //         = (15, -2.5e-4, 0.075).
+    let s2 = e.state().unwrap();
+    assert_relative_eq!(s2.rpm, 2025.0, epsilon = 1e-9);
+    assert_relative_eq!(s2.feed, 0.04025, epsilon = 1e-12);
+    assert_relative_eq!(s2.g, 0.125, epsilon = 1e-12);
+    let f = e.filter_state();
+    assert_relative_eq!(f[0], 15.0, epsilon = 1e-12);
+    assert_relative_eq!(f[1], -2.5e-4, epsilon = 1e-15);
+
+    // alpha = 1, clip at the lower spindle bound: 2000 - 20 -> 2000.
+    let mut e = env(EnvConfig {
+        alpha: 1.0,
+        ..EnvConfig::default()
+    });
+    e.reset().unwrap();
+    let tr = e.step(&[-1.0, 1.0, -1.0]).unwrap();
+    let s = e.state().unwrap();
+    assert_eq!(s.rpm, 2000.0);
+    assert_relative_eq!(s.feed, 0.041, epsilon = 1e-12);
+    assert_relative_eq!(s.g, -0.2, epsilon = 1e-12);
+    assert!(!tr.done);
+    assert!(tr.observation.iter().all(|v| (-1.0..=1.0).contains(v)));
+    // The step reward is eq. 12 of the NEW state on segment 1 (Algorithm 1).
+    let c = e.cell();
+    let cs = c
+        .evaluate(
+            1,
+            -0.2,
+            Some(&e.initial_info().unwrap().evaluation.unwrap().joints),
+        )
+        .unwrap();
+    let mu = chatter_indicator(
+        &cs.modal,
+        &c.milling_process(),
+        2000.0,
+        0.041,
+        c.indicator_settings(),
+    )
+    .unwrap()
+    .spectral_radius;
+    let r = step_reward(
+        &RewardWeights::default(),
+        cs.condition_number,
+        0.041,
+        0.06,
+        mu,
+    )
+    .unwrap();
+    assert_relative_eq!(tr.reward, r.total, epsilon = 1e-12);
+}
+
+#[test]
+fn clip_at_the_upper_feed_bound() {
+    let mut e = env(EnvConfig {
+        alpha: 1.0,
+        initial_feed: 0.0595,
+        ..EnvConfig::default()
+    });
+    e.reset().unwrap();
+    e.step(&[0.0, 1.0, 0.5]).unwrap();
+    assert_eq!(e.state().unwrap().feed, 0.06);
+}
+
+#[test]
+fn bad_actions_are_errors_and_change_nothing() {
+    let mut e = env(EnvConfig::default());
+    assert!(e.step(&[0.0, 0.0, 0.0]).is_err(), "step before reset");
+    e.reset().unwrap();
+    let before = e.state().unwrap();
+    for bad in [
+        vec![f32::NAN, 0.0, 0.0],
+        vec![0.0, 1.5, 0.0],
+        vec![0.0, 0.0, -1.0001],
+        vec![0.0, f32::INFINITY, 0.0],
+        vec![0.0, 0.0],
+        vec![0.0, 0.0, 0.0, 0.0],
+    ] {
+        let err = e.step(&bad).unwrap_err();
+        assert!(
+            matches!(
+                err,
+                MillPlanError::InvalidParameter { .. } | MillPlanError::InvalidConfig { .. }
+            ),
+            "{err}"
+        );
+        assert_eq!(e.state().unwrap(), before);
+        assert_eq!(e.filter_state(), [0.0; 3]);
+    }
+    // The fixed-g ablation takes (dOmega, df).
+    let mut e = env(EnvConfig {
+        fixed_g: true,
+        ..EnvConfig::default()
+    });
+    assert_eq!(e.action_dim(), 2);
+    e.reset().unwrap();
+    assert!(e.step(&[0.0, 0.0, 1.0]).is_err());
+    e.step(&[1.0, 1.0]).unwrap();
+    assert_eq!(e.state().unwrap().g, 0.0);
+    // Bad configurations.
+    for bad in [
+        EnvConfig {
+            alpha: 0.0,
+            ..EnvConfig::default()
+        },
+        EnvConfig {
+            alpha: f64::NAN,
+            ..EnvConfig::default()
+        },
+        EnvConfig {
+            initial_feed: 0.0,
+            ..EnvConfig::default()
+        },
+        EnvConfig {
+            initial_rpm: 5000.0,
+            ..EnvConfig::default()
+        },
+        EnvConfig {
+            violation_penalty: 1.0,
+            ..EnvConfig::default()
+        },
+    ] {
+        assert!(MillEnv::new(cell(), None, bad).is_err());
+    }
+}
+
+#[test]
+fn infeasible_g_is_a_terminal_violation() {
+    let mut e = env(EnvConfig {
+        alpha: 1.0,
+        ..EnvConfig::default()
+    });
+    e.reset().unwrap();
+    // Turn g down by 0.2 rad per step: every segment is valid only down to
+    // about -0.87 rad (kerf_mill tests/reachability.rs), so the episode
+    // must end before g is clipped at -pi (16 steps).
+    let mut last = None;
+    for _ in 0..20 {
+        let tr = e.step(&[0.0, 0.0, -1.0]).unwrap();
+        if tr.done {
+            last = Some(tr);
+            break;
+        }
+    }
+    let tr = last.expect("a violation within 20 steps");
+    assert_eq!(tr.reward, -100.0);
+    let info = e.last_info().unwrap();
+    assert!(info.evaluation.is_none());
+    let reason = info.violation.clone().unwrap();
+    assert!(
+        reason.contains("joint") || reason.contains("unreachable"),
+        "{reason}"
+    );
+    let s = e.state().unwrap();
+    assert!(s.g < -0.8 && s.segment < 17, "{s:?}");
+    // Independent check: the model refuses that (segment, g).
+    assert!(e.cell().evaluate(s.segment, s.g, None).is_err());
+    // The episode is over.
+    assert!(e.is_done());
+    assert!(e.step(&[0.0, 0.0, 0.0]).is_err());
+}
+
+#[test]
+fn zero_feed_is_a_terminal_violation() {
+    let mut e = env(EnvConfig {
+        alpha: 1.0,
+        initial_feed: 0.0015,
+        ..EnvConfig::default()
+    });
+    e.reset().unwrap();
+    let tr = e.step(&[0.0, -1.0, 0.0]).unwrap();
+    assert!(!tr.done);
+    let tr = e.step(&[0.0, -1.0, 0.0]).unwrap();
+    assert!(tr.done);
+    assert_eq!(tr.reward, -100.0);
+    assert_eq!(e.state().unwrap().feed, 0.0);
+    assert!(e
+        .last_info()
+        .unwrap()
+        .violation
+        .as_ref()
+        .unwrap()
+        .contains("zero feed"));
+}
+
+#[test]
+fn time_accounting_and_plan_totals() {
+    // A whole episode of gentle actions at g in the reachable band.
+    let mut e = env(EnvConfig::default());
+    let rollout = e
+        .rollout(|_, s| {
+            let g_action = if s.g < 0.6 { 0.5 } else { 0.0 };
+            Ok(vec![0.5, 0.5, g_action])
+        })
+        .unwrap();
+    assert!(rollout.completed);
+    assert_eq!(rollout.steps.len(), 99);
+    let cell = e.cell();
+    let mut time = rollout.initial.evaluation.unwrap().segment_time;
+    for st in &rollout.steps {
+        let ev = st.evaluation.unwrap();
+        let l = cell.path().segments()[st.state.segment].length;
+        assert_relative_eq!(ev.segment_time, l / st.state.feed, epsilon = 1e-15);
+        time += ev.segment_time;
+    }
+    let states = rollout.states();
+    assert_eq!(states.len(), 100);
+    // The plan re-evaluates the same states directly: same rewards, same
+    // joints (same branch-continuous IK), times adding up.
+    let plan = Plan::evaluate(cell, &RewardWeights::default(), &states, "test").unwrap();
+    assert_relative_eq!(plan.total_time, time, epsilon = 1e-9);
+    let by_hand: f64 = states
+        .iter()
+        .map(|s| cell.path().segments()[s.segment].length / s.feed)
+        .sum();
+    assert_relative_eq!(plan.total_time, by_hand, epsilon = 1e-9);
+    assert_relative_eq!(plan.total_reward, rollout.total_reward, epsilon = 1e-9);
+    for (p, st) in plan.segments.iter().skip(1).zip(&rollout.steps) {
+        let ev = st.evaluation.unwrap();
+        assert_eq!(p.joints, ev.joints);
+        assert_eq!(p.spectral_radius, ev.spectral_radius);
+    }
+    let max_mu = plan
+        .segments
+        .iter()
+        .map(|s| s.spectral_radius)
+        .fold(0.0, f64::max);
+    assert_eq!(plan.max_spectral_radius, max_mu);
+    assert_eq!(plan.chatter_free, max_mu < 1.0);
+    let min_ind = plan
+        .segments
+        .iter()
+        .map(|s| s.condition_indicator)
+        .fold(f64::INFINITY, f64::min);
+    assert_eq!(plan.min_condition_indicator, min_ind);
+    let table = comparison_table(&[plan.row()]);
+    assert!(
+        table.contains(&format!("| test | {:.2} |", plan.total_time)),
+        "{table}"
+    );
+    assert_eq!(table.lines().count(), 3);
+
+    // Plans refuse a zero feed and a wrong length.
+    let mut bad = states.clone();
+    bad[10].feed = 0.0;
+    assert!(Plan::evaluate(cell, &RewardWeights::default(), &bad, "bad").is_err());
+    assert!(Plan::evaluate(cell, &RewardWeights::default(), &states[1..], "bad").is_err());
+}
