@@ -319,7 +319,7 @@ pub fn feed_map(path: &Path, r: &LobesReport) -> Result<(), String> {
     let mut chart = ChartBuilder::on(&main)
         .caption(
             format!(
-                "|mu|max at a_p = {} mm, segment {}, g = {} rad ({})",
+                "|mu|max at a_p = {} mm, segment {}, g = {} rad ({}); black: |mu|max = 1",
                 r.process.axial_depth * 1e3,
                 r.segment,
                 r.g,
@@ -364,21 +364,12 @@ pub fn feed_map(path: &Path, r: &LobesReport) -> Result<(), String> {
         .map(|row| row.iter().map(|m| m.unwrap_or(f64::NAN)).collect())
         .collect();
     let segs = contour(&r.rpms, &r.feeds, &grid, 1.0);
-    let mut labelled = false;
-    for s in segs {
-        let series = chart
-            .draw_series(std::iter::once(PathElement::new(
-                s.to_vec(),
-                BLACK.stroke_width(3),
-            )))
-            .map_err(&err)?;
-        if !labelled {
-            series
-                .label("|mu|max = 1 (stability boundary)")
-                .legend(|(x, y)| PathElement::new([(x, y), (x + 20, y)], BLACK.stroke_width(3)));
-            labelled = true;
-        }
-    }
+    chart
+        .draw_series(
+            segs.into_iter()
+                .map(|s| PathElement::new(s.to_vec(), BLACK.stroke_width(3))),
+        )
+        .map_err(&err)?;
     if r.rpms.len() < 2 || r.feeds.len() < 2 {
         let mut outlines = Vec::new();
         for (i, row) in r.map.iter().enumerate() {
@@ -398,15 +389,6 @@ pub fn feed_map(path: &Path, r: &LobesReport) -> Result<(), String> {
             }
         }
         chart.draw_series(outlines).map_err(&err)?;
-    }
-    if labelled {
-        chart
-            .configure_series_labels()
-            .background_style(WHITE.mix(0.85))
-            .border_style(BLACK)
-            .position(SeriesLabelPosition::UpperRight)
-            .draw()
-            .map_err(&err)?;
     }
     // Colour bar.
     let mut cb = ChartBuilder::on(&bar)
