@@ -26,3 +26,7 @@ pub mod rng;
 
 pub use error::MillPlanError;
 pub use rl::{Environment, Transition};
+
+// DDPG and trained policies.
+pub use ddpg::{train, DdpgSettings, EpisodeReport, TrainedAgent};
+pub use policy::{Policy, PolicyMetadata};

@@ -1,1 +1,556 @@
-//! (being written; see the crate documentation)
+//! The actor and critic networks of DDPG (seed 004 Algorithm 1, Table 2:
+//! "2×256 ReLU") on candle, initialized from the crate's seeded generator,
+//! and the CPU settings that make small-batch training fast.
+//!
+//! # Networks
+//! * Actor A(s | wᵃ): observation → hidden ReLU layers → action dimension,
+//!   tanh output, so every action entry is in [−1, 1] (the normalized action
+//!   of [`crate::rl::Environment`]).
+//! * Critic Q(s, a | w^q): the concatenation [s, a] → hidden ReLU layers → 1,
+//!   linear output (the action enters at the input, as in Fujimoto et al.'s
+//!   TD3 reference code; seed 004 does not say where it enters).
+//!
+//! # Initialization (deterministic)
+//! candle's CPU random generator cannot be seeded, so the weights are drawn
+//! from [`Rng`]:
+//! * hidden layers: PyTorch's `nn.Linear` default — `kaiming_uniform_` with
+//!   a = √5 gives the bound gain·√(3/fan_in) with gain = √(2/(1 + a²)) =
+//!   √(1/3), i.e. W, b ~ U(−1/√fan_in, 1/√fan_in);
+//! * output layers of both networks: U(−3·10⁻³, 3·10⁻³) for W and b
+//!   (Lillicrap et al., "Continuous control with deep reinforcement
+//!   learning", ICLR 2016, section 7), so initial actions and Q-values are
+//!   near 0 and the tanh starts in its linear range.
+//!
+//! Draw order: layer by layer from the input, the weight matrix row-major
+//! (shape out × in, candle's `Linear` layout), then the bias.
+
+use std::collections::HashMap;
+
+use candle_core::{DType, Device, Tensor, Var};
+use candle_nn::{Linear, Module};
+
+use crate::error::MillPlanError;
+use crate::rng::Rng;
+
+/// Bound of the uniform initialization of the output layers (Lillicrap et
+/// al. 2016, section 7).
+pub const OUTPUT_INIT_BOUND: f64 = 3e-3;
+
+/// The parameters of one layer as flat vectors: (weight row-major
+/// out × in, bias of length out).
+pub type LayerParameters = (Vec<f32>, Vec<f32>);
+
+/// Converts a candle error into the crate's error.
+pub(crate) fn backend(e: candle_core::Error) -> MillPlanError {
+    MillPlanError::Backend(e.to_string())
+}
+
+/// The activation of a network's last layer.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum OutputActivation {
+    /// tanh, output in [−1, 1] (the actor).
+    Tanh,
+    /// Identity (the critic).
+    Linear,
+}
+
+/// One fully connected layer: weight `out × in` and bias `out`, both
+/// trainable candle variables.
+#[derive(Debug, Clone)]
+struct Layer {
+    weight: Var,
+    bias: Var,
+    linear: Linear,
+}
+
+impl Layer {
+    fn new(weight: Var, bias: Var) -> Self {
+        let linear = Linear::new(weight.as_tensor().clone(), Some(bias.as_tensor().clone()));
+        Self {
+            weight,
+            bias,
+            linear,
+        }
+    }
+
+    /// The layer with weights detached from the autograd graph (gradients
+    /// flow to the input only).
+    fn detached(&self) -> Linear {
+        Linear::new(
+            self.weight.as_tensor().detach(),
+            Some(self.bias.as_tensor().detach()),
+        )
+    }
+}
+
+/// A multilayer perceptron with ReLU hidden layers (the actor or the
+/// critic).
+#[derive(Debug, Clone)]
+pub struct Mlp {
+    sizes: Vec<usize>,
+    layers: Vec<Layer>,
+    output: OutputActivation,
+}
+
+impl Mlp {
+    /// A network with layer sizes `sizes` = [input, hidden…, output],
+    /// initialized as in the module documentation from `rng`.
+    ///
+    /// # Arguments
+    /// * `sizes` — at least 2 entries, every entry ≥ 1.
+    /// * `output` — activation of the last layer.
+    /// * `rng` — the seeded generator; the draws advance it.
+    ///
+    /// # Errors
+    /// [`MillPlanError::InvalidConfig`] for bad sizes,
+    /// [`MillPlanError::Backend`] when candle fails.
+    pub fn new(
+        sizes: &[usize],
+        output: OutputActivation,
+        rng: &mut Rng,
+    ) -> Result<Self, MillPlanError> {
+        if sizes.len() < 2 || sizes.contains(&0) {
+            return Err(MillPlanError::InvalidConfig {
+                name: "network layer sizes".to_string(),
+                reason: format!(
+                    "need at least an input and an output size, all ≥ 1; got {sizes:?}"
+                ),
+            });
+        }
+        let n_layers = sizes.len() - 1;
+        let mut params = Vec::with_capacity(n_layers);
+        for (k, pair) in sizes.windows(2).enumerate() {
+            let (fan_in, fan_out) = (pair[0], pair[1]);
+            let bound = if k + 1 == n_layers {
+                OUTPUT_INIT_BOUND
+            } else {
+                1.0 / (fan_in as f64).sqrt()
+            };
+            let weight: Vec<f32> = (0..fan_in * fan_out)
+                .map(|_| rng.uniform(-bound, bound) as f32)
+                .collect();
+            let bias: Vec<f32> = (0..fan_out)
+                .map(|_| rng.uniform(-bound, bound) as f32)
+                .collect();
+            params.push((weight, bias));
+        }
+        Self::from_parameters(sizes, output, params)
+    }
+
+    /// A network with the given parameters: for each layer k, the weight
+    /// `sizes[k+1] × sizes[k]` row-major and the bias `sizes[k+1]`.
+    ///
+    /// # Errors
+    /// [`MillPlanError::InvalidConfig`] when the sizes or the parameter
+    /// lengths are inconsistent or a parameter is not finite;
+    /// [`MillPlanError::Backend`] when candle fails.
+    pub fn from_parameters(
+        sizes: &[usize],
+        output: OutputActivation,
+        params: Vec<LayerParameters>,
+    ) -> Result<Self, MillPlanError> {
+        if sizes.len() < 2 || sizes.contains(&0) || params.len() + 1 != sizes.len() {
+            return Err(MillPlanError::InvalidConfig {
+                name: "network layer sizes".to_string(),
+                reason: format!("{} parameter pairs for layer sizes {sizes:?}", params.len()),
+            });
+        }
+        let device = Device::Cpu;
+        let mut layers = Vec::with_capacity(params.len());
+        for (k, ((weight, bias), pair)) in params.into_iter().zip(sizes.windows(2)).enumerate() {
+            let (fan_in, fan_out) = (pair[0], pair[1]);
+            if weight.len() != fan_in * fan_out || bias.len() != fan_out {
+                return Err(MillPlanError::InvalidConfig {
+                    name: format!("layer {k} parameters"),
+                    reason: format!(
+                        "weight has {} entries and bias {}, expected {} ({fan_out}×{fan_in}) and {fan_out}",
+                        weight.len(),
+                        bias.len(),
+                        fan_in * fan_out
+                    ),
+                });
+            }
+            if weight.iter().chain(bias.iter()).any(|v| !v.is_finite()) {
+                return Err(MillPlanError::InvalidConfig {
+                    name: format!("layer {k} parameters"),
+                    reason: "contain NaN or infinite values".to_string(),
+                });
+            }
+            let w = Var::from_vec(weight, (fan_out, fan_in), &device).map_err(backend)?;
+            let b = Var::from_vec(bias, fan_out, &device).map_err(backend)?;
+            layers.push(Layer::new(w, b));
+        }
+        Ok(Self {
+            sizes: sizes.to_vec(),
+            layers,
+            output,
+        })
+    }
+
+    /// A copy with its own variables (the target networks of Algorithm 1:
+    /// w′ ← w at initialization).
+    ///
+    /// # Errors
+    /// [`MillPlanError::Backend`] when candle fails.
+    pub fn deep_copy(&self) -> Result<Self, MillPlanError> {
+        Self::from_parameters(&self.sizes, self.output, self.parameters()?)
+    }
+
+    /// Layer sizes [input, hidden…, output].
+    pub fn sizes(&self) -> &[usize] {
+        &self.sizes
+    }
+
+    /// Activation of the last layer.
+    pub fn output_activation(&self) -> OutputActivation {
+        self.output
+    }
+
+    /// The trainable variables (weight, bias per layer, from the input).
+    pub fn vars(&self) -> Vec<Var> {
+        self.layers
+            .iter()
+            .flat_map(|l| [l.weight.clone(), l.bias.clone()])
+            .collect()
+    }
+
+    /// Forward pass of a batch `x` (rows × input size); gradients flow to
+    /// the network's variables.
+    ///
+    /// # Errors
+    /// [`MillPlanError::Backend`] for a shape mismatch or a candle failure.
+    pub fn forward(&self, x: &Tensor) -> Result<Tensor, MillPlanError> {
+        self.forward_with(x, |l| l.linear.clone())
+    }
+
+    /// Forward pass with the weights detached from the autograd graph:
+    /// gradients flow to `x` only (the critic inside the actor loss, whose
+    /// own weight gradients would be computed and thrown away).
+    ///
+    /// # Errors
+    /// [`MillPlanError::Backend`] for a shape mismatch or a candle failure.
+    pub fn forward_detached(&self, x: &Tensor) -> Result<Tensor, MillPlanError> {
+        self.forward_with(x, Layer::detached)
+    }
+
+    fn forward_with(
+        &self,
+        x: &Tensor,
+        linear: impl Fn(&Layer) -> Linear,
+    ) -> Result<Tensor, MillPlanError> {
+        let mut h = x.clone();
+        let last = self.layers.len().saturating_sub(1);
+        for (k, layer) in self.layers.iter().enumerate() {
+            h = linear(layer).forward(&h).map_err(backend)?;
+            h = if k < last {
+                h.relu()
+            } else {
+                match self.output {
+                    OutputActivation::Tanh => h.tanh(),
+                    OutputActivation::Linear => Ok(h),
+                }
+            }
+            .map_err(backend)?;
+        }
+        Ok(h)
+    }
+
+    /// Soft target update (seed 004 Algorithm 1, "soft target network
+    /// update"; Lillicrap et al. 2016 Algorithm 1): w′ ← τ w + (1 − τ) w′
+    /// for every variable, `self` being the target w′.
+    ///
+    /// # Errors
+    /// [`MillPlanError::InvalidConfig`] when the architectures differ,
+    /// [`MillPlanError::Backend`] when candle fails.
+    pub fn soft_update_from(&self, source: &Mlp, tau: f64) -> Result<(), MillPlanError> {
+        if self.sizes != source.sizes {
+            return Err(MillPlanError::InvalidConfig {
+                name: "soft update".to_string(),
+                reason: format!(
+                    "target sizes {:?} differ from source sizes {:?}",
+                    self.sizes, source.sizes
+                ),
+            });
+        }
+        for (target, src) in self.vars().iter().zip(source.vars().iter()) {
+            let mixed = src
+                .as_tensor()
+                .affine(tau, 0.0)
+                .and_then(|s| target.as_tensor().affine(1.0 - tau, 0.0)? + s)
+                .map_err(backend)?;
+            target.set(&mixed).map_err(backend)?;
+        }
+        Ok(())
+    }
+
+    /// The parameters as flat `f32` vectors: (weight row-major out × in,
+    /// bias) per layer.
+    ///
+    /// # Errors
+    /// [`MillPlanError::Backend`] when candle fails.
+    pub fn parameters(&self) -> Result<Vec<LayerParameters>, MillPlanError> {
+        self.layers
+            .iter()
+            .map(|l| {
+                let w = l
+                    .weight
+                    .as_tensor()
+                    .flatten_all()
+                    .and_then(|t| t.to_vec1::<f32>())
+                    .map_err(backend)?;
+                let b = l.bias.as_tensor().to_vec1::<f32>().map_err(backend)?;
+                Ok((w, b))
+            })
+            .collect()
+    }
+
+    /// The variables as named tensors `l{k}.weight`, `l{k}.bias` (k from 0
+    /// at the input), the layout of the policy file.
+    pub fn named_tensors(&self) -> HashMap<String, Tensor> {
+        let mut map = HashMap::new();
+        for (k, l) in self.layers.iter().enumerate() {
+            map.insert(format!("l{k}.weight"), l.weight.as_tensor().detach());
+            map.insert(format!("l{k}.bias"), l.bias.as_tensor().detach());
+        }
+        map
+    }
+}
+
+/// Builds a `rows × cols` f32 tensor from row-major data.
+///
+/// # Errors
+/// [`MillPlanError::Backend`] when the length is not `rows · cols`.
+pub fn matrix(data: Vec<f32>, rows: usize, cols: usize) -> Result<Tensor, MillPlanError> {
+    Tensor::from_vec(data, (rows, cols), &Device::Cpu).map_err(backend)
+}
+
+/// Reads a scalar (0-d or one-element) f32 tensor as f64.
+pub(crate) fn scalar(t: &Tensor) -> Result<f64, MillPlanError> {
+    let v = t
+        .to_dtype(DType::F64)
+        .and_then(|t| t.flatten_all())
+        .and_then(|t| t.to_vec1::<f64>())
+        .map_err(backend)?;
+    match v.as_slice() {
+        [x] => Ok(*x),
+        _ => Err(MillPlanError::Backend(format!(
+            "expected a scalar, got {} values",
+            v.len()
+        ))),
+    }
+}
+
+// ---------------------------------------------------------------------------
+// CPU settings for small-batch training
+// ---------------------------------------------------------------------------
+
+/// `M_TRIM_THRESHOLD` of glibc's `mallopt` (malloc.h).
+#[cfg(all(target_os = "linux", target_env = "gnu"))]
+const M_TRIM_THRESHOLD: std::os::raw::c_int = -1;
+/// `M_MMAP_THRESHOLD` of glibc's `mallopt` (malloc.h).
+#[cfg(all(target_os = "linux", target_env = "gnu"))]
+const M_MMAP_THRESHOLD: std::os::raw::c_int = -3;
+
+#[cfg(all(target_os = "linux", target_env = "gnu"))]
+extern "C" {
+    /// glibc's `int mallopt(int param, int value)`; returns 1 on success.
+    fn mallopt(param: std::os::raw::c_int, value: std::os::raw::c_int) -> std::os::raw::c_int;
+}
+
+/// The malloc mmap threshold [`CpuTuning::apply`] sets: 16 MiB (glibc's
+/// maximum is 32 MiB on 64-bit targets).
+pub const MMAP_THRESHOLD_BYTES: i32 = 16 << 20;
+
+/// MXCSR bits: flush-to-zero (bit 15) and denormals-are-zero (bit 6)
+/// (Intel SDM vol. 1, §10.2.3).
+#[cfg(target_arch = "x86_64")]
+const MXCSR_FTZ_DAZ: u32 = (1 << 15) | (1 << 6);
+
+/// What [`CpuTuning::apply`] changed.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct CpuTuningReport {
+    /// `RAYON_NUM_THREADS` was set to 1 by this call.
+    pub single_thread: bool,
+    /// The MXCSR FTZ and DAZ bits were set on the calling thread (x86_64).
+    pub flush_to_zero: bool,
+    /// glibc's mmap and trim thresholds were raised.
+    pub malloc_tuned: bool,
+}
+
+/// CPU settings that make DDPG's small matrix products about twice as fast
+/// on a 2-core machine (measured in issue 5), active while the guard lives.
+///
+/// 1. **One thread**: sets the environment variable `RAYON_NUM_THREADS=1`,
+///    which candle reads before every matrix product (`gemm` then runs
+///    without its thread pool) and when it creates its element-wise pool.
+///    For batch 64 × 256 the fork/join cost exceeds the gain. The variable
+///    stays set after the guard is dropped (candle's pool, once created,
+///    keeps its size). Call this before anything else uses candle, from the
+///    main thread of a program; a caller who wants several threads sets
+///    `single_thread = false` and its own `RAYON_NUM_THREADS`.
+/// 2. **Flush-to-zero** (x86_64 only; no-op elsewhere): sets the FTZ and
+///    DAZ bits of the calling thread's MXCSR, so denormal results and inputs
+///    are treated as 0 instead of taking the slow microcode path (weights
+///    and Adam moments decay into the denormal range). The previous MXCSR is
+///    restored when the guard is dropped. Only the calling thread is
+///    affected, which with one thread is every thread that computes. Note:
+///    Rust assumes the default floating-point environment; code that
+///    depends on denormals must not run on this thread while the guard
+///    lives.
+/// 3. **Malloc thresholds** (glibc only; no-op elsewhere): `mallopt`
+///    `M_MMAP_THRESHOLD` and `M_TRIM_THRESHOLD` = [`MMAP_THRESHOLD_BYTES`].
+///    A 256×256 f32 tensor (256 KiB) is above glibc's default 128 KiB
+///    threshold, so every temporary of that size would be a fresh
+///    `mmap`/`munmap` pair with page faults; raised, they are recycled from
+///    the heap. Process-wide and not undone (it only changes which memory
+///    is reused).
+#[derive(Debug)]
+pub struct CpuTuning {
+    report: CpuTuningReport,
+    #[cfg(target_arch = "x86_64")]
+    saved_mxcsr: u32,
+}
+
+impl CpuTuning {
+    /// Applies the settings (see the type documentation).
+    ///
+    /// # Arguments
+    /// * `single_thread` — set `RAYON_NUM_THREADS=1`.
+    pub fn apply(single_thread: bool) -> Self {
+        if single_thread {
+            std::env::set_var("RAYON_NUM_THREADS", "1");
+        }
+        #[cfg(all(target_os = "linux", target_env = "gnu"))]
+        // SAFETY: mallopt only changes allocator tuning parameters; glibc
+        // takes its arena lock.
+        let malloc_tuned = unsafe {
+            mallopt(M_MMAP_THRESHOLD, MMAP_THRESHOLD_BYTES) == 1
+                && mallopt(M_TRIM_THRESHOLD, MMAP_THRESHOLD_BYTES) == 1
+        };
+        #[cfg(not(all(target_os = "linux", target_env = "gnu")))]
+        let malloc_tuned = false;
+        #[cfg(target_arch = "x86_64")]
+        {
+            // SAFETY: SSE is part of the x86_64 baseline; reading and
+            // writing MXCSR only changes this thread's rounding/denormal
+            // modes (restored on drop).
+            #[allow(deprecated)]
+            let saved_mxcsr = unsafe { std::arch::x86_64::_mm_getcsr() };
+            #[allow(deprecated)]
+            unsafe {
+                std::arch::x86_64::_mm_setcsr(saved_mxcsr | MXCSR_FTZ_DAZ)
+            };
+            Self {
+                report: CpuTuningReport {
+                    single_thread,
+                    flush_to_zero: true,
+                    malloc_tuned,
+                },
+                saved_mxcsr,
+            }
+        }
+        #[cfg(not(target_arch = "x86_64"))]
+        {
+            Self {
+                report: CpuTuningReport {
+                    single_thread,
+                    flush_to_zero: false,
+                    malloc_tuned,
+                },
+            }
+        }
+    }
+
+    /// What was changed.
+    pub fn report(&self) -> CpuTuningReport {
+        self.report
+    }
+}
+
+impl Drop for CpuTuning {
+    fn drop(&mut self) {
+        #[cfg(target_arch = "x86_64")]
+        // SAFETY: restores the MXCSR value read in `apply` on this thread.
+        #[allow(deprecated)]
+        unsafe {
+            std::arch::x86_64::_mm_setcsr(self.saved_mxcsr)
+        };
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The candle forward pass equals a hand-written one
+    /// (h = relu(W x + b), y = tanh(W x + b)) on the same parameters.
+    #[test]
+    fn forward_matches_plain_computation() {
+        let mut rng = Rng::new(3);
+        let net = Mlp::new(&[3, 5, 4, 2], OutputActivation::Tanh, &mut rng).expect("valid");
+        let params = net.parameters().expect("params");
+        let x = [0.3f32, -0.7, 0.9];
+        let mut h: Vec<f32> = x.to_vec();
+        for (k, (w, b)) in params.iter().enumerate() {
+            let n_out = b.len();
+            let n_in = h.len();
+            let mut y = vec![0f32; n_out];
+            for i in 0..n_out {
+                let mut s = f64::from(b[i]);
+                for j in 0..n_in {
+                    s += f64::from(w[i * n_in + j]) * f64::from(h[j]);
+                }
+                y[i] = if k + 1 < params.len() {
+                    s.max(0.0) as f32
+                } else {
+                    s.tanh() as f32
+                };
+            }
+            h = y;
+        }
+        let out = net
+            .forward(&matrix(x.to_vec(), 1, 3).expect("matrix"))
+            .and_then(|t| t.flatten_all().map_err(backend))
+            .and_then(|t| t.to_vec1::<f32>().map_err(backend))
+            .expect("forward");
+        for (a, b) in out.iter().zip(h.iter()) {
+            assert!((a - b).abs() < 1e-6, "{a} vs {b}");
+        }
+    }
+
+    /// Initialization bounds: hidden layers within 1/√fan_in and using it
+    /// (max close to the bound), output layer within 3e-3.
+    #[test]
+    fn initialization_bounds() {
+        let mut rng = Rng::new(11);
+        let net = Mlp::new(&[4, 256, 256, 3], OutputActivation::Tanh, &mut rng).expect("valid");
+        let params = net.parameters().expect("params");
+        let bounds = [0.5, 1.0 / 16.0, 3e-3];
+        for ((w, _b), bound) in params.iter().zip(bounds) {
+            let max = w.iter().fold(0f32, |m, v| m.max(v.abs()));
+            assert!(f64::from(max) <= bound);
+            assert!(f64::from(max) > 0.9 * bound);
+        }
+    }
+
+    /// Soft update: w′ ← τ w + (1 − τ) w′ exactly (to f32 rounding).
+    #[test]
+    fn soft_update_mixes() {
+        let mut rng = Rng::new(4);
+        let a = Mlp::new(&[2, 3, 1], OutputActivation::Linear, &mut rng).expect("valid");
+        let b = Mlp::new(&[2, 3, 1], OutputActivation::Linear, &mut rng).expect("valid");
+        let pa = a.parameters().expect("p");
+        let pb = b.parameters().expect("p");
+        b.soft_update_from(&a, 0.25).expect("same sizes");
+        let pc = b.parameters().expect("p");
+        for ((wa, wb), wc) in pa.iter().zip(pb.iter()).zip(pc.iter()) {
+            for ((x, y), z) in wa.0.iter().zip(wb.0.iter()).zip(wc.0.iter()) {
+                assert!((0.25 * x + 0.75 * y - z).abs() < 1e-7);
+            }
+        }
+        let c = Mlp::new(&[2, 4, 1], OutputActivation::Linear, &mut rng).expect("valid");
+        assert!(c.soft_update_from(&a, 0.5).is_err());
+        assert!(Mlp::new(&[2], OutputActivation::Linear, &mut rng).is_err());
+        assert!(Mlp::new(&[2, 0, 1], OutputActivation::Linear, &mut rng).is_err());
+    }
+}
