@@ -68,8 +68,8 @@ fn grid_dp_equals_brute_force_enumeration() {
         for (t, x) in dp.nodes.iter().enumerate() {
             sum += synthetic(t, *x).unwrap();
             if t > 0 {
-                for a in 0..3 {
-                    assert!(x[a].abs_diff(dp.nodes[t - 1][a]) <= 1);
+                for (a, b) in x.iter().zip(dp.nodes[t - 1]) {
+                    assert!(a.abs_diff(b) <= 1);
                 }
             }
         }
