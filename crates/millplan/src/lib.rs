@@ -30,3 +30,11 @@ pub use rl::{Environment, Transition};
 // DDPG and trained policies.
 pub use ddpg::{train, DdpgSettings, EpisodeReport, TrainedAgent};
 pub use policy::{Policy, PolicyMetadata};
+
+// The environment, the indicator cache, the baselines and plans.
+pub use cache::{GridSpec, IndicatorCache};
+pub use dp::{DpResult, DpSpec};
+pub use env::{EnvConfig, MillEnv, PhysicalState, Rollout, StepInfo};
+pub use naive::NaiveResult;
+pub use plan::{comparison_table, ComparisonRow, Plan};
+pub use reward::{RewardParts, RewardWeights};
