@@ -88,7 +88,7 @@ pub struct Policy {
 
 /// The result of a greedy rollout ([`Policy::rollout`]).
 #[derive(Debug, Clone, PartialEq)]
-pub struct Rollout {
+pub struct GreedyRollout {
     /// The observation after `reset`.
     pub initial_observation: Vec<f32>,
     /// The actions taken, one per step.
@@ -429,11 +429,14 @@ impl Policy {
     /// # Errors
     /// [`Policy::check_sizes`] against the environment; every error of the
     /// environment, propagated.
-    pub fn rollout<E: Environment + ?Sized>(&self, env: &mut E) -> Result<Rollout, MillPlanError> {
+    pub fn rollout<E: Environment + ?Sized>(
+        &self,
+        env: &mut E,
+    ) -> Result<GreedyRollout, MillPlanError> {
         self.check_sizes(env.observation_dim(), env.action_dim())?;
         let initial_observation = env.reset()?;
         let mut observation = initial_observation.clone();
-        let mut rollout = Rollout {
+        let mut rollout = GreedyRollout {
             initial_observation,
             actions: Vec::new(),
             transitions: Vec::new(),
