@@ -44,9 +44,9 @@
 //! 0, 5, …, 95, 99 (21) × Ω 2000–4000 rpm every 100 rpm (21) × f at 0.01,
 //! 0.02, 0.03, 0.035 … 0.06 m/s (9) × g −3.0…3.0 rad every 0.2 rad (31) =
 //! 123 039 nodes, of which 46 116 are infeasible (g outside the reachable
-//! band). Build: 189 s with 2 threads on the shared 2-core machine (load
-//! about 4; the indicator measured 1.34 ms per evaluation under that load,
-//! `--probe`). Error against direct evaluation (seed 2025, 1000 random
+//! band). Build: 125 s (189 s in an earlier run) with 2 threads on the
+//! shared 2-core machine (load about 4; the indicator measured 1.34 ms per
+//! evaluation under that load, `--probe`). Error against direct evaluation (seed 2025, 1000 random
 //! points, the infeasible ones skipped):
 //!
 //! | queries | compared | max | p99 | mean | stated bound (1.5 × max) |
@@ -259,13 +259,47 @@ fn fnv1a(bytes: &[u8]) -> u64 {
     h
 }
 
+/// Rewrites every decimal number of a `Debug` text with 9 significant
+/// digits, so that last-ulp differences of computed values (a different
+/// libm on another machine) do not change a fingerprint.
+fn canonical_numbers(text: &str) -> String {
+    let mut out = String::with_capacity(text.len());
+    let mut token = String::new();
+    let flush = |token: &mut String, out: &mut String| {
+        if token.contains('.') {
+            match token.parse::<f64>() {
+                Ok(v) => out.push_str(&format!("{v:.8e}")),
+                Err(_) => out.push_str(token),
+            }
+        } else {
+            out.push_str(token);
+        }
+        token.clear();
+    };
+    for c in text.chars() {
+        let continues = c.is_ascii_digit()
+            || c == '.'
+            || ((c == 'e' || c == 'E') && !token.is_empty())
+            || ((c == '-' || c == '+') && (token.is_empty() || token.ends_with(['e', 'E'])));
+        if continues {
+            token.push(c);
+        } else {
+            flush(&mut token, &mut out);
+            out.push(c);
+        }
+    }
+    flush(&mut token, &mut out);
+    out
+}
+
 /// A fingerprint of everything in the cell that the indicator depends on:
 /// the milling process, the indicator settings, the state limits, the
 /// dynamics model, the characteristic length, the reference joints, every
 /// segment's geometry, and the cell state (joints, K, modal matrices) at
 /// g = 0 of the first, middle and last segments (which catches a changed
-/// URDF or TCP). FNV-1a over the exact `Debug` texts (f64 `Debug` is
-/// round-trip exact), as 16 hex digits.
+/// URDF or TCP). FNV-1a over the `Debug` texts with every number rounded
+/// to 9 significant digits (so a last-ulp difference of a computed value
+/// on another machine does not make a cache stale), as 16 hex digits.
 pub fn cell_fingerprint(cell: &MillCell) -> String {
     let mut text = String::new();
     text.push_str(&format!("{:?}", cell.milling_process()));
@@ -284,7 +318,7 @@ pub fn cell_fingerprint(cell: &MillCell) -> String {
             Err(e) => text.push_str(&e.to_string()),
         }
     }
-    format!("{:016x}", fnv1a(text.as_bytes()))
+    format!("{:016x}", fnv1a(canonical_numbers(&text).as_bytes()))
 }
 
 /// Whether a cell-model error means "this (segment, g) is not a feasible
@@ -904,5 +938,27 @@ impl IndicatorCache {
     /// `crates/millplan/data/indicator_cache.bin`.
     pub fn default_path() -> std::path::PathBuf {
         Path::new(env!("CARGO_MANIFEST_DIR")).join("data/indicator_cache.bin")
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn canonical_numbers_round_to_nine_digits() {
+        let a =
+            canonical_numbers("Mode { f: 1.2345678901234567, m: -3.0e-5, n: 7, x: [0.1, 2e3] }");
+        assert_eq!(
+            a,
+            "Mode { f: 1.23456789e0, m: -3.00000000e-5, n: 7, x: [1.00000000e-1, 2e3] }"
+        );
+        // A last-ulp difference vanishes.
+        let x = 0.1f64 + 0.2;
+        assert_ne!(format!("{x:?}"), format!("{:?}", 0.3));
+        assert_eq!(
+            canonical_numbers(&format!("{x:?}")),
+            canonical_numbers(&format!("{:?}", 0.3))
+        );
     }
 }

@@ -555,17 +555,21 @@ impl Environment for MillEnv {
             raw[2] = 0.0;
         }
         // Seed 004 eq. 11: inertial filter, then the clip to the state range.
+        // The environment changes only when the evaluation succeeds (a model
+        // failure leaves the state and the filter as they were).
         let alpha = self.config.alpha;
-        for (f, r) in self.filter.iter_mut().zip(raw) {
+        let mut filter = self.filter;
+        for (f, r) in filter.iter_mut().zip(raw) {
             *f = alpha * r + (1.0 - alpha) * *f;
         }
         let next = PhysicalState {
             segment: current.segment + 1,
-            rpm: (current.rpm + self.filter[0]).clamp(lim.spindle_rpm[0], lim.spindle_rpm[1]),
-            feed: (current.feed + self.filter[1]).clamp(lim.feed[0], lim.feed[1]),
-            g: (current.g + self.filter[2]).clamp(lim.redundancy_angle[0], lim.redundancy_angle[1]),
+            rpm: (current.rpm + filter[0]).clamp(lim.spindle_rpm[0], lim.spindle_rpm[1]),
+            feed: (current.feed + filter[1]).clamp(lim.feed[0], lim.feed[1]),
+            g: (current.g + filter[2]).clamp(lim.redundancy_angle[0], lim.redundancy_angle[1]),
         };
         let eval = self.evaluate_state(&next, Some(&self.joints))?;
+        self.filter = filter;
         let violated = eval.is_err();
         if let Ok(e) = &eval {
             self.joints = e.joints;

@@ -43,9 +43,8 @@ pub struct NaiveResult {
     /// Chatter-free at every segment by direct evaluation (false: the IVP
     /// fallback, chatter flagged).
     pub chatter_free: bool,
-    /// Largest |μ|max over the segments by direct evaluation (of the
-    /// chosen pair, or of the last candidate checked for the fallback's
-    /// chatter flag: the fallback's own value is in its plan).
+    /// Largest |μ|max over the segments by direct evaluation, of the
+    /// returned pair.
     pub max_spectral_radius: f64,
     /// Candidates verified directly.
     pub verified: usize,
@@ -90,7 +89,8 @@ fn direct_max(
 ///   redundancy angle \[rad\] (0 for the paper's setting).
 ///
 /// # Errors
-/// [`MillPlanError::InvalidParameter`] for a NaN g; model errors.
+/// [`MillPlanError::InvalidParameter`] for a NaN g, or a g infeasible at
+/// some segment; model errors.
 ///
 /// # Performance
 /// 101 × 60 × N cache queries and up to 10 × N direct evaluations.
@@ -147,11 +147,9 @@ pub fn solve(
             .collect()
     };
     let mut verified = 0;
-    let mut last_max = f64::NAN;
     for (feed, _, rpm) in candidates.iter().take(MAX_VERIFICATIONS) {
         verified += 1;
         if let Some(max) = direct_max(cell, *rpm, *feed, g, true)? {
-            last_max = max;
             if max < 1.0 {
                 return Ok(NaiveResult {
                     rpm: *rpm,
@@ -170,7 +168,13 @@ pub fn solve(
         2000.0_f64.clamp(lim.spindle_rpm[0], lim.spindle_rpm[1]),
         0.04,
     );
-    let max = direct_max(cell, rpm, feed, g, false)?.unwrap_or(last_max);
+    let max =
+        direct_max(cell, rpm, feed, g, false)?.ok_or_else(|| MillPlanError::InvalidParameter {
+            name: "naive redundancy angle g [rad]".to_string(),
+            value: g,
+            reason: "infeasible (IK or joint limit) at some segment: no constant plan exists"
+                .to_string(),
+        })?;
     Ok(NaiveResult {
         rpm,
         feed,

@@ -19,10 +19,15 @@
 //! 0.05 ± 0.01 (seed 004 section 4, Fig. 6a), so its figures are
 //! plausible on our scale. Efficiency dominates the operability term
 //! (w_e = 4 w_o: a 1e-3 m/s feed gain above 0.7 f_max is worth
-//! 0.4·3/60·1e-3/1e-3 = 0.02, as much as raising 1/K by 0.2), and chatter
-//! is penalized at once by the largest weight: |μ| = 1.2 costs
-//! 0.5·(e^0.2 − 1) = 0.11 per step, more than the whole efficiency gain
-//! between f = 0.042 and 0.06 m/s.
+//! 0.4 · 3 · 1e-3/0.06 = 0.02, as much as raising 1/K by 0.2), and chatter
+//! is penalized by the largest weight: |μ| = 1.2 costs 0.5·(e^0.2 − 1) =
+//! 0.11 per step, the value of 5.5e-3 m/s of feed above 0.042 m/s.
+//!
+//! Measured consequence (`crate::dp`): eq. 17 has no jump at |μ| = 1
+//! (its slope there is w_p = 0.5 per unit of |μ|), so the reward optimum
+//! may accept marginal chatter (|μ| ≈ 1.00–1.01) where that buys feed or
+//! conditioning; the DP's hard-constraint variant shows the price of
+//! avoiding it.
 //!
 //! The weights are parameters ([`RewardWeights::new`] checks them).
 

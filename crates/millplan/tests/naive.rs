@@ -98,4 +98,8 @@ fn no_chatter_free_pair_falls_back_to_the_ivp_with_chatter_flagged() {
     assert!(max >= 1.0);
     assert!((max - r.max_spectral_radius).abs() < 1e-12);
     assert!(naive::solve(&cell, &cache, f64::NAN).is_err());
+    // g = 3 rad is out of the reachable band at some segments: no
+    // constant plan exists, an error rather than a plan.
+    let err = naive::solve(&cell, &cache, 3.0).unwrap_err().to_string();
+    assert!(err.contains("infeasible"), "{err}");
 }
