@@ -26,8 +26,9 @@
 
 use std::collections::HashMap;
 
+use candle_core::backprop::GradStore;
 use candle_core::{DType, Device, Tensor, Var};
-use candle_nn::{Linear, Module};
+use candle_nn::{Linear, Module, ParamsAdamW};
 
 use crate::error::MillPlanError;
 use crate::rng::Rng;
@@ -272,12 +273,17 @@ impl Mlp {
                 ),
             });
         }
+        // Fused: one pass over plain vectors instead of three candle ops
+        // (same f32 arithmetic: τ·s + (1 − τ)·t with τ rounded to f32).
+        let tau32 = tau as f32;
+        let keep32 = (1.0 - tau) as f32;
         for (target, src) in self.vars().iter().zip(source.vars().iter()) {
-            let mixed = src
-                .as_tensor()
-                .affine(tau, 0.0)
-                .and_then(|s| target.as_tensor().affine(1.0 - tau, 0.0)? + s)
-                .map_err(backend)?;
+            let s = flat(src.as_tensor())?;
+            let mut t = flat(target.as_tensor())?;
+            for (t, s) in t.iter_mut().zip(&s) {
+                *t = s * tau32 + *t * keep32;
+            }
+            let mixed = Tensor::from_vec(t, target.shape(), &Device::Cpu).map_err(backend)?;
             target.set(&mixed).map_err(backend)?;
         }
         Ok(())
@@ -337,6 +343,137 @@ pub(crate) fn scalar(t: &Tensor) -> Result<f64, MillPlanError> {
             "expected a scalar, got {} values",
             v.len()
         ))),
+    }
+}
+
+/// The values of a tensor as a flat `f32` vector (a copy).
+fn flat(t: &Tensor) -> Result<Vec<f32>, MillPlanError> {
+    t.flatten_all()
+        .and_then(|t| t.to_vec1::<f32>())
+        .map_err(backend)
+}
+
+/// AdamW (Loshchilov & Hutter, "Decoupled weight decay regularization",
+/// ICLR 2019, Algorithm 2; Kingma & Ba, ICLR 2015, Algorithm 1 for the
+/// moments and bias correction) with exactly the update of
+/// `candle_nn::AdamW` and its [`ParamsAdamW`], fused into one pass per
+/// variable over plain vectors:
+///
+/// m ← β₁ m + (1 − β₁) g, v ← β₂ v + (1 − β₂) g²,
+/// m̂ = m / (1 − β₁ᵗ), v̂ = v / (1 − β₂ᵗ),
+/// θ ← θ (1 − lr λ) − lr m̂ / (√v̂ + ε).
+///
+/// Same arithmetic as candle's (f32, the scalars rounded to f32, the same
+/// operation order; the test compares both), but candle's version runs a
+/// dozen tensor operations per variable, each allocating and traversing a
+/// 256×256 buffer; this one reads the gradient and the weights once and
+/// writes the weights once, which makes a DDPG update markedly faster
+/// (`benches/ddpg_update.rs`).
+#[derive(Debug)]
+pub struct FusedAdamW {
+    vars: Vec<Var>,
+    first_moment: Vec<Vec<f32>>,
+    second_moment: Vec<Vec<f32>>,
+    step_t: i32,
+    params: ParamsAdamW,
+}
+
+impl FusedAdamW {
+    /// An optimizer over `vars` with zero moments.
+    ///
+    /// # Errors
+    /// [`MillPlanError::InvalidParameter`] for a learning rate that is not
+    /// finite and positive, β outside [0, 1), ε or λ negative or not finite.
+    pub fn new(vars: Vec<Var>, params: ParamsAdamW) -> Result<Self, MillPlanError> {
+        let bad = |name: &str, value: f64, reason: &str| {
+            Err(MillPlanError::InvalidParameter {
+                name: name.to_string(),
+                value,
+                reason: reason.to_string(),
+            })
+        };
+        if !(params.lr.is_finite() && params.lr > 0.0) {
+            return bad(
+                "AdamW learning rate",
+                params.lr,
+                "must be finite and positive",
+            );
+        }
+        for (name, b) in [("AdamW beta1", params.beta1), ("AdamW beta2", params.beta2)] {
+            if !(0.0..1.0).contains(&b) {
+                return bad(name, b, "must be in [0, 1)");
+            }
+        }
+        for (name, x) in [
+            ("AdamW eps", params.eps),
+            ("AdamW weight decay", params.weight_decay),
+        ] {
+            if !(x.is_finite() && x >= 0.0) {
+                return bad(name, x, "must be finite and ≥ 0");
+            }
+        }
+        let first_moment = vars.iter().map(|v| vec![0f32; v.elem_count()]).collect();
+        let second_moment = vars.iter().map(|v| vec![0f32; v.elem_count()]).collect();
+        Ok(Self {
+            vars,
+            first_moment,
+            second_moment,
+            step_t: 0,
+            params,
+        })
+    }
+
+    /// One AdamW step with the gradients in `grads` (variables without a
+    /// gradient are left unchanged, as in candle).
+    ///
+    /// # Errors
+    /// [`MillPlanError::Backend`] when candle fails or the step count
+    /// overflows.
+    pub fn step(&mut self, grads: &GradStore) -> Result<(), MillPlanError> {
+        self.step_t = self
+            .step_t
+            .checked_add(1)
+            .ok_or_else(|| MillPlanError::Backend("AdamW step count overflow".to_string()))?;
+        let p = &self.params;
+        let lr = p.lr as f32;
+        let decay = (1.0 - p.lr * p.weight_decay) as f32;
+        let (beta1, beta2) = (p.beta1 as f32, p.beta2 as f32);
+        let (one_m_beta1, one_m_beta2) = ((1.0 - p.beta1) as f32, (1.0 - p.beta2) as f32);
+        let scale_m = (1.0 / (1.0 - p.beta1.powi(self.step_t))) as f32;
+        let scale_v = (1.0 / (1.0 - p.beta2.powi(self.step_t))) as f32;
+        let eps = p.eps as f32;
+        for ((var, m), v) in self
+            .vars
+            .iter()
+            .zip(self.first_moment.iter_mut())
+            .zip(self.second_moment.iter_mut())
+        {
+            let Some(g) = grads.get(var.as_tensor()) else {
+                continue;
+            };
+            let g = flat(g)?;
+            let mut theta = flat(var.as_tensor())?;
+            for (((theta, m), v), g) in theta.iter_mut().zip(m.iter_mut()).zip(v.iter_mut()).zip(&g)
+            {
+                *m = *m * beta1 + g * one_m_beta1;
+                *v = *v * beta2 + (g * g) * one_m_beta2;
+                let m_hat = *m * scale_m;
+                let v_hat = *v * scale_v;
+                *theta = *theta * decay - (m_hat / (v_hat.sqrt() + eps)) * lr;
+            }
+            let next = Tensor::from_vec(theta, var.shape(), &Device::Cpu).map_err(backend)?;
+            var.set(&next).map_err(backend)?;
+        }
+        Ok(())
+    }
+
+    /// Backpropagates `loss` and takes one step.
+    ///
+    /// # Errors
+    /// As [`FusedAdamW::step`].
+    pub fn backward_step(&mut self, loss: &Tensor) -> Result<(), MillPlanError> {
+        let grads = loss.backward().map_err(backend)?;
+        self.step(&grads)
     }
 }
 
@@ -531,6 +668,61 @@ mod tests {
             assert!(f64::from(max) <= bound);
             assert!(f64::from(max) > 0.9 * bound);
         }
+    }
+
+    /// The fused AdamW gives the same weights as candle_nn::AdamW over 20
+    /// steps on the same losses (MSE of a 3→16→16→2 network on fixed
+    /// data), with nonzero weight decay to cover that term too.
+    #[test]
+    fn fused_adamw_matches_candle() {
+        use candle_nn::{AdamW, Optimizer};
+        let mut rng = Rng::new(21);
+        let a = Mlp::new(&[3, 16, 16, 2], OutputActivation::Tanh, &mut rng).expect("valid");
+        let b = a.deep_copy().expect("copy");
+        let x: Vec<f32> = (0..24).map(|_| rng.uniform(-1.0, 1.0) as f32).collect();
+        let y: Vec<f32> = (0..16).map(|_| rng.uniform(-0.5, 0.5) as f32).collect();
+        let x = matrix(x, 8, 3).expect("x");
+        let y = matrix(y, 8, 2).expect("y");
+        let params = ParamsAdamW {
+            lr: 1e-2,
+            weight_decay: 0.1,
+            ..ParamsAdamW::default()
+        };
+        let mut reference = AdamW::new(a.vars(), params.clone()).expect("adamw");
+        let mut fused = FusedAdamW::new(b.vars(), params).expect("fused");
+        let loss = |net: &Mlp| {
+            net.forward(&x)
+                .and_then(|p| (p - &y).map_err(backend))
+                .and_then(|d| d.sqr().and_then(|d| d.mean_all()).map_err(backend))
+                .expect("loss")
+        };
+        let first = scalar(&loss(&a)).expect("loss");
+        for _ in 0..20 {
+            reference.backward_step(&loss(&a)).expect("step");
+            fused.backward_step(&loss(&b)).expect("step");
+        }
+        let last = scalar(&loss(&a)).expect("loss");
+        assert!(
+            last < 0.8 * first,
+            "AdamW did not descend: {first} → {last}"
+        );
+        let pa = a.parameters().expect("p");
+        let pb = b.parameters().expect("p");
+        let mut max_diff = 0f32;
+        for ((wa, ba), (wb, bb)) in pa.iter().zip(&pb) {
+            for (u, v) in wa.iter().chain(ba).zip(wb.iter().chain(bb)) {
+                max_diff = max_diff.max((u - v).abs());
+            }
+        }
+        assert!(
+            max_diff < 1e-6,
+            "fused and candle AdamW differ by {max_diff}"
+        );
+        let bad = ParamsAdamW {
+            lr: f64::NAN,
+            ..ParamsAdamW::default()
+        };
+        assert!(FusedAdamW::new(a.vars(), bad).is_err());
     }
 
     /// Soft update: w′ ← τ w + (1 − τ) w′ exactly (to f32 rounding).
