@@ -129,6 +129,30 @@ fn compare(cell: &MillCell) -> Result<(), MillPlanError> {
     );
     rows.push(Plan::evaluate(cell, &w, &nv.states, "naive")?.row());
     println!("{}", comparison_table(&rows));
+    // Environment step cost, with and without the cache (a gentle policy).
+    use kerf_millplan::env::{EnvConfig, MillEnv};
+    use std::sync::Arc;
+    let cell = Arc::new(cell.clone());
+    for cached in [true, false] {
+        let c = if cached {
+            Some(Arc::new(cache.clone()))
+        } else {
+            None
+        };
+        let mut env = MillEnv::new(cell.clone(), c, EnvConfig::default())?;
+        let t = Instant::now();
+        let mut steps = 0;
+        let episodes = if cached { 20 } else { 2 };
+        for _ in 0..episodes {
+            let r = env.rollout(|_, s| Ok(vec![0.5, 0.5, if s.g > -0.6 { -0.5 } else { 0.0 }]))?;
+            steps += r.steps.len();
+        }
+        println!(
+            "env step ({}): {:.1} us per step over {steps} steps",
+            if cached { "cache" } else { "direct" },
+            t.elapsed().as_secs_f64() / steps as f64 * 1e6
+        );
+    }
     Ok(())
 }
 

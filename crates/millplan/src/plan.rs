@@ -222,7 +222,7 @@ impl Plan {
 
 /// The comparison table of issue 5 as Markdown: planner, machining time
 /// \[s\], chatter-free (yes/no), max |μ|max, min condition indicator, total
-/// reward.
+/// reward. A `|` in a planner name is escaped (`\|`) so it stays one cell.
 pub fn comparison_table(rows: &[ComparisonRow]) -> String {
     let mut out = String::from(
         "| planner | machining time [s] | chatter-free | max \\|μ\\|max | min 1/K | total reward |\n\
@@ -231,7 +231,7 @@ pub fn comparison_table(rows: &[ComparisonRow]) -> String {
     for r in rows {
         out.push_str(&format!(
             "| {} | {:.2} | {} | {:.4} | {:.3} | {:.3} |\n",
-            r.planner,
+            r.planner.replace('|', "\\|"),
             r.total_time,
             if r.chatter_free { "yes" } else { "no" },
             r.max_spectral_radius,

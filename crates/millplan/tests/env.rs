@@ -325,6 +325,12 @@ fn time_accounting_and_plan_totals() {
         "{table}"
     );
     assert_eq!(table.lines().count(), 3);
+    // A '|' in a name stays inside its cell: 7 unescaped separators a row.
+    let mut row = plan.row();
+    row.planner = "DP, |mu| < 0.99".to_string();
+    let table = comparison_table(&[row]);
+    let last = table.lines().last().unwrap();
+    assert_eq!(last.replace("\\|", "").matches('|').count(), 7, "{last}");
 
     // Plans refuse a zero feed and a wrong length.
     let mut bad = states.clone();
