@@ -209,3 +209,53 @@ fn chatter_constrained_dp_is_chatter_free_per_the_cache() {
     assert!(fixed.states.iter().all(|s| s.g == 0.0));
     assert!(fixed.value <= free.value + 1e-9);
 }
+
+#[test]
+fn dp_plan_replayed_in_the_unfiltered_environment_gives_its_value() {
+    // With alpha = 1 every DP plan is an action sequence of the
+    // environment (normalized actions -1/0/+1): replaying it must give the
+    // same states and, with the same cache, the same total reward.
+    use std::sync::Arc;
+
+    use kerf_millplan::env::{EnvConfig, MillEnv};
+    let cell = MillCell::default_cell().unwrap();
+    let cache = IndicatorCache::load(&IndicatorCache::default_path(), &cell).unwrap();
+    let r = dp::solve(&cell, &cache, &reduced_spec(&cell)).unwrap();
+    let actions: Vec<Vec<f32>> = r
+        .states
+        .windows(2)
+        .map(|w| {
+            vec![
+                ((w[1].rpm - w[0].rpm) / 20.0).round() as f32,
+                ((w[1].feed - w[0].feed) / 1e-3).round() as f32,
+                ((w[1].g - w[0].g) / 0.2).round() as f32,
+            ]
+        })
+        .collect();
+    let mut env = MillEnv::new(
+        Arc::new(cell),
+        Some(Arc::new(cache)),
+        EnvConfig {
+            alpha: 1.0,
+            ..EnvConfig::default()
+        },
+    )
+    .unwrap();
+    let rollout = env.rollout_actions(&actions).unwrap();
+    assert!(rollout.completed);
+    for (a, b) in rollout.states().iter().zip(&r.states) {
+        assert_eq!(a.segment, b.segment);
+        assert!((a.rpm - b.rpm).abs() < 1e-6 && (a.feed - b.feed).abs() < 1e-12);
+        assert!((a.g - b.g).abs() < 1e-12);
+    }
+    assert!(rollout
+        .steps
+        .iter()
+        .all(|s| s.evaluation.unwrap().from_cache));
+    assert!(
+        (rollout.total_reward - r.value).abs() < 1e-6,
+        "env {} vs dp {}",
+        rollout.total_reward,
+        r.value
+    );
+}
