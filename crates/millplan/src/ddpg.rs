@@ -17,7 +17,10 @@
 //! 4. Actor (seed 004 Algorithm 1 "actor network update", the deterministic
 //!    policy gradient ∇_{wᵃ} A · ∇_a Q): L_a = −(1/N) Σ Q(s_i, A(s_i | wᵃ));
 //!    one AdamW step on wᵃ (the critic's weights are held fixed in this
-//!    step; it uses the critic just updated, as Lillicrap's code does).
+//!    step; it uses the critic just updated, as Lillicrap's code does). The
+//!    action gradient ∇_a Q is computed by hand
+//!    ([`Mlp::output_and_input_gradient`]) and chained into the actor by
+//!    autograd.
 //! 5. Soft target updates (Algorithm 1): w′ ← τ w + (1 − τ) w′ for both
 //!    networks.
 //!
@@ -35,7 +38,7 @@
 //! 64 steps of the first episode.
 //!
 //! # Terminal versus time limit
-//! A transition whose [`Transition::done`] is true is terminal: no
+//! A transition whose [`crate::rl::Transition::done`] is true is terminal: no
 //! bootstrapping from s_{t+1} (the end of the path, a terminal violation).
 //! An episode cut at `steps_per_episode` without `done` is a time limit and
 //! its last transition still bootstraps.
@@ -458,19 +461,28 @@ impl Learner {
         }
         self.critic_opt.backward_step(&critic_loss)?;
 
-        // Actor: L_a = −mean Q(s, A(s)), critic weights held fixed.
+        // Actor: L_a = −mean Q(s, A(s)), critic weights held fixed. With
+        // G_i = ∇_a Q(s_i, a)|_{a = A(s_i)} from the critic (by hand,
+        // `Mlp::output_and_input_gradient`), the surrogate
+        // −(1/N) Σ_i A(s_i)·stop_gradient(G_i) has the same gradient in wᵃ,
+        // −(1/N) Σ_i ∇_{wᵃ}A(s_i) G_i (the deterministic policy gradient),
+        // without candle computing the critic's weight gradients.
         let pi = self.actor.forward(&s)?;
-        let q_pi = self
+        let (q_pi, dq_dx) = self
             .critic
-            .forward_detached(&Tensor::cat(&[&s, &pi], 1).map_err(backend)?)?;
-        let actor_loss = q_pi.mean_all().and_then(|m| m.neg()).map_err(backend)?;
-        let actor_value = scalar(&actor_loss)?;
+            .output_and_input_gradient(&Tensor::cat(&[&s, &pi], 1).map_err(backend)?)?;
+        let actor_value = -scalar(&q_pi.mean_all().map_err(backend)?)?;
         if !actor_value.is_finite() {
             return Err(MillPlanError::Backend(format!(
                 "training diverged: actor loss {actor_value}"
             )));
         }
-        self.actor_opt.backward_step(&actor_loss)?;
+        let dq_da = dq_dx.narrow(1, o, a).map_err(backend)?;
+        let surrogate = (&pi * &dq_da)
+            .and_then(|t| t.sum_all())
+            .and_then(|t| t.affine(-1.0 / n as f64, 0.0))
+            .map_err(backend)?;
+        self.actor_opt.backward_step(&surrogate)?;
 
         self.actor_target.soft_update_from(&self.actor, self.tau)?;
         self.critic_target

@@ -256,6 +256,76 @@ impl Mlp {
         Ok(h)
     }
 
+    /// The outputs y (rows × 1) of a single-output network and, without
+    /// autograd, the gradient of each row's output with respect to that
+    /// row's input, ∂y_i/∂x_i (rows × input size): the critic's action
+    /// gradient ∇_a Q(s, a) of the deterministic policy gradient (seed 004
+    /// Algorithm 1, "actor network update"; Silver et al., "Deterministic
+    /// policy gradient algorithms", ICML 2014, eq. 9).
+    ///
+    /// Backpropagation by hand through the ReLU layers, with
+    /// z_k = h_{k−1} W_kᵀ + b_k, h_k = relu(z_k), y = h_L W_outᵀ + b_out:
+    /// δ_L = W_out ⊙ 1[z_L ≥ 0], δ_{k−1} = (δ_k W_k) ⊙ 1[z_{k−1} ≥ 0] and
+    /// ∂y/∂x = δ_1 W_1 (the ReLU derivative taken as 1 at 0, as candle's).
+    /// candle's autograd would also compute every weight gradient, which the
+    /// actor update throws away; this costs one forward and one backward
+    /// matrix product per layer.
+    ///
+    /// # Errors
+    /// [`MillPlanError::InvalidConfig`] unless the network has a linear
+    /// output of size 1; [`MillPlanError::Backend`] when candle fails.
+    pub fn output_and_input_gradient(&self, x: &Tensor) -> Result<(Tensor, Tensor), MillPlanError> {
+        if self.output != OutputActivation::Linear || self.sizes.last() != Some(&1) {
+            return Err(MillPlanError::InvalidConfig {
+                name: "input gradient".to_string(),
+                reason: format!(
+                    "needs a linear single-output network, got sizes {:?} with {:?} output",
+                    self.sizes, self.output
+                ),
+            });
+        }
+        let Some((last, hidden)) = self.layers.split_last() else {
+            return Err(MillPlanError::InvalidConfig {
+                name: "input gradient".to_string(),
+                reason: "network without layers".to_string(),
+            });
+        };
+        let mut h = x.detach();
+        let mut masks = Vec::with_capacity(hidden.len());
+        for layer in hidden {
+            let z = layer.detached().forward(&h).map_err(backend)?;
+            let mask = z
+                .ge(0f32)
+                .and_then(|m| m.to_dtype(DType::F32))
+                .map_err(backend)?;
+            h = (&z * &mask).map_err(backend)?;
+            masks.push(mask);
+        }
+        let y = last.detached().forward(&h).map_err(backend)?;
+        // δ_L = W_out (1 × H_L) broadcast over rows, masked.
+        let mut delta = last
+            .weight
+            .as_tensor()
+            .detach()
+            .broadcast_mul(&masks.pop().ok_or_else(|| MillPlanError::InvalidConfig {
+                name: "input gradient".to_string(),
+                reason: "network without hidden layers".to_string(),
+            })?)
+            .map_err(backend)?;
+        for (k, layer) in hidden.iter().enumerate().rev() {
+            delta = delta
+                .matmul(&layer.weight.as_tensor().detach())
+                .map_err(backend)?;
+            if k > 0 {
+                let mask = masks.pop().ok_or_else(|| {
+                    MillPlanError::Backend("input gradient: mask stack empty".to_string())
+                })?;
+                delta = (&delta * &mask).map_err(backend)?;
+            }
+        }
+        Ok((y, delta))
+    }
+
     /// Soft target update (seed 004 Algorithm 1, "soft target network
     /// update"; Lillicrap et al. 2016 Algorithm 1): w′ ← τ w + (1 − τ) w′
     /// for every variable, `self` being the target w′.
@@ -723,6 +793,48 @@ mod tests {
             ..ParamsAdamW::default()
         };
         assert!(FusedAdamW::new(a.vars(), bad).is_err());
+    }
+
+    /// The hand-written input gradient equals candle's autograd gradient of
+    /// Σ_i y_i with respect to x (each row's output depends on its row
+    /// only), and the outputs equal the forward pass.
+    #[test]
+    fn input_gradient_matches_autograd() {
+        let mut rng = Rng::new(8);
+        let net = Mlp::new(&[5, 32, 24, 1], OutputActivation::Linear, &mut rng).expect("valid");
+        // Larger output weights than the ±3e-3 init, for a sensitive check.
+        let mut params = net.parameters().expect("p");
+        if let Some((w, _)) = params.last_mut() {
+            w.iter_mut().for_each(|v| *v *= 100.0);
+        }
+        let net =
+            Mlp::from_parameters(&[5, 32, 24, 1], OutputActivation::Linear, params).expect("valid");
+        let data: Vec<f32> = (0..40).map(|_| rng.uniform(-1.0, 1.0) as f32).collect();
+        let x = Var::from_vec(data.clone(), (8, 5), &Device::Cpu).expect("var");
+        let y_auto = net.forward_detached(x.as_tensor()).expect("forward");
+        let grads = y_auto
+            .sum_all()
+            .and_then(|s| s.backward())
+            .expect("backward");
+        let g_auto = flat(grads.get(x.as_tensor()).expect("grad")).expect("flat");
+        let (y, g) = net
+            .output_and_input_gradient(&matrix(data, 8, 5).expect("x"))
+            .expect("gradient");
+        assert_eq!(g.dims(), &[8, 5]);
+        let y_auto = flat(&y_auto).expect("flat");
+        for (a, b) in flat(&y).expect("flat").iter().zip(&y_auto) {
+            assert!((a - b).abs() < 1e-6, "{a} vs {b}");
+        }
+        let g = flat(&g).expect("flat");
+        let scale = g_auto.iter().fold(0f32, |m, v| m.max(v.abs()));
+        assert!(scale > 1e-2, "gradient too small to test: {scale}");
+        for (a, b) in g.iter().zip(&g_auto) {
+            assert!((a - b).abs() < 1e-5 * scale, "{a} vs {b}");
+        }
+        let actor = Mlp::new(&[5, 8, 2], OutputActivation::Tanh, &mut rng).expect("valid");
+        assert!(actor
+            .output_and_input_gradient(&matrix(vec![0.0; 5], 1, 5).expect("x"))
+            .is_err());
     }
 
     /// Soft update: w′ ← τ w + (1 − τ) w′ exactly (to f32 rounding).

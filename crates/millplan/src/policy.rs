@@ -22,7 +22,8 @@
 //! hidden layers, a = tanh(W h + b) for the output; [`crate::nets`]), f32
 //! with 8 partial sums per dot product. No candle, no allocation beyond the
 //! two activation vectors, no thread pool: a 100-step rollout of the 2×256
-//! actor takes about a millisecond (measured in `benches/ddpg_update.rs`).
+//! actor takes 1–2 ms in a release build (measured in
+//! `benches/ddpg_update.rs`).
 
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
