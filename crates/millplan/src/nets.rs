@@ -837,6 +837,26 @@ mod tests {
             .is_err());
     }
 
+    /// Flush-to-zero is on while the guard lives and off after: a product
+    /// with a denormal result (1e-20 × 1e-20 = 1e-40 < f32::MIN_POSITIVE
+    /// ≈ 1.18e-38) is 0 under FTZ and the denormal 1e-40 without it.
+    #[cfg(target_arch = "x86_64")]
+    #[test]
+    fn flush_to_zero_guard() {
+        let tiny = std::hint::black_box(1e-20f32);
+        let before = std::hint::black_box(tiny) * std::hint::black_box(tiny);
+        assert!(before > 0.0 && before < f32::MIN_POSITIVE);
+        {
+            let guard = CpuTuning::apply(false);
+            assert!(guard.report().flush_to_zero);
+            assert!(!guard.report().single_thread);
+            let flushed = std::hint::black_box(tiny) * std::hint::black_box(tiny);
+            assert_eq!(flushed, 0.0);
+        }
+        let after = std::hint::black_box(tiny) * std::hint::black_box(tiny);
+        assert_eq!(after, before);
+    }
+
     /// Soft update: w′ ← τ w + (1 − τ) w′ exactly (to f32 rounding).
     #[test]
     fn soft_update_mixes() {
