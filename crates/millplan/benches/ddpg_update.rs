@@ -12,9 +12,12 @@
 //! * `policy: 100 actions (plain forward)`: a 100-step greedy rollout's
 //!   actor cost with the saved policy.
 //!
-//! Besides criterion's numbers, a plain timing of 500 updates prints the
+//! Besides criterion's numbers, a plain timing of 300 updates prints the
 //! estimated training time: 100 000 × (update + candle action), without the
-//! environment's own step cost (see the integration numbers of MillEnv).
+//! environment's own step cost (see `examples/ddpg_mill_smoke.rs`), from the
+//! wall time and from the thread's CPU time (Linux `clock_gettime`; the
+//! wall time on the shared 2-core machine includes waiting for other
+//! jobs).
 //!
 //! Run: `cargo bench -p kerf_millplan --bench ddpg_update -- --quick`.
 
@@ -30,16 +33,57 @@ use kerf_millplan::{Environment, MillPlanError, Transition};
 const OBS: usize = 4;
 const ACT: usize = 3;
 
-/// Mean seconds per update over `n` updates after 20 warm-up updates.
-fn time_updates(update: &mut dyn FnMut() -> Result<(), MillPlanError>, n: usize) -> f64 {
+/// `struct timespec` of Linux (64-bit).
+#[cfg(target_os = "linux")]
+#[repr(C)]
+struct Timespec {
+    tv_sec: i64,
+    tv_nsec: i64,
+}
+
+#[cfg(target_os = "linux")]
+extern "C" {
+    /// POSIX `clock_gettime` (libc).
+    fn clock_gettime(clock: i32, tp: *mut Timespec) -> i32;
+}
+
+/// CPU time of the calling thread, s (`CLOCK_THREAD_CPUTIME_ID` = 3 on
+/// Linux): what the update costs on an otherwise idle core, independent of
+/// other jobs on the shared machine. `None` off Linux or on failure.
+fn thread_cpu_time() -> Option<f64> {
+    #[cfg(target_os = "linux")]
+    {
+        let mut ts = Timespec {
+            tv_sec: 0,
+            tv_nsec: 0,
+        };
+        // SAFETY: ts is a valid, writable timespec.
+        let rc = unsafe { clock_gettime(3, &mut ts) };
+        (rc == 0).then_some(ts.tv_sec as f64 + ts.tv_nsec as f64 * 1e-9)
+    }
+    #[cfg(not(target_os = "linux"))]
+    {
+        None
+    }
+}
+
+/// Mean wall seconds and mean thread-CPU seconds per update over `n`
+/// updates after 20 warm-up updates.
+fn time_updates(
+    update: &mut dyn FnMut() -> Result<(), MillPlanError>,
+    n: usize,
+) -> (f64, Option<f64>) {
     for _ in 0..20 {
         update().expect("update");
     }
+    let cpu0 = thread_cpu_time();
     let start = Instant::now();
     for _ in 0..n {
         update().expect("update");
     }
-    start.elapsed().as_secs_f64() / n as f64
+    let wall = start.elapsed().as_secs_f64() / n as f64;
+    let cpu = cpu0.zip(thread_cpu_time()).map(|(a, b)| (b - a) / n as f64);
+    (wall, cpu)
 }
 
 /// A 4-observation, 3-action environment with trivial dynamics, to get a
@@ -101,7 +145,7 @@ fn bench(c: &mut Criterion) {
         tuning.report()
     );
     let mut update = update_benchmark(OBS, ACT, &settings).expect("setup");
-    let tuned = time_updates(&mut update, 300);
+    let (tuned, tuned_cpu) = time_updates(&mut update, 300);
     c.bench_function("ddpg update, tuned", |b| {
         b.iter(|| update().expect("update"))
     });
@@ -156,6 +200,16 @@ fn bench(c: &mut Criterion) {
         steps * (tuned + act),
         steps * (tuned + act) / 60.0,
     );
+    if let Some(cpu) = tuned_cpu {
+        eprintln!(
+            "thread CPU time per update {:.3} ms (wall {:.3} ms): {:.0} s ({:.1} min) for \
+             1000 × 100 updates on an idle core",
+            cpu * 1e3,
+            tuned * 1e3,
+            steps * (cpu + act),
+            steps * (cpu + act) / 60.0
+        );
+    }
 }
 
 criterion_group!(benches, bench);
@@ -164,7 +218,7 @@ fn main() {
     if std::env::var_os(CHILD).is_some() {
         let settings = DdpgSettings::default();
         let mut update = update_benchmark(OBS, ACT, &settings).expect("setup");
-        println!("{}", time_updates(&mut update, 200));
+        println!("{}", time_updates(&mut update, 200).0);
         return;
     }
     benches();
