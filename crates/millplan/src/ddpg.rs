@@ -554,12 +554,13 @@ fn check_observation(observation: &[f32], dim: usize) -> Result<(), MillPlanErro
 ///
 /// # Performance
 /// The run applies [`CpuTuning`] for its duration. One update (batch 64,
-/// 2×256, release build) takes 2.7–3.1 ms on the 2-core development machine
-/// under load from other jobs, against 8.1 ms with candle's default CPU
-/// settings (`benches/ddpg_update.rs`); a training step on the milling
-/// environment with its indicator cache costs 3.2–3.7 ms in all
-/// (`examples/ddpg_mill_smoke.rs`), so 1000 × 99 steps take 5–6 min on
-/// that loaded machine.
+/// 2×256, release build, `benches/ddpg_update.rs`) costs 2.6 ms of CPU
+/// time on the 2-core development machine (2.2–3.0 ms wall time while other
+/// jobs run), against 8–10 ms with candle's default CPU settings. A
+/// training step on the milling environment with its indicator cache
+/// (`examples/ddpg_mill_smoke.rs`) costs 2.6 ms of CPU time in all (the
+/// environment ≈ 10–20 µs of it), so 1000 × 99 steps take about 4.4 min
+/// on an idle core (≈ 5 min wall time on the loaded machine).
 pub fn train<E: Environment>(
     env: &mut E,
     settings: &DdpgSettings,
