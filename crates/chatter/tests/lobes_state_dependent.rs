@@ -5,37 +5,26 @@
 //! critical depth of the independent per-unit-depth search of
 //! `stability_lobes` (scaled equation on one discretization).
 
+mod common;
+
 use std::f64::consts::PI;
 
 use kerf_chatter::lobes::state_dependent_critical_depth;
 use kerf_chatter::{
     chatter_indicator, stability_lobes, ChatterError, DelayModel, IndicatorSettings, LobeOptions,
-    MillingProcess, Modal2, Mode,
+    MillingProcess, Modal2,
 };
 
 /// A robot tool tip: two uncoupled 30 Hz modes, ζ = 0.05, k = 1e6 N/m
 /// (the representative mode of `benches/indicator.rs`).
 fn modal() -> Modal2 {
     let wn = 2.0 * PI * 30.0;
-    let mode = Mode {
-        natural_frequency_hz: 30.0,
-        damping_ratio: 0.05,
-        modal_mass: 1e6 / (wn * wn),
-    };
-    Modal2::from_modes(mode, mode).expect("valid modes")
+    common::symmetric_modal(30.0, 0.05, 1e6 / (wn * wn))
 }
 
 /// Seed 004 Table 1 process (2 teeth, R = 40 mm, down milling [0.75π, π]).
 fn process() -> MillingProcess {
-    MillingProcess {
-        teeth: 2,
-        radius: 0.04,
-        axial_depth: 3e-3,
-        kt: 6.44e8,
-        kn: 2.37e8,
-        entry_angle: 0.75 * PI,
-        exit_angle: PI,
-    }
+    common::seed004_process(3e-3)
 }
 
 /// The default cell's indicator: state-dependent, x_F = 0.75 at the paper's

@@ -2,21 +2,10 @@
 //! evaluate() is consistent with the path and the kinematics, and bad
 //! fields are reported by name.
 
-use std::path::Path;
+mod common;
+
 
 use kerf_mill::{MillCell, MillError};
-
-fn default_text() -> String {
-    std::fs::read_to_string(MillCell::default_path()).expect("read the default cell")
-}
-
-fn load_text(text: &str) -> Result<MillCell, MillError> {
-    let dir = MillCell::default_path()
-        .parent()
-        .expect("urdf dir")
-        .to_path_buf();
-    MillCell::from_yaml_str(text, &dir, Path::new("test.yaml"))
-}
 
 #[test]
 fn default_cell_has_the_table_1_values() {
@@ -100,7 +89,7 @@ fn unreachable_or_limited_states_name_segment_g_and_joint() {
 
 #[test]
 fn bad_fields_are_reported_by_name() {
-    let text = default_text();
+    let text = common::default_cell_text();
     let cases = [
         (
             "  damping_ratio: 0.05\n",
@@ -149,7 +138,7 @@ fn bad_fields_are_reported_by_name() {
     ];
     for (from, to, expect) in cases {
         assert!(text.contains(from), "fixture: {from}");
-        let Err(err) = load_text(&text.replacen(from, to, 1)) else {
+        let Err(err) = common::load_cell_text(&text.replacen(from, to, 1)) else {
             panic!("{expect}: accepted")
         };
         let msg = err.to_string();
@@ -158,7 +147,7 @@ fn bad_fields_are_reported_by_name() {
     }
     // `measured` without modes, then the measured model loading fine.
     let measured = text.replacen("model: compliance", "model: measured", 1);
-    let cell = load_text(&measured).expect("measured model");
+    let cell = common::load_cell_text(&measured).expect("measured model");
     let st = cell.evaluate(0, 0.0, None).expect("state");
     let w = 2.0 * std::f64::consts::PI * 20.0;
     assert!((st.modal.stiffness[(0, 0)] - 60.0 * w * w).abs() < 1e-6);

@@ -3,22 +3,11 @@
 //! the feed lower bound of seed 004 Fig. 4/7 on the default cell's real
 //! pose-dependent tool-tip dynamics.
 
-use std::path::Path;
+mod common;
+
 
 use kerf_chatter::indicator::{chatter_indicator, DelayModel, IndicatorSettings};
-use kerf_mill::{MillCell, MillError};
-
-fn load_text(text: &str) -> Result<MillCell, MillError> {
-    let dir = MillCell::default_path()
-        .parent()
-        .expect("urdf dir")
-        .to_path_buf();
-    MillCell::from_yaml_str(text, &dir, Path::new("test.yaml"))
-}
-
-fn default_text() -> String {
-    std::fs::read_to_string(MillCell::default_path()).expect("read the default cell")
-}
+use kerf_mill::MillCell;
 
 /// The text without its `chatter:` section (the section is the file's last).
 fn without_chatter(text: &str) -> String {
@@ -41,7 +30,8 @@ fn default_cell_uses_the_documented_force_law() {
 
 #[test]
 fn absent_section_is_the_papers_model() {
-    let cell = load_text(&without_chatter(&default_text())).expect("cell without chatter");
+    let cell = common::load_cell_text(&without_chatter(&common::default_cell_text()))
+        .expect("cell without chatter");
     assert_eq!(*cell.indicator_settings(), IndicatorSettings::default());
     assert_eq!(
         cell.indicator_settings().equilibrium.force_law.exponent,
@@ -51,7 +41,7 @@ fn absent_section_is_the_papers_model() {
 
 #[test]
 fn bad_chatter_values_are_named() {
-    let base = default_text();
+    let base = common::default_cell_text();
     for (from, to, field) in [
         ("model: state_dependent", "model: quantum", "chatter.model"),
         (
@@ -72,7 +62,7 @@ fn bad_chatter_values_are_named() {
         ("steps: 40", "steps: 1", "sub-intervals"),
     ] {
         assert!(base.contains(from), "default cell lacks `{from}`");
-        let err = load_text(&base.replacen(from, to, 1))
+        let err = common::load_cell_text(&base.replacen(from, to, 1))
             .expect_err(to)
             .to_string();
         assert!(err.contains(field), "`{to}`: {err}");

@@ -1,9 +1,9 @@
 //! Shared test helpers: a deterministic generator and the IRB-6660 model.
 #![allow(dead_code)]
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
-use kerf_mill::Kinematics;
+use kerf_mill::{Kinematics, MillCell, MillError};
 use kerf_robot::RobotModel;
 use nalgebra::Isometry3;
 
@@ -61,4 +61,18 @@ pub fn pose_error(a: &Isometry3<f64>, b: &Isometry3<f64>) -> (f64, f64) {
         - b.rotation.to_rotation_matrix().into_inner())
     .norm();
     (dp, dr)
+}
+
+/// The text of the shipped cell file `urdf/irb6660_milling.yaml`.
+pub fn default_cell_text() -> String {
+    std::fs::read_to_string(MillCell::default_path()).expect("read the default cell")
+}
+
+/// A cell from YAML text, with robot paths relative to the shipped `urdf/`.
+pub fn load_cell_text(text: &str) -> Result<MillCell, MillError> {
+    let dir = MillCell::default_path()
+        .parent()
+        .expect("urdf dir")
+        .to_path_buf();
+    MillCell::from_yaml_str(text, &dir, Path::new("test.yaml"))
 }
