@@ -4,7 +4,6 @@
 
 mod common;
 
-
 use kerf_mill::{MillCell, MillError};
 
 #[test]

@@ -5,7 +5,6 @@
 
 mod common;
 
-
 use kerf_chatter::indicator::{chatter_indicator, DelayModel, IndicatorSettings};
 use kerf_mill::MillCell;
 
