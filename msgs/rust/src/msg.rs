@@ -1,6 +1,7 @@
 //! kerf's own messages (`kerf_msgs/msg`, defined in `msgs/msg/`): the trajectory executor's
-//! [`TrajectoryStatus`] and the MJTO planner's [`CutRequest`] / [`CutPlan`] (with [`CutRto`],
-//! [`CutMetrics`], [`CutCollision`]).
+//! [`TrajectoryStatus`], the MJTO planner's [`CutRequest`] / [`CutPlan`] (with [`CutRto`],
+//! [`CutMetrics`], [`CutCollision`]) and the milling planner's [`MillRequest`] / [`MillPlan`]
+//! (with [`MillSegment`]).
 
 use serde::{Deserialize, Serialize};
 
@@ -274,6 +275,173 @@ impl CutPlan {
     }
 }
 
+/// `kerf_msgs/msg/MillRequest`: a milling request for the milling planner node (seed 004:
+/// spindle speed Ω, feed f and redundancy angle g planned per path segment under the chatter
+/// constraint, ABB IRB 6660), sent to its `~/mill_request` topic; answered by a [`MillPlan`] on
+/// `~/mill_plan`.
+///
+/// SI units except where a name says rpm. Each group of fields is read only when its `has_*`
+/// flag is true; with the flag false the whole group is the cell's
+/// (`urdf/irb6660_milling.yaml`). Nothing else is defaulted: every value used is checked.
+#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
+pub struct MillRequest {
+    /// Any text; echoed in the [`MillPlan`].
+    pub request_id: String,
+    /// Points the cubic B-spline tool path interpolates, robot base frame (m): at least 2,
+    /// coplanar within 1e-6 m.
+    pub points: Vec<Point>,
+    /// Equal-arc-length segments (planning steps); 0 = the cell's 100.
+    pub segments: u32,
+    /// Whether the tool and cutting parameters below are given; false = the cell's `process:`.
+    pub has_process: bool,
+    /// Number of teeth, ≥ 1.
+    pub teeth: u32,
+    /// Tool radius R (m), > 0.
+    pub tool_radius: f64,
+    /// Axial depth of cut a_p (m), > 0.
+    pub axial_depth: f64,
+    /// Tangential cutting force coefficient Kt (N/m²), ≥ 0.
+    pub kt: f64,
+    /// Normal cutting force coefficient Kn (N/m²), ≥ 0.
+    pub kn: f64,
+    /// Entry angle of the engagement (rad), in [0, π].
+    pub entry_angle: f64,
+    /// Exit angle of the engagement (rad), in [0, π], > `entry_angle`.
+    pub exit_angle: f64,
+    /// Whether the state ranges and step bounds below are given; false = the cell's.
+    pub has_limits: bool,
+    /// Lowest spindle speed (rpm), > 0.
+    pub spindle_min_rpm: f64,
+    /// Highest spindle speed (rpm), > `spindle_min_rpm`.
+    pub spindle_max_rpm: f64,
+    /// Lowest feed (m/s), ≥ 0.
+    pub feed_min: f64,
+    /// Highest feed (m/s), > `feed_min`.
+    pub feed_max: f64,
+    /// Lowest redundancy angle (rad), ≥ −π.
+    pub g_min: f64,
+    /// Highest redundancy angle (rad), in (`g_min`, π].
+    pub g_max: f64,
+    /// Largest spindle-speed change between consecutive segments (rpm), > 0.
+    pub max_spindle_step_rpm: f64,
+    /// Largest feed change between consecutive segments (m/s), > 0.
+    pub max_feed_step: f64,
+    /// Largest redundancy-angle change between consecutive segments (rad), > 0.
+    pub max_g_step: f64,
+    /// Whether the initial state below is given; false = the cell's (2000 rpm, 0.04 m/s, 0 rad).
+    pub has_initial_state: bool,
+    /// Initial spindle speed (rpm), inside the spindle range.
+    pub initial_spindle_rpm: f64,
+    /// Initial feed (m/s), inside the feed range.
+    pub initial_feed: f64,
+    /// Initial redundancy angle (rad), inside the g range.
+    pub initial_g: f64,
+    /// One of the `PLANNER_*` constants ([`PLANNER_DDPG`](Self::PLANNER_DDPG) …); empty =
+    /// `"ddpg"`.
+    pub planner: String,
+    /// Path of the actor (safetensors) of the ddpg / fixed_g planner; empty = the shipped
+    /// policy of that planner.
+    pub policy_file: String,
+}
+impl_ros_type!(MillRequest, "kerf_msgs", msg, "MillRequest");
+
+impl MillRequest {
+    /// DDPG actor of seed 004 Algorithm 1, optimizing Ω, f and g.
+    pub const PLANNER_DDPG: &'static str = "ddpg";
+    /// DDPG actor trained with g held at 0 (seed 004 Fig. 8 ablation).
+    pub const PLANNER_FIXED_G: &'static str = "fixed_g";
+    /// Dynamic programming over a discretized (Ω, f, g) grid (the deterministic optimum).
+    pub const PLANNER_DP: &'static str = "dp";
+    /// Constant feed and spindle speed.
+    pub const PLANNER_NAIVE: &'static str = "naive";
+}
+
+/// `kerf_msgs/msg/MillSegment`: one planned segment of a [`MillPlan`], with the model's
+/// figures evaluated directly.
+#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
+pub struct MillSegment {
+    /// Segment index along the path, from 0.
+    pub index: u32,
+    /// Spindle speed Ω (rpm).
+    pub spindle_rpm: f64,
+    /// Feed f (m/s).
+    pub feed: f64,
+    /// Redundancy angle g (rad).
+    pub redundancy_angle: f64,
+    /// Chatter indicator |μ|max; chatter-free when < 1.
+    pub mu_max: f64,
+    /// Singularity indicator 1/K of seed 004 eq. 14, in [0, 1].
+    pub condition_indicator: f64,
+    /// Segment time, arc length / feed (s).
+    pub time: f64,
+    /// Reward of the segment (seed 004 eq. 12).
+    pub reward: f64,
+    /// Joint positions joint_1..joint_6 (rad) at the segment's midpoint.
+    pub joint_positions: Vec<f64>,
+}
+impl_ros_type!(MillSegment, "kerf_msgs", msg, "MillSegment");
+
+/// `kerf_msgs/msg/MillPlan`: the milling planner's answer to one [`MillRequest`], published on
+/// `~/mill_plan`; failures carry their status and message.
+#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
+pub struct MillPlan {
+    /// `request_id` of the request (empty when it could not be read).
+    pub request_id: String,
+    /// One of the status constants ([`SUCCESS`](Self::SUCCESS) …).
+    pub status: u8,
+    /// Human-readable result or reason.
+    pub message: String,
+    /// The planner that produced the plan (a `MillRequest::PLANNER_*` value).
+    pub planner: String,
+    /// The IRB 6660 joint trajectory joint_1..joint_6, timed by the planned feed; empty unless
+    /// SUCCESS.
+    pub trajectory: JointTrajectory,
+    /// One entry per segment, in path order; empty unless SUCCESS.
+    pub segments: Vec<MillSegment>,
+    /// Machining time, Σ segment times (s).
+    pub machining_time: f64,
+    /// Every segment has |μ|max < 1.
+    pub chatter_free: bool,
+    /// Largest |μ|max.
+    pub max_mu: f64,
+    /// Smallest condition indicator 1/K.
+    pub min_condition_indicator: f64,
+    /// Σ segment rewards (seed 004 eq. 12).
+    pub total_reward: f64,
+}
+impl_ros_type!(MillPlan, "kerf_msgs", msg, "MillPlan");
+
+impl MillPlan {
+    /// The plan succeeded.
+    pub const SUCCESS: u8 = 0;
+    /// The request is malformed (field and value in the message).
+    pub const INVALID_REQUEST: u8 = 1;
+    /// A segment has no IK solution at the redundancy angle needed.
+    pub const UNREACHABLE: u8 = 2;
+    /// The policy file is missing, unreadable or incompatible.
+    pub const POLICY_ERROR: u8 = 3;
+    /// The chatter model failed.
+    pub const CHATTER_MODEL_ERROR: u8 = 4;
+    /// The request queue is full; the request was not planned.
+    pub const QUEUE_FULL: u8 = 5;
+    /// Another internal error.
+    pub const INTERNAL_ERROR: u8 = 6;
+
+    /// Name of a status value (`"SUCCESS"` …), or `None` for an unknown value.
+    pub fn status_name(status: u8) -> Option<&'static str> {
+        match status {
+            Self::SUCCESS => Some("SUCCESS"),
+            Self::INVALID_REQUEST => Some("INVALID_REQUEST"),
+            Self::UNREACHABLE => Some("UNREACHABLE"),
+            Self::POLICY_ERROR => Some("POLICY_ERROR"),
+            Self::CHATTER_MODEL_ERROR => Some("CHATTER_MODEL_ERROR"),
+            Self::QUEUE_FULL => Some("QUEUE_FULL"),
+            Self::INTERNAL_ERROR => Some("INTERNAL_ERROR"),
+            _ => None,
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -295,5 +463,23 @@ mod tests {
         assert_eq!(CutPlan::status_name(5), Some("COLLISION"));
         assert_eq!(CutPlan::status_name(7), Some("INTERNAL_ERROR"));
         assert_eq!(CutPlan::status_name(8), None);
+    }
+
+    #[test]
+    fn mill_plan_status_names() {
+        assert_eq!(MillPlan::status_name(MillPlan::SUCCESS), Some("SUCCESS"));
+        assert_eq!(MillPlan::status_name(2), Some("UNREACHABLE"));
+        assert_eq!(MillPlan::status_name(3), Some("POLICY_ERROR"));
+        assert_eq!(MillPlan::status_name(4), Some("CHATTER_MODEL_ERROR"));
+        assert_eq!(MillPlan::status_name(5), Some("QUEUE_FULL"));
+        assert_eq!(MillPlan::status_name(6), Some("INTERNAL_ERROR"));
+        assert_eq!(MillPlan::status_name(7), None);
+        // Every name is distinct and round-trips through its code.
+        let names: Vec<&str> = (0..=u8::MAX).filter_map(MillPlan::status_name).collect();
+        assert_eq!(names.len(), 7);
+        let mut sorted = names.clone();
+        sorted.sort_unstable();
+        sorted.dedup();
+        assert_eq!(sorted.len(), 7);
     }
 }

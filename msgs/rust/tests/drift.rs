@@ -194,6 +194,9 @@ fn all_mirrors() -> Vec<Mirror> {
         msg::CutRto,
         msg::CutMetrics,
         msg::CutCollision,
+        msg::MillRequest,
+        msg::MillSegment,
+        msg::MillPlan,
         srv::ValidateTrajectoryRequest,
         srv::ValidateTrajectoryResponse,
     ]
@@ -398,6 +401,9 @@ fn c_u16(name: &'static str, v: u16) -> (&'static str, &'static str, Value) {
 fn c_i32(name: &'static str, v: i32) -> (&'static str, &'static str, Value) {
     (name, "int32", Value::Int(v.into()))
 }
+fn c_str(name: &'static str, v: &'static str) -> (&'static str, &'static str, Value) {
+    (name, "string", Value::String(v.to_owned()))
+}
 
 type ConstantTable = Vec<(&'static str, Vec<(&'static str, &'static str, Value)>)>;
 
@@ -406,6 +412,8 @@ fn rust_constants() -> ConstantTable {
     type Fjr = control_msgs::FollowJointTrajectoryResult;
     type Ts = msg::TrajectoryStatus;
     type Cp = msg::CutPlan;
+    type Mr = msg::MillRequest;
+    type Mp = msg::MillPlan;
     vec![
         (
             Jct::ROS_TYPE,
@@ -450,6 +458,27 @@ fn rust_constants() -> ConstantTable {
                 c_u8("COLLISION", Cp::COLLISION),
                 c_u8("LIMIT_VIOLATION", Cp::LIMIT_VIOLATION),
                 c_u8("INTERNAL_ERROR", Cp::INTERNAL_ERROR),
+            ],
+        ),
+        (
+            Mr::ROS_TYPE,
+            vec![
+                c_str("PLANNER_DDPG", Mr::PLANNER_DDPG),
+                c_str("PLANNER_FIXED_G", Mr::PLANNER_FIXED_G),
+                c_str("PLANNER_DP", Mr::PLANNER_DP),
+                c_str("PLANNER_NAIVE", Mr::PLANNER_NAIVE),
+            ],
+        ),
+        (
+            Mp::ROS_TYPE,
+            vec![
+                c_u8("SUCCESS", Mp::SUCCESS),
+                c_u8("INVALID_REQUEST", Mp::INVALID_REQUEST),
+                c_u8("UNREACHABLE", Mp::UNREACHABLE),
+                c_u8("POLICY_ERROR", Mp::POLICY_ERROR),
+                c_u8("CHATTER_MODEL_ERROR", Mp::CHATTER_MODEL_ERROR),
+                c_u8("QUEUE_FULL", Mp::QUEUE_FULL),
+                c_u8("INTERNAL_ERROR", Mp::INTERNAL_ERROR),
             ],
         ),
     ]
@@ -545,7 +574,7 @@ fn every_mirror_matches_its_interface_file() {
         "mirror drift:\n{}",
         problems.join("\n")
     );
-    assert_eq!(mirrors.len(), 29, "every mirror is checked");
+    assert_eq!(mirrors.len(), 32, "every mirror is checked");
 }
 
 #[test]
@@ -597,6 +626,9 @@ fn ros_types_name_their_files() {
     check::<msg::CutRto>();
     check::<msg::CutMetrics>();
     check::<msg::CutCollision>();
+    check::<msg::MillRequest>();
+    check::<msg::MillSegment>();
+    check::<msg::MillPlan>();
 }
 
 // Negative tests: the comparator must catch drift.
@@ -863,5 +895,5 @@ fn rust_parser_agrees_with_rosidl() {
             mine["file"]
         );
     }
-    assert_eq!(ours.len(), 26, "every interface file is compared");
+    assert_eq!(ours.len(), 29, "every interface file is compared");
 }
