@@ -514,3 +514,181 @@ fn process_from(p: &ProcessSection) -> Result<(MillingProcess, StateLimits), Mil
     };
     Ok((process, limits))
 }
+
+impl StateLimits {
+    /// Checks the limits with the rules of the cell YAML's `process`
+    /// section ([`MillCell::from_yaml_str`]): every value finite; each
+    /// range `[min, max]` with min < max; the spindle range above 0 rpm;
+    /// the feed range from ≥ 0 m/s; the redundancy-angle range inside
+    /// [−π, π] (1e-12 slack); every step bound > 0.
+    ///
+    /// # Errors
+    /// [`MillError::InvalidParameter`] naming the field as
+    /// `state_limits.<field>[index]` with its unit.
+    pub fn validate(&self) -> Result<(), MillError> {
+        use std::f64::consts::PI;
+        let range = |name: &str, r: [f64; 2], min: f64, max: f64| -> Result<(), MillError> {
+            for (i, v) in r.iter().enumerate() {
+                check_finite(&format!("state_limits.{name}[{i}]"), *v)?;
+            }
+            if r[1] <= r[0] {
+                return Err(MillError::InvalidParameter {
+                    name: format!("state_limits.{name}[1]"),
+                    value: r[1],
+                    reason: format!("must be > state_limits.{name}[0] = {}", r[0]),
+                });
+            }
+            if r[0] < min {
+                return Err(MillError::InvalidParameter {
+                    name: format!("state_limits.{name}[0]"),
+                    value: r[0],
+                    reason: format!("must be >= {min}"),
+                });
+            }
+            if r[1] > max {
+                return Err(MillError::InvalidParameter {
+                    name: format!("state_limits.{name}[1]"),
+                    value: r[1],
+                    reason: format!("must be <= {max}"),
+                });
+            }
+            Ok(())
+        };
+        range("spindle_rpm [rpm]", self.spindle_rpm, 0.0, f64::INFINITY)?;
+        check_positive("state_limits.spindle_rpm[0] [rpm]", self.spindle_rpm[0])?;
+        range("feed [m/s]", self.feed, 0.0, f64::INFINITY)?;
+        range(
+            "redundancy_angle [rad]",
+            self.redundancy_angle,
+            -PI - 1e-12,
+            PI + 1e-12,
+        )?;
+        check_positive("state_limits.max_feed_step [m/s]", self.max_feed_step)?;
+        check_positive(
+            "state_limits.max_spindle_step_rpm [rpm]",
+            self.max_spindle_step_rpm,
+        )?;
+        check_positive(
+            "state_limits.max_redundancy_step [rad]",
+            self.max_redundancy_step,
+        )?;
+        Ok(())
+    }
+}
+
+/// Derived cells: the same robot, TCP, dynamics model, characteristic
+/// length, reference joints and chatter settings with another path,
+/// process or state limits (a planner request that overrides part of the
+/// cell file).
+impl MillCell {
+    /// This cell with another milling path.
+    ///
+    /// The characteristic length L of eq. 14 stays this cell's: L is a
+    /// normalization constant of the Jacobian (Angeles' choice minimizes
+    /// the mean K over the cell file's task); for another path it still
+    /// gives a valid, comparable condition number, though no longer the
+    /// minimizing one — recompute it with [`crate::characteristic_length`]
+    /// and a new cell file when that matters.
+    ///
+    /// # Errors
+    /// Those of [`MillingPath::new`]: too few, non-finite or repeated
+    /// points, N = 0, [`MillError::NotCoplanar`] with the worst point and
+    /// its distance, a non-converged arc length.
+    ///
+    /// # Performance
+    /// One spline fit and the arc-length table (about a millisecond), plus
+    /// a clone of the cell.
+    pub fn with_path(&self, spec: &PathSpec) -> Result<MillCell, MillError> {
+        let path = MillingPath::new(spec)?;
+        Ok(Self {
+            path,
+            ..self.clone()
+        })
+    }
+
+    /// This cell with another milling process (tool, cutting coefficients,
+    /// engagement).
+    ///
+    /// # Errors
+    /// [`MillError::Chatter`] when [`MillingProcess::validate`] refuses it.
+    pub fn with_process(&self, process: MillingProcess) -> Result<MillCell, MillError> {
+        process.validate()?;
+        Ok(Self {
+            process,
+            ..self.clone()
+        })
+    }
+
+    /// This cell with other state ranges and step bounds, validated by
+    /// [`StateLimits::validate`] (the rules of the cell YAML).
+    ///
+    /// # Errors
+    /// [`MillError::InvalidParameter`] naming the field.
+    pub fn with_state_limits(&self, limits: StateLimits) -> Result<MillCell, MillError> {
+        limits.validate()?;
+        Ok(Self {
+            limits,
+            ..self.clone()
+        })
+    }
+
+    /// The tool-tip pose at arc length `s` along the path and redundancy
+    /// angle `g`: `[R0 · RotZ(g), P(u(s))]` with the tangent of
+    /// [`MillingPath::tool_pose`] taken at u(s) (the derivative P'(u)
+    /// projected on the path plane). At a segment's arc-length midpoint it
+    /// is that segment's [`MillingPath::tool_pose`].
+    ///
+    /// # Errors
+    /// [`MillError::InvalidParameter`] for s outside [0, total length] or a
+    /// non-finite g; [`MillError::NotConverged`] from the arc-length
+    /// inversion; [`MillError::Singular`] for a zero tangent.
+    pub fn tool_pose_at(&self, s: f64, g: f64) -> Result<Isometry3<f64>, MillError> {
+        let g = check_finite("redundancy angle g [rad]", g)?;
+        let u = self.path.parameter_at(s)?;
+        let p = self.path.point(u)?;
+        let n = self.path.normal();
+        let d = self.path.derivative(u)?;
+        let d = d - d.dot(&n) * n;
+        let norm = d.norm();
+        if norm.is_nan() || norm <= 0.0 {
+            return Err(MillError::Singular {
+                what: format!("path tangent at arc length {s} m (zero speed)"),
+            });
+        }
+        Ok(crate::path::tool_pose(
+            &p,
+            &(d / norm),
+            &self.path.approach(),
+            g,
+        ))
+    }
+
+    /// The joint vector at arc length `s` and redundancy angle `g`: the
+    /// valid IK solution of [`MillCell::tool_pose_at`] nearest `reference`
+    /// (the YAML's reference joints for `None`), as [`MillCell::evaluate`]
+    /// does at segment midpoints.
+    ///
+    /// # Errors
+    /// As [`MillCell::tool_pose_at`]; [`MillError::InvalidParameter`] for g
+    /// outside the configured range; [`MillError::Unreachable`] /
+    /// [`MillError::JointLimit`] with g (no segment).
+    pub fn joints_at(
+        &self,
+        s: f64,
+        g: f64,
+        reference: Option<&[f64; 6]>,
+    ) -> Result<[f64; 6], MillError> {
+        let [lo, hi] = self.limits.redundancy_angle;
+        if !(g >= lo - 1e-12 && g <= hi + 1e-12) {
+            return Err(MillError::InvalidParameter {
+                name: "redundancy angle g [rad]".to_string(),
+                value: g,
+                reason: format!("must be in [{lo}, {hi}]"),
+            });
+        }
+        let pose = self.tool_pose_at(s, g)?;
+        self.kinematics
+            .ik_nearest(&pose, reference.unwrap_or(&self.reference))
+            .map_err(|e| e.with_context(None, Some(g)))
+    }
+}
