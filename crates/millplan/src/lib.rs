@@ -17,6 +17,10 @@ pub mod naive;
 pub mod plan;
 pub mod reward;
 
+// The planner node's ROS-free front half: requests and planning.
+pub mod planner;
+pub mod request;
+
 // DDPG (seed 004 Algorithm 1, Table 2) on candle.
 pub mod ddpg;
 pub mod nets;
@@ -37,4 +41,8 @@ pub use dp::{DpResult, DpSpec};
 pub use env::{EnvConfig, MillEnv, PhysicalState, Rollout, StepInfo};
 pub use naive::NaiveResult;
 pub use plan::{comparison_table, ComparisonRow, Plan};
+pub use planner::{
+    default_policy_path, status_of, JointTrajectory, MillPlanOutput, MillPlanner, TrajectoryPoint,
+};
+pub use request::{MillRequest, PlannerKind};
 pub use reward::{RewardParts, RewardWeights};

@@ -1,0 +1,546 @@
+//! The milling planner's request (issue 5 section 4): the schema of the
+//! node's YAML text topic and of `kerf plan mill --request FILE`, with its
+//! validation (issue 5 section 5, "bad input").
+//!
+//! # Schema (YAML or JSON; unknown fields are refused)
+//!
+//! ```yaml
+//! request_id: job-17
+//! points: [[1.4, -0.3, 1.7], [1.6, -0.1, 1.7], [1.8, 0.1, 1.7], [2.1, 0.3, 1.7]]  # m, coplanar
+//! segments: 100            # optional, default: the cell's (100)
+//! process:                 # optional, all fields when given
+//!   {teeth: 2, tool_radius: 0.04, axial_depth: 0.003, kt: 6.44e8, kn: 2.37e8,
+//!    entry_angle: 2.356194490192345, exit_angle: 3.141592653589793}   # m, N/m^2, rad
+//! limits:                  # optional, each field optional (the cell's otherwise)
+//!   spindle_rpm: [2000, 4000]
+//!   feed: [0.0, 0.06]                 # m/s
+//!   redundancy_angle: [-3.14, 3.14]   # rad
+//!   step_bounds: {spindle_rpm: 20, feed: 0.001, redundancy_angle: 0.2}
+//! initial: {spindle_rpm: 2000, feed: 0.04, g: 0.0}   # optional, each field optional
+//! planner: ddpg            # ddpg | fixed_g | dp | naive (default ddpg)
+//! policy_file: crates/millplan/policies/ddpg.safetensors   # optional
+//! ```
+//!
+//! The path is machined from the +z side ([`REQUEST_UP`], tool pointing
+//! down into a horizontal plane), as in the default cell file; the
+//! request does not change the robot, the TCP, the dynamics model or the
+//! chatter settings of the cell.
+
+use std::f64::consts::PI;
+use std::path::Path;
+
+use kerf_chatter::{ChatterError, MillingProcess};
+use kerf_mill::{MillingPath, PathSpec, StateLimits};
+use serde::{Deserialize, Serialize};
+
+use crate::error::MillPlanError;
+
+/// The side the tool comes from for a request's path (the plane normal is
+/// oriented towards it and the tool approaches against it).
+pub const REQUEST_UP: [f64; 3] = [0.0, 0.0, 1.0];
+
+/// Default initial spindle speed \[rpm\] (seed 004's IVP Ω0).
+pub const DEFAULT_INITIAL_RPM: f64 = 2000.0;
+/// Default initial feed [m/s] (seed 004's IVP f0).
+pub const DEFAULT_INITIAL_FEED: f64 = 0.04;
+/// Default initial redundancy angle \[rad\] (seed 004's IVP g0).
+pub const DEFAULT_INITIAL_G: f64 = 0.0;
+
+/// Which planner answers a request.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum PlannerKind {
+    /// Greedy rollout of a DDPG policy with the redundancy angle free.
+    Ddpg,
+    /// Greedy rollout of a DDPG policy trained with g fixed at g0 (the
+    /// paper's ablation).
+    FixedG,
+    /// The dynamic-programming optimum ([`crate::dp`]).
+    Dp,
+    /// Constant spindle speed and feed ([`crate::naive`]).
+    Naive,
+}
+
+impl PlannerKind {
+    /// Every planner, in the order of the comparison table.
+    pub const ALL: [PlannerKind; 4] = [Self::Ddpg, Self::FixedG, Self::Dp, Self::Naive];
+
+    /// The name used in requests (`ddpg`, `fixed_g`, `dp`, `naive`).
+    pub fn name(&self) -> &'static str {
+        match self {
+            Self::Ddpg => "ddpg",
+            Self::FixedG => "fixed_g",
+            Self::Dp => "dp",
+            Self::Naive => "naive",
+        }
+    }
+
+    /// Parses a request's `planner` field.
+    ///
+    /// # Errors
+    /// [`MillPlanError::InvalidConfig`] naming `planner` and the accepted
+    /// names.
+    pub fn parse(name: &str) -> Result<Self, MillPlanError> {
+        Self::ALL
+            .into_iter()
+            .find(|k| k.name() == name)
+            .ok_or_else(|| MillPlanError::InvalidConfig {
+                name: "planner".to_string(),
+                reason: format!("unknown planner `{name}`: must be ddpg, fixed_g, dp or naive"),
+            })
+    }
+}
+
+/// The milling process of a request (all fields required when the section
+/// is given).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RequestProcess {
+    /// Number of teeth.
+    pub teeth: usize,
+    /// Tool radius \[m\].
+    pub tool_radius: f64,
+    /// Axial depth of cut \[m\].
+    pub axial_depth: f64,
+    /// Tangential cutting coefficient K_t [N/m²].
+    pub kt: f64,
+    /// Normal cutting coefficient K_n [N/m²].
+    pub kn: f64,
+    /// Entry immersion angle \[rad\].
+    pub entry_angle: f64,
+    /// Exit immersion angle \[rad\].
+    pub exit_angle: f64,
+}
+
+impl RequestProcess {
+    /// As a `kerf_chatter` process.
+    pub fn to_process(&self) -> MillingProcess {
+        MillingProcess {
+            teeth: self.teeth,
+            radius: self.tool_radius,
+            axial_depth: self.axial_depth,
+            kt: self.kt,
+            kn: self.kn,
+            entry_angle: self.entry_angle,
+            exit_angle: self.exit_angle,
+        }
+    }
+}
+
+/// Per-step bounds of a request (each optional: the cell's otherwise).
+#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RequestStepBounds {
+    /// |ΔΩ| per segment \[rpm\].
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub spindle_rpm: Option<f64>,
+    /// |Δf| per segment [m/s].
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub feed: Option<f64>,
+    /// |Δg| per segment \[rad\].
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub redundancy_angle: Option<f64>,
+}
+
+/// State ranges and step bounds of a request (each optional).
+#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RequestLimits {
+    /// Spindle speed [min, max] \[rpm\].
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub spindle_rpm: Option<[f64; 2]>,
+    /// Feed [min, max] [m/s].
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub feed: Option<[f64; 2]>,
+    /// Redundancy angle [min, max] \[rad\].
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub redundancy_angle: Option<[f64; 2]>,
+    /// Per-step bounds.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub step_bounds: Option<RequestStepBounds>,
+}
+
+impl RequestLimits {
+    /// `base` with the fields this request gives replaced.
+    pub fn apply(&self, base: &StateLimits) -> StateLimits {
+        let steps = self.step_bounds.unwrap_or_default();
+        StateLimits {
+            spindle_rpm: self.spindle_rpm.unwrap_or(base.spindle_rpm),
+            feed: self.feed.unwrap_or(base.feed),
+            redundancy_angle: self.redundancy_angle.unwrap_or(base.redundancy_angle),
+            max_feed_step: steps.feed.unwrap_or(base.max_feed_step),
+            max_spindle_step_rpm: steps.spindle_rpm.unwrap_or(base.max_spindle_step_rpm),
+            max_redundancy_step: steps.redundancy_angle.unwrap_or(base.max_redundancy_step),
+        }
+    }
+}
+
+/// The initial state (each field optional: seed 004's IVP otherwise).
+#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RequestInitial {
+    /// Ω0 \[rpm\] (default 2000).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub spindle_rpm: Option<f64>,
+    /// f0 [m/s] (default 0.04).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub feed: Option<f64>,
+    /// g0 \[rad\] (default 0).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub g: Option<f64>,
+}
+
+/// A milling planning request (module documentation).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct MillRequest {
+    /// Caller's identifier, echoed in the answer.
+    #[serde(default)]
+    pub request_id: String,
+    /// The coplanar path points \[m\], base frame, interpolated by a cubic
+    /// B-spline (seed 004 section 4).
+    pub points: Vec<[f64; 3]>,
+    /// Number of equal-arc-length segments (the cell's when absent).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub segments: Option<usize>,
+    /// Milling process (the cell's when absent).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub process: Option<RequestProcess>,
+    /// State ranges and step bounds (the cell's when absent).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub limits: Option<RequestLimits>,
+    /// Initial state (seed 004's IVP when absent).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub initial: Option<RequestInitial>,
+    /// `ddpg`, `fixed_g`, `dp` or `naive`.
+    #[serde(default = "default_planner")]
+    pub planner: String,
+    /// The policy file of `ddpg`/`fixed_g` (relative paths: to the working
+    /// directory); the planner's default policy when absent.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub policy_file: Option<String>,
+}
+
+fn default_planner() -> String {
+    PlannerKind::Ddpg.name().to_string()
+}
+
+impl Default for MillRequest {
+    /// The seed 004 path (the default cell's points), no overrides, planner
+    /// `ddpg`.
+    fn default() -> Self {
+        Self {
+            request_id: String::new(),
+            points: PathSpec::default().points,
+            segments: None,
+            process: None,
+            limits: None,
+            initial: None,
+            planner: default_planner(),
+            policy_file: None,
+        }
+    }
+}
+
+fn check_finite(name: &str, v: f64) -> Result<(), MillPlanError> {
+    if v.is_finite() {
+        Ok(())
+    } else {
+        Err(MillPlanError::InvalidParameter {
+            name: name.to_string(),
+            value: v,
+            reason: "must be finite (NaN and infinities are refused)".to_string(),
+        })
+    }
+}
+
+fn check_range(name: &str, r: [f64; 2], lo: f64, hi: f64) -> Result<(), MillPlanError> {
+    for (i, v) in r.iter().enumerate() {
+        check_finite(&format!("{name}[{i}]"), *v)?;
+    }
+    if r[0] > r[1] {
+        return Err(MillPlanError::InvalidParameter {
+            name: format!("{name}[0]"),
+            value: r[0],
+            reason: format!("min > max ({name}[1] = {})", r[1]),
+        });
+    }
+    if r[0] == r[1] {
+        return Err(MillPlanError::InvalidParameter {
+            name: format!("{name}[1]"),
+            value: r[1],
+            reason: "must be > min (an empty range)".to_string(),
+        });
+    }
+    if r[0] < lo {
+        return Err(MillPlanError::InvalidParameter {
+            name: format!("{name}[0]"),
+            value: r[0],
+            reason: format!("must be >= {lo}"),
+        });
+    }
+    if r[1] > hi {
+        return Err(MillPlanError::InvalidParameter {
+            name: format!("{name}[1]"),
+            value: r[1],
+            reason: format!("must be <= {hi}"),
+        });
+    }
+    Ok(())
+}
+
+fn check_step(name: &str, v: Option<f64>) -> Result<(), MillPlanError> {
+    match v {
+        Some(v) if !(v.is_finite() && v > 0.0) => Err(MillPlanError::InvalidParameter {
+            name: name.to_string(),
+            value: v,
+            reason: "step bounds must be finite and > 0".to_string(),
+        }),
+        _ => Ok(()),
+    }
+}
+
+impl MillRequest {
+    /// Parses YAML (or JSON, a subset of YAML) text.
+    ///
+    /// # Errors
+    /// [`MillPlanError::InvalidConfig`] naming `request` with the parser's
+    /// message (unknown or missing field, wrong type, with line and column).
+    pub fn from_yaml_str(text: &str) -> Result<Self, MillPlanError> {
+        serde_yaml_ng::from_str(text).map_err(|e| MillPlanError::InvalidConfig {
+            name: "request".to_string(),
+            reason: e.to_string(),
+        })
+    }
+
+    /// Parses JSON text.
+    ///
+    /// # Errors
+    /// As [`MillRequest::from_yaml_str`].
+    pub fn from_json_str(text: &str) -> Result<Self, MillPlanError> {
+        serde_json::from_str(text).map_err(|e| MillPlanError::InvalidConfig {
+            name: "request".to_string(),
+            reason: e.to_string(),
+        })
+    }
+
+    /// Reads a request file: JSON when the name ends in `.json`, YAML
+    /// otherwise.
+    ///
+    /// # Errors
+    /// [`MillPlanError::Io`] when unreadable; the parse errors above.
+    pub fn from_file(path: &Path) -> Result<Self, MillPlanError> {
+        let text = std::fs::read_to_string(path).map_err(|e| MillPlanError::Io {
+            path: path.display().to_string(),
+            message: e.to_string(),
+        })?;
+        if path.extension().is_some_and(|e| e == "json") {
+            Self::from_json_str(&text)
+        } else {
+            Self::from_yaml_str(&text)
+        }
+    }
+
+    /// The request as YAML.
+    ///
+    /// # Errors
+    /// [`MillPlanError::InvalidConfig`] if serialization fails.
+    pub fn to_yaml_string(&self) -> Result<String, MillPlanError> {
+        serde_yaml_ng::to_string(self).map_err(|e| MillPlanError::InvalidConfig {
+            name: "request".to_string(),
+            reason: e.to_string(),
+        })
+    }
+
+    /// The planner named by the request.
+    ///
+    /// # Errors
+    /// [`PlannerKind::parse`].
+    pub fn planner_kind(&self) -> Result<PlannerKind, MillPlanError> {
+        PlannerKind::parse(&self.planner)
+    }
+
+    /// The initial state (Ω0 \[rpm\], f0 [m/s], g0 \[rad\]) with the defaults
+    /// filled in.
+    pub fn initial_state(&self) -> [f64; 3] {
+        let i = self.initial.unwrap_or_default();
+        [
+            i.spindle_rpm.unwrap_or(DEFAULT_INITIAL_RPM),
+            i.feed.unwrap_or(DEFAULT_INITIAL_FEED),
+            i.g.unwrap_or(DEFAULT_INITIAL_G),
+        ]
+    }
+
+    /// The path of the request with `default_segments` when it gives none
+    /// (tool from [`REQUEST_UP`]).
+    pub fn path_spec(&self, default_segments: usize) -> PathSpec {
+        PathSpec {
+            points: self.points.clone(),
+            segments: self.segments.unwrap_or(default_segments),
+            approach_from_above: true,
+            up: REQUEST_UP,
+        }
+    }
+
+    /// Checks everything that does not need the cell: at least 2 points,
+    /// every number finite, no repeated consecutive points, the points
+    /// coplanar (`kerf_mill`'s path validation: the worst point and its
+    /// distance), `segments` ≥ 1, the process, every limit with
+    /// min < max, step bounds > 0, the planner's name, and the initial
+    /// state against the limits the request gives. [`Self::validate_with`]
+    /// also checks the initial state against the cell's limits.
+    ///
+    /// # Errors
+    /// [`MillPlanError::InvalidParameter`] / [`MillPlanError::InvalidConfig`]
+    /// naming the field and index (e.g. `points[2][1] [m]`,
+    /// `limits.feed[0]`); [`MillPlanError::Mill`] with
+    /// [`kerf_mill::MillError::NotCoplanar`] for points off a plane.
+    ///
+    /// # Performance
+    /// Builds the spline once with one segment (well under a millisecond
+    /// for a few points).
+    pub fn validate(&self) -> Result<(), MillPlanError> {
+        if self.points.len() < 2 {
+            return Err(MillPlanError::InvalidParameter {
+                name: "points (count)".to_string(),
+                value: self.points.len() as f64,
+                reason: "a path needs at least 2 points".to_string(),
+            });
+        }
+        for (i, p) in self.points.iter().enumerate() {
+            for (c, v) in p.iter().enumerate() {
+                check_finite(&format!("points[{i}][{c}] [m]"), *v)?;
+            }
+        }
+        for (i, w) in self.points.windows(2).enumerate() {
+            let d = ((w[1][0] - w[0][0]).powi(2)
+                + (w[1][1] - w[0][1]).powi(2)
+                + (w[1][2] - w[0][2]).powi(2))
+            .sqrt();
+            if d <= kerf_mill::path::REPEAT_TOL {
+                return Err(MillPlanError::InvalidParameter {
+                    name: format!("points[{}]", i + 1),
+                    value: d,
+                    reason: format!("repeats points[{i}] (distance shown)"),
+                });
+            }
+        }
+        if self.segments == Some(0) {
+            return Err(MillPlanError::InvalidParameter {
+                name: "segments".to_string(),
+                value: 0.0,
+                reason: "must be >= 1".to_string(),
+            });
+        }
+        // Coplanarity (and everything else of the path) by kerf_mill.
+        MillingPath::new(&self.path_spec(1))?;
+        if let Some(p) = &self.process {
+            for (name, v) in [
+                ("process.tool_radius [m]", p.tool_radius),
+                ("process.axial_depth [m]", p.axial_depth),
+                ("process.kt [N/m^2]", p.kt),
+                ("process.kn [N/m^2]", p.kn),
+                ("process.entry_angle [rad]", p.entry_angle),
+                ("process.exit_angle [rad]", p.exit_angle),
+            ] {
+                check_finite(name, v)?;
+            }
+            p.to_process().validate().map_err(|e| match e {
+                ChatterError::InvalidParameter {
+                    name,
+                    value,
+                    reason,
+                } => MillPlanError::InvalidParameter {
+                    name: format!("process ({name})"),
+                    value,
+                    reason,
+                },
+                other => MillPlanError::InvalidConfig {
+                    name: "process".to_string(),
+                    reason: other.to_string(),
+                },
+            })?;
+        }
+        if let Some(l) = &self.limits {
+            if let Some(r) = l.spindle_rpm {
+                check_range("limits.spindle_rpm [rpm]", r, f64::MIN_POSITIVE, f64::MAX)?;
+            }
+            if let Some(r) = l.feed {
+                check_range("limits.feed [m/s]", r, 0.0, f64::MAX)?;
+            }
+            if let Some(r) = l.redundancy_angle {
+                check_range("limits.redundancy_angle [rad]", r, -PI - 1e-12, PI + 1e-12)?;
+            }
+            if let Some(s) = l.step_bounds {
+                check_step("limits.step_bounds.spindle_rpm [rpm]", s.spindle_rpm)?;
+                check_step("limits.step_bounds.feed [m/s]", s.feed)?;
+                check_step(
+                    "limits.step_bounds.redundancy_angle [rad]",
+                    s.redundancy_angle,
+                )?;
+            }
+        }
+        let [rpm, feed, g] = self.initial_state();
+        check_finite("initial.spindle_rpm [rpm]", rpm)?;
+        check_finite("initial.feed [m/s]", feed)?;
+        check_finite("initial.g [rad]", g)?;
+        if feed <= 0.0 {
+            return Err(MillPlanError::InvalidParameter {
+                name: "initial.feed [m/s]".to_string(),
+                value: feed,
+                reason: "must be > 0 (a zero feed never finishes a segment)".to_string(),
+            });
+        }
+        self.planner_kind()?;
+        if let Some(l) = &self.limits {
+            self.check_initial(&l.apply(&StateLimits {
+                spindle_rpm: [f64::MIN, f64::MAX],
+                feed: [f64::MIN, f64::MAX],
+                redundancy_angle: [f64::MIN, f64::MAX],
+                max_feed_step: 1.0,
+                max_spindle_step_rpm: 1.0,
+                max_redundancy_step: 1.0,
+            }))?;
+        }
+        Ok(())
+    }
+
+    /// [`Self::validate`], then the initial state against the effective
+    /// limits (the request's over `cell_limits`), and those limits by the
+    /// cell's rules.
+    ///
+    /// # Errors
+    /// As [`Self::validate`]; [`MillPlanError::InvalidParameter`] naming
+    /// `initial.<field>` when the initial state is outside the limits.
+    pub fn validate_with(&self, cell_limits: &StateLimits) -> Result<(), MillPlanError> {
+        self.validate()?;
+        let limits = self.effective_limits(cell_limits);
+        limits.validate()?;
+        self.check_initial(&limits)
+    }
+
+    /// The request's limits over `cell_limits`.
+    pub fn effective_limits(&self, cell_limits: &StateLimits) -> StateLimits {
+        match &self.limits {
+            Some(l) => l.apply(cell_limits),
+            None => *cell_limits,
+        }
+    }
+
+    fn check_initial(&self, limits: &StateLimits) -> Result<(), MillPlanError> {
+        let [rpm, feed, g] = self.initial_state();
+        for (name, v, r) in [
+            ("initial.spindle_rpm [rpm]", rpm, limits.spindle_rpm),
+            ("initial.feed [m/s]", feed, limits.feed),
+            ("initial.g [rad]", g, limits.redundancy_angle),
+        ] {
+            if !(v >= r[0] && v <= r[1]) {
+                return Err(MillPlanError::InvalidParameter {
+                    name: name.to_string(),
+                    value: v,
+                    reason: format!("outside the limits [{}, {}]", r[0], r[1]),
+                });
+            }
+        }
+        Ok(())
+    }
+}
