@@ -1,0 +1,265 @@
+//! The milling planner end to end (kerf_millplan::planner): the naive, DP
+//! and DDPG planners on the default request give plans whose joint
+//! trajectory is timed by the planned feeds and follows the path, whose
+//! |μ|max is the direct evaluation, and whose DDPG states are the policy's
+//! greedy rollout.
+
+use std::path::PathBuf;
+use std::sync::{Arc, OnceLock};
+
+use kerf_mill::MillCell;
+use kerf_millplan::cache::direct_indicator;
+use kerf_millplan::request::{RequestLimits, RequestProcess};
+use kerf_millplan::{
+    status_of, train, DdpgSettings, EnvConfig, Environment, MillEnv, MillPlanError, MillPlanOutput,
+    MillPlanner, MillRequest, PlannerKind, Policy,
+};
+
+fn planner() -> &'static MillPlanner {
+    static P: OnceLock<MillPlanner> = OnceLock::new();
+    P.get_or_init(|| MillPlanner::with_default_cell().expect("planner"))
+}
+
+fn temp_dir(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!(
+        "kerf_millplan_planner_{name}_{}",
+        std::process::id()
+    ));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).expect("temp dir");
+    dir
+}
+
+/// The checks every plan of the default path must pass.
+fn check_plan(cell: &MillCell, out: &MillPlanOutput) {
+    let plan = &out.plan;
+    let n = cell.path().segments().len();
+    assert_eq!(plan.segments.len(), n);
+    // Trajectory: joint names, N + 2 points, times strictly increasing from
+    // 0 to the machining time Σ l/f (recomputed here from the path).
+    let traj = &out.trajectory;
+    let names: Vec<String> = (1..=6).map(|i| format!("joint_{i}")).collect();
+    assert_eq!(traj.joint_names, names);
+    assert_eq!(traj.points.len(), n + 2);
+    assert_eq!(traj.points[0].time_from_start, 0.0);
+    for w in traj.points.windows(2) {
+        assert!(w[1].time_from_start > w[0].time_from_start);
+        assert!(w[1].arc_length > w[0].arc_length);
+    }
+    let sum: f64 = plan
+        .segments
+        .iter()
+        .map(|s| cell.path().segments()[s.segment].length / s.feed)
+        .sum();
+    let end = traj.points[n + 1].time_from_start;
+    assert!((end - sum).abs() < 1e-9 * sum, "{end} vs {sum}");
+    assert!((plan.total_time - sum).abs() < 1e-9 * sum);
+    // Midpoint k reached at Σ_{j<k} l_j/f_j + l_k/(2 f_k).
+    let mut elapsed = 0.0;
+    for (k, s) in plan.segments.iter().enumerate() {
+        let l = cell.path().segments()[k].length;
+        let t = traj.points[k + 1].time_from_start;
+        assert!((t - (elapsed + 0.5 * l / s.feed)).abs() < 1e-9);
+        elapsed += l / s.feed;
+        assert_eq!(traj.points[k + 1].positions, s.joints);
+    }
+    // The tool tip follows the path: FK at the midpoints, start and end.
+    let kin = cell.kinematics();
+    let mut worst = 0.0f64;
+    for (k, p) in traj.points.iter().enumerate() {
+        let tip = kin.tcp_pose(&p.positions).expect("fk").translation.vector;
+        let expected = if k == 0 {
+            cell.path().point(0.0).expect("start")
+        } else if k == n + 1 {
+            cell.path().point(1.0).expect("end")
+        } else {
+            cell.path().segments()[k - 1].mid
+        };
+        worst = worst.max((tip - expected).norm());
+    }
+    assert!(worst < 1e-9, "tool tip off the path by {worst} m");
+    // Velocities: the three-point derivative is the h-weighted mean of the
+    // two one-sided slopes (an equivalent closed form).
+    for k in 1..=n {
+        let (a, b, c) = (&traj.points[k - 1], &traj.points[k], &traj.points[k + 1]);
+        let (h1, h2) = (
+            b.time_from_start - a.time_from_start,
+            c.time_from_start - b.time_from_start,
+        );
+        for j in 0..6 {
+            let s1 = (b.positions[j] - a.positions[j]) / h1;
+            let s2 = (c.positions[j] - b.positions[j]) / h2;
+            let v = (h2 * s1 + h1 * s2) / (h1 + h2);
+            assert!((b.velocities[j] - v).abs() <= 1e-9 * (1.0 + v.abs()));
+        }
+    }
+    // |μ|max of every segment is the direct evaluation (branch-continuous
+    // IK), and the totals are those of the segments.
+    let mut reference: Option<[f64; 6]> = None;
+    let mut max_mu = 0.0f64;
+    for s in &plan.segments {
+        let mu = direct_indicator(cell, s.segment, s.rpm, s.feed, s.g, reference.as_ref())
+            .expect("direct")
+            .expect("feasible");
+        assert_eq!(mu, s.spectral_radius, "segment {}", s.segment);
+        max_mu = max_mu.max(mu);
+        reference = Some(s.joints);
+    }
+    assert_eq!(plan.max_spectral_radius, max_mu);
+    assert_eq!(plan.chatter_free, max_mu < 1.0);
+    assert!(out.branch_jumps.is_empty(), "{:?}", out.branch_jumps);
+}
+
+#[test]
+fn naive_on_the_default_request() {
+    let request = MillRequest {
+        request_id: "naive-1".to_string(),
+        planner: "naive".to_string(),
+        ..MillRequest::default()
+    };
+    let out = planner().plan(&request).expect("naive plan");
+    assert_eq!(out.request_id, "naive-1");
+    assert_eq!(out.planner, PlannerKind::Naive);
+    assert!(out.cache_used);
+    check_plan(planner().cell(), &out);
+    let s0 = out.plan.segments[0];
+    assert!(out
+        .plan
+        .segments
+        .iter()
+        .all(|s| (s.rpm, s.feed, s.g) == (s0.rpm, s0.feed, 0.0)));
+    println!(
+        "naive: {} rpm, {} m/s, time {:.3} s, max |mu| {:.4}, {:.2} s",
+        s0.rpm, s0.feed, out.plan.total_time, out.plan.max_spectral_radius, out.planning_seconds
+    );
+}
+
+#[test]
+fn dp_on_the_default_request_and_with_narrower_limits() {
+    let request = MillRequest {
+        planner: "dp".to_string(),
+        ..MillRequest::default()
+    };
+    let out = planner().plan(&request).expect("dp plan");
+    assert!(out.cache_used);
+    check_plan(planner().cell(), &out);
+    let segs = &out.plan.segments;
+    assert_eq!((segs[0].rpm, segs[0].feed, segs[0].g), (2000.0, 0.04, 0.0));
+    for w in segs.windows(2) {
+        assert!((w[1].rpm - w[0].rpm).abs() <= 20.0 + 1e-9);
+        assert!((w[1].feed - w[0].feed).abs() <= 1e-3 + 1e-12);
+        assert!((w[1].g - w[0].g).abs() <= 0.2 + 1e-12);
+    }
+    println!(
+        "dp: time {:.3} s, max |mu| {:.4}, reward {:.3}, {:.2} s",
+        out.plan.total_time,
+        out.plan.max_spectral_radius,
+        out.plan.total_reward,
+        out.planning_seconds
+    );
+    // Limits only: the cache still applies and the plan keeps the limits.
+    let narrow = MillRequest {
+        limits: Some(RequestLimits {
+            spindle_rpm: Some([2000.0, 2200.0]),
+            feed: Some([0.02, 0.05]),
+            redundancy_angle: Some([-1.0, 1.0]),
+            step_bounds: None,
+        }),
+        ..request.clone()
+    };
+    let out2 = planner().plan(&narrow).expect("narrow dp");
+    assert!(out2.cache_used);
+    assert!(out2.plan.segments.iter().all(|s| s.rpm <= 2200.0
+        && (0.02..=0.05).contains(&s.feed)
+        && (-1.0..=1.0).contains(&s.g)));
+    // A narrower feed range cannot be faster.
+    assert!(out2.plan.total_time >= out.plan.total_time - 1e-9);
+    // Another process: the cache does not apply; dp refuses clearly.
+    let mut process = planner().cell().milling_process();
+    process.radius = 0.03;
+    let other = MillRequest {
+        process: Some(RequestProcess {
+            teeth: process.teeth,
+            tool_radius: process.radius,
+            axial_depth: process.axial_depth,
+            kt: process.kt,
+            kn: process.kn,
+            entry_angle: process.entry_angle,
+            exit_angle: process.exit_angle,
+        }),
+        ..request
+    };
+    let e = planner().plan(&other).expect_err("no cache for this cell");
+    assert!(matches!(e, MillPlanError::InvalidConfig { .. }));
+    assert!(e.to_string().contains("changes the path/process"), "{e}");
+    assert_eq!(status_of(&e), 1);
+}
+
+/// A policy trained for 2 episodes on the default cell (tiny network),
+/// saved, then planned through a request: the plan's states are the greedy
+/// rollout of the same policy run here in a fresh environment.
+#[test]
+fn ddpg_and_fixed_g_with_a_policy_trained_in_the_test() {
+    let dir = temp_dir("ddpg");
+    let cell = planner().cell().clone();
+    let cache = planner().cache().cloned();
+    for (kind, fixed_g) in [(PlannerKind::Ddpg, false), (PlannerKind::FixedG, true)] {
+        let config = EnvConfig {
+            fixed_g,
+            ..EnvConfig::default()
+        };
+        let mut env = MillEnv::new(cell.clone(), cache.clone(), config).expect("env");
+        let settings = DdpgSettings::default()
+            .with_episodes(2)
+            .with_hidden_sizes(vec![16, 16])
+            .with_seed(11);
+        let agent = train(&mut env, &settings, &mut |_| {}).expect("training");
+        let mut policy = Policy::from_agent(&agent, "test: default cell").expect("policy");
+        let path = dir.join(format!("{}.safetensors", kind.name()));
+        policy.save(&path).expect("save");
+        let request = MillRequest {
+            planner: kind.name().to_string(),
+            policy_file: Some(path.display().to_string()),
+            ..MillRequest::default()
+        };
+        let out = planner().plan(&request).expect("plan");
+        assert_eq!(out.planner, kind);
+        assert_eq!(out.policy_file.as_deref(), Some(path.as_path()));
+        check_plan(&cell, &out);
+        // The greedy rollout, independently.
+        let loaded = Policy::load(&path).expect("load");
+        let mut env = MillEnv::new(Arc::clone(&cell), cache.clone(), config).expect("env");
+        let mut obs = env.reset().expect("reset");
+        let mut states = vec![env.state().expect("state")];
+        loop {
+            let a = loaded.act(&obs).expect("act");
+            let tr = env.step(&a).expect("step");
+            obs = tr.observation;
+            states.push(env.state().expect("state"));
+            if tr.done {
+                break;
+            }
+        }
+        assert_eq!(states.len(), out.plan.segments.len());
+        for (a, b) in states.iter().zip(&out.plan.segments) {
+            assert_eq!(
+                (a.segment, a.rpm, a.feed, a.g),
+                (b.segment, b.rpm, b.feed, b.g)
+            );
+        }
+        if fixed_g {
+            assert!(out.plan.segments.iter().all(|s| s.g == 0.0));
+        }
+        // Planned again: the cached policy gives the same plan.
+        let again = planner().plan(&request).expect("plan again");
+        assert_eq!(again.plan, out.plan);
+        println!(
+            "{}: time {:.3} s, max |mu| {:.4}, reward {:.3}, {:.3} s",
+            kind.name(),
+            out.plan.total_time,
+            out.plan.max_spectral_radius,
+            out.plan.total_reward,
+            again.planning_seconds
+        );
+    }
+}
