@@ -8,14 +8,19 @@
 //! 2. The request's cell: the default cell with the request's path
 //!    ([`kerf_mill::MillCell::with_path`]), process and limits.
 //! 3. Reachability: every segment must have a feasible redundancy angle
-//!    (the initial g0 first, then a sweep of the g range at its step
-//!    bound); otherwise the cell's error of the least-violating g is
+//!    (the initial g0 first, then 65 equally spaced values of the g
+//!    range); otherwise the cell's error of the least-violating g is
 //!    returned (segment, joint and excess, or the distance beyond reach).
 //!    The initial state itself must be feasible at segment 0.
 //! 4. The planner: `ddpg`/`fixed_g` — greedy rollout of the policy in
 //!    [`MillEnv`] (α and weights of [`MillPlanner::env_config`]); `dp` —
 //!    [`crate::dp::solve`] over the full state ranges from the request's
 //!    initial state; `naive` — [`crate::naive::solve`] at g = g0.
+//!    A policy is applied as it is to any request whose sizes fit: its
+//!    observations are normalized by the REQUEST's limits and number of segments,
+//!    so a policy trained on the default cell is only meaningful for
+//!    requests close to it (a rollout that leaves the feasible set is a
+//!    [`MillPlanError::Policy`] error).
 //! 5. [`Plan::evaluate`]: every segment evaluated directly (|μ|max never
 //!    from the cache), the totals.
 //! 6. The joint trajectory ([`JointTrajectory`]).
@@ -294,8 +299,9 @@ impl MillPlanner {
         self.cache.as_ref()
     }
 
-    /// The policy at `path`, loaded on first use and kept; reloaded when
-    /// the file's modification time or size changes.
+    /// The policy at `path` (relative paths: to the working directory),
+    /// loaded on first use and kept; reloaded when the weights file's
+    /// modification time or size changes.
     ///
     /// # Errors
     /// [`Policy::load`]'s [`MillPlanError::Policy`] errors.
@@ -348,6 +354,10 @@ impl MillPlanner {
     /// # Performance
     /// Dominated by the N direct indicator evaluations of
     /// [`Plan::evaluate`] and, for `dp`, the DP (seconds on the full grid).
+    /// Measured in the dev profile (`tests/planner.rs`, shared 2-core
+    /// machine, default request, cache loaded): ddpg/fixed_g 0.22–0.26 s
+    /// (greedy rollout with the cache plus the direct evaluation of the
+    /// 100 segments), naive 0.41 s, dp 4.8 s.
     pub fn plan(&self, request: &MillRequest) -> Result<MillPlanOutput, MillPlanError> {
         let start = Instant::now();
         let base = *self.cell.state_limits();
@@ -448,20 +458,21 @@ impl MillPlanner {
     }
 }
 
-/// Every segment has a feasible g (g0 first, then the g range swept at its
-/// step bound), and segment 0 is feasible at g0.
+/// Samples of the redundancy-angle range tried per segment by the
+/// reachability check (after g0).
+const REACH_SAMPLES: usize = 64;
+
+/// Every segment has a feasible g (g0 first, then [`REACH_SAMPLES`] + 1
+/// equally spaced values of the g range), and segment 0 is feasible at g0.
 ///
 /// # Errors
 /// The cell's error of the least-violating g of the first segment without
 /// a feasible g (a joint-limit error beats an unreachable one; among
 /// those, the smallest excess or distance).
 fn check_reachable(cell: &MillCell, g0: f64) -> Result<(), MillPlanError> {
-    let lim = cell.state_limits();
-    let [lo, hi] = lim.redundancy_angle;
-    let h = lim.max_redundancy_step;
-    let count = (((hi - lo) / h).floor() as usize).min(10_000);
+    let [lo, hi] = cell.state_limits().redundancy_angle;
     let mut sweep = vec![g0];
-    sweep.extend((0..=count).map(|k| (lo + k as f64 * h).min(hi)));
+    sweep.extend((0..=REACH_SAMPLES).map(|k| lo + (hi - lo) * k as f64 / REACH_SAMPLES as f64));
     let score = |e: &MillError| match e {
         MillError::JointLimit { excess, .. } => *excess,
         MillError::Unreachable {

@@ -39,6 +39,12 @@ use crate::error::MillPlanError;
 /// oriented towards it and the tool approaches against it).
 pub const REQUEST_UP: [f64; 3] = [0.0, 0.0, 1.0];
 
+/// Largest number of path points a request may give.
+pub const MAX_POINTS: usize = 10_000;
+/// Largest number of segments a request may ask for (the planners and the
+/// direct evaluation of a plan scale linearly with it).
+pub const MAX_SEGMENTS: usize = 10_000;
+
 /// Default initial spindle speed \[rpm\] (seed 004's IVP Ω0).
 pub const DEFAULT_INITIAL_RPM: f64 = 2000.0;
 /// Default initial feed [m/s] (seed 004's IVP f0).
@@ -406,6 +412,13 @@ impl MillRequest {
                 reason: "a path needs at least 2 points".to_string(),
             });
         }
+        if self.points.len() > MAX_POINTS {
+            return Err(MillPlanError::InvalidParameter {
+                name: "points (count)".to_string(),
+                value: self.points.len() as f64,
+                reason: format!("at most {MAX_POINTS} points are accepted"),
+            });
+        }
         for (i, p) in self.points.iter().enumerate() {
             for (c, v) in p.iter().enumerate() {
                 check_finite(&format!("points[{i}][{c}] [m]"), *v)?;
@@ -424,12 +437,14 @@ impl MillRequest {
                 });
             }
         }
-        if self.segments == Some(0) {
-            return Err(MillPlanError::InvalidParameter {
-                name: "segments".to_string(),
-                value: 0.0,
-                reason: "must be >= 1".to_string(),
-            });
+        if let Some(n) = self.segments {
+            if n == 0 || n > MAX_SEGMENTS {
+                return Err(MillPlanError::InvalidParameter {
+                    name: "segments".to_string(),
+                    value: n as f64,
+                    reason: format!("must be in 1..={MAX_SEGMENTS}"),
+                });
+            }
         }
         // Coplanarity (and everything else of the path) by kerf_mill.
         MillingPath::new(&self.path_spec(1))?;
@@ -462,7 +477,14 @@ impl MillRequest {
         }
         if let Some(l) = &self.limits {
             if let Some(r) = l.spindle_rpm {
-                check_range("limits.spindle_rpm [rpm]", r, f64::MIN_POSITIVE, f64::MAX)?;
+                check_range("limits.spindle_rpm [rpm]", r, 0.0, f64::MAX)?;
+                if r[0] <= 0.0 {
+                    return Err(MillPlanError::InvalidParameter {
+                        name: "limits.spindle_rpm [rpm][0]".to_string(),
+                        value: r[0],
+                        reason: "must be > 0".to_string(),
+                    });
+                }
             }
             if let Some(r) = l.feed {
                 check_range("limits.feed [m/s]", r, 0.0, f64::MAX)?;

@@ -149,7 +149,12 @@ fn fewer_than_two_points_repeated_points_and_zero_segments() {
         segments: Some(0),
         ..MillRequest::default()
     };
-    expect_invalid(&r, "segments", ">= 1");
+    expect_invalid(&r, "segments", "1..=10000");
+    let r = MillRequest {
+        segments: Some(10_001),
+        ..MillRequest::default()
+    };
+    expect_invalid(&r, "segments", "1..=10000");
 }
 
 /// Square corners in z = 1.7 and the centre lifted by h = 1 mm: the
@@ -256,6 +261,22 @@ fn limits_min_above_max_and_other_limit_errors() {
         }),
         "limits.spindle_rpm [rpm][0]",
         "min > max",
+    );
+    expect_invalid(
+        &with(RequestLimits {
+            spindle_rpm: Some([0.0, 2000.0]),
+            ..RequestLimits::default()
+        }),
+        "limits.spindle_rpm [rpm][0]",
+        "> 0",
+    );
+    expect_invalid(
+        &with(RequestLimits {
+            feed: Some([0.03, 0.03]),
+            ..RequestLimits::default()
+        }),
+        "limits.feed [m/s][1]",
+        "empty range",
     );
     expect_invalid(
         &with(RequestLimits {
