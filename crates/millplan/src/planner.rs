@@ -111,7 +111,8 @@ pub fn status_name(value: u8) -> Option<&'static str> {
 /// | `Chatter`, `Mill(Chatter)` | CHATTER_MODEL_ERROR 4 |
 /// | `Io`, `Backend`, `Mill` of a non-finite value, non-convergence, a file or robot-model failure | INTERNAL_ERROR 6 |
 ///
-/// Value 5 is not produced here (left free by the message).
+/// Value 5 (`QUEUE_FULL` of `kerf_msgs/msg/MillPlan`) belongs to the node
+/// (its request queue) and is not produced here.
 pub fn status_of(error: &MillPlanError) -> u8 {
     match error {
         MillPlanError::InvalidParameter { .. } | MillPlanError::InvalidConfig { .. } => {
