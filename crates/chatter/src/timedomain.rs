@@ -724,17 +724,10 @@ impl RingHistory {
 
 impl History for RingHistory {
     fn at(&self, s: f64) -> Result<(Vector2<f64>, Vector2<f64>), ChatterError> {
-        let u = s / self.step;
-        let k = u.floor();
-        if !k.is_finite() {
-            return Err(ChatterError::NonFinite {
-                what: "delayed time".to_string(),
-            });
-        }
-        let k = k as i64;
+        let (k, frac) = grid_cell(s, self.step)?;
         let (p0, v0) = self.get(k)?;
         let (p1, v1) = self.get(k + 1)?;
-        Ok(hermite(p0, v0, p1, v1, self.step, u - k as f64))
+        Ok(hermite(p0, v0, p1, v1, self.step, frac))
     }
 }
 
@@ -747,15 +740,8 @@ struct PeriodicHistory {
 
 impl History for PeriodicHistory {
     fn at(&self, s: f64) -> Result<(Vector2<f64>, Vector2<f64>), ChatterError> {
-        let u = s / self.step;
-        let k = u.floor();
-        if !k.is_finite() {
-            return Err(ChatterError::NonFinite {
-                what: "delayed time".to_string(),
-            });
-        }
+        let (k0, frac) = grid_cell(s, self.step)?;
         let n = self.pos.len() as i64;
-        let k0 = k as i64;
         let i0 = k0.rem_euclid(n) as usize;
         let i1 = (k0 + 1).rem_euclid(n) as usize;
         let get = |i: usize| {
@@ -767,8 +753,24 @@ impl History for PeriodicHistory {
         };
         let (p0, v0) = get(i0)?;
         let (p1, v1) = get(i1)?;
-        Ok(hermite(p0, v0, p1, v1, self.step, u - k))
+        Ok(hermite(p0, v0, p1, v1, self.step, frac))
     }
+}
+
+/// The grid cell of time `s` on a grid of spacing `step`: the index k of
+/// `t_k = k step ≤ s` and the fraction `(s − t_k)/step` in [0, 1).
+///
+/// # Errors
+/// [`ChatterError::NonFinite`] for a non-finite time.
+fn grid_cell(s: f64, step: f64) -> Result<(i64, f64), ChatterError> {
+    let u = s / step;
+    let k = u.floor();
+    if !k.is_finite() {
+        return Err(ChatterError::NonFinite {
+            what: "delayed time".to_string(),
+        });
+    }
+    Ok((k as i64, u - k))
 }
 
 /// The cutter of seed 004 eq. 2-4 with its force law.
