@@ -187,11 +187,7 @@ impl EquilibriumSettings {
     /// # Errors
     /// [`ChatterError::InvalidParameter`].
     pub fn validate(&self) -> Result<(), ChatterError> {
-        let bad = |name: &str, value: f64, reason: &str| ChatterError::InvalidParameter {
-            name: name.to_string(),
-            value,
-            reason: reason.to_string(),
-        };
+        let bad = ChatterError::invalid;
         if self.points_per_period < 200 {
             return Err(bad(
                 "equilibrium grid points per period",

@@ -42,6 +42,17 @@ pub enum ChatterError {
     },
 }
 
+impl ChatterError {
+    /// [`ChatterError::InvalidParameter`] from borrowed parts.
+    pub fn invalid(name: &str, value: f64, reason: &str) -> Self {
+        Self::InvalidParameter {
+            name: name.to_string(),
+            value,
+            reason: reason.to_string(),
+        }
+    }
+}
+
 /// Checks that `value` is finite and strictly positive.
 ///
 /// # Errors

@@ -544,11 +544,7 @@ fn internal() -> ChatterError {
 }
 
 fn check_settings(s: &SimulationSettings) -> Result<(), ChatterError> {
-    let bad = |name: &str, value: f64, reason: &str| ChatterError::InvalidParameter {
-        name: name.to_string(),
-        value,
-        reason: reason.to_string(),
-    };
+    let bad = ChatterError::invalid;
     if s.steps_per_period < 200 {
         return Err(bad(
             "steps per period",
