@@ -1,0 +1,180 @@
+//! The node's parameters, read once at start-up and checked.
+
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+
+use kerf_mill::MillCell;
+use kerf_millplan::{default_policy_path, IndicatorCache, MillPlanner, PlannerKind};
+use kerf_ros::Params;
+
+use crate::NodeError;
+
+/// Parameter names this node reads; others are refused at start-up.
+pub const KNOWN_PARAMS: &[&str] = &[
+    "cell_file",
+    "indicator_cache_file",
+    "ddpg_policy_file",
+    "fixed_g_policy_file",
+    "queue_depth",
+];
+
+/// Default of `queue_depth`: requests waiting or being planned.
+pub const DEFAULT_QUEUE_DEPTH: usize = 10;
+
+/// Everything the node needs, checked.
+#[derive(Debug)]
+pub struct NodeConfig {
+    /// The planner: the cell, and its indicator cache when one applies.
+    pub planner: MillPlanner,
+    /// Where the cell came from (for the start-up log).
+    pub cell_source: String,
+    /// Whether and from where the indicator cache was loaded, or why not (start-up log).
+    pub cache_note: String,
+    /// The policy of `ddpg` requests that name none.
+    pub ddpg_policy_file: PathBuf,
+    /// The policy of `fixed_g` requests that name none.
+    pub fixed_g_policy_file: PathBuf,
+    /// Requests waiting or being planned before new ones are refused (≥ 1).
+    pub queue_depth: usize,
+}
+
+fn param_err(name: &str, reason: impl Into<String>) -> NodeError {
+    NodeError::Config {
+        name: name.to_string(),
+        reason: reason.into(),
+    }
+}
+
+/// A path parameter: `None` when unset, an error when set to the empty string.
+fn path_param(params: &Params, name: &str) -> Result<Option<PathBuf>, NodeError> {
+    match params.string(name)? {
+        None => Ok(None),
+        Some(s) if s.trim().is_empty() => Err(param_err(
+            name,
+            "is empty; leave it unset for the default, or give a file path",
+        )),
+        Some(s) => Ok(Some(PathBuf::from(s))),
+    }
+}
+
+/// The shipped policy of `kind` (a planner with a policy).
+fn shipped_policy(kind: PlannerKind) -> Result<PathBuf, NodeError> {
+    default_policy_path(kind).ok_or_else(|| {
+        param_err(
+            &format!("{}_policy_file", kind.name()),
+            "kerf_millplan names no shipped policy for this planner",
+        )
+    })
+}
+
+impl NodeConfig {
+    /// Reads and checks every parameter, loads the cell and the indicator cache, and builds
+    /// the planner.
+    ///
+    /// # Parameters
+    /// * `cell_file` (string): the milling cell YAML (robot files, tool, path, dynamics,
+    ///   process, limits, chatter settings); unset = the shipped `urdf/irb6660_milling.yaml`.
+    /// * `indicator_cache_file` (string): the |μ|max cache of the cell
+    ///   (`kerf_millplan::IndicatorCache`). Unset = the shipped
+    ///   `crates/millplan/data/indicator_cache.bin`, used when it was built for this cell and
+    ///   otherwise skipped with a warning (the `dp` and `naive` planners then refuse requests;
+    ///   `ddpg` and `fixed_g` evaluate directly). Set = it must load and fit the cell, else the
+    ///   node does not start.
+    /// * `ddpg_policy_file`, `fixed_g_policy_file` (strings): the policy (safetensors actor)
+    ///   used by `ddpg` / `fixed_g` requests that name none; unset = the shipped
+    ///   `crates/millplan/policies/{ddpg,fixed_g}.safetensors`. The files are read per request
+    ///   (a missing or incompatible one is that request's POLICY_ERROR), so they may be
+    ///   replaced while the node runs.
+    /// * `queue_depth` (integer ≥ 1, default 10): requests waiting or being planned; a request
+    ///   arriving when the queue is full is answered at once with status QUEUE_FULL.
+    ///
+    /// Empty strings are refused (leave a parameter unset for its default). Relative paths
+    /// are relative to the node's working directory.
+    ///
+    /// # Errors
+    /// [`NodeError::Config`] naming the parameter, [`NodeError::Ros`] for a wrong type,
+    /// [`NodeError::Planner`] when the cell or a given cache does not load.
+    pub fn from_params(params: &Params) -> Result<Self, NodeError> {
+        let cell_file = path_param(params, "cell_file")?;
+        let cache_file = path_param(params, "indicator_cache_file")?;
+        let ddpg_policy_file = match path_param(params, "ddpg_policy_file")? {
+            Some(p) => p,
+            None => shipped_policy(PlannerKind::Ddpg)?,
+        };
+        let fixed_g_policy_file = match path_param(params, "fixed_g_policy_file")? {
+            Some(p) => p,
+            None => shipped_policy(PlannerKind::FixedG)?,
+        };
+        let depth = params.i64_or("queue_depth", DEFAULT_QUEUE_DEPTH as i64)?;
+        let queue_depth = usize::try_from(depth)
+            .ok()
+            .filter(|d| *d >= 1)
+            .ok_or_else(|| param_err("queue_depth", format!("must be >= 1, got {depth}")))?;
+
+        let (planner, cell_source, cache_note) = match (cell_file, cache_file) {
+            (None, None) => {
+                // The library's default: the shipped cell, its cache when fresh.
+                let planner = MillPlanner::with_default_cell()?;
+                let path = IndicatorCache::default_path();
+                let note = if planner.cache().is_some() {
+                    format!("indicator cache {}", path.display())
+                } else {
+                    let why = IndicatorCache::load(&path, planner.cell())
+                        .err()
+                        .map(|e| e.to_string())
+                        .unwrap_or_else(|| "it changed while loading".to_string());
+                    format!("no indicator cache (dp and naive unavailable): {why}")
+                };
+                let source = MillCell::default_path().display().to_string();
+                (planner, source, note)
+            }
+            (cell_file, cache_file) => {
+                let cell_path = cell_file.unwrap_or_else(MillCell::default_path);
+                let cell = Arc::new(MillCell::load(&cell_path)?);
+                let (cache, note) = match cache_file {
+                    Some(path) => {
+                        let cache = IndicatorCache::load(&path, &cell)?;
+                        (Some(Arc::new(cache)), cache_source(&path))
+                    }
+                    None => {
+                        let path = IndicatorCache::default_path();
+                        match IndicatorCache::load(&path, &cell) {
+                            Ok(c) => (Some(Arc::new(c)), cache_source(&path)),
+                            Err(e) => (
+                                None,
+                                format!(
+                                    "no indicator cache (dp and naive unavailable): the shipped \
+                                     one does not fit this cell: {e}"
+                                ),
+                            ),
+                        }
+                    }
+                };
+                let planner = MillPlanner::new(cell, cache)?;
+                (planner, cell_path.display().to_string(), note)
+            }
+        };
+        Ok(Self {
+            planner,
+            cell_source,
+            cache_note,
+            ddpg_policy_file,
+            fixed_g_policy_file,
+            queue_depth,
+        })
+    }
+
+    /// The policy a `ddpg` / `fixed_g` request without `policy_file` uses; `None` for the
+    /// planners without a policy.
+    pub fn default_policy(&self, kind: PlannerKind) -> Option<&Path> {
+        match kind {
+            PlannerKind::Ddpg => Some(&self.ddpg_policy_file),
+            PlannerKind::FixedG => Some(&self.fixed_g_policy_file),
+            PlannerKind::Dp | PlannerKind::Naive => None,
+        }
+    }
+}
+
+fn cache_source(path: &Path) -> String {
+    format!("indicator cache {}", path.display())
+}

@@ -1,0 +1,315 @@
+//! Messages ⇄ planner types: `kerf_msgs/msg/MillRequest` → [`kerf_millplan::MillRequest`]
+//! (with the `has_*` flags of the `.msg` file), [`MillPlanOutput`] and [`MillPlanError`] →
+//! `kerf_msgs/msg/MillPlan`.
+//!
+//! Nothing here checks the values themselves: [`kerf_millplan::MillRequest::validate_with`]
+//! (called by the planner) does that and names the field. The conversion only maps the
+//! message's groups onto the request's optional sections and refuses what the message
+//! contract forbids and the request form cannot express (a `policy_file` for `dp` or
+//! `naive`).
+
+use kerf_millplan::{
+    planner::status,
+    request::{RequestInitial, RequestLimits, RequestProcess, RequestStepBounds},
+    MillPlanError, MillPlanOutput, MillRequest, PlannerKind,
+};
+use kerf_msgs::{
+    builtin_interfaces::Duration,
+    msg,
+    std_msgs::Header,
+    trajectory_msgs::{JointTrajectory, JointTrajectoryPoint},
+};
+
+/// Status of a request refused because the queue is full (`MillPlan::QUEUE_FULL`; the
+/// planner library has no such status, it belongs to the node).
+pub const QUEUE_FULL: u8 = msg::MillPlan::QUEUE_FULL;
+
+/// A count for a `uint32` field, saturating at `u32::MAX` (never reached by a plan that fits
+/// in memory).
+fn to_u32(v: usize) -> u32 {
+    u32::try_from(v).unwrap_or(u32::MAX)
+}
+
+/// The planner name of a request's `planner` field as the message means it: empty = `ddpg`.
+pub fn planner_name(field: &str) -> &str {
+    if field.is_empty() {
+        msg::MillRequest::PLANNER_DDPG
+    } else {
+        field
+    }
+}
+
+/// Converts a `MillRequest` message to the planner's request.
+///
+/// * `points` → `points`; `segments` 0 → the cell's (`None`).
+/// * `has_process` → `process` (every field of the group), else `None` (the cell's).
+/// * `has_limits` → `limits` with every range and step bound given, else `None`.
+/// * `has_initial_state` → `initial` with the three values, else `None` (seed 004's IVP).
+/// * `planner` "" → `ddpg`; `policy_file` "" → `None` (the node's default policy).
+///
+/// Every value is passed on unchanged for the planner's validation (NaN, min > max, …).
+///
+/// # Errors
+/// [`MillPlanError::InvalidConfig`] naming `policy_file` when one is given for `dp` or
+/// `naive`, which use no policy (`MillRequest.msg`: "Must be empty for dp and naive").
+pub fn request_from_msg(m: &msg::MillRequest) -> Result<MillRequest, MillPlanError> {
+    let planner = planner_name(&m.planner).to_string();
+    let policy_file = if m.policy_file.is_empty() {
+        None
+    } else {
+        Some(m.policy_file.clone())
+    };
+    if let (Ok(kind @ (PlannerKind::Dp | PlannerKind::Naive)), Some(p)) =
+        (PlannerKind::parse(&planner), &policy_file)
+    {
+        return Err(MillPlanError::InvalidConfig {
+            name: "policy_file".to_string(),
+            reason: format!(
+                "{p:?} was given for planner {}, which uses no policy; leave policy_file empty",
+                kind.name()
+            ),
+        });
+    }
+    let process = m.has_process.then(|| RequestProcess {
+        // u32 always fits usize on the targets kerf supports.
+        teeth: usize::try_from(m.teeth).unwrap_or(usize::MAX),
+        tool_radius: m.tool_radius,
+        axial_depth: m.axial_depth,
+        kt: m.kt,
+        kn: m.kn,
+        entry_angle: m.entry_angle,
+        exit_angle: m.exit_angle,
+    });
+    let limits = m.has_limits.then_some(RequestLimits {
+        spindle_rpm: Some([m.spindle_min_rpm, m.spindle_max_rpm]),
+        feed: Some([m.feed_min, m.feed_max]),
+        redundancy_angle: Some([m.g_min, m.g_max]),
+        step_bounds: Some(RequestStepBounds {
+            spindle_rpm: Some(m.max_spindle_step_rpm),
+            feed: Some(m.max_feed_step),
+            redundancy_angle: Some(m.max_g_step),
+        }),
+    });
+    let initial = m.has_initial_state.then_some(RequestInitial {
+        spindle_rpm: Some(m.initial_spindle_rpm),
+        feed: Some(m.initial_feed),
+        g: Some(m.initial_g),
+    });
+    Ok(MillRequest {
+        request_id: m.request_id.clone(),
+        points: m.points.iter().map(|p| [p.x, p.y, p.z]).collect(),
+        segments: (m.segments != 0).then(|| usize::try_from(m.segments).unwrap_or(usize::MAX)),
+        process,
+        limits,
+        initial,
+        planner,
+        policy_file,
+    })
+}
+
+/// Checks that a planned trajectory is usable: six joint names, one position and velocity
+/// per joint and point, finite values, times from 0 strictly increasing.
+///
+/// # Errors
+/// A sentence naming the first defect (a planner bug: the node answers INTERNAL_ERROR rather
+/// than publish it).
+pub fn check_trajectory(t: &kerf_millplan::JointTrajectory) -> Result<(), String> {
+    if t.joint_names.len() != 6 {
+        return Err(format!(
+            "{} joint names {:?}, expected 6",
+            t.joint_names.len(),
+            t.joint_names
+        ));
+    }
+    if t.points.len() < 2 {
+        return Err(format!(
+            "{} trajectory point(s); at least 2 are needed",
+            t.points.len()
+        ));
+    }
+    if t.points.first().map(|p| p.time_from_start) != Some(0.0) {
+        return Err("the first point is not at time 0".to_string());
+    }
+    for (k, w) in t.points.windows(2).enumerate() {
+        let (a, b) = (w[0].time_from_start, w[1].time_from_start);
+        if !(b.is_finite() && b > a) {
+            return Err(format!(
+                "times do not increase at point {}: {a} then {b} s",
+                k + 1
+            ));
+        }
+    }
+    for (k, p) in t.points.iter().enumerate() {
+        for (what, values) in [("position", &p.positions), ("velocity", &p.velocities)] {
+            if let Some(j) = values.iter().position(|v| !v.is_finite()) {
+                return Err(format!(
+                    "{what} of {} at point {k} (t = {} s) is {}",
+                    t.joint_names.get(j).map(String::as_str).unwrap_or("?"),
+                    p.time_from_start,
+                    values[j]
+                ));
+            }
+        }
+    }
+    Ok(())
+}
+
+/// The plan's trajectory as a `trajectory_msgs/JointTrajectory`: the planner's joint names
+/// (`joint_1` … `joint_6`), one point per trajectory point with positions and velocities (no
+/// accelerations: the executor interpolates cubically), `header.stamp` zero (the executor
+/// starts it on receipt).
+///
+/// # Errors
+/// As [`check_trajectory`], or a time that does not fit a `Duration`.
+pub fn trajectory_msg(t: &kerf_millplan::JointTrajectory) -> Result<JointTrajectory, String> {
+    check_trajectory(t)?;
+    let points = t
+        .points
+        .iter()
+        .map(|p| {
+            Ok(JointTrajectoryPoint {
+                positions: p.positions.to_vec(),
+                velocities: p.velocities.to_vec(),
+                accelerations: Vec::new(),
+                effort: Vec::new(),
+                time_from_start: Duration::from_secs_f64(p.time_from_start)
+                    .map_err(|e| format!("time {} s: {e}", p.time_from_start))?,
+            })
+        })
+        .collect::<Result<Vec<_>, String>>()?;
+    Ok(JointTrajectory {
+        header: Header::default(),
+        joint_names: t.joint_names.clone(),
+        points,
+    })
+}
+
+/// The `MillSegment` messages of a plan, in path order.
+pub fn segments_msg(out: &MillPlanOutput) -> Vec<msg::MillSegment> {
+    out.plan
+        .segments
+        .iter()
+        .map(|s| msg::MillSegment {
+            index: to_u32(s.segment),
+            spindle_rpm: s.rpm,
+            feed: s.feed,
+            redundancy_angle: s.g,
+            mu_max: s.spectral_radius,
+            condition_indicator: s.condition_indicator,
+            time: s.time,
+            reward: s.reward.total,
+            joint_positions: s.joints.to_vec(),
+        })
+        .collect()
+}
+
+/// A one-line summary of a successful plan, for the `message` field and logs.
+pub fn success_message(out: &MillPlanOutput) -> String {
+    let p = &out.plan;
+    let policy = out
+        .policy_file
+        .as_ref()
+        .map(|f| format!(" (policy {})", f.display()))
+        .unwrap_or_default();
+    let chatter = if p.chatter_free {
+        "chatter-free"
+    } else {
+        "CHATTER: some segment has |mu|max >= 1"
+    };
+    let jumps = if out.branch_jumps.is_empty() {
+        String::new()
+    } else {
+        let list: Vec<String> = out
+            .branch_jumps
+            .iter()
+            .map(|j| format!("point {} {} {:.3} rad", j.index, j.joint, j.step))
+            .collect();
+        format!(
+            "; WARNING: {} IK branch jump(s) in the trajectory: {}",
+            list.len(),
+            list.join(", ")
+        )
+    };
+    format!(
+        "planned {} segments with {}{policy}: machining time {:.3} s, max |mu| {:.4} ({chatter}), \
+         min condition indicator {:.3}, total reward {:.3}; indicator cache {}; planning took \
+         {:.3} s{jumps}",
+        p.segments.len(),
+        out.planner.name(),
+        p.total_time,
+        p.max_spectral_radius,
+        p.min_condition_indicator,
+        p.total_reward,
+        if out.cache_used { "used" } else { "not used" },
+        out.planning_seconds,
+    )
+}
+
+/// The `MillPlan` message of a successful plan (status SUCCESS).
+///
+/// A plan whose trajectory fails [`check_trajectory`] is answered INTERNAL_ERROR with the
+/// defect instead, so a planner bug never reaches the executor.
+pub fn output_to_msg(out: &MillPlanOutput) -> msg::MillPlan {
+    let planner = out.planner.name();
+    let trajectory = match trajectory_msg(&out.trajectory) {
+        Ok(t) => t,
+        Err(reason) => {
+            return failure_msg(
+                &out.request_id,
+                planner,
+                status::INTERNAL_ERROR,
+                format!("the planner produced an unusable trajectory: {reason}"),
+            )
+        }
+    };
+    let p = &out.plan;
+    msg::MillPlan {
+        request_id: out.request_id.clone(),
+        status: status::SUCCESS,
+        message: success_message(out),
+        planner: planner.to_string(),
+        trajectory,
+        segments: segments_msg(out),
+        machining_time: p.total_time,
+        chatter_free: p.chatter_free,
+        max_mu: p.max_spectral_radius,
+        min_condition_indicator: p.min_condition_indicator,
+        total_reward: p.total_reward,
+    }
+}
+
+/// A `MillPlan` that carries only the request id, planner, status and message (everything
+/// else empty or zero).
+pub fn failure_msg(
+    request_id: &str,
+    planner: &str,
+    status: u8,
+    message: impl Into<String>,
+) -> msg::MillPlan {
+    msg::MillPlan {
+        request_id: request_id.to_string(),
+        status,
+        message: message.into(),
+        planner: planner.to_string(),
+        ..msg::MillPlan::default()
+    }
+}
+
+/// The planner field of an answer to a request whose `planner` text is `field`: the name
+/// when it is a planner, else empty.
+pub fn answer_planner(field: &str) -> &'static str {
+    PlannerKind::parse(planner_name(field))
+        .map(|k| k.name())
+        .unwrap_or("")
+}
+
+/// The `MillPlan` of a planner error: status from [`kerf_millplan::status_of`], message the
+/// error's text.
+pub fn error_to_msg(request_id: &str, planner: &str, err: &MillPlanError) -> msg::MillPlan {
+    failure_msg(
+        request_id,
+        answer_planner(planner),
+        kerf_millplan::status_of(err),
+        err.to_string(),
+    )
+}
