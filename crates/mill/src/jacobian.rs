@@ -16,8 +16,8 @@
 //! [`characteristic_length`] computes it (golden-section search); the value
 //! stored in `urdf/irb6660_milling.yaml` (`condition.characteristic_length`)
 //! is its result, and `tests/condition.rs` recomputes it and checks the
-//! stored value: **L = 1.2896 m**, mean K = 2.440 over the 500 reachable
-//! (segment, g) samples (K = 3.05 at L/2 and at 2L). It is of the order of
+//! stored value: **L = 1.2799 m**, mean K = 2.188 over the 491 reachable
+//! (segment, g) samples (K = 2.73 at L/2 and at 2L). It is of the order of
 //! the arm's reach from the wrist to the tool (a2 ≈ 1.28 m, d4 ≈ 1.51 m),
 //! as Angeles' length typically is. Any other value can be configured
 //! (`condition.characteristic_length`).

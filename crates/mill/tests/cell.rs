@@ -112,7 +112,7 @@ fn bad_fields_are_reported_by_name() {
             "process.spindle_rpm",
         ),
         (
-            "characteristic_length: 1.2896",
+            "characteristic_length: 1.2799",
             "characteristic_length: 0.0",
             "characteristic_length",
         ),

@@ -69,14 +69,15 @@ fn bad_chatter_values_are_named() {
 }
 
 /// Seed 004 Fig. 4/7: at a fixed spindle speed, raising the feed lowers
-/// |μ|max. On the default cell (segment 50, g = 0, 3500 rpm, the real
+/// |μ|max. On the default cell (segment 50, g = −0.4 rad — tool x axis
+/// along the flange axis, the mount's reference —, 3500 rpm, the real
 /// compliance-model dynamics) the constant-delay model is unstable and
 /// feed-independent; the state-dependent model with the cell's force law
 /// falls with the feed from 0.03 m/s on and is stable at f_max.
 #[test]
 fn default_cell_shows_the_feed_lower_bound() {
     let cell = MillCell::default_cell().expect("default cell");
-    let state = cell.evaluate(50, 0.0, None).expect("segment 50, g = 0");
+    let state = cell.evaluate(50, -0.4, None).expect("segment 50, g = -0.4");
     let process = cell.milling_process();
     let s = *cell.indicator_settings();
     let rho = |f: f64, settings: &IndicatorSettings| {
@@ -91,7 +92,7 @@ fn default_cell_shows_the_feed_lower_bound() {
     let feeds = [0.03, 0.04, 0.05, 0.06];
     let mu: Vec<f64> = feeds.iter().map(|&f| rho(f, &s)).collect();
     println!(
-        "segment 50, g 0, 3500 rpm: constant {c0:.4}, state-dependent {mu:.4?} at {feeds:?} m/s"
+        "segment 50, g -0.4, 3500 rpm: constant {c0:.4}, state-dependent {mu:.4?} at {feeds:?} m/s"
     );
     for w in mu.windows(2) {
         assert!(w[1] < w[0] - 1e-3, "not decreasing: {mu:?}");

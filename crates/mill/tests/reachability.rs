@@ -41,10 +41,11 @@ fn reachability_map_of_the_default_path() {
             println!("g = {g:+.3}  {line}  (no valid segment)");
         }
     }
-    // Every segment is reachable for g in [0, 2] (the paper's g stays in
-    // 0..2 rad) and for none at g = +-pi.
+    // Every segment is reachable for g in [-1.2, 1.6] (the band the cell
+    // file states; the mount angle is calibrated in it) and for none at
+    // g = +-pi.
     for (gi, &g) in gs.iter().enumerate() {
-        if (0.0..=2.0).contains(&g) {
+        if (-1.2..=1.6).contains(&g) {
             assert!(valid[gi].iter().all(|&v| v), "g = {g}");
         }
         if g.abs() > 3.1 {
@@ -72,4 +73,43 @@ fn reachability_map_of_the_default_path() {
         }
     }
     println!("union of the bands: [{band_lo:.3}, {band_hi:.3}]");
+}
+
+/// The tool mount's angle about the tool axis only moves the zero of g:
+/// the shipped cell (tip x axis turned 0.4 rad about the tool axis) at g
+/// is the unturned mount at g + 0.4 — same joints, same condition number,
+/// same tool-tip modes.
+#[test]
+fn mount_angle_is_a_shift_of_g() {
+    let cell = MillCell::default_cell().expect("cell");
+    let text = std::fs::read_to_string(MillCell::default_path()).expect("cell file");
+    let turned = "x_axis: [0.0, 0.3894183423086505, 0.9210609940028851]";
+    assert!(text.contains(turned), "the shipped mount changed");
+    let dir = MillCell::default_path()
+        .parent()
+        .expect("urdf directory")
+        .to_path_buf();
+    let plain = MillCell::from_yaml_str(
+        &text.replacen(turned, "x_axis: [0.0, 0.0, 1.0]", 1),
+        &dir,
+        std::path::Path::new("unturned.yaml"),
+    )
+    .expect("unturned cell");
+    for (segment, g) in [(0, 0.0), (37, -0.8), (50, 0.6), (99, 1.2)] {
+        let a = cell.evaluate(segment, g, None).expect("shipped");
+        let b = plain.evaluate(segment, g + 0.4, None).expect("unturned");
+        for j in 0..6 {
+            assert!(
+                (a.joints[j] - b.joints[j]).abs() < 1e-9,
+                "{segment} {g}: {a:?} {b:?}"
+            );
+        }
+        assert!((a.condition_number - b.condition_number).abs() < 1e-9 * a.condition_number);
+        let (ka, kb) = (a.modal.stiffness, b.modal.stiffness);
+        assert!(
+            (ka - kb).norm() < 1e-9 * ka.norm(),
+            "{segment} {g}: {ka} vs {kb}"
+        );
+        assert!((a.modal.mass - b.modal.mass).norm() < 1e-9 * a.modal.mass.norm());
+    }
 }

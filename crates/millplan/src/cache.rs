@@ -44,17 +44,17 @@
 //! 0, 5, …, 95, 99 (21) × Ω 2000–4000 rpm every 100 rpm (21) × f at 0.01,
 //! 0.02, 0.03, 0.035 … 0.06 m/s (9) × g −3.0…3.0 rad every 0.2 rad (31) =
 //! 123 039 nodes, of which 46 116 are infeasible (g outside the reachable
-//! band). Build: 125 s (189 s in an earlier run) with 2 threads on the
-//! shared 2-core machine (load about 4; the indicator measured 1.34 ms per
-//! evaluation under that load, `--probe`). Error against direct evaluation (seed 2025, 1000 random
-//! points, the infeasible ones skipped):
+//! band). Build: 64 s with 2 threads on the shared 2-core machine (125–189 s
+//! in earlier runs under more load; the indicator measured 1.34 ms per
+//! evaluation under load, `--probe`). Error against direct evaluation
+//! (seed 2025, 1000 random points, the infeasible ones skipped):
 //!
 //! | queries | compared | max | p99 | mean | stated bound (1.5 × max) |
 //! |---|---:|---:|---:|---:|---:|
-//! | any (segment, Ω, f, g) | 620 | 0.0824 | 0.0483 | 0.0048 | 0.124 |
-//! | g on a g node (the DP's) | 643 | 0.0416 | 0.0097 | 0.0008 | 0.063 |
+//! | any (segment, Ω, f, g) | 630 | 0.1086 | 0.0414 | 0.0049 | 0.163 |
+//! | g on a g node (the DP's) | 651 | 0.0328 | 0.0184 | 0.0010 | 0.050 |
 //!
-//! The largest errors are at g ≈ −0.7 rad, near the lower edge of the
+//! The largest errors are at g ≈ −1.1 rad, near the lower edge of the
 //! reachable band, where the tool-tip dynamics change fast with g (0.2 rad
 //! spacing); elsewhere the error is about 0.005. The numbers are in the
 //! file header and re-checked by `tests/cache.rs`. A planner that needs

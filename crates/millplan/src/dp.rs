@@ -80,7 +80,10 @@ use kerf_mill::MillCell;
 use crate::cache::{is_infeasible, IndicatorCache};
 use crate::env::PhysicalState;
 use crate::error::MillPlanError;
-use crate::reward::{efficiency_reward, operational_reward, stability_reward, RewardWeights};
+use crate::joint_speed;
+use crate::reward::{
+    efficiency_reward, operational_reward, stability_reward, ChatterMargin, RewardWeights,
+};
 
 /// The DP grid: node ranges on each axis, in multiples of the step bound
 /// from the initial state (so the IVP is a node).
@@ -102,11 +105,21 @@ pub struct DpSpec {
     /// no jump at |μ| = 1, so that optimum may ride marginally above 1
     /// where the efficiency gain outweighs w_p (e^(|μ|−1) − 1).
     pub chatter_limit: Option<(f64, usize)>,
+    /// kerf's chatter margin subtracted from each state's reward, as in
+    /// the environment ([`crate::env::EnvConfig::chatter_margin`]); the
+    /// default spec uses the environment's default.
+    pub chatter_margin: Option<ChatterMargin>,
+    /// Forbid moves whose joints would exceed the URDF's velocity limits
+    /// between the two segments' midpoints, as the environment does
+    /// ([`crate::joint_speed`]; joints of the cell's reference IK branch,
+    /// compared over the equivalent wrist solutions).
+    pub joint_speed_limits: bool,
 }
 
 impl DpSpec {
     /// The full state ranges of the cell from the IVP (2000 rpm, 0.04 m/s,
-    /// 0 rad); `fixed_g` restricts g to g0 = 0.
+    /// 0 rad), the default [`ChatterMargin`] (the environment's objective);
+    /// `fixed_g` restricts g to g0 = 0.
     pub fn full(cell: &MillCell, weights: RewardWeights, fixed_g: bool) -> Self {
         let lim = cell.state_limits();
         Self {
@@ -120,6 +133,8 @@ impl DpSpec {
             },
             weights,
             chatter_limit: None,
+            chatter_margin: Some(ChatterMargin::default()),
+            joint_speed_limits: true,
         }
     }
 }
@@ -166,10 +181,30 @@ pub fn solve_grid<F>(
     stages: usize,
     dims: [usize; 3],
     start: [usize; 3],
-    mut stage: F,
+    stage: F,
 ) -> Result<Option<GridPath>, MillPlanError>
 where
     F: FnMut(usize, [usize; 3]) -> Option<f64>,
+{
+    solve_grid_with_moves(stages, dims, start, stage, |_, _, _| true)
+}
+
+/// As [`solve_grid`], with a filter on moves: `allowed(t, x, y)` says
+/// whether the move from node x at stage t to node y at stage t + 1 is
+/// allowed (e.g. joint speeds, [`crate::joint_speed`]).
+///
+/// # Errors
+/// As [`solve_grid`].
+pub fn solve_grid_with_moves<F, M>(
+    stages: usize,
+    dims: [usize; 3],
+    start: [usize; 3],
+    mut stage: F,
+    allowed: M,
+) -> Result<Option<GridPath>, MillPlanError>
+where
+    F: FnMut(usize, [usize; 3]) -> Option<f64>,
+    M: Fn(usize, [usize; 3], [usize; 3]) -> bool,
 {
     let nodes = dims[0] * dims[1] * dims[2];
     if stages == 0 || nodes == 0 || (0..3).any(|a| start[a] >= dims[a]) {
@@ -231,7 +266,7 @@ where
                                     continue;
                                 };
                                 let v = next[index(ni, nj, nk)];
-                                if v > best {
+                                if v > best && allowed(t, [i, j, k], [ni, nj, nk]) {
                                     best = v;
                                     best_m = (di * 9 + dj * 3 + dk) as u8;
                                 }
@@ -310,6 +345,9 @@ pub fn solve(
 ) -> Result<DpResult, MillPlanError> {
     let start_time = Instant::now();
     spec.weights.validate()?;
+    if let Some(m) = &spec.chatter_margin {
+        m.validate()?;
+    }
     let lim = *cell.state_limits();
     let clip = |r: [f64; 2], l: [f64; 2]| [r[0].max(l[0]), r[1].min(l[1])];
     let (rpm, i0) = axis(
@@ -333,15 +371,43 @@ pub fn solve(
     let n = cell.path().segments().len();
     // (segment, g) table of r_o = 1/(K + ε); None = infeasible.
     let mut ro: Vec<Option<f64>> = Vec::with_capacity(n * g.len());
+    let mut joints: Vec<[f64; 6]> = Vec::with_capacity(n * g.len());
     for t in 0..n {
         for gv in &g {
             match cell.evaluate(t, *gv, None) {
-                Ok(cs) => ro.push(Some(operational_reward(cs.condition_number)?)),
-                Err(e) if is_infeasible(&e) => ro.push(None),
+                Ok(cs) => {
+                    ro.push(Some(operational_reward(cs.condition_number)?));
+                    joints.push(cs.joints);
+                }
+                Err(e) if is_infeasible(&e) => {
+                    ro.push(None);
+                    joints.push([f64::NAN; 6]);
+                }
                 Err(e) => return Err(e.into()),
             }
         }
     }
+    let velocity_limits = joint_speed::velocity_limits(cell)?;
+    let lengths: Vec<f64> = cell.path().segments().iter().map(|s| s.length).collect();
+    let ng = g.len();
+    let allowed = |t: usize, x: [usize; 3], y: [usize; 3]| -> bool {
+        if !spec.joint_speed_limits {
+            return true;
+        }
+        let (Some(a), Some(b), Some(la), Some(lb), Some(fa), Some(fb)) = (
+            joints.get(t * ng + x[2]),
+            joints.get((t + 1) * ng + y[2]),
+            lengths.get(t),
+            lengths.get(t + 1),
+            feed.get(x[1]),
+            feed.get(y[1]),
+        ) else {
+            return false;
+        };
+        let dt = joint_speed::midpoint_interval([*la, *lb], [*fa, *fb]);
+        let motion = joint_speed::smallest_motion(a, b);
+        joint_speed::first_violation(&motion, dt, &velocity_limits).is_none()
+    };
     let re: Vec<f64> = feed
         .iter()
         .map(|f| efficiency_reward(*f, lim.feed[1]))
@@ -349,7 +415,7 @@ pub fn solve(
     let w = spec.weights;
     let mut forbidden = 0usize;
     let mut error: Option<MillPlanError> = None;
-    let path = solve_grid(
+    let path = solve_grid_with_moves(
         n,
         [rpm.len(), feed.len(), g.len()],
         [i0, j0, k0],
@@ -372,8 +438,14 @@ pub fn solve(
                     forbidden += 1;
                     None
                 }
-                Ok(Some(mu)) => match stability_reward(mu) {
-                    Ok(rs) => Some(w.operational * ro + w.efficiency * re + w.stability * rs),
+                Ok(Some(mu)) => match stability_reward(mu).and_then(|rs| {
+                    let penalty = match &spec.chatter_margin {
+                        Some(m) => m.penalty(mu)?,
+                        None => 0.0,
+                    };
+                    Ok(w.operational * ro + w.efficiency * re + w.stability * rs - penalty)
+                }) {
+                    Ok(r) => Some(r),
                     Err(e) => {
                         error.get_or_insert(e);
                         None
@@ -389,6 +461,7 @@ pub fn solve(
                 }
             }
         },
+        allowed,
     )?;
     if let Some(e) = error {
         return Err(e);

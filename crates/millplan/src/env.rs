@@ -34,6 +34,11 @@
 //!   r(s_0) is the same for every policy and is reported by
 //!   [`MillEnv::initial_info`]. Plan totals ([`Rollout::total_reward`],
 //!   [`crate::plan`]) sum all N segments, r(s_0) included.
+//! * **Chatter margin** (kerf's, [`EnvConfig::chatter_margin`], on by
+//!   default): the step reward is eq. 12 minus
+//!   [`ChatterMargin::penalty`] (0 below |μ|max = 0.95). Without it the
+//!   optimum of eq. 12 chatters marginally (reward module); `None` gives
+//!   the paper's reward exactly.
 //! * **Observation** (4 entries, each in [−1, 1]): `2t/(N−1) − 1`, and Ω, f,
 //!   g mapped linearly from their ranges to [−1, 1].
 //! * **Segment time** `l_t / f_t` (the segment's arc length over its feed).
@@ -48,6 +53,10 @@
 //!   reward is ≥ −w_p e^(|μ|−1) ≥ −1.01 there with the default weights),
 //!   so ending an episode on purpose never pays; the default cell's
 //!   measured |μ| stays below 1.2.
+//! * **Joint speeds** (kerf's, [`EnvConfig::joint_speed_limits`], on by
+//!   default): a step whose joints move faster than the URDF's velocity
+//!   limits between the two segments' midpoints
+//!   ([`crate::joint_speed`]) is a terminal violation like an infeasible g.
 //! * **IK branch continuity**: each state's joints are the IK solution
 //!   nearest the previous state's joints (`MillCell::evaluate` with the
 //!   previous joints as reference).
@@ -61,7 +70,8 @@ use kerf_mill::MillCell;
 
 use crate::cache::{is_infeasible, IndicatorCache};
 use crate::error::MillPlanError;
-use crate::reward::{step_reward, RewardParts, RewardWeights};
+use crate::joint_speed;
+use crate::reward::{step_reward, ChatterMargin, RewardParts, RewardWeights};
 use crate::rl::{Environment, Transition};
 
 /// Settings of [`MillEnv`].
@@ -81,11 +91,19 @@ pub struct EnvConfig {
     pub violation_penalty: f64,
     /// The paper's ablation: g fixed at g0, action (ΔΩ, Δf).
     pub fixed_g: bool,
+    /// kerf's chatter margin subtracted from the step reward
+    /// ([`ChatterMargin`]; `None` = seed 004 eq. 12 alone).
+    pub chatter_margin: Option<ChatterMargin>,
+    /// Whether a step whose joints would move faster than the URDF's
+    /// velocity limits between the two segments' midpoints is a terminal
+    /// violation ([`crate::joint_speed`]; kerf's constraint, default on).
+    pub joint_speed_limits: bool,
 }
 
 impl Default for EnvConfig {
     /// Seed 004's IVP (2000 rpm, 0.04 m/s, 0 rad), α = 0.5, penalty −100,
-    /// default weights, g free (module documentation).
+    /// default weights, g free, the default [`ChatterMargin`] (module
+    /// documentation).
     fn default() -> Self {
         Self {
             weights: RewardWeights::default(),
@@ -95,6 +113,8 @@ impl Default for EnvConfig {
             initial_g: 0.0,
             violation_penalty: -100.0,
             fixed_g: false,
+            chatter_margin: Some(ChatterMargin::default()),
+            joint_speed_limits: true,
         }
     }
 }
@@ -129,6 +149,9 @@ pub struct Evaluation {
     pub segment_time: f64,
     /// Reward parts (eq. 12, 15-17).
     pub reward: RewardParts,
+    /// The chatter-margin penalty ([`EnvConfig::chatter_margin`], ≥ 0; 0
+    /// without a margin). The step reward is `reward.total − chatter_penalty`.
+    pub chatter_penalty: f64,
 }
 
 /// Diagnostics of one state (the initial state or the result of a step).
@@ -180,6 +203,8 @@ pub struct MillEnv {
     filter: [f64; 3],
     joints: [f64; 6],
     done: bool,
+    /// Joint velocity limits of the cell's robot \[rad/s\].
+    velocity_limits: [f64; 6],
 }
 
 fn check_range(name: &str, v: f64, lo: f64, hi: f64) -> Result<f64, MillPlanError> {
@@ -257,16 +282,21 @@ impl MillEnv {
                 reason: "must be finite and < 0".to_string(),
             });
         }
+        if let Some(m) = &config.chatter_margin {
+            m.validate()?;
+        }
         if cell.path().segments().len() < 2 {
             return Err(MillPlanError::InvalidConfig {
                 name: "milling path".to_string(),
                 reason: "needs at least 2 segments".to_string(),
             });
         }
+        let velocity_limits = joint_speed::velocity_limits(&cell)?;
         Ok(Self {
             cell,
             cache,
             config,
+            velocity_limits,
             current: None,
             initial: None,
             filter: [0.0; 3],
@@ -363,6 +393,10 @@ impl MillEnv {
             max_feed,
             mu,
         )?;
+        let chatter_penalty = match &self.config.chatter_margin {
+            Some(m) => m.penalty(mu)?,
+            None => 0.0,
+        };
         Ok(Ok(Evaluation {
             joints: cs.joints,
             condition_number: cs.condition_number,
@@ -371,6 +405,7 @@ impl MillEnv {
             from_cache,
             segment_time: segment.length / state.feed,
             reward,
+            chatter_penalty,
         }))
     }
 
@@ -396,7 +431,7 @@ impl MillEnv {
             Ok(e) => StepInfo {
                 state,
                 filtered_action,
-                reward: e.reward.total,
+                reward: e.reward.total - e.chatter_penalty,
                 evaluation: Some(e),
                 violation: None,
             },
@@ -568,7 +603,30 @@ impl Environment for MillEnv {
             feed: (current.feed + filter[1]).clamp(lim.feed[0], lim.feed[1]),
             g: (current.g + filter[2]).clamp(lim.redundancy_angle[0], lim.redundancy_angle[1]),
         };
-        let eval = self.evaluate_state(&next, Some(&self.joints))?;
+        let mut eval = self.evaluate_state(&next, Some(&self.joints))?;
+        if self.config.joint_speed_limits {
+            if let Ok(e) = &eval {
+                let segments = self.cell.path().segments();
+                let lengths = [
+                    segments.get(current.segment).map_or(0.0, |s| s.length),
+                    segments.get(next.segment).map_or(0.0, |s| s.length),
+                ];
+                let dt = joint_speed::midpoint_interval(lengths, [current.feed, next.feed]);
+                let motion: [f64; 6] = std::array::from_fn(|j| e.joints[j] - self.joints[j]);
+                if let Some((j, speed)) =
+                    joint_speed::first_violation(&motion, dt, &self.velocity_limits)
+                {
+                    eval = Err(format!(
+                        "joint {} would move at {speed:.3} rad/s between segments {} and {} \
+                         (limit {:.3} rad/s)",
+                        j + 1,
+                        current.segment,
+                        next.segment,
+                        self.velocity_limits[j]
+                    ));
+                }
+            }
+        }
         self.filter = filter;
         let violated = eval.is_err();
         if let Ok(e) = &eval {

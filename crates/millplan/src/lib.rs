@@ -13,6 +13,7 @@ pub mod rl;
 pub mod cache;
 pub mod dp;
 pub mod env;
+pub mod joint_speed;
 pub mod naive;
 pub mod plan;
 pub mod reward;

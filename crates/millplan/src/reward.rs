@@ -135,6 +135,76 @@ fn finite(name: &str, v: f64) -> Result<f64, MillPlanError> {
     Ok(v)
 }
 
+/// A chatter margin: kerf's shaping term added to the TRAINING objective
+/// (environment and DP), NOT part of seed 004 eq. 12. The reward of a state
+/// is lowered by `slope · max(0, |μ|max − limit)`.
+///
+/// Why: eq. 17 (`−exp(clip(|μ|max − 1, 0, 5))`) has no jump at |μ| = 1 and
+/// a slope of only w_p = 0.5 per unit of |μ| there, so the optimum of
+/// eq. 12 rides marginally above 1 wherever that buys feed or conditioning
+/// (measured by the DP on the default cell: every eq. 12 optimum chatters,
+/// `crate::dp`). The paper calls the stability term a constraint
+/// "embedded in the reward shaping process" (seed 004 section 3); this
+/// margin makes it one. The default limit lies below 1 by the indicator
+/// cache's stated error bound for states on its g nodes (0.050,
+/// [`crate::cache`]), so that the DP's plans (g on nodes) that the cache
+/// calls safe are safe when evaluated directly.
+///
+/// Plans are REPORTED with eq. 12 alone ([`step_reward`],
+/// [`crate::plan`]); the margin only shapes what the planners optimize.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ChatterMargin {
+    /// |μ|max above which the penalty starts (0 < limit ≤ 1).
+    pub limit: f64,
+    /// Penalty per unit of |μ|max above the limit (≥ 0).
+    pub slope: f64,
+}
+
+impl Default for ChatterMargin {
+    /// limit 0.95, slope 20: at |μ| = 1.0 a step loses 1.0, as much as the
+    /// whole efficiency reward of f = 0.75 f_max; below 0.95 nothing.
+    fn default() -> Self {
+        Self {
+            limit: 0.95,
+            slope: 20.0,
+        }
+    }
+}
+
+impl ChatterMargin {
+    /// Checks the margin.
+    ///
+    /// # Errors
+    /// [`MillPlanError::InvalidParameter`] for a limit outside (0, 1] or a
+    /// negative or non-finite slope.
+    pub fn validate(&self) -> Result<(), MillPlanError> {
+        if !(self.limit > 0.0 && self.limit <= 1.0) {
+            return Err(MillPlanError::InvalidParameter {
+                name: "chatter margin limit [-]".to_string(),
+                value: self.limit,
+                reason: "must be in (0, 1]".to_string(),
+            });
+        }
+        if !(self.slope.is_finite() && self.slope >= 0.0) {
+            return Err(MillPlanError::InvalidParameter {
+                name: "chatter margin slope [-]".to_string(),
+                value: self.slope,
+                reason: "must be finite and >= 0".to_string(),
+            });
+        }
+        Ok(())
+    }
+
+    /// The penalty `slope · max(0, |μ|max − limit)` (≥ 0; subtract it).
+    ///
+    /// # Errors
+    /// [`MillPlanError::InvalidParameter`] for a NaN |μ|max.
+    pub fn penalty(&self, spectral_radius: f64) -> Result<f64, MillPlanError> {
+        let mu = finite("chatter indicator |mu|max [-]", spectral_radius)?;
+        Ok(self.slope * (mu - self.limit).max(0.0))
+    }
+}
+
 /// Singularity-avoidance reward, seed 004 eq. 15: `r_o = 1/(K + ε)`,
 /// ε = 1e-6.
 ///
@@ -246,6 +316,41 @@ pub fn step_reward(
 mod tests {
     use super::*;
     use approx::assert_relative_eq;
+
+    #[test]
+    fn chatter_margin_is_zero_below_the_limit_and_linear_above() {
+        let m = ChatterMargin::default();
+        assert_eq!(m.penalty(0.5).unwrap(), 0.0);
+        assert_eq!(m.penalty(0.95).unwrap(), 0.0);
+        assert_relative_eq!(m.penalty(1.0).unwrap(), 1.0, epsilon = 1e-12);
+        assert_relative_eq!(m.penalty(1.2).unwrap(), 5.0, epsilon = 1e-12);
+        assert!(m.penalty(f64::NAN).is_err());
+        for bad in [
+            ChatterMargin {
+                limit: 0.0,
+                slope: 1.0,
+            },
+            ChatterMargin {
+                limit: 1.1,
+                slope: 1.0,
+            },
+            ChatterMargin {
+                limit: f64::NAN,
+                slope: 1.0,
+            },
+            ChatterMargin {
+                limit: 0.9,
+                slope: -1.0,
+            },
+            ChatterMargin {
+                limit: 0.9,
+                slope: f64::INFINITY,
+            },
+        ] {
+            assert!(bad.validate().is_err(), "{bad:?}");
+        }
+        assert!(m.validate().is_ok());
+    }
 
     #[test]
     fn operational_hand_values() {

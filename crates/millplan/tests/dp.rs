@@ -7,7 +7,7 @@ use kerf_millplan::cache::{IndicatorCache, SplitMix64};
 use kerf_millplan::dp::{self, solve_grid, DpSpec};
 use kerf_millplan::env::PhysicalState;
 use kerf_millplan::plan::Plan;
-use kerf_millplan::reward::{step_reward, RewardWeights};
+use kerf_millplan::reward::{step_reward, ChatterMargin, RewardWeights};
 
 /// A pseudo-random stage reward with forbidden states.
 fn synthetic(t: usize, x: [usize; 3]) -> Option<f64> {
@@ -103,15 +103,29 @@ fn grid_dp_closed_form_and_infeasible_start() {
 }
 
 /// The value of a state sequence with |μ| from the cache and K from the
-/// cell's reference branch — the DP's own objective, computed here with
-/// the reward functions.
+/// cell's reference branch — the DP's own objective (eq. 12 minus the
+/// default chatter margin), computed here with the reward functions.
 fn cache_value(cell: &MillCell, cache: &IndicatorCache, states: &[PhysicalState]) -> Option<f64> {
+    cache_value_with(cell, cache, states, Some(ChatterMargin::default()))
+}
+
+/// As [`cache_value`] with another margin (`None`: eq. 12 alone).
+fn cache_value_with(
+    cell: &MillCell,
+    cache: &IndicatorCache,
+    states: &[PhysicalState],
+    margin: Option<ChatterMargin>,
+) -> Option<f64> {
     let w = RewardWeights::default();
     let mut total = 0.0;
     for s in states {
         let k = cell.evaluate(s.segment, s.g, None).ok()?.condition_number;
         let mu = cache.try_query(s.segment, s.rpm, s.feed, s.g).ok()??;
         total += step_reward(&w, k, s.feed, 0.06, mu).ok()?.total;
+        if let Some(m) = margin {
+            // Independent of ChatterMargin::penalty: slope (|mu| - limit)+.
+            total -= m.slope * (mu - m.limit).max(0.0);
+        }
     }
     Some(total)
 }
@@ -173,11 +187,27 @@ fn cell_dp_beats_every_feasible_plan_it_is_compared_with() {
             walks += 1;
         }
     }
-    // The plan re-evaluated directly: same objective within the cache's
-    // stated bound per segment (w_p e^(|mu|-1) slope about 0.5-0.6).
+    // The plan re-evaluated directly (eq. 12, no margin): the same eq. 12
+    // value within the cache's stated bound per segment (w_p e^(|mu|-1)
+    // slope about 0.5-0.6).
     let plan = Plan::evaluate(&cell, &RewardWeights::default(), &r.states, "dp").unwrap();
     let bound = cache.header().error_bound_g_nodes.unwrap();
-    assert!((plan.total_reward - r.value).abs() <= 100.0 * 0.7 * bound);
+    let eq12 = cache_value_with(&cell, &cache, &r.states, None).unwrap();
+    assert!((plan.total_reward - eq12).abs() <= 100.0 * 0.7 * bound);
+    // Without the margin the DP optimizes eq. 12 alone, and is no worse on
+    // it than the margin's plan.
+    let plain = dp::solve(
+        &cell,
+        &cache,
+        &DpSpec {
+            chatter_margin: None,
+            ..spec
+        },
+    )
+    .unwrap();
+    let own = cache_value_with(&cell, &cache, &plain.states, None).unwrap();
+    assert!((own - plain.value).abs() < 1e-9, "{own} vs {}", plain.value);
+    assert!(plain.value >= eq12 - 1e-9);
 }
 
 #[test]

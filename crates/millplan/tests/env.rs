@@ -63,7 +63,12 @@ fn initial_value_problem_observation_and_reward() {
     let ev = info.evaluation.unwrap();
     assert_eq!(ev.spectral_radius, mu);
     assert!(!ev.from_cache);
-    assert_relative_eq!(info.reward, r.total, epsilon = 1e-15);
+    // The step reward is eq. 12 minus the default chatter margin
+    // 20 (|mu| - 0.95)+ (kerf's shaping, reward::ChatterMargin).
+    let margin = 20.0 * (mu - 0.95).max(0.0);
+    assert_relative_eq!(ev.chatter_penalty, margin, epsilon = 1e-15);
+    assert_relative_eq!(ev.reward.total, r.total, epsilon = 1e-15);
+    assert_relative_eq!(info.reward, r.total - margin, epsilon = 1e-15);
     assert_relative_eq!(
         ev.segment_time,
         c.path().segments()[0].length / 0.04,
@@ -218,7 +223,7 @@ fn infeasible_g_is_a_terminal_violation() {
     });
     e.reset().unwrap();
     // Turn g down by 0.2 rad per step: every segment is valid only down to
-    // about -0.87 rad (kerf_mill tests/reachability.rs), so the episode
+    // about -1.27 rad (kerf_mill tests/reachability.rs), so the episode
     // must end before g is clipped at -pi (16 steps).
     let mut last = None;
     for _ in 0..20 {
@@ -238,7 +243,7 @@ fn infeasible_g_is_a_terminal_violation() {
         "{reason}"
     );
     let s = e.state().unwrap();
-    assert!(s.g < -0.8 && s.segment < 17, "{s:?}");
+    assert!(s.g < -1.2 && s.segment < 17, "{s:?}");
     // Independent check: the model refuses that (segment, g).
     assert!(e.cell().evaluate(s.segment, s.g, None).is_err());
     // The episode is over.
@@ -275,7 +280,7 @@ fn time_accounting_and_plan_totals() {
     let mut e = env(EnvConfig::default());
     let rollout = e
         .rollout(|_, s| {
-            let g_action = if s.g < 0.6 { 0.5 } else { 0.0 };
+            let g_action = if s.g < 0.2 { 0.5 } else { 0.0 };
             Ok(vec![0.5, 0.5, g_action])
         })
         .unwrap();
@@ -300,7 +305,17 @@ fn time_accounting_and_plan_totals() {
         .map(|s| cell.path().segments()[s.segment].length / s.feed)
         .sum();
     assert_relative_eq!(plan.total_time, by_hand, epsilon = 1e-9);
-    assert_relative_eq!(plan.total_reward, rollout.total_reward, epsilon = 1e-9);
+    // The plan reports eq. 12; the rollout's rewards also carry the chatter
+    // margin of the environment.
+    let penalties: f64 = std::iter::once(&rollout.initial)
+        .chain(&rollout.steps)
+        .map(|st| st.evaluation.unwrap().chatter_penalty)
+        .sum();
+    assert_relative_eq!(
+        plan.total_reward - penalties,
+        rollout.total_reward,
+        epsilon = 1e-9
+    );
     for (p, st) in plan.segments.iter().skip(1).zip(&rollout.steps) {
         let ev = st.evaluation.unwrap();
         assert_eq!(p.joints, ev.joints);
