@@ -21,8 +21,10 @@
 //!    so a policy trained on the default cell is only meaningful for
 //!    requests close to it (a rollout that leaves the feasible set is a
 //!    [`MillPlanError::Policy`] error).
-//! 5. [`Plan::evaluate`]: every segment evaluated directly (|μ|max never
-//!    from the cache), the totals.
+//! 5. [`Plan::evaluate_with_threads`]: every segment evaluated directly
+//!    (|μ|max never from the cache) on [`MillPlanner::eval_threads`]
+//!    threads (the same plan, bit for bit, for every thread count), the
+//!    totals.
 //! 6. The joint trajectory ([`JointTrajectory`]).
 //!
 //! # When the indicator cache applies
@@ -66,7 +68,7 @@ use crate::dp::{self, DpSpec};
 use crate::env::{EnvConfig, MillEnv, PhysicalState};
 use crate::error::MillPlanError;
 use crate::naive;
-use crate::plan::Plan;
+use crate::plan::{default_eval_threads, Plan};
 use crate::policy::Policy;
 use crate::request::{MillRequest, PlannerKind};
 use crate::rl::Environment;
@@ -195,6 +197,24 @@ pub struct MillPlanOutput {
     pub cache_used: bool,
     /// Wall-clock planning time \[s\].
     pub planning_seconds: f64,
+    /// Wall-clock time of each step of [`MillPlanner::plan`] \[s\].
+    pub phases: PlanningPhases,
+}
+
+/// Wall-clock seconds of the steps of [`MillPlanner::plan`] (module
+/// documentation); their sum is at most
+/// [`MillPlanOutput::planning_seconds`].
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct PlanningPhases {
+    /// Steps 1–3: request validation, the request's cell, reachability.
+    pub setup: f64,
+    /// Step 4: the planner (policy rollout, DP or naive), including the
+    /// policy's loading when not already loaded.
+    pub planner: f64,
+    /// Step 5: [`Plan::evaluate`] (direct |μ|max of every segment).
+    pub evaluation: f64,
+    /// Step 6: the joint trajectory.
+    pub trajectory: f64,
 }
 
 #[derive(Debug)]
@@ -212,6 +232,7 @@ pub struct MillPlanner {
     cache: Option<Arc<IndicatorCache>>,
     cache_note: String,
     env_config: EnvConfig,
+    eval_threads: usize,
     policies: Mutex<HashMap<PathBuf, CachedPolicy>>,
 }
 
@@ -253,6 +274,7 @@ impl MillPlanner {
             cache,
             cache_note,
             env_config: EnvConfig::default(),
+            eval_threads: default_eval_threads(),
             policies: Mutex::new(HashMap::new()),
         })
     }
@@ -283,6 +305,33 @@ impl MillPlanner {
     pub fn with_env_config(mut self, config: EnvConfig) -> Self {
         self.env_config = config;
         self
+    }
+
+    /// Sets the number of threads of the plan evaluation (step 5,
+    /// [`Plan::evaluate_with_threads`]; default [`default_eval_threads`]).
+    /// The plan does not depend on it (bit for bit); only the latency does.
+    ///
+    /// # Arguments
+    /// * `threads` — 1 = sequential; at most [`crate::plan::MAX_EVAL_THREADS`]
+    ///   are used.
+    ///
+    /// # Errors
+    /// [`MillPlanError::InvalidParameter`] for 0.
+    pub fn with_eval_threads(mut self, threads: usize) -> Result<Self, MillPlanError> {
+        if threads == 0 {
+            return Err(MillPlanError::InvalidParameter {
+                name: "evaluation threads".to_string(),
+                value: 0.0,
+                reason: "must be >= 1".to_string(),
+            });
+        }
+        self.eval_threads = threads;
+        Ok(self)
+    }
+
+    /// The number of threads of the plan evaluation.
+    pub fn eval_threads(&self) -> usize {
+        self.eval_threads
     }
 
     /// The environment settings.
@@ -368,6 +417,11 @@ impl MillPlanner {
         let (cell, cache_applies) = self.request_cell(request, limits)?;
         let [rpm0, feed0, g0] = request.initial_state();
         check_reachable(&cell, g0)?;
+        let mut phases = PlanningPhases {
+            setup: start.elapsed().as_secs_f64(),
+            ..PlanningPhases::default()
+        };
+        let step = Instant::now();
         let cache = if cache_applies {
             self.cache.clone()
         } else {
@@ -444,8 +498,19 @@ impl MillPlanner {
                 }
             }
         };
-        let plan = Plan::evaluate(&cell, &self.env_config.weights, &states, kind.name())?;
+        phases.planner = step.elapsed().as_secs_f64();
+        let step = Instant::now();
+        let plan = Plan::evaluate_with_threads(
+            &cell,
+            &self.env_config.weights,
+            &states,
+            kind.name(),
+            self.eval_threads,
+        )?;
+        phases.evaluation = step.elapsed().as_secs_f64();
+        let step = Instant::now();
         let (trajectory, branch_jumps) = trajectory(&cell, &plan)?;
+        phases.trajectory = step.elapsed().as_secs_f64();
         Ok(MillPlanOutput {
             request_id: request.request_id.clone(),
             planner: kind,
@@ -455,6 +520,7 @@ impl MillPlanner {
             branch_jumps,
             cache_used: cache_applies,
             planning_seconds: start.elapsed().as_secs_f64(),
+            phases,
         })
     }
 }

@@ -1,0 +1,280 @@
+//! Planning latency of the milling planner (issue 5 figure: "planning one
+//! 100-segment path with the trained policy, IK and trajectory included:
+//! goal ≤ 50 ms"): [`MillPlanner::plan`] on the default 100-segment
+//! request, for the `naive` and `ddpg` planners, with the plan evaluation
+//! (direct |μ|max of every segment, the dominant cost) on one thread and on
+//! the default number of threads ([`default_eval_threads`]).
+//!
+//! * The `ddpg` policy is `crates/millplan/policies/ddpg.safetensors` when
+//!   it exists; otherwise a policy is trained here for 5 episodes (seed 1,
+//!   Table 2 settings) and the output says so — its rollout costs the same
+//!   as the shipped policy's (same network sizes), its plan differs.
+//! * Before criterion's numbers, each configuration is planned 5 times and
+//!   the mean wall time of each step ([`MillPlanOutput::phases`]: setup =
+//!   validation, request cell and reachability; planner = rollout or naive
+//!   search; evaluation; trajectory) is printed, with the process CPU time
+//!   per plan (Linux `clock_gettime`): on the shared 2-core machine the
+//!   wall time includes waiting for other jobs, the CPU time does not (for
+//!   several threads it is their sum). The load average is printed too.
+//! * The plans of 1 and of the default number of threads are checked to be
+//!   identical (bit for bit) before timing.
+//!
+//! Run (small sample counts, the machine is shared):
+//! `cargo bench -p kerf_millplan --bench plan_latency -- --warm-up-time 1 --measurement-time 5`
+
+use std::path::PathBuf;
+use std::time::Instant;
+
+use criterion::{criterion_group, Criterion};
+use kerf_millplan::plan::default_eval_threads;
+use kerf_millplan::planner::PlanningPhases;
+use kerf_millplan::{
+    default_policy_path, train, DdpgSettings, EnvConfig, MillEnv, MillPlanError, MillPlanOutput,
+    MillPlanner, MillRequest, PlannerKind, Policy,
+};
+
+/// `struct timespec` of Linux (64-bit).
+#[cfg(target_os = "linux")]
+#[repr(C)]
+struct Timespec {
+    tv_sec: i64,
+    tv_nsec: i64,
+}
+
+#[cfg(target_os = "linux")]
+extern "C" {
+    /// POSIX `clock_gettime` (libc).
+    fn clock_gettime(clock: i32, tp: *mut Timespec) -> i32;
+}
+
+/// CPU time of the whole process, s (`CLOCK_PROCESS_CPUTIME_ID` = 2 on
+/// Linux: all threads). `None` off Linux or on failure.
+fn process_cpu_time() -> Option<f64> {
+    #[cfg(target_os = "linux")]
+    {
+        let mut ts = Timespec {
+            tv_sec: 0,
+            tv_nsec: 0,
+        };
+        // SAFETY: ts is a valid, writable timespec.
+        let rc = unsafe { clock_gettime(2, &mut ts) };
+        (rc == 0).then_some(ts.tv_sec as f64 + ts.tv_nsec as f64 * 1e-9)
+    }
+    #[cfg(not(target_os = "linux"))]
+    {
+        None
+    }
+}
+
+/// The 1-minute load average (Linux), for reading the wall times.
+fn load_average() -> String {
+    std::fs::read_to_string("/proc/loadavg")
+        .ok()
+        .and_then(|s| s.split_whitespace().next().map(str::to_string))
+        .unwrap_or_else(|| "unknown".to_string())
+}
+
+/// The shipped ddpg policy, or one trained here for 5 episodes (seeds 1,
+/// 2, … until its greedy rollout stays feasible, at most 6 seeds), and a
+/// sentence saying which.
+fn ddpg_policy(planner: &MillPlanner) -> Result<(PathBuf, String), MillPlanError> {
+    if let Some(p) = default_policy_path(PlannerKind::Ddpg).filter(|p| p.exists()) {
+        let note = format!("the shipped policy {}", p.display());
+        return Ok((p, note));
+    }
+    let dir = std::env::temp_dir().join(format!("kerf_plan_latency_{}", std::process::id()));
+    std::fs::create_dir_all(&dir).map_err(|e| MillPlanError::Io {
+        path: dir.display().to_string(),
+        message: e.to_string(),
+    })?;
+    let mut last = None;
+    for seed in 1..=6u64 {
+        let mut env = MillEnv::new(
+            planner.cell().clone(),
+            planner.cache().cloned(),
+            EnvConfig::default(),
+        )?;
+        let settings = DdpgSettings::default().with_episodes(5).with_seed(seed);
+        let start = Instant::now();
+        let agent = train(&mut env, &settings, &mut |_| {})?;
+        let mut policy = Policy::from_agent(&agent, "plan_latency bench: 5 episodes")?;
+        let path = dir.join(format!("ddpg_seed{seed}.safetensors"));
+        policy.save(&path)?;
+        let request = MillRequest {
+            planner: "ddpg".to_string(),
+            policy_file: Some(path.display().to_string()),
+            ..MillRequest::default()
+        };
+        match planner.plan(&request) {
+            Ok(_) => {
+                let note = format!(
+                    "NO shipped policy ({} missing): a policy trained in this bench for 5 \
+                     episodes (seed {seed}, 2×256, {:.1} s) — same network sizes as the shipped \
+                     one, so the same rollout cost; its plan differs",
+                    default_policy_path(PlannerKind::Ddpg)
+                        .map(|p| p.display().to_string())
+                        .unwrap_or_default(),
+                    start.elapsed().as_secs_f64()
+                );
+                return Ok((path, note));
+            }
+            Err(e) => {
+                eprintln!("ddpg policy of seed {seed} (5 episodes) rejected: {e}");
+                last = Some(e);
+            }
+        }
+    }
+    Err(last.unwrap_or_else(|| MillPlanError::InvalidConfig {
+        name: "bench policy".to_string(),
+        reason: "no seed tried".to_string(),
+    }))
+}
+
+/// Plans `request` `n` times; prints the mean phases, wall and CPU time.
+fn report(name: &str, planner: &MillPlanner, request: &MillRequest, n: usize) -> Option<f64> {
+    let mut sum = PlanningPhases::default();
+    let mut total = 0.0;
+    let cpu0 = process_cpu_time();
+    for _ in 0..n {
+        let out = match planner.plan(request) {
+            Ok(o) => o,
+            Err(e) => {
+                eprintln!("{name}: plan failed: {e}");
+                return None;
+            }
+        };
+        let p = out.phases;
+        sum.setup += p.setup;
+        sum.planner += p.planner;
+        sum.evaluation += p.evaluation;
+        sum.trajectory += p.trajectory;
+        total += out.planning_seconds;
+    }
+    let cpu = cpu0
+        .zip(process_cpu_time())
+        .map(|(a, b)| format!("{:.1} ms", (b - a) / n as f64 * 1e3))
+        .unwrap_or_else(|| "unknown".to_string());
+    let k = 1e3 / n as f64;
+    eprintln!(
+        "{name}: {:.1} ms per plan (mean of {n}; process CPU {cpu}) = setup {:.2} + planner {:.2} \
+         + evaluation {:.1} + trajectory {:.2} ms",
+        total * k,
+        sum.setup * k,
+        sum.planner * k,
+        sum.evaluation * k,
+        sum.trajectory * k
+    );
+    Some(total / n as f64)
+}
+
+/// Plans `request` with 1 thread and with `threads`; `true` when both
+/// succeed with identical plans and trajectories.
+fn same_plan(one: &MillPlanner, many: &MillPlanner, request: &MillRequest) -> bool {
+    match (one.plan(request), many.plan(request)) {
+        (Ok(a), Ok(b)) => identical(&a, &b),
+        (a, b) => {
+            eprintln!("plan failed: 1 thread {:?}, several {:?}", a.err(), b.err());
+            false
+        }
+    }
+}
+
+/// Bit-for-bit equality of the plan and the trajectory (timings aside).
+fn identical(a: &MillPlanOutput, b: &MillPlanOutput) -> bool {
+    let bits = |o: &MillPlanOutput| -> Vec<u64> {
+        o.plan
+            .segments
+            .iter()
+            .flat_map(|s| {
+                [
+                    s.spectral_radius,
+                    s.reward.total,
+                    s.condition_number,
+                    s.time,
+                ]
+            })
+            .chain(o.trajectory.points.iter().flat_map(|p| p.positions))
+            .map(f64::to_bits)
+            .collect()
+    };
+    a.plan == b.plan && a.trajectory == b.trajectory && bits(a) == bits(b)
+}
+
+fn bench(c: &mut Criterion) {
+    let threads = default_eval_threads();
+    let one = match MillPlanner::with_default_cell().and_then(|p| p.with_eval_threads(1)) {
+        Ok(p) => p,
+        Err(e) => {
+            eprintln!("plan_latency: no planner: {e}");
+            return;
+        }
+    };
+    let many = match MillPlanner::with_default_cell().and_then(|p| p.with_eval_threads(threads)) {
+        Ok(p) => p,
+        Err(e) => {
+            eprintln!("plan_latency: no planner: {e}");
+            return;
+        }
+    };
+    eprintln!(
+        "plan_latency: default request, {} segments, indicator cache {}, {threads} evaluation \
+         threads by default, load average {}",
+        many.cell().path().segments().len(),
+        if many.cache().is_some() {
+            "loaded"
+        } else {
+            "NOT loaded (naive fails; ddpg's rollout evaluates directly)"
+        },
+        load_average()
+    );
+    let mut requests = vec![(
+        "naive".to_string(),
+        MillRequest {
+            planner: "naive".to_string(),
+            ..MillRequest::default()
+        },
+    )];
+    match ddpg_policy(&many) {
+        Ok((path, note)) => {
+            eprintln!("ddpg policy: {note}");
+            requests.push((
+                "ddpg".to_string(),
+                MillRequest {
+                    planner: "ddpg".to_string(),
+                    policy_file: Some(path.display().to_string()),
+                    ..MillRequest::default()
+                },
+            ));
+        }
+        Err(e) => eprintln!("ddpg policy: none ({e}); ddpg not benchmarked"),
+    }
+    let planners: [(&MillPlanner, usize); 2] = [(&one, 1), (&many, threads)];
+    for (name, request) in &requests {
+        if !same_plan(&one, &many, request) {
+            eprintln!("{name}: 1-thread and {threads}-thread plans differ or failed; skipped");
+            continue;
+        }
+        for (planner, t) in planners {
+            let label = format!("plan {name}, {t} evaluation thread(s)");
+            if report(&label, planner, request, 5).is_none() {
+                continue;
+            }
+            c.bench_function(&label, |b| {
+                b.iter(|| planner.plan(request).expect("plan"));
+            });
+        }
+    }
+    eprintln!("load average after: {}", load_average());
+}
+
+criterion_group! {
+    name = benches;
+    // Few samples: one plan takes 0.1-0.5 s and the machine is shared.
+    config = Criterion::default().sample_size(10);
+    targets = bench
+}
+
+fn main() {
+    benches();
+    Criterion::default().configure_from_args().final_summary();
+}

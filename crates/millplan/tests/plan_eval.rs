@@ -1,0 +1,235 @@
+//! Plan evaluation on several threads (kerf_millplan::plan): the plan is
+//! bit for bit the sequential one whatever the thread count, every
+//! segment's |μ|max is the direct evaluation, errors are those of a
+//! sequential evaluation (the first bad segment), and the planner's
+//! evaluation-thread option and phase timings.
+
+use std::sync::{Arc, OnceLock};
+
+use kerf_mill::MillCell;
+use kerf_millplan::cache::direct_indicator;
+use kerf_millplan::plan::{default_eval_threads, Plan, MAX_EVAL_THREADS};
+use kerf_millplan::{MillPlanError, MillPlanner, MillRequest, PhysicalState, RewardWeights};
+
+fn cell() -> &'static Arc<MillCell> {
+    static C: OnceLock<Arc<MillCell>> = OnceLock::new();
+    C.get_or_init(|| Arc::new(MillCell::default_cell().expect("default cell")))
+}
+
+/// A feasible state sequence of the default cell with Ω, f and g varying
+/// along the path (g falls back to 0 where the varied g is infeasible on
+/// the branch-continuous IK chain).
+fn varied_states(cell: &MillCell) -> Vec<PhysicalState> {
+    let lim = *cell.state_limits();
+    let n = cell.path().segments().len();
+    let mut states = Vec::with_capacity(n);
+    let mut reference: Option<[f64; 6]> = None;
+    for i in 0..n {
+        let x = i as f64 / n as f64;
+        let rpm = lim.spindle_rpm[0]
+            + (lim.spindle_rpm[1] - lim.spindle_rpm[0]) * (0.5 + 0.45 * (7.0 * x).sin());
+        let feed = lim.feed[0] + (lim.feed[1] - lim.feed[0]) * (0.5 + 0.45 * (5.0 * x).cos());
+        let mut g = 0.3 * (4.0 * x).sin();
+        let cs = match cell.evaluate(i, g, reference.as_ref()) {
+            Ok(cs) => cs,
+            Err(_) => {
+                g = 0.0;
+                cell.evaluate(i, g, reference.as_ref())
+                    .expect("g = 0 feasible on the default path")
+            }
+        };
+        reference = Some(cs.joints);
+        states.push(PhysicalState {
+            segment: i,
+            rpm,
+            feed,
+            g,
+        });
+    }
+    states
+}
+
+/// Every f64 of a plan as bits, for a bit-for-bit comparison (NaN-safe,
+/// unlike `==`).
+fn bits(plan: &Plan) -> Vec<u64> {
+    let mut out = vec![
+        plan.total_time.to_bits(),
+        plan.max_spectral_radius.to_bits(),
+        plan.min_condition_indicator.to_bits(),
+        plan.total_reward.to_bits(),
+        u64::from(plan.chatter_free),
+    ];
+    for s in &plan.segments {
+        out.extend(
+            [
+                s.rpm,
+                s.feed,
+                s.g,
+                s.spectral_radius,
+                s.condition_number,
+                s.condition_indicator,
+                s.time,
+                s.reward.total,
+                s.reward.operational,
+                s.reward.efficiency,
+                s.reward.stability,
+            ]
+            .iter()
+            .chain(&s.joints)
+            .map(|v| v.to_bits()),
+        );
+        out.push(s.segment as u64);
+    }
+    out
+}
+
+#[test]
+fn parallel_evaluation_is_the_sequential_one_bit_for_bit_and_direct() {
+    let cell = cell();
+    let states = varied_states(cell);
+    let w = RewardWeights::default();
+    let seq = Plan::evaluate_with_threads(cell, &w, &states, "varied", 1).expect("sequential");
+    assert_eq!(seq.segments.len(), states.len());
+    // 2 (the machine), 3 (uneven hand-out), more than the cap.
+    for threads in [2, 3, MAX_EVAL_THREADS + 5] {
+        let par =
+            Plan::evaluate_with_threads(cell, &w, &states, "varied", threads).expect("parallel");
+        assert_eq!(bits(&par), bits(&seq), "{threads} threads");
+        assert_eq!(par, seq);
+    }
+    let default = Plan::evaluate(cell, &w, &states, "varied").expect("default threads");
+    assert_eq!(bits(&default), bits(&seq));
+    // Every |μ|max is the direct evaluation on the branch-continuous chain,
+    // and the states are the ones given.
+    let mut reference: Option<[f64; 6]> = None;
+    let mut distinct_mu = std::collections::BTreeSet::new();
+    for (s, st) in seq.segments.iter().zip(&states) {
+        assert_eq!(
+            (s.segment, s.rpm, s.feed, s.g),
+            (st.segment, st.rpm, st.feed, st.g)
+        );
+        let mu = direct_indicator(cell, s.segment, s.rpm, s.feed, s.g, reference.as_ref())
+            .expect("direct")
+            .expect("feasible");
+        assert_eq!(
+            mu.to_bits(),
+            s.spectral_radius.to_bits(),
+            "segment {}",
+            s.segment
+        );
+        distinct_mu.insert(mu.to_bits());
+        reference = Some(s.joints);
+    }
+    // The sequence really varies (a constant |μ| would hide a mix-up of
+    // segments between threads).
+    assert!(
+        distinct_mu.len() > 90,
+        "{} distinct |mu|",
+        distinct_mu.len()
+    );
+    let max = seq
+        .segments
+        .iter()
+        .map(|s| s.spectral_radius)
+        .fold(0.0, f64::max);
+    assert_eq!(seq.max_spectral_radius, max);
+}
+
+#[test]
+fn errors_are_those_of_the_first_bad_segment_for_every_thread_count() {
+    let cell = cell();
+    let states = varied_states(cell);
+    let w = RewardWeights::default();
+    // Two bad segments: a NaN feed at 37 and a NaN spindle speed at 12.
+    let mut bad = states.clone();
+    bad[37].feed = f64::NAN;
+    bad[12].rpm = f64::NAN;
+    for threads in [1, 2, 4] {
+        let e =
+            Plan::evaluate_with_threads(cell, &w, &bad, "bad", threads).expect_err("NaN refused");
+        match &e {
+            MillPlanError::InvalidParameter { name, value, .. } => {
+                assert!(
+                    name.contains("spindle speed") && name.contains("segment 12"),
+                    "{e}"
+                );
+                assert!(value.is_nan());
+            }
+            other => panic!("{threads} threads: {other:?}"),
+        }
+    }
+    // Only the NaN feed: named, never evaluated into a plan.
+    let mut nan_feed = states.clone();
+    nan_feed[99].feed = f64::NAN;
+    let e = Plan::evaluate_with_threads(cell, &w, &nan_feed, "bad", 2).expect_err("NaN feed");
+    assert!(e.to_string().contains("feed [m/s] at segment 99"), "{e}");
+    // Out of order, wrong length, zero threads.
+    let mut order = states.clone();
+    order.swap(3, 4);
+    let e = Plan::evaluate_with_threads(cell, &w, &order, "bad", 2).expect_err("order");
+    assert!(e.to_string().contains("state 3 is for segment 4"), "{e}");
+    assert!(matches!(
+        Plan::evaluate_with_threads(cell, &w, &states[1..], "bad", 2),
+        Err(MillPlanError::InvalidConfig { .. })
+    ));
+    assert!(matches!(
+        Plan::evaluate_with_threads(cell, &w, &states, "bad", 0),
+        Err(MillPlanError::InvalidParameter { .. })
+    ));
+    // An infeasible g at segment 50 (beyond the cell's range is a
+    // parameter error; the message names the segment).
+    let mut far = states;
+    far[50].g = cell.state_limits().redundancy_angle[1] + 1.0;
+    let e = Plan::evaluate_with_threads(cell, &w, &far, "bad", 3).expect_err("g range");
+    assert!(e.to_string().contains("segment 50"), "{e}");
+}
+
+#[test]
+fn planner_eval_threads_option_and_phases() {
+    assert!((1..=MAX_EVAL_THREADS).contains(&default_eval_threads()));
+    let base = MillPlanner::with_default_cell().expect("planner");
+    assert_eq!(base.eval_threads(), default_eval_threads());
+    assert!(matches!(
+        MillPlanner::with_default_cell()
+            .expect("planner")
+            .with_eval_threads(0),
+        Err(MillPlanError::InvalidParameter { .. })
+    ));
+    assert!(
+        base.cache().is_some(),
+        "the default indicator cache must load (naive planner)"
+    );
+    let one = base.with_eval_threads(1).expect("1 thread");
+    let two = MillPlanner::with_default_cell()
+        .and_then(|p| p.with_eval_threads(2))
+        .expect("2 threads");
+    assert_eq!((one.eval_threads(), two.eval_threads()), (1, 2));
+    let request = MillRequest {
+        planner: "naive".to_string(),
+        ..MillRequest::default()
+    };
+    let a = one.plan(&request).expect("naive, 1 thread");
+    let b = two.plan(&request).expect("naive, 2 threads");
+    assert_eq!(bits(&a.plan), bits(&b.plan));
+    assert_eq!(a.trajectory, b.trajectory);
+    for out in [&a, &b] {
+        let p = out.phases;
+        for v in [p.setup, p.planner, p.evaluation, p.trajectory] {
+            assert!(v.is_finite() && v >= 0.0, "{p:?}");
+        }
+        // The evaluation (100 indicator evaluations) is not free, and the
+        // phases fit in the total.
+        assert!(p.evaluation > 0.0, "{p:?}");
+        let sum = p.setup + p.planner + p.evaluation + p.trajectory;
+        assert!(
+            sum <= out.planning_seconds + 1e-9,
+            "{p:?} vs {}",
+            out.planning_seconds
+        );
+        assert!(
+            sum >= 0.5 * out.planning_seconds,
+            "{p:?} vs {}",
+            out.planning_seconds
+        );
+    }
+}
