@@ -289,3 +289,36 @@ fn dp_plan_replayed_in_the_unfiltered_environment_gives_its_value() {
         r.value
     );
 }
+
+#[test]
+fn dp_plans_respect_the_joint_speed_limits() {
+    // Joint speeds between segment midpoints, from the plan's
+    // branch-continuous joints (Plan::evaluate), against the URDF limits
+    // read here from the robot model.
+    let cell = MillCell::default_cell().unwrap();
+    let cache = IndicatorCache::load(&IndicatorCache::default_path(), &cell).unwrap();
+    let spec = DpSpec {
+        g_range: [-1.2, 1.6],
+        ..reduced_spec(&cell)
+    };
+    let r = dp::solve(&cell, &cache, &spec).unwrap();
+    let plan = Plan::evaluate(&cell, &RewardWeights::default(), &r.states, "dp").unwrap();
+    let limits: Vec<f64> = cell
+        .robot()
+        .joints()
+        .iter()
+        .map(|j| j.max_velocity)
+        .collect();
+    assert_eq!(limits.len(), 6);
+    let segments = cell.path().segments();
+    let mut worst: f64 = 0.0;
+    for w in plan.segments.windows(2) {
+        let dt = segments[w[0].segment].length / (2.0 * w[0].feed)
+            + segments[w[1].segment].length / (2.0 * w[1].feed);
+        for j in 0..6 {
+            let ratio = (w[1].joints[j] - w[0].joints[j]).abs() / dt / limits[j];
+            worst = worst.max(ratio);
+        }
+    }
+    assert!(worst <= 1.0 + 1e-9, "speed / limit up to {worst}");
+}
