@@ -315,9 +315,8 @@ fn dp_plans_respect_the_joint_speed_limits() {
     for w in plan.segments.windows(2) {
         let dt = segments[w[0].segment].length / (2.0 * w[0].feed)
             + segments[w[1].segment].length / (2.0 * w[1].feed);
-        for j in 0..6 {
-            let ratio = (w[1].joints[j] - w[0].joints[j]).abs() / dt / limits[j];
-            worst = worst.max(ratio);
+        for ((a, b), v) in w[0].joints.iter().zip(&w[1].joints).zip(&limits) {
+            worst = worst.max((b - a).abs() / dt / v);
         }
     }
     assert!(worst <= 1.0 + 1e-9, "speed / limit up to {worst}");
