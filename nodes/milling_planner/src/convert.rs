@@ -154,26 +154,70 @@ pub fn check_trajectory(t: &kerf_millplan::JointTrajectory) -> Result<(), String
     Ok(())
 }
 
+/// The times of the published trajectory for the planner's point times `t` (path start 0,
+/// the N segment midpoints, path end; at least 2): the first and the last half-segment take
+/// twice their planned time, every other interval is unchanged.
+///
+/// The robot starts the cut from rest and ends it at rest: an executor cannot step the
+/// velocity at the start, and kerf's refuses a trajectory that does not end at rest. The
+/// planner's trajectory passes the path start and end at the planned feed; here the first
+/// and the last point carry zero velocity instead, and the half-segments to and from them
+/// are ramps: a cubic from rest to the planned velocity at the first midpoint over twice the
+/// planned half-segment time is a constant acceleration when the joints move uniformly over
+/// that half-segment (and likewise the ramp down to rest at the end). Every point keeps its
+/// position; the tool passes every segment midpoint at the planned feed, `T0` later than
+/// planned (`T0` the planned time from the path start to the first midpoint), and reaches
+/// the path end `T0 + T1` after the machining time (`T1` the planned time from the last
+/// midpoint to the path end).
+pub fn ramped_times(t: &[f64]) -> Vec<f64> {
+    let n = t.len();
+    if n < 2 {
+        return t.to_vec();
+    }
+    let first = t[1] - t[0];
+    let last = t[n - 1] - t[n - 2];
+    let mut out: Vec<f64> = t.iter().map(|v| v + first).collect();
+    out[0] = t[0];
+    if n == 2 {
+        // One interval: it is both ramps.
+        out[1] = t[0] + 2.0 * first;
+    } else {
+        out[n - 1] += last;
+    }
+    out
+}
+
 /// The plan's trajectory as a `trajectory_msgs/JointTrajectory`: the planner's joint names
-/// (`joint_1` … `joint_6`), one point per trajectory point with positions and velocities (no
-/// accelerations: the executor interpolates cubically), `header.stamp` zero (the executor
-/// starts it on receipt).
+/// (`joint_1` … `joint_6`), one point per trajectory point with its positions and velocities
+/// (no accelerations: the executor interpolates cubic Hermite segments), from rest and to
+/// rest: zero velocity at the first and the last point, times from [`ramped_times`].
+/// `header.stamp` is zero (the executor starts it on receipt).
 ///
 /// # Errors
 /// As [`check_trajectory`], or a time that does not fit a `Duration`.
 pub fn trajectory_msg(t: &kerf_millplan::JointTrajectory) -> Result<JointTrajectory, String> {
     check_trajectory(t)?;
+    let planned: Vec<f64> = t.points.iter().map(|p| p.time_from_start).collect();
+    let times = ramped_times(&planned);
+    let last = t.points.len().saturating_sub(1);
     let points = t
         .points
         .iter()
-        .map(|p| {
+        .zip(&times)
+        .enumerate()
+        .map(|(k, (p, &time))| {
+            let velocities = if k == 0 || k == last {
+                vec![0.0; p.velocities.len()]
+            } else {
+                p.velocities.to_vec()
+            };
             Ok(JointTrajectoryPoint {
                 positions: p.positions.to_vec(),
-                velocities: p.velocities.to_vec(),
+                velocities,
                 accelerations: Vec::new(),
                 effort: Vec::new(),
-                time_from_start: Duration::from_secs_f64(p.time_from_start)
-                    .map_err(|e| format!("time {} s: {e}", p.time_from_start))?,
+                time_from_start: Duration::from_secs_f64(time)
+                    .map_err(|e| format!("time {time} s: {e}"))?,
             })
         })
         .collect::<Result<Vec<_>, String>>()?;
@@ -230,13 +274,21 @@ pub fn success_message(out: &MillPlanOutput) -> String {
             list.join(", ")
         )
     };
+    let planned: Vec<f64> = out
+        .trajectory
+        .points
+        .iter()
+        .map(|p| p.time_from_start)
+        .collect();
+    let duration = ramped_times(&planned).last().copied().unwrap_or(0.0);
     format!(
-        "planned {} segments with {}{policy}: machining time {:.3} s, max |mu| {:.4} ({chatter}), \
-         min condition indicator {:.3}, total reward {:.3}; indicator cache {}; planning took \
-         {:.3} s{jumps}",
+        "planned {} segments with {}{policy}: machining time {:.3} s (trajectory {:.3} s from \
+         rest to rest), max |mu| {:.4} ({chatter}), min condition indicator {:.3}, total reward \
+         {:.3}; indicator cache {}; planning took {:.3} s{jumps}",
         p.segments.len(),
         out.planner.name(),
         p.total_time,
+        duration,
         p.max_spectral_radius,
         p.min_condition_indicator,
         p.total_reward,

@@ -32,11 +32,16 @@
 //! -p queue_depth:=4`.
 //!
 //! # Behaviour
-//! The trajectory's first point (time 0) is the robot at the start of the path and its
-//! `header.stamp` is zero, so an executor starts it on receipt and accepts it only when its
-//! commanded position is that first point (within its `start_tolerance`): move the robot
-//! there first, or start the executor with `initial_positions` at the plan's first point. The
-//! trajectory topic is volatile on purpose: a restarted executor must not receive an old cut.
+//! The trajectory has the planner's N + 2 points (path start, the N segment midpoints, path
+//! end) with their joint positions and velocities, except that it starts and ends at rest:
+//! zero velocity at the path start and end, reached by ramps over twice the planned time of
+//! the first and the last half-segment ([`convert::ramped_times`]); every midpoint is passed
+//! at the planned feed. Its first point (time 0) is the robot at the start of the path and
+//! its `header.stamp` is zero, so an executor starts it on receipt and accepts it only when
+//! its commanded position is that first point (within its `start_tolerance`): move the robot
+//! there first, or start the executor with `initial_positions` at the plan's first point
+//! (`MillPlan.trajectory.points[0].positions`). The trajectory topic is volatile on purpose: a
+//! restarted executor must not receive an old cut.
 //!
 //! Planning takes from a fraction of a second (a policy) to seconds (`dp`), so it runs on a
 //! worker thread ([`kerf_ros::Worker`]) and the node keeps reading requests meanwhile.

@@ -246,6 +246,7 @@ fn a_real_plan_becomes_its_mill_plan() {
     for needle in [
         "planned 100 segments with naive",
         "machining time",
+        "from rest to rest",
         "cache used",
     ] {
         assert!(
@@ -254,7 +255,8 @@ fn a_real_plan_becomes_its_mill_plan() {
             m.message
         );
     }
-    // Trajectory: the planner's points exactly (times to the nanosecond of a Duration).
+    // Trajectory: the planner's points exactly, from rest to rest (times to the nanosecond of
+    // a Duration).
     let t = &m.trajectory;
     assert_eq!(
         t.joint_names,
@@ -263,16 +265,41 @@ fn a_real_plan_becomes_its_mill_plan() {
     assert_eq!(t.points.len(), out.trajectory.points.len());
     assert_eq!(t.points.len(), 102);
     assert!(t.header.stamp.sec == 0 && t.header.stamp.nanosec == 0);
-    for (a, b) in t.points.iter().zip(&out.trajectory.points) {
+    let last = t.points.len() - 1;
+    let planned: Vec<f64> = out
+        .trajectory
+        .points
+        .iter()
+        .map(|p| p.time_from_start)
+        .collect();
+    let times = convert::ramped_times(&planned);
+    for (k, (a, b)) in t.points.iter().zip(&out.trajectory.points).enumerate() {
         assert_eq!(a.positions, b.positions.to_vec());
-        assert_eq!(a.velocities, b.velocities.to_vec());
+        if k == 0 || k == last {
+            // From rest and to rest (the planner's one-sided differences are not zero).
+            assert_eq!(a.velocities, vec![0.0; 6]);
+            assert!(
+                b.velocities.iter().any(|v| v.abs() > 1e-3),
+                "{k}: {:?}",
+                b.velocities
+            );
+        } else {
+            assert_eq!(a.velocities, b.velocities.to_vec());
+        }
         assert!(a.accelerations.is_empty() && a.effort.is_empty());
-        assert!((a.time_from_start.as_secs_f64() - b.time_from_start).abs() <= 1e-9);
+        assert!((a.time_from_start.as_secs_f64() - times[k]).abs() <= 1e-9);
     }
+    // The ramps: the midpoints T0 later than planned, the end T0 + T1 after the machining
+    // time.
+    let (t0, t1) = (planned[1], planned[last] - planned[last - 1]);
+    for k in 1..last {
+        assert!((times[k] - (planned[k] + t0)).abs() < 1e-12);
+    }
+    assert!((planned[last] - m.machining_time).abs() <= 1e-9);
     let end = t.points.last().unwrap().time_from_start.as_secs_f64();
     assert!(
-        (end - m.machining_time).abs() <= 1e-9,
-        "{end} vs {}",
+        (end - (m.machining_time + t0 + t1)).abs() <= 1e-9,
+        "{end} vs {} + {t0} + {t1}",
         m.machining_time
     );
     // Segments and totals: the plan's.
@@ -349,4 +376,22 @@ fn a_defective_trajectory_is_an_internal_error_not_a_plan() {
         assert!(m.trajectory.points.is_empty() && m.segments.is_empty());
         assert_eq!(m.request_id, "naive-convert");
     }
+}
+
+#[test]
+fn ramps_double_the_first_and_last_half_segments() {
+    assert_eq!(
+        convert::ramped_times(&[0.0, 1.0, 3.0, 4.5]),
+        [0.0, 2.0, 4.0, 7.0]
+    );
+    assert_eq!(convert::ramped_times(&[0.0, 0.5]), [0.0, 1.0]);
+    assert_eq!(convert::ramped_times(&[0.0]), [0.0]);
+    // A joint moving uniformly at v over the first half-segment of planned time h: the cubic
+    // from rest to (v h, v) over 2h has the same acceleration v / (2h) at both ends
+    // (Hermite: a(0) = 6 d / T^2 - 2 v / T, a(T) = -6 d / T^2 + 4 v / T).
+    let (v, h): (f64, f64) = (0.3, 0.08);
+    let (d, t) = (v * h, 2.0 * h);
+    let a0 = 6.0 * d / (t * t) - 2.0 * v / t;
+    let a1 = -6.0 * d / (t * t) + 4.0 * v / t;
+    assert!((a0 - v / (2.0 * h)).abs() < 1e-12 && (a1 - v / (2.0 * h)).abs() < 1e-12);
 }

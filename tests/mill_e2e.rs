@@ -1,0 +1,846 @@
+//! End to end over DDS (loopback only) for the milling planner node (issue 5 sections 4-5).
+//!
+//! * Bad requests on `~/mill_request` and `~/mill_request_text` — fewer than 2 points, a path
+//!   off a plane, unreachable points, limits with min > max, NaN, a missing policy file, an
+//!   incompatible policy file (other state and action sizes), a policy file for `naive`, an
+//!   unknown planner, YAML errors, an empty text — each get one `MillPlan` with the right
+//!   status, a message naming the cause and the request id, in arrival order; no trajectory is
+//!   published for them, and the node keeps serving (later good requests, `naive` by text and
+//!   `ddpg` with a policy trained in the test, are planned).
+//! * The seed 004 path planned by `naive` goes planner → executor (IRB 6660, trajectory topic
+//!   remapped) → `/joint_states`, which move along the plan and reach its last point: once
+//!   from the message form and, after a move back to the start, once from the text form.
+//! * A full queue is answered QUEUE_FULL, not dropped.
+//!
+//! Each DDS test runs its own nodes (in this process, own Contexts) on its own domain (71-73).
+//! `naive` needs the shipped indicator cache of the shipped cell
+//! (`crates/millplan/data/indicator_cache.bin`): while it is being rebuilt these tests fail
+//! with "needs the default cell's indicator cache"; rerun them when it is back.
+
+use std::{
+    path::{Path, PathBuf},
+    sync::Arc,
+    thread::JoinHandle,
+    time::{Duration, Instant},
+};
+
+use kerf_millplan::{
+    ddpg::DdpgSettings,
+    nets::{Mlp, OutputActivation},
+    policy::{PolicyMetadata, POLICY_FORMAT},
+    rng::Rng,
+    train, EnvConfig, MillEnv, MillPlanOutput, MillPlanner, MillRequest, Policy,
+};
+use kerf_msgs::{
+    builtin_interfaces::Duration as RosDuration,
+    geometry_msgs::Point,
+    msg::{self, MillPlan, TrajectoryStatus},
+    sensor_msgs::JointState,
+    std_msgs::StringMsg,
+    trajectory_msgs::{JointTrajectory, JointTrajectoryPoint},
+    RosType,
+};
+use kerf_ros::{qos, KerfNode, RosEnv, StopToken};
+use ros2_client::{Publisher, ServiceMapping, Subscription};
+
+#[allow(dead_code)] // shared with the other end-to-end tests
+mod support;
+
+/// Waiting for an answer that needs no planning (validation, parsing) or a quick plan.
+const QUICK: Duration = Duration::from_secs(30);
+/// Waiting for an answer that runs a planner on a busy machine.
+const PLANNING: Duration = Duration::from_secs(120);
+/// Joint names of the IRB 6660 (urdf/irb6660.urdf).
+const JOINTS: [&str; 6] = [
+    "joint_1", "joint_2", "joint_3", "joint_4", "joint_5", "joint_6",
+];
+
+/// The seed 004 path (Table 1), the default cell's.
+fn seed_points() -> Vec<[f64; 3]> {
+    MillRequest::default().points
+}
+
+fn to_points(points: &[[f64; 3]]) -> Vec<Point> {
+    points
+        .iter()
+        .map(|p| Point {
+            x: p[0],
+            y: p[1],
+            z: p[2],
+        })
+        .collect()
+}
+
+/// A request message for the seed 004 path with `planner`.
+fn request_msg(id: &str, planner: &str) -> msg::MillRequest {
+    msg::MillRequest {
+        request_id: id.into(),
+        points: to_points(&seed_points()),
+        planner: planner.into(),
+        ..msg::MillRequest::default()
+    }
+}
+
+/// The YAML text of a request for the seed 004 path with `planner`.
+fn request_text(id: &str, planner: &str) -> String {
+    let points: Vec<String> = seed_points()
+        .iter()
+        .map(|p| format!("[{:?}, {:?}, {:?}]", p[0], p[1], p[2]))
+        .collect();
+    format!(
+        "request_id: {id}\nplanner: {planner}\npoints: [{}]\n",
+        points.join(", ")
+    )
+}
+
+fn scratch(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("kerf_mill_e2e_{}_{name}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+/// A milling planner node plus a client node talking to it.
+struct PlannerClient {
+    requests: Publisher<msg::MillRequest>,
+    texts: Publisher<StringMsg>,
+    plans: Subscription<MillPlan>,
+    plan_texts: Subscription<StringMsg>,
+    trajectories: Subscription<JointTrajectory>,
+    /// Keeps the client node (and its Context) alive; dropped after the endpoints above.
+    _client: KerfNode,
+    stop: StopToken,
+    planner: Option<JoinHandle<Result<(), String>>>,
+}
+
+impl PlannerClient {
+    /// Starts a milling planner on `env` with extra ROS arguments, and a client matched to it.
+    fn start(env: &RosEnv, extra: &[&str]) -> Self {
+        let mut words: Vec<String> = vec!["--ros-args".into(), "--disable-rosout-logs".into()];
+        words.extend(extra.iter().map(|s| s.to_string()));
+        let (stop, planner) = support::spawn_node(env, words, |a, e, s| {
+            kerf_milling_planner::run(a, e, s).map_err(|e| e.to_string())
+        });
+        let mut client = support::client_node("mill_client", env);
+        let requests = client
+            .publisher(
+                "/milling_planner/mill_request",
+                msg::MillRequest::ROS_TYPE,
+                qos::commands(),
+            )
+            .unwrap();
+        let texts = client
+            .publisher(
+                "/milling_planner/mill_request_text",
+                StringMsg::ROS_TYPE,
+                qos::commands(),
+            )
+            .unwrap();
+        let plans = client
+            .subscription(
+                "/milling_planner/mill_plan",
+                MillPlan::ROS_TYPE,
+                qos::latched(),
+            )
+            .unwrap();
+        let plan_texts = client
+            .subscription(
+                "/milling_planner/mill_plan_text",
+                StringMsg::ROS_TYPE,
+                qos::latched(),
+            )
+            .unwrap();
+        let trajectories = client
+            .subscription(
+                "/milling_planner/joint_trajectory",
+                JointTrajectory::ROS_TYPE,
+                qos::commands(),
+            )
+            .unwrap();
+        assert!(
+            client.wait_for_subscriber(&requests, QUICK),
+            "mill_request not matched"
+        );
+        assert!(
+            client.wait_for_subscriber(&texts, QUICK),
+            "mill_request_text not matched"
+        );
+        PlannerClient {
+            requests,
+            texts,
+            plans,
+            plan_texts,
+            trajectories,
+            _client: client,
+            stop,
+            planner: Some(planner),
+        }
+    }
+
+    fn send(&self, m: msg::MillRequest) {
+        self.requests.publish(m).expect("publish MillRequest");
+    }
+
+    fn send_text(&self, text: &str) {
+        self.texts
+            .publish(StringMsg { data: text.into() })
+            .expect("publish text request");
+    }
+
+    fn next_plan(&self, timeout: Duration) -> MillPlan {
+        take(&self.plans, timeout, "MillPlan")
+    }
+
+    fn next_plan_text(&self) -> MillPlan {
+        let text = take(&self.plan_texts, QUICK, "plan text");
+        serde_yaml_ng::from_str(&text.data).expect("plan text is a MillPlan as YAML")
+    }
+
+    fn trajectories_received(&self) -> usize {
+        let mut n = 0;
+        while let Ok(Some(_)) = self.trajectories.take() {
+            n += 1;
+        }
+        n
+    }
+
+    fn assert_running(&self) {
+        let h = self.planner.as_ref().expect("planner handle");
+        assert!(!h.is_finished(), "the milling planner node stopped");
+    }
+
+    /// Stops the planner; it must end cleanly.
+    fn finish(mut self) {
+        self.stop.stop();
+        let h = self.planner.take().expect("planner handle");
+        h.join()
+            .expect("planner thread")
+            .expect("planner ends cleanly");
+    }
+}
+
+fn take<M: serde::de::DeserializeOwned + 'static>(
+    sub: &Subscription<M>,
+    timeout: Duration,
+    what: &str,
+) -> M {
+    let deadline = Instant::now() + timeout;
+    while Instant::now() < deadline {
+        match sub.take() {
+            Ok(Some((m, _))) => return m,
+            Ok(None) => std::thread::sleep(Duration::from_millis(2)),
+            Err(e) => panic!("reading {what}: {e:?}"),
+        }
+    }
+    panic!("no {what} within {timeout:?}");
+}
+
+/// Checks status, request id and that `message` contains every needle.
+fn expect(plan: &MillPlan, id: &str, status: u8, needles: &[&str]) {
+    let name = |s| MillPlan::status_name(s).unwrap_or("?");
+    assert_eq!(
+        (plan.request_id.as_str(), name(plan.status)),
+        (id, name(status)),
+        "{}",
+        plan.message
+    );
+    for n in needles {
+        assert!(
+            plan.message.contains(n),
+            "{id}: {:?} lacks {n:?}",
+            plan.message
+        );
+    }
+    if status != MillPlan::SUCCESS {
+        assert!(
+            plan.trajectory.points.is_empty() && plan.segments.is_empty(),
+            "{id}: a failure carries no plan"
+        );
+    }
+}
+
+/// Writes a valid actor with 5 observations and 2 actions (the milling environment has 4 and
+/// 3), hidden layer 8.
+fn write_incompatible_policy(path: &Path) {
+    let mut rng = Rng::new(5);
+    let net = Mlp::new(&[5, 8, 2], OutputActivation::Tanh, &mut rng).unwrap();
+    let metadata = PolicyMetadata {
+        format: POLICY_FORMAT.to_string(),
+        crate_version: "test".to_string(),
+        observation_dim: 5,
+        action_dim: 2,
+        hidden_sizes: vec![8],
+        seed: 5,
+        settings: DdpgSettings::default()
+            .with_hidden_sizes(vec![8])
+            .with_seed(5),
+        environment: "mill_e2e: an actor of other sizes".to_string(),
+        episodes: 0,
+        final_reward: None,
+    };
+    Policy::from_actor(&net, metadata)
+        .unwrap()
+        .save(path)
+        .unwrap();
+}
+
+/// Trains a tiny DDPG actor (2 episodes, 16×16) on the shipped cell and saves it, as
+/// crates/millplan/tests/planner.rs does.
+fn write_trained_policy(planner: &MillPlanner, path: &Path) {
+    let mut env = MillEnv::new(
+        Arc::clone(planner.cell()),
+        planner.cache().cloned(),
+        EnvConfig::default(),
+    )
+    .unwrap();
+    let settings = DdpgSettings::default()
+        .with_episodes(2)
+        .with_hidden_sizes(vec![16, 16])
+        .with_seed(11);
+    let agent = train(&mut env, &settings, &mut |_| {}).unwrap();
+    Policy::from_agent(&agent, "mill_e2e: tiny policy")
+        .unwrap()
+        .save(path)
+        .unwrap();
+}
+
+#[test]
+fn bad_requests_get_their_status_and_the_node_keeps_serving() {
+    let dir = scratch("bad");
+    let incompatible = dir.join("incompatible.safetensors");
+    write_incompatible_policy(&incompatible);
+    let missing = dir.join("no_such_policy.safetensors");
+
+    let env = support::loopback(71, ServiceMapping::Enhanced);
+    let planner = PlannerClient::start(&env, &[]);
+    type Case = (
+        &'static str,
+        u8,
+        Box<dyn Fn(&mut msg::MillRequest)>,
+        Vec<String>,
+    );
+    let s = |v: &[&str]| v.iter().map(|x| x.to_string()).collect::<Vec<_>>();
+    let (missing_c, incompatible_c) = (
+        missing.display().to_string(),
+        incompatible.display().to_string(),
+    );
+    let cases: Vec<Case> = vec![
+        (
+            "one-point",
+            MillPlan::INVALID_REQUEST,
+            Box::new(|m| m.points.truncate(1)),
+            s(&["points (count)", "at least 2 points"]),
+        ),
+        (
+            "not-planar",
+            MillPlan::INVALID_REQUEST,
+            Box::new(|m| m.points[2].z += 0.05),
+            s(&["not coplanar", "best-fit plane"]),
+        ),
+        (
+            "unreachable",
+            MillPlan::UNREACHABLE,
+            // The whole (planar) path 3 m further out: beyond the IRB 6660's 3.1 m reach.
+            Box::new(|m| m.points.iter_mut().for_each(|p| p.x += 3.0)),
+            s(&["unreachable", "segment 0", "beyond the reach"]),
+        ),
+        (
+            "min-greater-than-max",
+            MillPlan::INVALID_REQUEST,
+            Box::new(|m| {
+                m.has_limits = true;
+                m.spindle_min_rpm = 2000.0;
+                m.spindle_max_rpm = 4000.0;
+                m.feed_min = 0.05;
+                m.feed_max = 0.01;
+                m.g_min = -1.0;
+                m.g_max = 1.0;
+                m.max_spindle_step_rpm = 20.0;
+                m.max_feed_step = 1e-3;
+                m.max_g_step = 0.2;
+            }),
+            s(&["limits.feed [m/s][0]", "min > max"]),
+        ),
+        (
+            "nan-point",
+            MillPlan::INVALID_REQUEST,
+            Box::new(|m| m.points[1].y = f64::NAN),
+            s(&["points[1][1] [m]", "NaN"]),
+        ),
+        (
+            "nan-initial-feed",
+            MillPlan::INVALID_REQUEST,
+            Box::new(|m| {
+                m.has_initial_state = true;
+                m.initial_spindle_rpm = 2000.0;
+                m.initial_feed = f64::NAN;
+                m.initial_g = 0.0;
+            }),
+            s(&["initial.feed [m/s]", "finite"]),
+        ),
+        (
+            "missing-policy",
+            MillPlan::POLICY_ERROR,
+            Box::new(move |m| {
+                m.planner = "ddpg".into();
+                m.policy_file = missing_c.clone();
+            }),
+            s(&["no_such_policy.safetensors", "weights file not found"]),
+        ),
+        (
+            "incompatible-policy",
+            MillPlan::POLICY_ERROR,
+            Box::new(move |m| {
+                m.planner = "ddpg".into();
+                m.policy_file = incompatible_c.clone();
+            }),
+            s(&[
+                "incompatible.safetensors",
+                "trained for observations of 5 and actions of 2 entries",
+                "the environment has 4 and 3",
+            ]),
+        ),
+        (
+            "policy-for-naive",
+            MillPlan::INVALID_REQUEST,
+            Box::new(|m| m.policy_file = "x.safetensors".into()),
+            s(&["policy_file", "naive", "uses no policy"]),
+        ),
+        (
+            "unknown-planner",
+            MillPlan::INVALID_REQUEST,
+            Box::new(|m| m.planner = "greedy".into()),
+            s(&["unknown planner `greedy`"]),
+        ),
+    ];
+    for (id, _, mutate, _) in &cases {
+        let mut m = request_msg(id, "naive");
+        mutate(&mut m);
+        planner.send(m);
+    }
+    // One topic, one worker: answers come back in the order the requests were sent.
+    for (id, status, _, needles) in &cases {
+        let plan = planner.next_plan(PLANNING);
+        let needles: Vec<&str> = needles.iter().map(String::as_str).collect();
+        expect(&plan, id, *status, &needles);
+        assert_eq!(
+            planner.next_plan_text(),
+            plan,
+            "{id}: text form of the same answer"
+        );
+        println!("{id}: {}", plan.message);
+    }
+
+    // The text topic: YAML errors, an empty text, NaN, min > max; ids kept when present.
+    planner.send_text("request_id: yaml-syntax\npoints: [[1.4, -0.3, 1.7], [2.1");
+    planner.send_text(&format!(
+        "{}speed: 3\n",
+        request_text("yaml-unknown", "naive")
+    ));
+    planner.send_text("");
+    planner.send_text(
+        "request_id: text-nan\nplanner: naive\npoints: [[1.4, -0.3, 1.7], [2.1, .nan, 1.7]]\n",
+    );
+    planner.send_text(&format!(
+        "{}limits: {{spindle_rpm: [4000, 2000]}}\n",
+        request_text("text-min-max", "naive")
+    ));
+    planner.send_text("request_id: text-one-point\nplanner: naive\npoints: [[1.4, -0.3, 1.7]]\n");
+    expect(
+        &planner.next_plan(QUICK),
+        "",
+        MillPlan::INVALID_REQUEST,
+        &["invalid request"],
+    );
+    expect(
+        &planner.next_plan(QUICK),
+        "yaml-unknown",
+        MillPlan::INVALID_REQUEST,
+        &["unknown field `speed`"],
+    );
+    expect(
+        &planner.next_plan(QUICK),
+        "",
+        MillPlan::INVALID_REQUEST,
+        &["the text is empty"],
+    );
+    expect(
+        &planner.next_plan(PLANNING),
+        "text-nan",
+        MillPlan::INVALID_REQUEST,
+        &["points[1][1] [m]", "NaN"],
+    );
+    expect(
+        &planner.next_plan(PLANNING),
+        "text-min-max",
+        MillPlan::INVALID_REQUEST,
+        &["limits.spindle_rpm [rpm][0]", "min > max"],
+    );
+    expect(
+        &planner.next_plan(PLANNING),
+        "text-one-point",
+        MillPlan::INVALID_REQUEST,
+        &["at least 2 points"],
+    );
+    // No failure published a trajectory.
+    std::thread::sleep(Duration::from_millis(300));
+    assert_eq!(planner.trajectories_received(), 0);
+
+    // Still serving: a naive plan by text, and a ddpg plan with a policy trained here.
+    planner.assert_running();
+    let offline = MillPlanner::with_default_cell().unwrap();
+    let trained = dir.join("tiny.safetensors");
+    write_trained_policy(&offline, &trained);
+    // (Two topics: the order between them is not kept, so one at a time.)
+    planner.send_text(&request_text("after-naive", "naive"));
+    let naive = planner.next_plan(PLANNING);
+    expect(&naive, "after-naive", MillPlan::SUCCESS, &["naive"]);
+    assert_eq!(naive.planner, "naive");
+    assert_eq!(naive.segments.len(), 100);
+    assert_eq!(naive.trajectory.points.len(), 102);
+    let mut m = request_msg("after-ddpg", "ddpg");
+    m.policy_file = trained.display().to_string();
+    planner.send(m);
+    let ddpg = planner.next_plan(PLANNING);
+    expect(
+        &ddpg,
+        "after-ddpg",
+        MillPlan::SUCCESS,
+        &["with ddpg", "tiny.safetensors"],
+    );
+    // The node's ddpg plan is the library's for the same request and policy.
+    let request = MillRequest {
+        request_id: "after-ddpg".into(),
+        planner: "ddpg".into(),
+        policy_file: Some(trained.display().to_string()),
+        ..MillRequest::default()
+    };
+    let direct = offline.plan(&request).unwrap();
+    assert_same_plan(&ddpg, &direct);
+    std::thread::sleep(Duration::from_millis(300));
+    assert_eq!(planner.trajectories_received(), 2, "one per success");
+    planner.assert_running();
+    planner.finish();
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// The node's answer carries the library's plan: per-segment states, |μ|max, totals, and the
+/// trajectory (positions exact; times those of the planner with the ramps from and to rest,
+/// `convert::ramped_times`, to the nanosecond of a ROS Duration).
+fn assert_same_plan(answer: &MillPlan, direct: &MillPlanOutput) {
+    assert_eq!(answer.segments.len(), direct.plan.segments.len());
+    for (a, b) in answer.segments.iter().zip(&direct.plan.segments) {
+        assert_eq!(
+            (a.spindle_rpm, a.feed, a.redundancy_angle, a.mu_max),
+            (b.rpm, b.feed, b.g, b.spectral_radius),
+            "segment {}",
+            b.segment
+        );
+    }
+    assert_eq!(answer.machining_time, direct.plan.total_time);
+    assert_eq!(answer.max_mu, direct.plan.max_spectral_radius);
+    assert_eq!(answer.chatter_free, direct.plan.chatter_free);
+    assert_eq!(answer.trajectory.joint_names, JOINTS);
+    assert_eq!(
+        answer.trajectory.points.len(),
+        direct.trajectory.points.len()
+    );
+    let planned: Vec<f64> = direct
+        .trajectory
+        .points
+        .iter()
+        .map(|p| p.time_from_start)
+        .collect();
+    let times = kerf_milling_planner::convert::ramped_times(&planned);
+    for ((a, b), t) in answer
+        .trajectory
+        .points
+        .iter()
+        .zip(&direct.trajectory.points)
+        .zip(times)
+    {
+        assert_eq!(a.positions, b.positions.to_vec());
+        assert!((a.time_from_start.as_secs_f64() - t).abs() <= 1e-9);
+    }
+}
+
+/// Starts an IRB 6660 executor at `initial` on `env`.
+fn spawn_irb6660_executor(
+    env: &RosEnv,
+    initial: &[f64],
+) -> (StopToken, JoinHandle<Result<(), String>>) {
+    let initial: Vec<String> = initial.iter().map(|v| format!("{v:?}")).collect();
+    support::spawn_executor(
+        env,
+        &[format!("initial_positions:=[{}]", initial.join(", "))],
+    )
+}
+
+/// Watches the executor until `SUCCEEDED`: every measured state lies on the plan (within
+/// one trajectory step of a plan point, and within 1e-6 rad of the path between points),
+/// nothing is rejected or aborted; then the robot rests at the plan's last point.
+fn follow_to_the_end(
+    states: &Subscription<JointState>,
+    statuses: &Subscription<TrajectoryStatus>,
+    plan: &MillPlan,
+    what: &str,
+) {
+    let points: Vec<&[f64]> = plan
+        .trajectory
+        .points
+        .iter()
+        .map(|p| p.positions.as_slice())
+        .collect();
+    let (first, last) = (points[0], points[points.len() - 1]);
+    let largest_step = points
+        .windows(2)
+        .flat_map(|w| (0..6).map(move |j| (w[1][j] - w[0][j]).abs()))
+        .fold(0.0, f64::max);
+    let deadline = Instant::now() + Duration::from_secs_f64(plan.machining_time) + PLANNING;
+    let mut accepted = false;
+    let mut succeeded = false;
+    let mut seen = 0usize;
+    let mut moved = 0.0_f64;
+    while Instant::now() < deadline && !succeeded {
+        while let Ok(Some((s, _))) = statuses.take() {
+            assert!(
+                s.status != TrajectoryStatus::REJECTED && s.status != TrajectoryStatus::ABORTED,
+                "{what}: executor {}: {}",
+                TrajectoryStatus::status_name(s.status).unwrap_or("?"),
+                s.message
+            );
+            accepted |= s.status == TrajectoryStatus::ACCEPTED;
+            succeeded |= s.status == TrajectoryStatus::SUCCEEDED;
+        }
+        while let Ok(Some((s, _))) = states.take() {
+            assert_eq!(s.name, JOINTS);
+            let off = points
+                .iter()
+                .map(|q| {
+                    q.iter()
+                        .zip(&s.position)
+                        .map(|(a, b)| (a - b).abs())
+                        .fold(0.0, f64::max)
+                })
+                .fold(f64::INFINITY, f64::min);
+            assert!(
+                off <= largest_step + 1e-6,
+                "{what}: state {:?} is {off} rad off the plan",
+                s.position
+            );
+            moved = moved.max((s.position[0] - first[0]).abs());
+            seen += 1;
+        }
+        std::thread::sleep(Duration::from_millis(5));
+    }
+    assert!(accepted && succeeded, "{what}: the executor did not finish");
+    assert!(
+        moved > 0.5 * (last[0] - first[0]).abs(),
+        "{what}: joint_1 moved only {moved} rad"
+    );
+    // 250 Hz over the machining time, with slack for a busy machine.
+    assert!(
+        seen as f64 > 50.0 * plan.machining_time,
+        "{what}: {seen} joint states during {} s",
+        plan.machining_time
+    );
+    std::thread::sleep(Duration::from_millis(200));
+    let mut end = take(states, QUICK, "joint state after the cut");
+    while let Ok(Some((s, _))) = states.take() {
+        end = s;
+    }
+    for (j, (got, want)) in end.position.iter().zip(last).enumerate() {
+        assert!(
+            (got - want).abs() < 1e-6,
+            "{what}: {} ends at {got}, plan {want}",
+            JOINTS[j]
+        );
+    }
+    assert!(
+        end.velocity.iter().all(|v| v.abs() < 1e-6),
+        "{what}: {:?}",
+        end.velocity
+    );
+}
+
+#[test]
+fn naive_plan_runs_from_planner_through_executor_by_message_and_by_text() {
+    // The plan computed in this process, for the executor's start and for comparison.
+    let offline = MillPlanner::with_default_cell().unwrap();
+    let request = MillRequest {
+        request_id: "run-msg".into(),
+        planner: "naive".into(),
+        ..MillRequest::default()
+    };
+    let direct = offline.plan(&request).unwrap_or_else(|e| {
+        panic!("naive plan failed ({e}); is the indicator cache being rebuilt? retry later")
+    });
+    let first = direct.trajectory.points[0].positions;
+
+    let env = support::loopback(73, ServiceMapping::Enhanced);
+    // The executor starts where the cut starts: the plan's first point is due at once and must
+    // equal the commanded position.
+    let (exec_stop, executor) = spawn_irb6660_executor(&env, &first);
+    let planner = PlannerClient::start(
+        &env,
+        &[
+            "-r",
+            "~/joint_trajectory:=/trajectory_executor/joint_trajectory",
+        ],
+    );
+    let mut watch = support::client_node("mill_watch", &env);
+    let states: Subscription<JointState> = watch
+        .subscription("/joint_states", JointState::ROS_TYPE, qos::state())
+        .unwrap();
+    let statuses: Subscription<TrajectoryStatus> = watch
+        .subscription(
+            "/trajectory_executor/trajectory_status",
+            TrajectoryStatus::ROS_TYPE,
+            qos::latched(),
+        )
+        .unwrap();
+    let back: Publisher<JointTrajectory> = watch
+        .publisher(
+            "/trajectory_executor/joint_trajectory",
+            JointTrajectory::ROS_TYPE,
+            qos::commands(),
+        )
+        .unwrap();
+    let start = take(&states, QUICK, "first joint state");
+    for (got, want) in start.position.iter().zip(first) {
+        assert!(
+            (got - want).abs() < 1e-12,
+            "{:?} vs {first:?}",
+            start.position
+        );
+    }
+    // The planner's (remapped) trajectory writer must be matched by the executor before
+    // planning: the topic is volatile.
+    let deadline = Instant::now() + QUICK;
+    while watch
+        .discovered_topics()
+        .iter()
+        .filter(|(t, _)| t == "/trajectory_executor/joint_trajectory")
+        .count()
+        == 0
+    {
+        assert!(
+            Instant::now() < deadline,
+            "the planner's remapped trajectory writer was not discovered"
+        );
+        std::thread::sleep(Duration::from_millis(20));
+    }
+    assert!(
+        watch.wait_for_subscriber(&back, QUICK),
+        "executor input not matched"
+    );
+    std::thread::sleep(Duration::from_millis(500));
+
+    // 1. The message form.
+    planner.send(request_msg("run-msg", "naive"));
+    let plan = planner.next_plan(PLANNING);
+    expect(
+        &plan,
+        "run-msg",
+        MillPlan::SUCCESS,
+        &["planned 100 segments with naive"],
+    );
+    assert_same_plan(&plan, &direct);
+    println!("message form: {}", plan.message);
+    follow_to_the_end(&states, &statuses, &plan, "message form");
+
+    // Back to the start (rest to rest, 4 s), then 2. the text form.
+    let home = JointTrajectory {
+        joint_names: JOINTS.iter().map(|s| s.to_string()).collect(),
+        points: vec![JointTrajectoryPoint {
+            positions: first.to_vec(),
+            velocities: vec![0.0; 6],
+            time_from_start: RosDuration { sec: 4, nanosec: 0 },
+            ..JointTrajectoryPoint::default()
+        }],
+        ..JointTrajectory::default()
+    };
+    back.publish(home).unwrap();
+    wait_succeeded(&statuses, "move back");
+    std::thread::sleep(Duration::from_millis(200));
+    let mut end = take(&states, QUICK, "joint state at the start");
+    while let Ok(Some((s, _))) = states.take() {
+        end = s;
+    }
+    for (got, want) in end.position.iter().zip(first) {
+        assert!((got - want).abs() < 1e-9, "back at {:?}", end.position);
+    }
+
+    planner.send_text(&request_text("run-text", "naive"));
+    let plan = planner.next_plan(PLANNING);
+    expect(
+        &plan,
+        "run-text",
+        MillPlan::SUCCESS,
+        &["planned 100 segments with naive"],
+    );
+    assert_same_plan(&plan, &direct);
+    follow_to_the_end(&states, &statuses, &plan, "text form");
+
+    planner.finish();
+    drop((states, statuses, back, watch));
+    exec_stop.stop();
+    executor.join().unwrap().unwrap();
+}
+
+/// Waits for the executor's next SUCCEEDED; fails on REJECTED or ABORTED.
+fn wait_succeeded(statuses: &Subscription<TrajectoryStatus>, what: &str) {
+    let deadline = Instant::now() + PLANNING;
+    while Instant::now() < deadline {
+        while let Ok(Some((s, _))) = statuses.take() {
+            assert!(
+                s.status != TrajectoryStatus::REJECTED && s.status != TrajectoryStatus::ABORTED,
+                "{what}: executor {}: {}",
+                TrajectoryStatus::status_name(s.status).unwrap_or("?"),
+                s.message
+            );
+            if s.status == TrajectoryStatus::SUCCEEDED {
+                return;
+            }
+        }
+        std::thread::sleep(Duration::from_millis(5));
+    }
+    panic!("{what}: no SUCCEEDED within {PLANNING:?}");
+}
+
+#[test]
+fn full_queue_is_answered_not_dropped() {
+    let env = support::loopback(72, ServiceMapping::Enhanced);
+    let planner = PlannerClient::start(&env, &["-p", "queue_depth:=1"]);
+    // A burst of six naive requests against a queue of one: the first is planned (about half
+    // a second), and the ones arriving meanwhile are refused at once.
+    let ids: Vec<String> = (0..6).map(|i| format!("burst-{i}")).collect();
+    for id in &ids {
+        planner.send(request_msg(id, "naive"));
+    }
+    let mut answers: Vec<MillPlan> = (0..ids.len())
+        .map(|_| planner.next_plan(PLANNING))
+        .collect();
+    answers.sort_by(|a, b| a.request_id.cmp(&b.request_id));
+    // Every request is answered exactly once: nothing is dropped.
+    let answered: Vec<&str> = answers.iter().map(|a| a.request_id.as_str()).collect();
+    assert_eq!(answered, ids.iter().map(String::as_str).collect::<Vec<_>>());
+    expect(&answers[0], "burst-0", MillPlan::SUCCESS, &[]);
+    let mut busy = 0;
+    for a in &answers[1..] {
+        if a.status == MillPlan::SUCCESS {
+            continue;
+        }
+        expect(
+            a,
+            &a.request_id,
+            MillPlan::QUEUE_FULL,
+            &["planner busy", "queue_depth 1"],
+        );
+        assert_eq!(a.planner, "naive");
+        busy += 1;
+    }
+    assert!(busy >= 1, "no request of the burst found the queue full");
+    planner.assert_running();
+    planner.finish();
+}
