@@ -57,6 +57,12 @@
 //!   default): a step whose joints move faster than the URDF's velocity
 //!   limits between the two segments' midpoints
 //!   ([`crate::joint_speed`]) is a terminal violation like an infeasible g.
+//! * **Projection of the g move** (kerf's, [`EnvConfig::project_g`], on by
+//!   default): a g move into an infeasible state is shortened to the
+//!   largest feasible fraction (bisection) — the clip of eq. 11 extended
+//!   from the state range to the feasible set, so that exploring g does
+//!   not end episodes at the edge of the reachable band or at a joint-speed
+//!   limit; the step is terminal only when keeping g is infeasible too.
 //! * **IK branch continuity**: each state's joints are the IK solution
 //!   nearest the previous state's joints (`MillCell::evaluate` with the
 //!   previous joints as reference).
@@ -98,7 +104,17 @@ pub struct EnvConfig {
     /// velocity limits between the two segments' midpoints is a terminal
     /// violation ([`crate::joint_speed`]; kerf's constraint, default on).
     pub joint_speed_limits: bool,
+    /// kerf's projection of the g move (default on): when the filtered move
+    /// leads to an infeasible state (IK, joint limit, joint speed), the
+    /// largest fraction of its g part that keeps the state feasible is
+    /// applied instead (bisection, [`PROJECTION_BISECTIONS`] steps), and
+    /// the filter state takes the applied move. Only when g unchanged is
+    /// infeasible too is the step a terminal violation.
+    pub project_g: bool,
 }
+
+/// Bisection steps of [`EnvConfig::project_g`] (resolution 2⁻⁸ of the move).
+pub const PROJECTION_BISECTIONS: usize = 8;
 
 impl Default for EnvConfig {
     /// Seed 004's IVP (2000 rpm, 0.04 m/s, 0 rad), α = 0.5, penalty −100,
@@ -115,6 +131,7 @@ impl Default for EnvConfig {
             fixed_g: false,
             chatter_margin: Some(ChatterMargin::default()),
             joint_speed_limits: true,
+            project_g: true,
         }
     }
 }
@@ -421,6 +438,43 @@ impl MillEnv {
         ]
     }
 
+    /// [`MillEnv::evaluate_state`] of `next` (IK from the current joints)
+    /// plus the joint-speed check from `current` when
+    /// [`EnvConfig::joint_speed_limits`] is set.
+    fn checked_evaluation(
+        &self,
+        current: &PhysicalState,
+        next: &PhysicalState,
+    ) -> Result<Result<Evaluation, String>, MillPlanError> {
+        let eval = self.evaluate_state(next, Some(&self.joints))?;
+        let Ok(e) = &eval else {
+            return Ok(eval);
+        };
+        if !self.config.joint_speed_limits {
+            return Ok(eval);
+        }
+        let segments = self.cell.path().segments();
+        let lengths = [
+            segments.get(current.segment).map_or(0.0, |s| s.length),
+            segments.get(next.segment).map_or(0.0, |s| s.length),
+        ];
+        let dt = joint_speed::midpoint_interval(lengths, [current.feed, next.feed]);
+        let motion: [f64; 6] = std::array::from_fn(|j| e.joints[j] - self.joints[j]);
+        Ok(
+            match joint_speed::first_violation(&motion, dt, &self.velocity_limits) {
+                Some((j, speed)) => Err(format!(
+                    "joint {} would move at {speed:.3} rad/s between segments {} and {} \
+                     (limit {:.3} rad/s)",
+                    j + 1,
+                    current.segment,
+                    next.segment,
+                    self.velocity_limits.get(j).copied().unwrap_or(f64::NAN)
+                )),
+                None => eval,
+            },
+        )
+    }
+
     fn info_from(
         &self,
         state: PhysicalState,
@@ -603,28 +657,38 @@ impl Environment for MillEnv {
             feed: (current.feed + filter[1]).clamp(lim.feed[0], lim.feed[1]),
             g: (current.g + filter[2]).clamp(lim.redundancy_angle[0], lim.redundancy_angle[1]),
         };
-        let mut eval = self.evaluate_state(&next, Some(&self.joints))?;
-        if self.config.joint_speed_limits {
-            if let Ok(e) = &eval {
-                let segments = self.cell.path().segments();
-                let lengths = [
-                    segments.get(current.segment).map_or(0.0, |s| s.length),
-                    segments.get(next.segment).map_or(0.0, |s| s.length),
-                ];
-                let dt = joint_speed::midpoint_interval(lengths, [current.feed, next.feed]);
-                let motion: [f64; 6] = std::array::from_fn(|j| e.joints[j] - self.joints[j]);
-                if let Some((j, speed)) =
-                    joint_speed::first_violation(&motion, dt, &self.velocity_limits)
-                {
-                    eval = Err(format!(
-                        "joint {} would move at {speed:.3} rad/s between segments {} and {} \
-                         (limit {:.3} rad/s)",
-                        j + 1,
-                        current.segment,
-                        next.segment,
-                        self.velocity_limits[j]
-                    ));
+        let mut next = next;
+        let mut eval = self.checked_evaluation(&current, &next)?;
+        // kerf's projection of the g move (EnvConfig::project_g): the
+        // largest fraction of the filtered g move that keeps the state
+        // feasible (IK, joint limits, joint speeds), by bisection.
+        if eval.is_err() && self.config.project_g && !self.config.fixed_g && filter[2] != 0.0 {
+            let full = filter[2];
+            let at = |fraction: f64| PhysicalState {
+                g: (current.g + fraction * full)
+                    .clamp(lim.redundancy_angle[0], lim.redundancy_angle[1]),
+                ..next
+            };
+            let still = at(0.0);
+            let still_eval = self.checked_evaluation(&current, &still)?;
+            if still_eval.is_ok() {
+                let (mut good, mut bad) = (0.0, 1.0);
+                let (mut best, mut best_eval) = (still, still_eval);
+                for _ in 0..PROJECTION_BISECTIONS {
+                    let mid = 0.5 * (good + bad);
+                    let candidate = at(mid);
+                    let e = self.checked_evaluation(&current, &candidate)?;
+                    if e.is_ok() {
+                        good = mid;
+                        best = candidate;
+                        best_eval = e;
+                    } else {
+                        bad = mid;
+                    }
                 }
+                next = best;
+                eval = best_eval;
+                filter[2] = next.g - current.g;
             }
         }
         self.filter = filter;

@@ -219,6 +219,7 @@ fn bad_actions_are_errors_and_change_nothing() {
 fn infeasible_g_is_a_terminal_violation() {
     let mut e = env(EnvConfig {
         alpha: 1.0,
+        project_g: false,
         ..EnvConfig::default()
     });
     e.reset().unwrap();
@@ -352,4 +353,42 @@ fn time_accounting_and_plan_totals() {
     bad[10].feed = 0.0;
     assert!(Plan::evaluate(cell, &RewardWeights::default(), &bad, "bad").is_err());
     assert!(Plan::evaluate(cell, &RewardWeights::default(), &states[1..], "bad").is_err());
+}
+
+#[test]
+fn projection_stops_g_at_the_edge_of_the_feasible_set() {
+    // The walk of infeasible_g_is_a_terminal_violation with the projection
+    // on: the episode runs to the end, every state is feasible for the
+    // model, g never goes below the edge it would have crossed, and the
+    // filter holds the applied (shortened) move.
+    let mut e = env(EnvConfig {
+        alpha: 1.0,
+        ..EnvConfig::default()
+    });
+    e.reset().unwrap();
+    let mut shortened = 0;
+    let mut previous = e.state().unwrap();
+    loop {
+        let tr = e.step(&[0.0, 0.0, -1.0]).unwrap();
+        let s = e.state().unwrap();
+        let info = e.last_info().unwrap();
+        assert!(info.violation.is_none(), "{:?}", info.violation);
+        assert!(e.cell().evaluate(s.segment, s.g, None).is_ok());
+        let moved = s.g - previous.g;
+        assert!((-0.2 - 1e-12..=1e-12).contains(&moved), "{moved}");
+        assert!((e.filter_state()[2] - moved).abs() < 1e-12);
+        if moved > -0.2 + 1e-9 {
+            shortened += 1;
+        }
+        previous = s;
+        if tr.done {
+            break;
+        }
+    }
+    assert_eq!(previous.segment, 99);
+    // The band's lower edge is about -1.2 rad at the start and moves to
+    // about -1.9 rad at the end (kerf_mill tests/reachability.rs): the walk
+    // reaches it and is held there.
+    assert!(shortened > 50, "{shortened}");
+    assert!(previous.g < -1.5, "{previous:?}");
 }
