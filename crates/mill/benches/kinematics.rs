@@ -3,7 +3,7 @@
 //! number, tool-tip dynamics).
 //!
 //! The chatter indicator on the DEFAULT CELL's tool-tip dynamics (segment
-//! 50, g = 0; the cell's `chatter` settings: m = 40, state-dependent,
+//! 50, g = −0.4 rad; the cell's `chatter` settings: m = 40, state-dependent,
 //! x_F = 0.75, wall term) — here because kerf_chatter's own benches cannot
 //! load the cell (kerf_mill depends on kerf_chatter):
 //!
@@ -54,14 +54,14 @@ fn bench(c: &mut Criterion) {
 
 fn bench_cell_indicator(c: &mut Criterion) {
     let cell = MillCell::default_cell().expect("default cell");
-    let state = cell.evaluate(50, 0.0, None).expect("segment 50, g = 0");
+    let state = cell.evaluate(50, -0.4, None).expect("segment 50, g = -0.4");
     let modal = state.modal;
     let process = cell.milling_process();
     let settings = *cell.indicator_settings();
     let m = settings.steps;
     let (rpm, feed) = (3000.0, 0.04);
     eprintln!(
-        "cell segment 50, g = 0: K = {:.4}, stiffness {:?} N/m, m = {m}",
+        "cell segment 50, g = -0.4: K = {:.4}, stiffness {:?} N/m, m = {m}",
         state.condition_number, modal.stiffness
     );
     c.bench_function(
