@@ -8,8 +8,9 @@ ament packages, so they are started with ExecuteProcess and the usual --ros-args
 
 Arguments:
     robot       laser_cutter | irb6660 (selects urdf/<robot>.urdf and its limits YAML);
-                laser_cutter also starts the MJTO planner (mjto_planner), its
-                ~/joint_trajectory remapped to the executor's input
+                laser_cutter also starts the MJTO planner (mjto_planner), irb6660 the
+                milling planner (milling_planner), its ~/joint_trajectory remapped to the
+                executor's input
     namespace   node namespace (default /)
     params_file executor parameters (default launch_scripts/params/<robot>.yaml)
     kerf_root   the kerf source tree (default: the parent of this file's directory)
@@ -72,6 +73,25 @@ def _nodes(context):
                     "-r", f"~/joint_trajectory:={ns}/trajectory_executor/joint_trajectory",
                     "-p", f"urdf_file:={os.path.join(urdf_dir, robot + '.urdf')}",
                     "-p", f"joint_limits_file:={os.path.join(urdf_dir, robot + '_limits.yaml')}",
+                ],
+            )
+        )
+    if robot == "irb6660":
+        # The milling planner (issue 5): the shipped cell urdf/irb6660_milling.yaml, its
+        # indicator cache and policies; its trajectories go straight to the executor.
+        planner_binary = os.path.join(root, "target", profile, "milling_planner")
+        if not os.path.exists(planner_binary):
+            raise RuntimeError(f"{planner_binary} not found: run 'cargo build --{profile} --workspace' in {root}")
+        ns = namespace.rstrip("/")
+        nodes.append(
+            ExecuteProcess(
+                name="milling_planner",
+                output="screen",
+                cmd=[
+                    planner_binary,
+                    "--ros-args",
+                    "-r", f"__ns:={namespace}",
+                    "-r", f"~/joint_trajectory:={ns}/trajectory_executor/joint_trajectory",
                 ],
             )
         )

@@ -1,5 +1,6 @@
 //! `kerf launch`: every node in one process, each with its own Context and thread: the
-//! trajectory executor, and with `--with-planner` (laser cutter) the MJTO planner.
+//! trajectory executor, and with `--with-planner` the robot's planner (laser cutter: the MJTO
+//! planner; IRB 6660: the milling planner).
 
 use std::path::PathBuf;
 
@@ -31,7 +32,8 @@ pub struct LaunchArgs {
     /// shipped descriptions; `-p` arguments after `--ros-args` override them).
     #[arg(long, value_enum, default_value = "laser-cutter")]
     robot: Robot,
-    /// Also start the MJTO laser-cutting planner (`mjto_planner`; laser cutter only). Its
+    /// Also start the robot's planner: the MJTO laser-cutting planner (`mjto_planner`) for
+    /// the laser cutter, the milling planner (`milling_planner`) for the IRB 6660. Its
     /// `~/joint_trajectory` reaches the executor only when remapped (README).
     #[arg(long)]
     with_planner: bool,
@@ -76,6 +78,30 @@ fn args_for(args: &RosArgs, known: &[&str], all_known: &[&[&str]]) -> RosArgs {
     out
 }
 
+/// A node of the launch: default name, known parameters, entry point.
+type LaunchNode = (
+    &'static str,
+    &'static [&'static str],
+    fn(&RosArgs, &RosEnv, StopToken) -> Result<(), String>,
+);
+
+/// The planner of `--with-planner` for `robot`: the MJTO planner plans for the laser cutter,
+/// the milling planner for the IRB 6660.
+fn planner_node(robot: Robot) -> LaunchNode {
+    match robot {
+        Robot::LaserCutter => (
+            kerf_mjto_planner::DEFAULT_NAME,
+            kerf_mjto_planner::KNOWN_PARAMS,
+            |a, e, s| kerf_mjto_planner::run(a, e, s).map_err(|e| e.to_string()),
+        ),
+        Robot::Irb6660 => (
+            kerf_milling_planner::DEFAULT_NAME,
+            kerf_milling_planner::KNOWN_PARAMS,
+            |a, e, s| kerf_milling_planner::run(a, e, s).map_err(|e| e.to_string()),
+        ),
+    }
+}
+
 /// Runs `kerf launch` until Ctrl-C or until a node fails.
 pub fn run(a: LaunchArgs) -> Result<(), String> {
     let mut args = RosArgs::parse(a.ros_args.iter().cloned()).map_err(|e| e.to_string())?;
@@ -101,24 +127,13 @@ pub fn run(a: LaunchArgs) -> Result<(), String> {
     shutdown::install_handler()?;
     let stop = StopToken::new();
 
-    type NodeMain = fn(&RosArgs, &RosEnv, StopToken) -> Result<(), String>;
-    let mut nodes: Vec<(&str, &[&str], NodeMain)> = vec![(
+    let mut nodes: Vec<LaunchNode> = vec![(
         kerf_trajectory_executor::DEFAULT_NAME,
         kerf_trajectory_executor::KNOWN_PARAMS,
         |a, e, s| kerf_trajectory_executor::run(a, e, s).map_err(|e| e.to_string()),
     )];
     if a.with_planner {
-        // The MJTO planner plans for the laser cutter only.
-        if !matches!(a.robot, Robot::LaserCutter) {
-            return Err(
-                "--with-planner: the MJTO planner plans for --robot laser-cutter only".into(),
-            );
-        }
-        nodes.push((
-            kerf_mjto_planner::DEFAULT_NAME,
-            kerf_mjto_planner::KNOWN_PARAMS,
-            |a, e, s| kerf_mjto_planner::run(a, e, s).map_err(|e| e.to_string()),
-        ));
+        nodes.push(planner_node(a.robot));
     }
     let all_known: Vec<&[&str]> = nodes.iter().map(|(_, known, _)| *known).collect();
     let mut handles = Vec::new();
@@ -196,8 +211,32 @@ mod tests {
             names(args_for(&args, planner, &all)),
             ["queue_depth", "urdf_file", "no_such_param"]
         );
+        // The IRB 6660 launch: the milling planner's parameters go to it alone.
+        let mill = kerf_milling_planner::KNOWN_PARAMS;
+        let args = RosArgs::parse([
+            "--ros-args",
+            "-p",
+            "queue_depth:=2",
+            "-p",
+            "cell_file:=/c.yaml",
+            "-p",
+            "urdf_file:=/u.urdf",
+        ])
+        .unwrap();
+        assert_eq!(
+            names(args_for(&args, mill, &[exec, mill])),
+            ["queue_depth", "cell_file"]
+        );
+        assert_eq!(names(args_for(&args, exec, &[exec, mill])), ["urdf_file"]);
         assert!(knows(exec, "constraints.q1.goal"));
         assert!(!knows(exec, "constraints"));
         assert!(!knows(planner, "queue"));
+    }
+
+    #[test]
+    fn each_robot_gets_its_planner() {
+        assert_eq!(planner_node(Robot::LaserCutter).0, "mjto_planner");
+        assert_eq!(planner_node(Robot::Irb6660).0, "milling_planner");
+        assert!(planner_node(Robot::Irb6660).1.contains(&"cell_file"));
     }
 }

@@ -12,7 +12,11 @@
 //!   from the message form and, after a move back to the start, once from the text form.
 //! * A full queue is answered QUEUE_FULL, not dropped.
 //!
-//! Each DDS test runs its own nodes (in this process, own Contexts) on its own domain (71-73).
+//! * `kerf launch --robot irb6660 --with-planner` serves a request and feeds its executor.
+//!
+//! Each DDS test runs its own nodes (in this process, own Contexts; `kerf launch` as a child)
+//! on its own domain (71-74).
+//!
 //! `naive` needs the shipped indicator cache of the shipped cell
 //! (`crates/millplan/data/indicator_cache.bin`): while it is being rebuilt these tests fail
 //! with "needs the default cell's indicator cache"; rerun them when it is back.
@@ -843,4 +847,149 @@ fn full_queue_is_answered_not_dropped() {
     assert!(busy >= 1, "no request of the burst found the queue full");
     planner.assert_running();
     planner.finish();
+}
+
+/// Kills the child on drop (a failed test leaves no process behind).
+struct Killed(std::process::Child);
+
+impl Drop for Killed {
+    fn drop(&mut self) {
+        let _ = self.0.kill();
+        let _ = self.0.wait();
+    }
+}
+
+/// `kerf launch --robot irb6660 --with-planner` (the user's command, as a child process)
+/// runs the executor and the milling planner: a text request is planned, its trajectory
+/// (remapped on the command line) reaches the executor, which starts it from the
+/// `initial_positions` given on the same command line; Ctrl-C stops both cleanly.
+#[test]
+fn kerf_launch_irb6660_with_planner_serves_mill_requests() {
+    use std::io::{BufRead, BufReader};
+    use std::process::{Command, Stdio};
+
+    let offline = MillPlanner::with_default_cell().unwrap();
+    let direct = offline
+        .plan(&MillRequest {
+            planner: "naive".into(),
+            ..MillRequest::default()
+        })
+        .unwrap_or_else(|e| panic!("naive plan failed ({e}); retry when the cache is back"));
+    let first: Vec<String> = direct.trajectory.points[0]
+        .positions
+        .iter()
+        .map(|v| format!("{v:?}"))
+        .collect();
+    let child = Command::new(env!("CARGO_BIN_EXE_kerf"))
+        .env("ROS_DOMAIN_ID", "74")
+        .env("ROS_AUTOMATIC_DISCOVERY_RANGE", "LOCALHOST")
+        .env_remove("ROS_STATIC_PEERS")
+        .args([
+            "launch",
+            "--robot",
+            "irb6660",
+            "--with-planner",
+            "--ros-args",
+        ])
+        .args(["-p", "queue_depth:=2", "-p"])
+        .arg(format!("initial_positions:=[{}]", first.join(", ")))
+        .args([
+            "-r",
+            "milling_planner:~/joint_trajectory:=/trajectory_executor/joint_trajectory",
+        ])
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("start kerf launch");
+    let mut launch = Killed(child);
+    let stderr = launch.0.stderr.take().expect("stderr");
+    let (tx, rx) = std::sync::mpsc::channel();
+    std::thread::spawn(move || {
+        for line in BufReader::new(stderr).lines().map_while(Result::ok) {
+            let _ = tx.send(line);
+        }
+    });
+    let wait_line = |needle: &str| -> String {
+        let deadline = Instant::now() + QUICK;
+        while let Ok(line) = rx.recv_timeout(deadline.saturating_duration_since(Instant::now())) {
+            if line.contains(needle) {
+                return line;
+            }
+        }
+        panic!("kerf launch never printed {needle:?}");
+    };
+    let serving = wait_line("serving mill requests");
+    assert!(
+        serving.contains("queue_depth 2")
+            && serving.contains("trajectories on /trajectory_executor/joint_trajectory"),
+        "{serving}"
+    );
+
+    let env = support::loopback(74, ServiceMapping::Enhanced);
+    let mut client = support::client_node("mill_launch_client", &env);
+    let texts: Publisher<StringMsg> = client
+        .publisher(
+            "/milling_planner/mill_request_text",
+            StringMsg::ROS_TYPE,
+            qos::commands(),
+        )
+        .unwrap();
+    let plans: Subscription<MillPlan> = client
+        .subscription(
+            "/milling_planner/mill_plan",
+            MillPlan::ROS_TYPE,
+            qos::latched(),
+        )
+        .unwrap();
+    let statuses: Subscription<TrajectoryStatus> = client
+        .subscription(
+            "/trajectory_executor/trajectory_status",
+            TrajectoryStatus::ROS_TYPE,
+            qos::latched(),
+        )
+        .unwrap();
+    assert!(client.wait_for_subscriber(&texts, QUICK), "not matched");
+    texts
+        .publish(StringMsg {
+            data: request_text("launched", "naive"),
+        })
+        .unwrap();
+    let plan = take(&plans, PLANNING, "MillPlan");
+    expect(&plan, "launched", MillPlan::SUCCESS, &["with naive"]);
+    let deadline = Instant::now() + QUICK;
+    let mut accepted = None;
+    while Instant::now() < deadline && accepted.is_none() {
+        if let Ok(Some((s, _))) = statuses.take() {
+            accepted = Some(s);
+        } else {
+            std::thread::sleep(Duration::from_millis(5));
+        }
+    }
+    let s = accepted.expect("no trajectory status from the launched executor");
+    assert_eq!(
+        TrajectoryStatus::status_name(s.status),
+        Some("ACCEPTED"),
+        "{}",
+        s.message
+    );
+    drop((texts, plans, statuses, client));
+
+    // Ctrl-C: a clean shutdown of both nodes and exit status 0.
+    let pid = launch.0.id().to_string();
+    assert!(Command::new("kill")
+        .args(["-INT", &pid])
+        .status()
+        .unwrap()
+        .success());
+    let deadline = Instant::now() + QUICK;
+    loop {
+        if let Some(status) = launch.0.try_wait().unwrap() {
+            assert!(status.success(), "exit status {status}");
+            break;
+        }
+        assert!(
+            Instant::now() < deadline,
+            "kerf launch did not exit after SIGINT"
+        );
+        std::thread::sleep(Duration::from_millis(20));
+    }
 }
