@@ -170,7 +170,7 @@ fn bad_inputs_exit_2_with_a_message() {
             &["--segment", "100", "--g", "0"],
             "the path has 100 segments",
         ),
-        (&["--segment", "50", "--g", "3.1"], "joint_5"),
+        (&["--segment", "50", "--g", "2.7"], "joint_5"),
         (
             &["--segment", "50", "--g", "0", "--rpm", "4000:2000:5"],
             "MIN 4000 > MAX 2000",
@@ -202,7 +202,7 @@ fn bad_inputs_exit_2_with_a_message() {
         assert!(!stderr.contains("panicked"), "{args:?}: {stderr}");
     }
     // The unreachable g names the joint's excess over its limit.
-    let out = kerf(&["--segment", "50", "--g", "3.1", "--out", d]);
+    let out = kerf(&["--segment", "50", "--g", "2.7", "--out", d]);
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert!(
         stderr.contains("outside") && stderr.contains("by 0.33"),
