@@ -17,8 +17,10 @@
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 
 use kerf_chatter::indicator::chatter_indicator;
+use kerf_chatter::Modal2;
 use kerf_mill::{CellState, MillCell};
 
+use crate::cache::{is_infeasible, IndicatorCache};
 use crate::env::PhysicalState;
 use crate::error::MillPlanError;
 use crate::reward::{step_reward, RewardParts, RewardWeights};
@@ -154,82 +156,38 @@ impl Plan {
         planner: &str,
         threads: usize,
     ) -> Result<Self, MillPlanError> {
-        if threads == 0 {
-            return Err(MillPlanError::InvalidParameter {
-                name: "evaluation threads".to_string(),
-                value: 0.0,
-                reason: "must be >= 1".to_string(),
-            });
-        }
-        weights.validate()?;
-        let n = cell.path().segments().len();
-        if states.len() != n {
-            return Err(MillPlanError::InvalidConfig {
-                name: format!("plan `{planner}`"),
-                reason: format!("{} states for {n} segments", states.len()),
-            });
-        }
-        let lim = cell.state_limits();
-        // Step 1: checks and cell states, in order, up to the first error.
-        let mut cell_states: Vec<CellState> = Vec::with_capacity(n);
-        let mut first_error: Option<MillPlanError> = None;
-        let mut reference: Option<[f64; 6]> = None;
-        for (i, s) in states.iter().enumerate() {
-            match check_state(cell, i, s, planner)
-                .and_then(|()| Ok(cell.evaluate(i, s.g, reference.as_ref())?))
-            {
-                Ok(cs) => {
-                    reference = Some(cs.joints);
-                    cell_states.push(cs);
-                }
-                Err(e) => {
-                    first_error = Some(e);
-                    break;
-                }
-            }
-        }
-        // Step 2: |μ|max of the segments 0..cell_states.len().
-        let mus = spectral_radii(cell, states, &cell_states, threads);
-        // Step 3: in order; a |μ| error at segment j precedes a step-1
-        // error at a later segment (sequential order).
-        let mut segments = Vec::with_capacity(n);
-        for (i, (cs, mu)) in cell_states.iter().zip(mus).enumerate() {
-            let s = &states[i];
-            let mu = mu?;
-            let reward = step_reward(weights, cs.condition_number, s.feed, lim.feed[1], mu)?;
-            let length = cell.path().segment(i)?.length;
-            segments.push(SegmentPlan {
-                segment: i,
-                rpm: s.rpm,
-                feed: s.feed,
-                g: s.g,
-                spectral_radius: mu,
-                condition_number: cs.condition_number,
-                condition_indicator: cs.condition_indicator,
-                joints: cs.joints,
-                time: length / s.feed,
-                reward,
-            });
-        }
-        if let Some(e) = first_error {
-            return Err(e);
-        }
-        let max_mu = segments
-            .iter()
-            .map(|s| s.spectral_radius)
-            .fold(0.0, f64::max);
-        Ok(Self {
-            planner: planner.to_string(),
-            total_time: segments.iter().map(|s| s.time).sum(),
-            chatter_free: segments.iter().all(|s| s.spectral_radius < 1.0),
-            max_spectral_radius: max_mu,
-            min_condition_indicator: segments
-                .iter()
-                .map(|s| s.condition_indicator)
-                .fold(f64::INFINITY, f64::min),
-            total_reward: segments.iter().map(|s| s.reward.total).sum(),
-            segments,
-        })
+        evaluate_impl(cell, weights, states, planner, threads, None).map(|(plan, _)| plan)
+    }
+
+    /// [`Plan::evaluate_with_threads`] with |μ|max from `cache` where it
+    /// applies ([`IndicatorSource::Cache`]): a segment's cached value is
+    /// used when the cache has a stated error bound,
+    /// [`IndicatorCache::try_query`] answers, and the plan's cell state (IK
+    /// nearest the previous segment's joints) has the tool-tip dynamics of
+    /// the reference-joint IK state the cache was built with (mass,
+    /// damping and stiffness matrices equal within 1e-9 relative: |μ|
+    /// depends on the cell state only through them); every other segment
+    /// is evaluated directly. A cached segment's bound is the
+    /// cache's bound for g on a g node when its g is a node (and the cache
+    /// states one), else the general bound. `chatter_free` is then claimed
+    /// only when every cached |μ| + its bound < 1 (and every direct
+    /// |μ| < 1).
+    ///
+    /// The caller guarantees that the cache belongs to the cell's model
+    /// ([`crate::planner::MillPlanner`] checks the cell fingerprint):
+    /// hence crate-private.
+    ///
+    /// # Errors
+    /// As [`Plan::evaluate_with_threads`].
+    pub(crate) fn evaluate_cached(
+        cell: &MillCell,
+        weights: &RewardWeights,
+        states: &[PhysicalState],
+        planner: &str,
+        threads: usize,
+        cache: &IndicatorCache,
+    ) -> Result<(Self, IndicatorProvenance), MillPlanError> {
+        evaluate_impl(cell, weights, states, planner, threads, Some(cache))
     }
 
     /// The plan's row of the comparison table.
@@ -256,6 +214,292 @@ impl Plan {
             })
             .collect()
     }
+}
+
+/// Where the |μ|max of a plan's segments comes from.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum IndicatorSource {
+    /// Every segment evaluated directly with the chatter model (the
+    /// default; about 1.25 ms per segment in release).
+    #[default]
+    Direct,
+    /// The indicator cache's interpolation where it applies, with its
+    /// stated error bound reported ([`Plan::evaluate`] stays direct; see
+    /// [`crate::planner::MillPlanner::with_indicator_source`]).
+    Cache,
+}
+
+impl IndicatorSource {
+    /// `direct` or `cache`.
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Direct => "direct",
+            Self::Cache => "cache",
+        }
+    }
+}
+
+/// How the |μ|max values of a plan were obtained (part of the planner's
+/// answer, [`crate::planner::MillPlanOutput::indicator`]).
+#[derive(Debug, Clone, PartialEq)]
+pub struct IndicatorProvenance {
+    /// The source asked for.
+    pub requested: IndicatorSource,
+    /// Segments whose |μ|max is the cache's interpolation (ascending);
+    /// empty for a direct evaluation.
+    pub cached_segments: Vec<usize>,
+    /// Segments in the plan.
+    pub segments: usize,
+    /// The cache's stated bound on |cached − direct| |μ|max when some
+    /// segment is cached (the largest that applies: the bound for g on a
+    /// g node where every cached g is a node and the cache states one, else
+    /// the general bound), else `None`.
+    pub error_bound: Option<f64>,
+    /// One sentence for the answer's message: how many segments are
+    /// cached, the bound, and why the cache was not used where it was not.
+    pub note: String,
+}
+
+impl IndicatorProvenance {
+    /// Every segment evaluated directly, `requested` having been asked for
+    /// (`reason`: why the cache was not used, when it was asked for).
+    ///
+    /// # Arguments
+    /// * `requested` — the source asked for; `segments` — plan length;
+    /// * `reason` — appended to the note when not empty.
+    ///
+    /// # Returns
+    /// A provenance with no cached segment.
+    pub fn direct(requested: IndicatorSource, segments: usize, reason: &str) -> Self {
+        let mut note = format!("|mu|max evaluated directly for all {segments} segments");
+        if !reason.is_empty() {
+            note.push_str(&format!(" ({reason})"));
+        }
+        Self {
+            requested,
+            cached_segments: Vec::new(),
+            segments,
+            error_bound: None,
+            note,
+        }
+    }
+
+    /// Whether every |μ|max of the plan is a direct evaluation.
+    pub fn all_direct(&self) -> bool {
+        self.cached_segments.is_empty()
+    }
+}
+
+/// The evaluation of [`Plan::evaluate_with_threads`] and, with a cache,
+/// [`Plan::evaluate_cached`].
+fn evaluate_impl(
+    cell: &MillCell,
+    weights: &RewardWeights,
+    states: &[PhysicalState],
+    planner: &str,
+    threads: usize,
+    cache: Option<&IndicatorCache>,
+) -> Result<(Plan, IndicatorProvenance), MillPlanError> {
+    if threads == 0 {
+        return Err(MillPlanError::InvalidParameter {
+            name: "evaluation threads".to_string(),
+            value: 0.0,
+            reason: "must be >= 1".to_string(),
+        });
+    }
+    weights.validate()?;
+    let n = cell.path().segments().len();
+    if states.len() != n {
+        return Err(MillPlanError::InvalidConfig {
+            name: format!("plan `{planner}`"),
+            reason: format!("{} states for {n} segments", states.len()),
+        });
+    }
+    let lim = cell.state_limits();
+    // Step 1: checks and cell states, in order, up to the first error.
+    let mut cell_states: Vec<CellState> = Vec::with_capacity(n);
+    let mut first_error: Option<MillPlanError> = None;
+    let mut reference: Option<[f64; 6]> = None;
+    for (i, s) in states.iter().enumerate() {
+        match check_state(cell, i, s, planner)
+            .and_then(|()| Ok(cell.evaluate(i, s.g, reference.as_ref())?))
+        {
+            Ok(cs) => {
+                reference = Some(cs.joints);
+                cell_states.push(cs);
+            }
+            Err(e) => {
+                first_error = Some(e);
+                break;
+            }
+        }
+    }
+    // Step 2: cached values where the cache applies, the rest directly.
+    let k = cell_states.len();
+    let cached = match cache {
+        Some(c) => cached_values(cell, states, &cell_states, c)?,
+        None => vec![None; k],
+    };
+    let direct: Vec<usize> = (0..k).filter(|i| cached[*i].is_none()).collect();
+    let mut direct_mus = spectral_radii(cell, states, &cell_states, &direct, threads).into_iter();
+    let mut mus: Vec<Result<f64, MillPlanError>> = Vec::with_capacity(k);
+    for value in &cached {
+        match value {
+            Some((v, _)) => mus.push(Ok(*v)),
+            None => match direct_mus.next() {
+                Some(r) => mus.push(r),
+                // The direct evaluations stopped at an earlier error.
+                None => break,
+            },
+        }
+    }
+    // Step 3: in order; a |μ| error at segment j precedes a step-1 error at
+    // a later segment (sequential order).
+    let mut segments = Vec::with_capacity(n);
+    for (i, (cs, mu)) in cell_states.iter().zip(mus).enumerate() {
+        let s = &states[i];
+        let mu = mu?;
+        let reward = step_reward(weights, cs.condition_number, s.feed, lim.feed[1], mu)?;
+        let length = cell.path().segment(i)?.length;
+        segments.push(SegmentPlan {
+            segment: i,
+            rpm: s.rpm,
+            feed: s.feed,
+            g: s.g,
+            spectral_radius: mu,
+            condition_number: cs.condition_number,
+            condition_indicator: cs.condition_indicator,
+            joints: cs.joints,
+            time: length / s.feed,
+            reward,
+        });
+    }
+    if let Some(e) = first_error {
+        return Err(e);
+    }
+    if segments.len() != n {
+        // Unreachable: every segment is evaluated when none failed.
+        return Err(MillPlanError::InvalidConfig {
+            name: format!("plan `{planner}`"),
+            reason: format!("{} of {n} segments evaluated", segments.len()),
+        });
+    }
+    let cached_segments: Vec<usize> = (0..n).filter(|i| cached[*i].is_some()).collect();
+    let margin = |i: usize| cached[i].map_or(0.0, |(_, b)| b);
+    let bound = cached.iter().flatten().map(|(_, b)| *b).reduce(f64::max);
+    let max_mu = segments
+        .iter()
+        .map(|s| s.spectral_radius)
+        .fold(0.0, f64::max);
+    let plan = Plan {
+        planner: planner.to_string(),
+        total_time: segments.iter().map(|s| s.time).sum(),
+        chatter_free: segments
+            .iter()
+            .all(|s| s.spectral_radius + margin(s.segment) < 1.0),
+        max_spectral_radius: max_mu,
+        min_condition_indicator: segments
+            .iter()
+            .map(|s| s.condition_indicator)
+            .fold(f64::INFINITY, f64::min),
+        total_reward: segments.iter().map(|s| s.reward.total).sum(),
+        segments,
+    };
+    let provenance = match (cache, bound) {
+        (None, _) => IndicatorProvenance::direct(IndicatorSource::Direct, n, ""),
+        (Some(c), None) => IndicatorProvenance::direct(
+            IndicatorSource::Cache,
+            n,
+            if c.header().error_bound.is_none() {
+                "the indicator cache states no error bound"
+            } else {
+                "no state is inside the indicator cache's feasible grid with the cache's tool-tip dynamics"
+            },
+        ),
+        (Some(_), Some(b)) => IndicatorProvenance {
+            requested: IndicatorSource::Cache,
+            note: format!(
+                "|mu|max of {} of {n} segments INTERPOLATED from the indicator cache (stated \
+                 error bound +/-{b:.3}; chatter-free is claimed only where |mu|max + bound < 1), \
+                 {} evaluated directly",
+                cached_segments.len(),
+                n - cached_segments.len()
+            ),
+            cached_segments,
+            segments: n,
+            error_bound: Some(b),
+        },
+    };
+    Ok((plan, provenance))
+}
+
+/// Per cell state, the cache's |μ|max and the stated bound that applies
+/// to it (the bound for g on a g node when the state's g is a node and
+/// the cache states one, else the general bound), when the cache answers
+/// on the same IK branch ([`Plan::evaluate_cached`]); all `None` without
+/// a stated general bound.
+///
+/// # Errors
+/// A NaN state (refused earlier by [`check_state`]); a cell-model error
+/// other than an infeasible state.
+fn cached_values(
+    cell: &MillCell,
+    states: &[PhysicalState],
+    cell_states: &[CellState],
+    cache: &IndicatorCache,
+) -> Result<Vec<Option<(f64, f64)>>, MillPlanError> {
+    let k = cell_states.len();
+    let valid = |b: &f64| b.is_finite() && *b >= 0.0;
+    let header = cache.header();
+    let Some(general) = header.error_bound.filter(valid) else {
+        return Ok(vec![None; k]);
+    };
+    let on_nodes = header.error_bound_g_nodes.filter(valid);
+    let mut out = Vec::with_capacity(k);
+    for (s, cs) in states.iter().zip(cell_states) {
+        let Some(v) = cache.try_query(s.segment, s.rpm, s.feed, s.g)? else {
+            out.push(None);
+            continue;
+        };
+        // The cache's nodes use the IK nearest the reference joints; the
+        // cached |μ| applies when that state has the same tool-tip dynamics
+        // (|μ| depends on the cell state only through them; e.g. a wrist
+        // flip of the chain keeps them).
+        let same_dynamics = match cell.evaluate(s.segment, s.g, None) {
+            Ok(r) => same_modal(&r.modal, &cs.modal),
+            Err(e) if is_infeasible(&e) => false,
+            Err(e) => return Err(e.into()),
+        };
+        let bound = match on_nodes {
+            Some(b) if cache.grid().g.contains(&s.g) => b.min(general),
+            _ => general,
+        };
+        out.push((same_dynamics && v.is_finite()).then_some((v, bound)));
+    }
+    Ok(out)
+}
+
+/// Relative tolerance of [`same_modal`].
+const SAME_MODAL_TOLERANCE: f64 = 1e-9;
+
+/// Whether two tool-tip models are equal within [`SAME_MODAL_TOLERANCE`]
+/// relative to each matrix's largest entry (a NaN or infinite entry: not
+/// equal).
+fn same_modal(a: &Modal2, b: &Modal2) -> bool {
+    [
+        (&a.mass, &b.mass),
+        (&a.damping, &b.damping),
+        (&a.stiffness, &b.stiffness),
+    ]
+    .iter()
+    .all(|(x, y)| {
+        if !(x.iter().chain(y.iter()).all(|v| v.is_finite())) {
+            return false;
+        }
+        let scale = x.amax().max(y.amax());
+        let diff = (*x - *y).amax();
+        diff <= SAME_MODAL_TOLERANCE * scale
+    })
 }
 
 /// Largest number of threads [`Plan::evaluate`] uses, whatever the
@@ -340,23 +584,26 @@ fn spectral_radius(
     .spectral_radius)
 }
 
-/// Step 2 of [`Plan::evaluate_with_threads`]: one result per cell state,
-/// in segment order. Segments are handed out in increasing order from a
-/// shared counter; after the first error no new segment starts, so every
-/// slot before the lowest failing segment is filled, and a slot left
-/// empty lies after it (step 3 stops at that error first).
+/// Step 2 of [`Plan::evaluate_with_threads`]: the direct |μ|max of the
+/// segments `indices` (ascending), one result per index in that order.
+/// Indices are handed out in increasing order from a shared counter; after
+/// the first error no new one starts, so every result before the lowest
+/// failing index is computed; the list stops after that error (step 3
+/// stops there first).
 fn spectral_radii(
     cell: &MillCell,
     states: &[PhysicalState],
     cell_states: &[CellState],
+    indices: &[usize],
     threads: usize,
 ) -> Vec<Result<f64, MillPlanError>> {
-    let n = cell_states.len();
+    let n = indices.len();
+    let eval = |j: usize| spectral_radius(cell, &states[indices[j]], &cell_states[indices[j]]);
     let workers = threads.min(n).clamp(1, MAX_EVAL_THREADS);
     if workers == 1 {
         let mut out = Vec::with_capacity(n);
-        for (s, cs) in states.iter().zip(cell_states) {
-            let r = spectral_radius(cell, s, cs);
+        for j in 0..n {
+            let r = eval(j);
             let failed = r.is_err();
             out.push(r);
             if failed {
@@ -370,15 +617,15 @@ fn spectral_radii(
     let work = || {
         let mut done = Vec::new();
         while !failed.load(Ordering::Acquire) {
-            let i = next.fetch_add(1, Ordering::AcqRel);
-            if i >= n {
+            let j = next.fetch_add(1, Ordering::AcqRel);
+            if j >= n {
                 break;
             }
-            let r = spectral_radius(cell, &states[i], &cell_states[i]);
+            let r = eval(j);
             if r.is_err() {
                 failed.store(true, Ordering::Release);
             }
-            done.push((i, r));
+            done.push((j, r));
         }
         done
     };
@@ -399,12 +646,12 @@ fn spectral_radii(
                 Err(panic) => std::panic::resume_unwind(panic),
             }
         }
-        for (i, r) in all {
-            slots[i] = Some(r);
+        for (j, r) in all {
+            slots[j] = Some(r);
         }
     });
     let mut out = Vec::with_capacity(n);
-    for (i, slot) in slots.into_iter().enumerate() {
+    for (j, slot) in slots.into_iter().enumerate() {
         match slot {
             Some(r) => {
                 let failed = r.is_err();
@@ -414,10 +661,10 @@ fn spectral_radii(
                 }
             }
             None => {
-                // Only after a failing segment (see above); reported as an
+                // Only after a failing index (see above); reported as an
                 // error rather than dropped, should that ever not hold.
                 out.push(Err(MillPlanError::InvalidConfig {
-                    name: format!("plan evaluation of segment {i}"),
+                    name: format!("plan evaluation of segment {}", indices[j]),
                     reason: "not evaluated (an earlier segment failed)".to_string(),
                 }));
                 break;
@@ -447,4 +694,32 @@ pub fn comparison_table(rows: &[ComparisonRow]) -> String {
         ));
     }
     out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use kerf_chatter::Mode;
+
+    #[test]
+    fn same_modal_is_a_relative_tolerance_and_refuses_nan() {
+        let mode = Mode {
+            natural_frequency_hz: 25.0,
+            damping_ratio: 0.05,
+            modal_mass: 50.0,
+        };
+        let a = Modal2::from_modes(mode, mode).expect("modal");
+        assert!(same_modal(&a, &a));
+        let mut b = a;
+        b.stiffness[(0, 1)] += 1e-12 * a.stiffness.amax();
+        assert!(same_modal(&a, &b));
+        b.stiffness[(0, 1)] += 1e-6 * a.stiffness.amax();
+        assert!(!same_modal(&a, &b));
+        for bad in [f64::NAN, f64::INFINITY] {
+            let mut c = a;
+            c.mass[(1, 1)] = bad;
+            assert!(!same_modal(&a, &c));
+            assert!(!same_modal(&c, &c));
+        }
+    }
 }

@@ -68,7 +68,7 @@ use crate::dp::{self, DpSpec};
 use crate::env::{EnvConfig, MillEnv, PhysicalState};
 use crate::error::MillPlanError;
 use crate::naive;
-use crate::plan::{default_eval_threads, Plan};
+use crate::plan::{default_eval_threads, IndicatorProvenance, IndicatorSource, Plan};
 use crate::policy::Policy;
 use crate::request::{MillRequest, PlannerKind};
 use crate::rl::Environment;
@@ -199,6 +199,11 @@ pub struct MillPlanOutput {
     pub planning_seconds: f64,
     /// Wall-clock time of each step of [`MillPlanner::plan`] \[s\].
     pub phases: PlanningPhases,
+    /// Where the plan's |μ|max values come from: all direct (the default),
+    /// or partly the indicator cache with its stated error bound
+    /// ([`MillPlanner::with_indicator_source`]); its `note` belongs in the
+    /// answer's message.
+    pub indicator: IndicatorProvenance,
 }
 
 /// Wall-clock seconds of the steps of [`MillPlanner::plan`] (module
@@ -233,6 +238,7 @@ pub struct MillPlanner {
     cache_note: String,
     env_config: EnvConfig,
     eval_threads: usize,
+    indicator_source: IndicatorSource,
     policies: Mutex<HashMap<PathBuf, CachedPolicy>>,
 }
 
@@ -275,6 +281,7 @@ impl MillPlanner {
             cache_note,
             env_config: EnvConfig::default(),
             eval_threads: default_eval_threads(),
+            indicator_source: IndicatorSource::Direct,
             policies: Mutex::new(HashMap::new()),
         })
     }
@@ -332,6 +339,32 @@ impl MillPlanner {
     /// The number of threads of the plan evaluation.
     pub fn eval_threads(&self) -> usize {
         self.eval_threads
+    }
+
+    /// Sets where the plan's |μ|max comes from (step 5).
+    /// [`IndicatorSource::Direct`] (the default): every segment evaluated
+    /// directly. [`IndicatorSource::Cache`]: when the default cell's cache
+    /// applies to the request (module documentation) and states an error
+    /// bound, each segment that the cache answers on the state's IK branch
+    /// takes the cache's interpolated |μ|max (microseconds instead of
+    /// about 1.25 ms), the others are evaluated directly; the answer's
+    /// [`MillPlanOutput::indicator`] lists the cached segments and the
+    /// bound, and `chatter_free` is claimed only where |μ|max + bound < 1.
+    /// Otherwise the evaluation is direct and the note says why.
+    ///
+    /// # Arguments
+    /// * `source` — the source.
+    ///
+    /// # Returns
+    /// The planner with the source set.
+    pub fn with_indicator_source(mut self, source: IndicatorSource) -> Self {
+        self.indicator_source = source;
+        self
+    }
+
+    /// Where the plan's |μ|max comes from ([`MillPlanner::with_indicator_source`]).
+    pub fn indicator_source(&self) -> IndicatorSource {
+        self.indicator_source
     }
 
     /// The environment settings.
@@ -472,7 +505,7 @@ impl MillPlanner {
                 rollout.states()
             }
             PlannerKind::Dp | PlannerKind::Naive => {
-                let cache = cache.ok_or_else(|| MillPlanError::InvalidConfig {
+                let cache = cache.clone().ok_or_else(|| MillPlanError::InvalidConfig {
                     name: format!("planner {}", kind.name()),
                     reason: if self.cache.is_none() {
                         format!(
@@ -500,13 +533,32 @@ impl MillPlanner {
         };
         phases.planner = step.elapsed().as_secs_f64();
         let step = Instant::now();
-        let plan = Plan::evaluate_with_threads(
-            &cell,
-            &self.env_config.weights,
-            &states,
-            kind.name(),
-            self.eval_threads,
-        )?;
+        let weights = &self.env_config.weights;
+        let segments = states.len();
+        let (plan, indicator) = match (self.indicator_source, &cache) {
+            (IndicatorSource::Cache, Some(c)) => {
+                Plan::evaluate_cached(&cell, weights, &states, kind.name(), self.eval_threads, c)?
+            }
+            (source, _) => {
+                let plan = Plan::evaluate_with_threads(
+                    &cell,
+                    weights,
+                    &states,
+                    kind.name(),
+                    self.eval_threads,
+                )?;
+                let reason = if source == IndicatorSource::Cache {
+                    if self.cache.is_none() {
+                        format!("cache requested, but {}", self.cache_note)
+                    } else {
+                        "cache requested, but this request changes the path/process".to_string()
+                    }
+                } else {
+                    String::new()
+                };
+                (plan, IndicatorProvenance::direct(source, segments, &reason))
+            }
+        };
         phases.evaluation = step.elapsed().as_secs_f64();
         let step = Instant::now();
         let (trajectory, branch_jumps) = trajectory(&cell, &plan)?;
@@ -521,6 +573,7 @@ impl MillPlanner {
             cache_used: cache_applies,
             planning_seconds: start.elapsed().as_secs_f64(),
             phases,
+            indicator,
         })
     }
 }

@@ -8,7 +8,7 @@ use std::sync::{Arc, OnceLock};
 
 use kerf_mill::MillCell;
 use kerf_millplan::cache::direct_indicator;
-use kerf_millplan::plan::{default_eval_threads, Plan, MAX_EVAL_THREADS};
+use kerf_millplan::plan::{default_eval_threads, IndicatorSource, Plan, MAX_EVAL_THREADS};
 use kerf_millplan::{MillPlanError, MillPlanner, MillRequest, PhysicalState, RewardWeights};
 
 fn cell() -> &'static Arc<MillCell> {
@@ -232,4 +232,108 @@ fn planner_eval_threads_option_and_phases() {
             out.planning_seconds
         );
     }
+}
+
+/// `IndicatorSource::Cache`: the cached segments, their bound and the
+/// conservative chatter-free claim are reported; every cached |μ|max is
+/// within the stated bound of the direct value, every other segment is the
+/// direct value bit for bit; a cache without a stated bound falls back to
+/// direct evaluation and says so; the default stays direct.
+#[test]
+fn cache_source_reports_cached_segments_and_bound_and_stays_within_it() {
+    let direct = MillPlanner::with_default_cell().expect("planner");
+    assert_eq!(direct.indicator_source(), IndicatorSource::Direct);
+    let cache = direct
+        .cache()
+        .cloned()
+        .expect("the default cache must load");
+    let request = MillRequest {
+        planner: "naive".to_string(),
+        ..MillRequest::default()
+    };
+    let d = direct.plan(&request).expect("direct naive");
+    assert!(d.indicator.all_direct());
+    assert_eq!(d.indicator.requested, IndicatorSource::Direct);
+    assert_eq!(d.indicator.error_bound, None);
+    assert!(
+        d.indicator.note.contains("directly"),
+        "{}",
+        d.indicator.note
+    );
+
+    let cached = MillPlanner::new(direct.cell().clone(), Some(cache.clone()))
+        .expect("planner")
+        .with_indicator_source(IndicatorSource::Cache);
+    let c = cached.plan(&request).expect("cached naive");
+    let prov = &c.indicator;
+    assert_eq!(prov.requested, IndicatorSource::Cache);
+    assert_eq!(prov.segments, 100);
+    // The naive plan keeps g = g0 = 0, a g node of the default cache, so
+    // the bound is the g-node one when the cache states it.
+    assert!(!prov.cached_segments.is_empty(), "{}", prov.note);
+    let header = cache.header();
+    let expected_bound = header
+        .error_bound_g_nodes
+        .map_or(header.error_bound, |b| header.error_bound.map(|g| b.min(g)));
+    assert_eq!(prov.error_bound, expected_bound);
+    let bound = prov.error_bound.expect("bound");
+    assert!(prov.note.contains("INTERPOLATED"), "{}", prov.note);
+    assert!(prov.note.contains(&format!("{bound:.3}")), "{}", prov.note);
+    // Same states, same trajectory; |μ| cached within the bound or direct.
+    assert_eq!(d.trajectory, c.trajectory);
+    let mut reached_bound = 0.0f64;
+    for (a, b) in d.plan.segments.iter().zip(&c.plan.segments) {
+        assert_eq!(
+            (a.rpm, a.feed, a.g, a.joints),
+            (b.rpm, b.feed, b.g, b.joints)
+        );
+        if prov.cached_segments.contains(&a.segment) {
+            let err = (a.spectral_radius - b.spectral_radius).abs();
+            assert!(
+                err <= bound,
+                "segment {}: error {err} > bound {bound}",
+                a.segment
+            );
+            reached_bound = reached_bound.max(err);
+        } else {
+            assert_eq!(a.spectral_radius.to_bits(), b.spectral_radius.to_bits());
+        }
+    }
+    // The cache is an interpolation, not the direct value everywhere.
+    assert!(reached_bound > 0.0);
+    let conservative = c.plan.segments.iter().all(|s| {
+        let m = if prov.cached_segments.contains(&s.segment) {
+            bound
+        } else {
+            0.0
+        };
+        s.spectral_radius + m < 1.0
+    });
+    assert_eq!(c.plan.chatter_free, conservative);
+    println!(
+        "cache source: {} cached, max |cached - direct| {reached_bound:.4} (bound {bound}); \
+         evaluation {:.1} ms cached vs {:.1} ms direct (dev profile)",
+        prov.cached_segments.len(),
+        c.phases.evaluation * 1e3,
+        d.phases.evaluation * 1e3
+    );
+
+    // No stated bound: direct evaluation, and the note says why.
+    let mut unbounded = (*cache).clone();
+    unbounded
+        .set_error((None, None), (None, None), "test: no bound")
+        .expect("set");
+    let u = MillPlanner::new(direct.cell().clone(), Some(Arc::new(unbounded)))
+        .expect("planner")
+        .with_indicator_source(IndicatorSource::Cache)
+        .plan(&request)
+        .expect("unbounded cache plan");
+    assert!(u.indicator.all_direct());
+    assert_eq!(u.indicator.requested, IndicatorSource::Cache);
+    assert!(
+        u.indicator.note.contains("no error bound"),
+        "{}",
+        u.indicator.note
+    );
+    assert_eq!(bits(&u.plan), bits(&d.plan));
 }
