@@ -42,9 +42,10 @@
 //! * **Observation** (4 entries, each in [−1, 1]): `2t/(N−1) − 1`, and Ω, f,
 //!   g mapped linearly from their ranges to [−1, 1].
 //! * **Segment time** `l_t / f_t` (the segment's arc length over its feed).
-//!   A zero feed (reachable through the clip at f_min = 0) would take
-//!   infinitely long: it is a terminal constraint violation, like an
-//!   infeasible g.
+//!   The clip keeps f ≥ [`EnvConfig::min_feed`] (0.01 m/s by default,
+//!   kerf's); with `min_feed = 0` a zero feed (reachable through the
+//!   paper's clip at f_min = 0) would take infinitely long: it is then a
+//!   terminal constraint violation, like an infeasible g.
 //! * **Infeasible state** — IK unreachable, a joint limit or a singular
 //!   Jacobian at (segment t + 1, g_{t+1}), or a zero feed: the step returns
 //!   `done = true` with the reward [`EnvConfig::violation_penalty`]
@@ -111,6 +112,16 @@ pub struct EnvConfig {
     /// the filter state takes the applied move. Only when g unchanged is
     /// infeasible too is the step a terminal violation.
     pub project_g: bool,
+    /// Lowest feed of the clip of eq. 11 [m/s] (default 0.01, kerf's): the
+    /// transitions clip f to [max(f_min, min_feed), f_max]. Why: f = 0 is
+    /// no machining state (the segment never ends; it is undefined under the
+    /// cell's sublinear force law) and the indicator cache starts at
+    /// 0.01 m/s; with the paper's f_min = 0 a policy that drives the feed
+    /// down ends its episode with the violation penalty, a cliff that
+    /// measurably destabilized training. 0 restores the paper's clip (a zero
+    /// feed is then a terminal violation). The initial feed must be at least
+    /// this.
+    pub min_feed: f64,
 }
 
 /// Bisection steps of [`EnvConfig::project_g`] (resolution 2⁻⁸ of the move).
@@ -132,6 +143,7 @@ impl Default for EnvConfig {
             chatter_margin: Some(ChatterMargin::default()),
             joint_speed_limits: true,
             project_g: true,
+            min_feed: 0.01,
         }
     }
 }
@@ -284,6 +296,26 @@ impl MillEnv {
                 name: "initial feed [m/s]".to_string(),
                 value: config.initial_feed,
                 reason: "must be > 0 (a zero feed never finishes a segment)".to_string(),
+            });
+        }
+        if !(config.min_feed.is_finite()
+            && config.min_feed >= 0.0
+            && config.min_feed <= lim.feed[1])
+        {
+            return Err(MillPlanError::InvalidParameter {
+                name: "minimum feed of the clip [m/s]".to_string(),
+                value: config.min_feed,
+                reason: format!("must be in [0, {}] (the maximum feed)", lim.feed[1]),
+            });
+        }
+        if config.initial_feed < config.min_feed {
+            return Err(MillPlanError::InvalidParameter {
+                name: "initial feed [m/s]".to_string(),
+                value: config.initial_feed,
+                reason: format!(
+                    "is below the planner's minimum feed {} m/s (the lowest feed it plans with)",
+                    config.min_feed
+                ),
             });
         }
         check_range(
@@ -654,7 +686,8 @@ impl Environment for MillEnv {
         let next = PhysicalState {
             segment: current.segment + 1,
             rpm: (current.rpm + filter[0]).clamp(lim.spindle_rpm[0], lim.spindle_rpm[1]),
-            feed: (current.feed + filter[1]).clamp(lim.feed[0], lim.feed[1]),
+            feed: (current.feed + filter[1])
+                .clamp(lim.feed[0].max(self.config.min_feed), lim.feed[1]),
             g: (current.g + filter[2]).clamp(lim.redundancy_angle[0], lim.redundancy_angle[1]),
         };
         let mut next = next;

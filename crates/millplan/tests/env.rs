@@ -257,6 +257,8 @@ fn zero_feed_is_a_terminal_violation() {
     let mut e = env(EnvConfig {
         alpha: 1.0,
         initial_feed: 0.0015,
+        // The paper's clip at f_min = 0 (the default clips at 0.01 m/s).
+        min_feed: 0.0,
         ..EnvConfig::default()
     });
     e.reset().unwrap();
@@ -391,4 +393,37 @@ fn projection_stops_g_at_the_edge_of_the_feasible_set() {
     // reaches it and is held there.
     assert!(shortened > 50, "{shortened}");
     assert!(previous.g < -1.5, "{previous:?}");
+}
+
+#[test]
+fn default_clip_keeps_the_feed_at_the_minimum_feed() {
+    let mut e = env(EnvConfig {
+        alpha: 1.0,
+        initial_feed: 0.012,
+        ..EnvConfig::default()
+    });
+    e.reset().unwrap();
+    for _ in 0..5 {
+        let tr = e.step(&[0.0, -1.0, 0.0]).unwrap();
+        assert!(!tr.done);
+    }
+    assert_eq!(e.state().unwrap().feed, 0.01);
+    // An initial feed below it, or a minimum feed above f_max, is refused.
+    for bad in [
+        EnvConfig {
+            initial_feed: 0.005,
+            ..EnvConfig::default()
+        },
+        EnvConfig {
+            min_feed: 0.07,
+            ..EnvConfig::default()
+        },
+        EnvConfig {
+            min_feed: f64::NAN,
+            ..EnvConfig::default()
+        },
+    ] {
+        let cell = Arc::new(MillCell::default_cell().unwrap());
+        assert!(MillEnv::new(cell, None, bad).is_err());
+    }
 }
