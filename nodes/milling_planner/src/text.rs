@@ -75,8 +75,8 @@ fn yaml_string(text: &str, key: &str) -> String {
         .unwrap_or_default()
 }
 
-/// The YAML text of a `MillPlan` message, as published on `~/mill_plan_text` (the same
-/// document `kerf echo /milling_planner/mill_plan` prints).
+/// The YAML text of a `MillPlan` message, as published on `~/mill_plan_text` (serde's YAML of
+/// the message: every field, in `.msg` order).
 pub fn plan_text(plan: &msg::MillPlan) -> String {
     serde_yaml_ng::to_string(plan).unwrap_or_else(|e| {
         // Only reachable if serde_yaml_ng refused a value; keep the essentials readable.

@@ -1,0 +1,108 @@
+//! The worker's job function: already-answered jobs pass through, jobs queued when the node
+//! stops are answered without planning, and `ddpg` / `fixed_g` requests without a policy file
+//! get the node's default policy (a missing one is that request's POLICY_ERROR, naming it).
+
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::OnceLock;
+
+use kerf_milling_planner::{convert, work, DefaultPolicies, Job};
+use kerf_millplan::{MillPlanner, MillRequest};
+use kerf_msgs::msg::MillPlan;
+
+fn planner() -> &'static MillPlanner {
+    static P: OnceLock<MillPlanner> = OnceLock::new();
+    P.get_or_init(|| MillPlanner::with_default_cell().expect("planner"))
+}
+
+fn policies() -> DefaultPolicies {
+    DefaultPolicies {
+        ddpg: "/nonexistent/default_ddpg.safetensors".into(),
+        fixed_g: "/nonexistent/default_fixed_g.safetensors".into(),
+    }
+}
+
+fn request(id: &str, planner: &str, policy_file: Option<&str>) -> Box<MillRequest> {
+    Box::new(MillRequest {
+        request_id: id.into(),
+        planner: planner.into(),
+        policy_file: policy_file.map(String::from),
+        ..MillRequest::default()
+    })
+}
+
+#[test]
+fn answers_pass_through_and_stopping_skips_planning() {
+    let stopping = AtomicBool::new(false);
+    let failed = convert::failure_msg("w1", "dp", MillPlan::POLICY_ERROR, "gone");
+    let m = work(
+        planner(),
+        &policies(),
+        &stopping,
+        Job::Answer(Box::new(failed.clone())),
+    );
+    assert_eq!(m, failed);
+    stopping.store(true, Ordering::Relaxed);
+    let m = work(
+        planner(),
+        &policies(),
+        &stopping,
+        Job::Plan(request("w2", "naive", None)),
+    );
+    assert_eq!(m.status, MillPlan::INTERNAL_ERROR);
+    assert_eq!((m.request_id.as_str(), m.planner.as_str()), ("w2", "naive"));
+    assert!(
+        m.message.contains("stopped before planning"),
+        "{}",
+        m.message
+    );
+}
+
+#[test]
+fn default_policies_fill_requests_without_one() {
+    let stopping = AtomicBool::new(false);
+    for (planner_name, default) in [
+        ("ddpg", "/nonexistent/default_ddpg.safetensors"),
+        ("fixed_g", "/nonexistent/default_fixed_g.safetensors"),
+    ] {
+        let m = work(
+            planner(),
+            &policies(),
+            &stopping,
+            Job::Plan(request("p1", planner_name, None)),
+        );
+        assert_eq!(m.status, MillPlan::POLICY_ERROR, "{}", m.message);
+        assert_eq!(m.planner, planner_name);
+        assert!(
+            m.message.contains(default) && m.message.contains("not found"),
+            "{}",
+            m.message
+        );
+        // The request's own file wins over the default.
+        let m = work(
+            planner(),
+            &policies(),
+            &stopping,
+            Job::Plan(request(
+                "p2",
+                planner_name,
+                Some("/elsewhere/mine.safetensors"),
+            )),
+        );
+        assert_eq!(m.status, MillPlan::POLICY_ERROR);
+        assert!(
+            m.message.contains("/elsewhere/mine.safetensors"),
+            "{}",
+            m.message
+        );
+    }
+    // Planners without a policy are planned as they are.
+    let m = work(
+        planner(),
+        &policies(),
+        &stopping,
+        Job::Plan(request("p3", "naive", None)),
+    );
+    assert_eq!(m.status, MillPlan::SUCCESS, "{}", m.message);
+    assert_eq!((m.request_id.as_str(), m.planner.as_str()), ("p3", "naive"));
+    assert_eq!(m.segments.len(), 100);
+}
