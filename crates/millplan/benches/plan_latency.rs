@@ -18,6 +18,9 @@
 //!   several threads it is their sum). The load average is printed too.
 //! * The plans of 1 and of the default number of threads are checked to be
 //!   identical (bit for bit) before timing.
+//! * A third configuration plans with [`IndicatorSource::Cache`]: |μ|max
+//!   interpolated from the indicator cache where it applies, with its
+//!   stated bound in the answer (printed): NOT the direct evaluation.
 //!
 //! Run (small sample counts, the machine is shared):
 //! `cargo bench -p kerf_millplan --bench plan_latency -- --warm-up-time 1 --measurement-time 5`
@@ -26,7 +29,8 @@ use std::path::PathBuf;
 use std::time::Instant;
 
 use criterion::{criterion_group, Criterion};
-use kerf_millplan::plan::default_eval_threads;
+use kerf_millplan::cache::cell_fingerprint;
+use kerf_millplan::plan::{default_eval_threads, IndicatorSource};
 use kerf_millplan::planner::PlanningPhases;
 use kerf_millplan::{
     default_policy_path, train, DdpgSettings, EnvConfig, MillEnv, MillPlanError, MillPlanOutput,
@@ -167,6 +171,57 @@ fn report(name: &str, planner: &MillPlanner, request: &MillRequest, n: usize) ->
     Some(total / n as f64)
 }
 
+/// Mean wall ms of the parts of the setup step (validation, request cell,
+/// reachability) for the default request, from the public APIs the planner
+/// calls: the request's path ([`kerf_mill::MillCell::with_path`], B-spline
+/// fit and arc-length segments), the cell fingerprint (cache
+/// applicability), and 100 cell states (IK, Jacobian, K, tool-tip
+/// dynamics: what the reachability check costs when g0 is feasible
+/// everywhere). One cell state is also what the evaluation step pays per
+/// segment besides the indicator.
+fn setup_parts(planner: &MillPlanner, n: usize) {
+    let cell = planner.cell();
+    let segments = cell.path().segments().len();
+    let spec = MillRequest::default().path_spec(segments);
+    let start = Instant::now();
+    for _ in 0..n {
+        if let Err(e) = cell.with_path(&spec) {
+            eprintln!("setup parts: with_path failed: {e}");
+            return;
+        }
+    }
+    let with_path = start.elapsed().as_secs_f64() / n as f64;
+    let start = Instant::now();
+    for _ in 0..n {
+        if let Err(e) = cell.with_state_limits(*cell.state_limits()) {
+            eprintln!("setup parts: with_state_limits failed: {e}");
+            return;
+        }
+    }
+    let with_limits = start.elapsed().as_secs_f64() / n as f64;
+    let start = Instant::now();
+    for _ in 0..n {
+        std::hint::black_box(cell_fingerprint(cell));
+    }
+    let fingerprint = start.elapsed().as_secs_f64() / n as f64;
+    let start = Instant::now();
+    for _ in 0..n {
+        for i in 0..segments {
+            std::hint::black_box(cell.evaluate(i, 0.0, None).ok());
+        }
+    }
+    let states = start.elapsed().as_secs_f64() / n as f64;
+    eprintln!(
+        "setup parts (mean of {n}): request path (with_path) {:.2} ms, cell clone \
+         (with_state_limits) {:.2} ms, cell fingerprint {:.2} ms, {segments} cell states (IK, J, \
+         K, dynamics) {:.2} ms",
+        with_path * 1e3,
+        with_limits * 1e3,
+        fingerprint * 1e3,
+        states * 1e3
+    );
+}
+
 /// Plans `request` with 1 thread and with `threads`; `true` when both
 /// succeed with identical plans and trajectories.
 fn same_plan(one: &MillPlanner, many: &MillPlanner, request: &MillRequest) -> bool {
@@ -248,16 +303,34 @@ fn bench(c: &mut Criterion) {
         }
         Err(e) => eprintln!("ddpg policy: none ({e}); ddpg not benchmarked"),
     }
-    let planners: [(&MillPlanner, usize); 2] = [(&one, 1), (&many, threads)];
+    let cached = match MillPlanner::with_default_cell().and_then(|p| p.with_eval_threads(threads)) {
+        Ok(p) => p.with_indicator_source(IndicatorSource::Cache),
+        Err(e) => {
+            eprintln!("plan_latency: no planner: {e}");
+            return;
+        }
+    };
+    setup_parts(&many, 5);
+    let planners: [(&MillPlanner, String); 3] = [
+        (&one, "1 evaluation thread, direct |mu|".to_string()),
+        (&many, format!("{threads} evaluation threads, direct |mu|")),
+        (
+            &cached,
+            "cache source (|mu| interpolated, bound reported)".to_string(),
+        ),
+    ];
     for (name, request) in &requests {
         if !same_plan(&one, &many, request) {
             eprintln!("{name}: 1-thread and {threads}-thread plans differ or failed; skipped");
             continue;
         }
-        for (planner, t) in planners {
-            let label = format!("plan {name}, {t} evaluation thread(s)");
+        for (planner, what) in &planners {
+            let label = format!("plan {name}, {what}");
             if report(&label, planner, request, 5).is_none() {
                 continue;
+            }
+            if let Ok(out) = planner.plan(request) {
+                eprintln!("  {}", out.indicator.note);
             }
             c.bench_function(&label, |b| {
                 b.iter(|| planner.plan(request).expect("plan"));

@@ -6,7 +6,11 @@
 //! # Steps of [`MillPlanner::plan`]
 //! 1. [`MillRequest::validate_with`] against the default cell's limits.
 //! 2. The request's cell: the default cell with the request's path
-//!    ([`kerf_mill::MillCell::with_path`]), process and limits.
+//!    ([`kerf_mill::MillCell::with_path`]), process and limits. The cell
+//!    with the path and process (and its fingerprint) is kept for the
+//!    last 8 distinct (path, process) pairs: the path's spline fit and
+//!    arc-length table cost 10–30 ms, paid by the first request with a
+//!    path only (the memo is exact: the same inputs give the same cell).
 //! 3. Reachability: every segment must have a feasible redundancy angle
 //!    (the initial g0 first, then 65 equally spaced values of the g
 //!    range); otherwise the cell's error of the least-violating g is
@@ -61,7 +65,7 @@ use std::path::{Path, PathBuf};
 use std::sync::{Arc, Mutex};
 use std::time::{Instant, SystemTime};
 
-use kerf_mill::{BranchJump, MillCell, MillError, StateLimits};
+use kerf_mill::{BranchJump, MillCell, MillError, PathSpec, StateLimits};
 
 use crate::cache::{cell_fingerprint, is_infeasible, IndicatorCache};
 use crate::dp::{self, DpSpec};
@@ -70,7 +74,7 @@ use crate::error::MillPlanError;
 use crate::naive;
 use crate::plan::{default_eval_threads, IndicatorProvenance, IndicatorSource, Plan};
 use crate::policy::Policy;
-use crate::request::{MillRequest, PlannerKind};
+use crate::request::{MillRequest, PlannerKind, RequestProcess};
 use crate::rl::Environment;
 
 /// Status values of the planner's answer (the `MillPlan` message).
@@ -222,6 +226,18 @@ pub struct PlanningPhases {
     pub trajectory: f64,
 }
 
+/// Distinct (path, process) pairs of requests whose cells
+/// [`MillPlanner`] keeps (most recently used last).
+const MODEL_MEMO: usize = 8;
+
+/// What a request's cell depends on besides the limits (the memo key of
+/// `MillPlanner::model_cell`).
+#[derive(Debug, Clone, PartialEq)]
+struct RequestModel {
+    path: PathSpec,
+    process: Option<RequestProcess>,
+}
+
 #[derive(Debug)]
 struct CachedPolicy {
     policy: Arc<Policy>,
@@ -239,6 +255,7 @@ pub struct MillPlanner {
     env_config: EnvConfig,
     eval_threads: usize,
     indicator_source: IndicatorSource,
+    models: Mutex<Vec<(RequestModel, Arc<MillCell>, bool)>>,
     policies: Mutex<HashMap<PathBuf, CachedPolicy>>,
 }
 
@@ -282,6 +299,7 @@ impl MillPlanner {
             env_config: EnvConfig::default(),
             eval_threads: default_eval_threads(),
             indicator_source: IndicatorSource::Direct,
+            models: Mutex::new(Vec::new()),
             policies: Mutex::new(HashMap::new()),
         })
     }
@@ -415,13 +433,50 @@ impl MillPlanner {
         limits: StateLimits,
     ) -> Result<(Arc<MillCell>, bool), MillPlanError> {
         let segments = self.cell.path().segments().len();
-        let mut cell = self.cell.with_path(&request.path_spec(segments))?;
-        if let Some(p) = &request.process {
+        let key = RequestModel {
+            path: request.path_spec(segments),
+            process: request.process,
+        };
+        let (model_cell, same_model) = self.model_cell(key)?;
+        let cell = model_cell.with_state_limits(limits)?;
+        Ok((Arc::new(cell), same_model && self.cache.is_some()))
+    }
+
+    /// The default cell with a request's path and process, and whether it
+    /// has the default cell's fingerprint: from the memo of the last
+    /// [`MODEL_MEMO`] distinct (path, process) pairs when there, else
+    /// built (the path's spline fit and arc-length table, about 10–30 ms
+    /// in release on the shared 2-core machine, and the fingerprint,
+    /// about 1 ms) and kept. A pure function of the key and the planner's
+    /// default cell, so the memo never changes a plan.
+    ///
+    /// # Errors
+    /// [`MillCell::with_path`] / [`MillCell::with_process`] errors (not
+    /// kept).
+    fn model_cell(&self, key: RequestModel) -> Result<(Arc<MillCell>, bool), MillPlanError> {
+        {
+            let mut memo = self.models.lock().unwrap_or_else(|e| e.into_inner());
+            if let Some(k) = memo.iter().position(|(m, _, _)| *m == key) {
+                let entry = memo.remove(k);
+                let hit = (entry.1.clone(), entry.2);
+                memo.push(entry);
+                return Ok(hit);
+            }
+        }
+        let mut cell = self.cell.with_path(&key.path)?;
+        if let Some(p) = &key.process {
             cell = cell.with_process(p.to_process())?;
         }
         let same_model = cell_fingerprint(&cell) == self.fingerprint;
-        let cell = cell.with_state_limits(limits)?;
-        Ok((Arc::new(cell), same_model && self.cache.is_some()))
+        let cell = Arc::new(cell);
+        let mut memo = self.models.lock().unwrap_or_else(|e| e.into_inner());
+        if !memo.iter().any(|(m, _, _)| *m == key) {
+            memo.push((key, cell.clone(), same_model));
+            if memo.len() > MODEL_MEMO {
+                memo.remove(0);
+            }
+        }
+        Ok((cell, same_model))
     }
 
     /// Plans a request (module documentation).

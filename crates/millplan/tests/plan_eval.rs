@@ -337,3 +337,38 @@ fn cache_source_reports_cached_segments_and_bound_and_stays_within_it() {
     );
     assert_eq!(bits(&u.plan), bits(&d.plan));
 }
+
+/// The planner keeps the cells of recent (path, process) pairs: planning
+/// the default path, another path, then the default path again gives the
+/// first plan bit for bit, and the other path is still recognized as
+/// another model (the default cache does not apply to it).
+#[test]
+fn request_cells_are_kept_per_path_without_mixing_paths() {
+    let planner = MillPlanner::with_default_cell().expect("planner");
+    assert!(planner.cache().is_some(), "the default cache must load");
+    let a = MillRequest {
+        planner: "naive".to_string(),
+        ..MillRequest::default()
+    };
+    let mut b = a.clone();
+    for p in &mut b.points {
+        p[0] += 0.005;
+    }
+    let first = planner.plan(&a).expect("default path");
+    assert!(first.cache_used);
+    for round in 0..2 {
+        let e = planner
+            .plan(&b)
+            .expect_err("another path: no cache for naive");
+        assert!(e.to_string().contains("changes the path/process"), "{e}");
+        let again = planner.plan(&a).expect("default path again");
+        assert!(again.cache_used, "round {round}");
+        assert_eq!(bits(&again.plan), bits(&first.plan), "round {round}");
+        assert_eq!(again.trajectory, first.trajectory);
+        println!(
+            "setup: first {:.1} ms, kept {:.1} ms (dev profile)",
+            first.phases.setup * 1e3,
+            again.phases.setup * 1e3
+        );
+    }
+}
