@@ -507,6 +507,39 @@ impl MillEnv {
         )
     }
 
+    /// Whether `next` is feasible from `current` (feed > 0, IK within the
+    /// joint limits from the current joints, joint speeds when
+    /// [`EnvConfig::joint_speed_limits`] is set), without the chatter
+    /// evaluation.
+    ///
+    /// # Errors
+    /// Cell-model errors other than infeasibility.
+    fn feasible(
+        &self,
+        current: &PhysicalState,
+        next: &PhysicalState,
+    ) -> Result<bool, MillPlanError> {
+        if next.feed.is_nan() || next.feed <= 0.0 {
+            return Ok(false);
+        }
+        let cs = match self.cell.evaluate(next.segment, next.g, Some(&self.joints)) {
+            Ok(cs) => cs,
+            Err(e) if is_infeasible(&e) => return Ok(false),
+            Err(e) => return Err(e.into()),
+        };
+        if !self.config.joint_speed_limits {
+            return Ok(true);
+        }
+        let segments = self.cell.path().segments();
+        let lengths = [
+            segments.get(current.segment).map_or(0.0, |s| s.length),
+            segments.get(next.segment).map_or(0.0, |s| s.length),
+        ];
+        let dt = joint_speed::midpoint_interval(lengths, [current.feed, next.feed]);
+        let motion: [f64; 6] = std::array::from_fn(|j| cs.joints[j] - self.joints[j]);
+        Ok(joint_speed::first_violation(&motion, dt, &self.velocity_limits).is_none())
+    }
+
     fn info_from(
         &self,
         state: PhysicalState,
@@ -703,24 +736,20 @@ impl Environment for MillEnv {
                 ..next
             };
             let still = at(0.0);
-            let still_eval = self.checked_evaluation(&current, &still)?;
-            if still_eval.is_ok() {
+            if self.feasible(&current, &still)? {
+                // Bisection on feasibility alone (IK, limits, joint speeds:
+                // no chatter evaluation), then one evaluation of the result.
                 let (mut good, mut bad) = (0.0, 1.0);
-                let (mut best, mut best_eval) = (still, still_eval);
                 for _ in 0..PROJECTION_BISECTIONS {
                     let mid = 0.5 * (good + bad);
-                    let candidate = at(mid);
-                    let e = self.checked_evaluation(&current, &candidate)?;
-                    if e.is_ok() {
+                    if self.feasible(&current, &at(mid))? {
                         good = mid;
-                        best = candidate;
-                        best_eval = e;
                     } else {
                         bad = mid;
                     }
                 }
-                next = best;
-                eval = best_eval;
+                next = at(good);
+                eval = self.checked_evaluation(&current, &next)?;
                 filter[2] = next.g - current.g;
             }
         }
