@@ -4,7 +4,9 @@ use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
 use kerf_mill::MillCell;
-use kerf_millplan::{default_policy_path, IndicatorCache, MillPlanner, PlannerKind};
+use kerf_millplan::{
+    default_policy_path, plan::IndicatorSource, IndicatorCache, MillPlanner, PlannerKind,
+};
 use kerf_ros::Params;
 
 use crate::NodeError;
@@ -15,6 +17,8 @@ pub const KNOWN_PARAMS: &[&str] = &[
     "indicator_cache_file",
     "ddpg_policy_file",
     "fixed_g_policy_file",
+    "indicator_source",
+    "eval_threads",
     "queue_depth",
 ];
 
@@ -34,6 +38,8 @@ pub struct NodeConfig {
     pub ddpg_policy_file: PathBuf,
     /// The policy of `fixed_g` requests that name none.
     pub fixed_g_policy_file: PathBuf,
+    /// Where the plans' |μ|max come from (`indicator_source`).
+    pub indicator_source: IndicatorSource,
     /// Requests waiting or being planned before new ones are refused (≥ 1).
     pub queue_depth: usize,
 }
@@ -85,6 +91,14 @@ impl NodeConfig {
     ///   `crates/millplan/policies/{ddpg,fixed_g}.safetensors`. The files are read per request
     ///   (a missing or incompatible one is that request's POLICY_ERROR), so they may be
     ///   replaced while the node runs.
+    /// * `indicator_source` (string, `direct` or `cache`, default `direct`): where the plan's
+    ///   per-segment |μ|max come from (`kerf_millplan::MillPlanner::with_indicator_source`):
+    ///   every segment evaluated directly with the chatter model, or the indicator cache's
+    ///   interpolation where it applies, with its stated error bound (faster; `chatter_free`
+    ///   is then claimed only where |μ|max + bound < 1, and the answer's message says which
+    ///   segments were cached).
+    /// * `eval_threads` (integer ≥ 1, default: the planner's): threads of the direct plan
+    ///   evaluation (the plan does not depend on it, only the latency).
     /// * `queue_depth` (integer ≥ 1, default 10): requests waiting or being planned; a request
     ///   arriving when the queue is full is answered at once with status QUEUE_FULL.
     ///
@@ -105,6 +119,26 @@ impl NodeConfig {
             Some(p) => p,
             None => shipped_policy(PlannerKind::FixedG)?,
         };
+        let indicator_source = match params.string("indicator_source")?.as_deref() {
+            None | Some("direct") => IndicatorSource::Direct,
+            Some("cache") => IndicatorSource::Cache,
+            Some(other) => {
+                return Err(param_err(
+                    "indicator_source",
+                    format!("must be direct or cache, got {other:?}"),
+                ))
+            }
+        };
+        let eval_threads =
+            match params.get("eval_threads") {
+                None => None,
+                Some(_) => {
+                    let n = params.i64_or("eval_threads", 1)?;
+                    Some(usize::try_from(n).ok().filter(|n| *n >= 1).ok_or_else(|| {
+                        param_err("eval_threads", format!("must be >= 1, got {n}"))
+                    })?)
+                }
+            };
         let depth = params.i64_or("queue_depth", DEFAULT_QUEUE_DEPTH as i64)?;
         let queue_depth = usize::try_from(depth)
             .ok()
@@ -154,8 +188,13 @@ impl NodeConfig {
                 (planner, cell_path.display().to_string(), note)
             }
         };
+        let mut planner = planner.with_indicator_source(indicator_source);
+        if let Some(n) = eval_threads {
+            planner = planner.with_eval_threads(n)?;
+        }
         Ok(Self {
             planner,
+            indicator_source,
             cell_source,
             cache_note,
             ddpg_policy_file,

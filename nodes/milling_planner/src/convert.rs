@@ -284,7 +284,7 @@ pub fn success_message(out: &MillPlanOutput) -> String {
     format!(
         "planned {} segments with {}{policy}: machining time {:.3} s (trajectory {:.3} s from \
          rest to rest), max |mu| {:.4} ({chatter}), min condition indicator {:.3}, total reward \
-         {:.3}; indicator cache {}; planning took {:.3} s{jumps}",
+         {:.3}; indicator cache {} for planning; {}; planning took {:.3} s{jumps}",
         p.segments.len(),
         out.planner.name(),
         p.total_time,
@@ -293,6 +293,7 @@ pub fn success_message(out: &MillPlanOutput) -> String {
         p.min_condition_indicator,
         p.total_reward,
         if out.cache_used { "used" } else { "not used" },
+        out.indicator.note.trim_end_matches('.'),
         out.planning_seconds,
     )
 }

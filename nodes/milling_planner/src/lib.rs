@@ -13,7 +13,8 @@
 //! | `~/joint_trajectory` | `trajectory_msgs/msg/JointTrajectory` | the planned trajectory, on success only (reliable, volatile) |
 //!
 //! Parameters ([`NodeConfig::from_params`]): `cell_file`, `indicator_cache_file`,
-//! `ddpg_policy_file`, `fixed_g_policy_file`, `queue_depth`.
+//! `ddpg_policy_file`, `fixed_g_policy_file`, `indicator_source`, `eval_threads`,
+//! `queue_depth`.
 //!
 //! # How to run it
 //!
@@ -244,13 +245,14 @@ impl PlannerNode {
         }
         log.info(&format!(
             "serving mill requests on {} and {}; plans on {}, trajectories on {}; cell: {}; {}; \
-             default policies: ddpg {}, fixed_g {}; queue_depth {}",
+             |mu|max: {}; default policies: ddpg {}, fixed_g {}; queue_depth {}",
             node.resolve("~/mill_request")?,
             node.resolve("~/mill_request_text")?,
             node.resolve("~/mill_plan")?,
             node.resolve("~/joint_trajectory")?,
             cfg.cell_source,
             cfg.cache_note,
+            cfg.indicator_source.name(),
             policies.ddpg.display(),
             policies.fixed_g.display(),
             cfg.queue_depth,

@@ -4,7 +4,7 @@
 use std::path::Path;
 
 use kerf_milling_planner::{config::DEFAULT_QUEUE_DEPTH, NodeConfig, NodeError, KNOWN_PARAMS};
-use kerf_millplan::PlannerKind;
+use kerf_millplan::{plan::IndicatorSource, PlannerKind};
 use kerf_ros::RosArgs;
 
 const ROOT: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../..");
@@ -67,6 +67,8 @@ fn shipped_cell_and_policies_by_default_and_replaced_by_parameters() {
         .default_policy(PlannerKind::FixedG)
         .unwrap()
         .ends_with("crates/millplan/policies/fixed_g.safetensors"));
+    assert_eq!(c.indicator_source, IndicatorSource::Direct);
+    assert_eq!(c.planner.indicator_source(), IndicatorSource::Direct);
     assert_eq!(c.default_policy(PlannerKind::Dp), None);
     assert_eq!(c.default_policy(PlannerKind::Naive), None);
 
@@ -77,9 +79,13 @@ fn shipped_cell_and_policies_by_default_and_replaced_by_parameters() {
         "queue_depth:=3",
         "ddpg_policy_file:=/nonexistent/a.safetensors",
         "fixed_g_policy_file:=b.safetensors",
+        "indicator_source:=cache",
+        "eval_threads:=2",
     ])
     .unwrap();
     assert_eq!(c.queue_depth, 3);
+    assert_eq!(c.indicator_source, IndicatorSource::Cache);
+    assert_eq!(c.planner.indicator_source(), IndicatorSource::Cache);
     assert!(c.cell_source.ends_with("urdf/irb6660_milling.yaml"));
     assert_eq!(
         c.default_policy(PlannerKind::Ddpg),
@@ -102,6 +108,17 @@ fn bad_parameters_are_refused_by_name() {
         e.contains("'queue_depth'") && e.contains("expected integer"),
         "{e}"
     );
+    let e = config(&["indicator_source:=lookup"])
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("'indicator_source'") && e.contains("direct or cache"),
+        "{e}"
+    );
+    let e = config(&["eval_threads:=0"]).unwrap_err().to_string();
+    assert!(e.contains("'eval_threads'") && e.contains(">= 1"), "{e}");
+    let e = config(&["eval_threads:=1.5"]).unwrap_err().to_string();
+    assert!(e.contains("'eval_threads'"), "{e}");
     let e = config(&["urdf_file:=/x.urdf"]).unwrap_err().to_string();
     assert!(e.contains("'urdf_file'") && e.contains("unknown"), "{e}");
     for name in [

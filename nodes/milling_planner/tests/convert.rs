@@ -339,6 +339,7 @@ fn a_real_plan_becomes_its_mill_plan() {
     // The text form is the same message.
     let back: msg::MillPlan = serde_yaml_ng::from_str(&text::plan_text(&m)).unwrap();
     assert_eq!(back, m);
+    println!("{}", m.message);
     println!(
         "naive: {} rpm, {} m/s, machining time {:.3} s, max |mu| {:.4}",
         m.segments[0].spindle_rpm, m.segments[0].feed, m.machining_time, m.max_mu
