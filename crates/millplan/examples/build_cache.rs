@@ -65,97 +65,6 @@ fn probe(cell: &MillCell) -> Result<(), MillPlanError> {
     Ok(())
 }
 
-/// DP (g free and g = 0) and naive plans on the committed cache, each
-/// re-evaluated directly, as the comparison table.
-fn compare(cell: &MillCell) -> Result<(), MillPlanError> {
-    use kerf_millplan::dp::{self, DpSpec};
-    use kerf_millplan::naive;
-    use kerf_millplan::plan::{comparison_table, Plan};
-    use kerf_millplan::reward::RewardWeights;
-    let cache = IndicatorCache::load(&IndicatorCache::default_path(), cell)?;
-    let w = RewardWeights::default();
-    let mut rows = Vec::new();
-    for (name, fixed) in [("DP", false), ("DP, g = 0", true)] {
-        let r = dp::solve(cell, &cache, &DpSpec::full(cell, w, fixed))?;
-        println!(
-            "{name}: {:.2} s, grid {:?}, value (cache) {:.4}, forbidden states {}",
-            r.seconds, r.dims, r.value, r.forbidden_states
-        );
-        let plan = Plan::evaluate(cell, &w, &r.states, name)?;
-        let mut line = String::new();
-        for s in plan.segments.iter().step_by(5) {
-            line.push_str(&format!(
-                " [{} {:.0} {:.3} {:.1} {:.3}]",
-                s.segment, s.rpm, s.feed, s.g, s.spectral_radius
-            ));
-        }
-        println!("  seg rpm f g mu:{line}");
-        rows.push(plan.row());
-    }
-    // Hard chatter constraint |mu|cache < 0.99 from the first segment where
-    // a plan from the IVP can satisfy it (g free, then g = 0).
-    for fixed in [false, true] {
-        for from in 1..100 {
-            let mut spec = DpSpec::full(cell, w, fixed);
-            spec.chatter_limit = Some((0.99, from));
-            if let Ok(r) = dp::solve(cell, &cache, &spec) {
-                let name = format!(
-                    "DP{}, |mu|cache < 0.99 from segment {from}",
-                    if fixed { ", g = 0" } else { "" }
-                );
-                println!("{name}: {:.2} s, value (cache) {:.4}", r.seconds, r.value);
-                let plan = Plan::evaluate(cell, &w, &r.states, &name)?;
-                let late = plan
-                    .segments
-                    .iter()
-                    .skip(from)
-                    .map(|s| s.spectral_radius)
-                    .fold(0.0, f64::max);
-                println!("  max |mu| (direct) from segment {from}: {late:.4}");
-                rows.push(plan.row());
-                break;
-            }
-        }
-    }
-    let t = Instant::now();
-    let nv = naive::solve(cell, &cache, 0.0)?;
-    println!(
-        "naive: {:.2} s, {:.0} rpm, {:.3} m/s, chatter-free {}, verified {}",
-        t.elapsed().as_secs_f64(),
-        nv.rpm,
-        nv.feed,
-        nv.chatter_free,
-        nv.verified
-    );
-    rows.push(Plan::evaluate(cell, &w, &nv.states, "naive")?.row());
-    println!("{}", comparison_table(&rows));
-    // Environment step cost, with and without the cache (a gentle policy).
-    use kerf_millplan::env::{EnvConfig, MillEnv};
-    use std::sync::Arc;
-    let cell = Arc::new(cell.clone());
-    for cached in [true, false] {
-        let c = if cached {
-            Some(Arc::new(cache.clone()))
-        } else {
-            None
-        };
-        let mut env = MillEnv::new(cell.clone(), c, EnvConfig::default())?;
-        let t = Instant::now();
-        let mut steps = 0;
-        let episodes = if cached { 20 } else { 2 };
-        for _ in 0..episodes {
-            let r = env.rollout(|_, s| Ok(vec![0.5, 0.5, if s.g > -0.6 { -0.5 } else { 0.0 }]))?;
-            steps += r.steps.len();
-        }
-        println!(
-            "env step ({}): {:.1} us per step over {steps} steps",
-            if cached { "cache" } else { "direct" },
-            t.elapsed().as_secs_f64() / steps as f64 * 1e6
-        );
-    }
-    Ok(())
-}
-
 /// Prints the largest interpolation errors of the committed cache.
 fn worst(cell: &MillCell) -> Result<(), MillPlanError> {
     use kerf_millplan::cache::{direct_indicator, SplitMix64};
@@ -195,9 +104,6 @@ fn main() -> Result<(), MillPlanError> {
     }
     if args.iter().any(|a| a == "--worst") {
         return worst(&cell);
-    }
-    if args.iter().any(|a| a == "--compare") {
-        return compare(&cell);
     }
     if args.iter().any(|a| a == "--remeasure") {
         let mut cache = IndicatorCache::load(&IndicatorCache::default_path(), &cell)?;
