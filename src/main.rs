@@ -4,13 +4,20 @@
 //!   process (today: the trajectory executor).
 //! * `kerf echo TOPIC` prints a kerf or standard topic as YAML, with no ROS install.
 //! * `kerf plan cut --request FILE` plans a laser cut offline (exit code 2 on failure).
+//! * `kerf plan mill --request FILE` plans a milling path offline (issue 5; exit code 2 on
+//!   failure).
+//! * `kerf train mill --out FILE` trains the DDPG milling policy of seed 004 (exit code 2 on
+//!   failure).
 //! * `kerf lobes --segment N --g RAD` draws the stability lobes and the feed × speed chatter
 //!   map of a milling state (issue 4) and prints a table (exit code 2 on failure).
 
 mod echo;
 mod launch;
 mod lobes;
+mod mill_plots;
 mod plan_cut;
+mod plan_mill;
+mod train_mill;
 
 use std::process::ExitCode;
 
@@ -33,10 +40,13 @@ enum Command {
     Launch(launch::LaunchArgs),
     /// Print the messages of a topic as YAML.
     Echo(echo::EchoArgs),
-    /// Plan offline, without ROS (`kerf plan cut --request cut.yaml`).
+    /// Plan offline, without ROS (`kerf plan cut --request cut.yaml`,
+    /// `kerf plan mill --request mill.yaml`).
     Plan(plan_cut::PlanArgs),
     /// Stability lobes and feed map of a milling state (`kerf lobes --segment 50 --g 0`).
     Lobes(lobes::LobesArgs),
+    /// Train a planner's policy (`kerf train mill --out policy.safetensors`).
+    Train(Box<train_mill::TrainArgs>),
 }
 
 fn main() -> ExitCode {
@@ -46,6 +56,10 @@ fn main() -> ExitCode {
         Command::Echo(a) => (echo::run(a), ExitCode::FAILURE),
         Command::Plan(a) => (plan_cut::run(a), ExitCode::from(plan_cut::EXIT_FAILURE)),
         Command::Lobes(a) => (lobes::run(a), ExitCode::from(lobes::EXIT_FAILURE)),
+        Command::Train(a) => (
+            train_mill::run(*a),
+            ExitCode::from(train_mill::EXIT_FAILURE),
+        ),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

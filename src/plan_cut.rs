@@ -34,6 +34,8 @@ pub struct PlanArgs {
 enum PlanCommand {
     /// Plan a laser cut (MJTO, seed 001) from a request file.
     Cut(CutArgs),
+    /// Plan a milling path (DDPG, fixed g, DP or naive; seed 004) from a request file.
+    Mill(crate::plan_mill::MillArgs),
 }
 
 /// Arguments of `kerf plan cut`.
@@ -67,6 +69,7 @@ pub const EXIT_FAILURE: u8 = 2;
 pub fn run(a: PlanArgs) -> Result<(), String> {
     match a.command {
         PlanCommand::Cut(c) => cut(c),
+        PlanCommand::Mill(m) => crate::plan_mill::run(m),
     }
 }
 
