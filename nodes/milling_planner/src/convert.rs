@@ -228,6 +228,93 @@ pub fn trajectory_msg(t: &kerf_millplan::JointTrajectory) -> Result<JointTraject
     })
 }
 
+/// Velocity and acceleration limits of one joint (the cell's robot: its URDF and limits
+/// YAML).
+#[derive(Debug, Clone, PartialEq)]
+pub struct JointLimit {
+    /// Joint name.
+    pub name: String,
+    /// Largest speed \[rad/s\].
+    pub max_velocity: f64,
+    /// Largest acceleration \[rad/s²\], if known.
+    pub max_acceleration: Option<f64>,
+}
+
+/// Relative slack of [`first_limit_excess`] (the executor's `LIMIT_SLACK`).
+const LIMIT_SLACK: f64 = 1e-9;
+
+/// The first place where the cubic Hermite interpolation of `t` between its points (what the
+/// executor runs: positions and velocities at every point) exceeds a joint's velocity or
+/// acceleration limit, as a sentence; `None` when it stays within every limit. Joints of `t`
+/// without an entry in `limits` are not checked.
+///
+/// On a segment of duration h from (p0, v0) to (p1, v1), with Δ = p1 − p0, the acceleration
+/// is linear, from 6Δ/h² − (4 v0 + 2 v1)/h to −6Δ/h² + (2 v0 + 4 v1)/h, and the velocity is a
+/// parabola, checked at both ends and at its vertex.
+pub fn first_limit_excess(t: &JointTrajectory, limits: &[JointLimit]) -> Option<String> {
+    let joints: Vec<(usize, &JointLimit)> = t
+        .joint_names
+        .iter()
+        .enumerate()
+        .filter_map(|(j, n)| limits.iter().find(|l| &l.name == n).map(|l| (j, l)))
+        .collect();
+    for (k, w) in t.points.windows(2).enumerate() {
+        let (t0, t1) = (
+            w[0].time_from_start.as_secs_f64(),
+            w[1].time_from_start.as_secs_f64(),
+        );
+        let h = t1 - t0;
+        if h.is_nan() || h <= 0.0 {
+            continue;
+        }
+        for &(j, l) in &joints {
+            let value = |v: &Vec<f64>| v.get(j).copied().unwrap_or(0.0);
+            let (p0, p1) = (value(&w[0].positions), value(&w[1].positions));
+            let (v0, v1) = (value(&w[0].velocities), value(&w[1].velocities));
+            let d = p1 - p0;
+            let c2 = (3.0 * d / h - 2.0 * v0 - v1) / h;
+            let c3 = (-2.0 * d / h + v0 + v1) / (h * h);
+            let where_ = |tau: f64| {
+                format!(
+                    "at t = {:.3} s (between point {k} and point {})",
+                    t0 + tau,
+                    k + 1
+                )
+            };
+            for (tau, a) in [(0.0, 2.0 * c2), (h, 2.0 * c2 + 6.0 * c3 * h)] {
+                if let Some(max) = l.max_acceleration {
+                    if a.abs() > max * (1.0 + LIMIT_SLACK) {
+                        return Some(format!(
+                            "joint '{}': acceleration {a:.4} rad/s^2 {} exceeds its limit {max}",
+                            l.name,
+                            where_(tau)
+                        ));
+                    }
+                }
+            }
+            let mut taus = vec![0.0, h];
+            if c3 != 0.0 {
+                let vertex = -c2 / (3.0 * c3);
+                if vertex > 0.0 && vertex < h {
+                    taus.push(vertex);
+                }
+            }
+            for tau in taus {
+                let v = v0 + 2.0 * c2 * tau + 3.0 * c3 * tau * tau;
+                if v.abs() > l.max_velocity * (1.0 + LIMIT_SLACK) {
+                    return Some(format!(
+                        "joint '{}': velocity {v:.4} rad/s {} exceeds its limit {}",
+                        l.name,
+                        where_(tau),
+                        l.max_velocity
+                    ));
+                }
+            }
+        }
+    }
+    None
+}
+
 /// The `MillSegment` messages of a plan, in path order.
 pub fn segments_msg(out: &MillPlanOutput) -> Vec<msg::MillSegment> {
     out.plan

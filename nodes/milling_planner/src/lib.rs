@@ -158,8 +158,11 @@ pub fn run(args: &RosArgs, env: &RosEnv, stop: StopToken) -> Result<(), NodeErro
 }
 
 /// Plans one job (on the worker thread): the request with the node's default policy filled
-/// in when it names none, answered as a `MillPlan`. Jobs queued after the node began to stop
-/// are answered INTERNAL_ERROR without planning; already-answered jobs pass through.
+/// in when it names none, answered as a `MillPlan`. A successful plan whose trajectory
+/// exceeds the robot's velocity or acceleration limits ([`convert::first_limit_excess`]) is
+/// still SUCCESS (the plan itself is valid), with a WARNING in its message naming the joint,
+/// the value and the time. Jobs queued after the node began to stop are answered
+/// INTERNAL_ERROR without planning; already-answered jobs pass through.
 pub fn work(
     planner: &MillPlanner,
     policies: &DefaultPolicies,
@@ -188,9 +191,36 @@ pub fn work(
         request.policy_file = default.map(|p| p.display().to_string());
     }
     match planner.plan(&request) {
-        Ok(out) => convert::output_to_msg(&out),
+        Ok(out) => {
+            let mut m = convert::output_to_msg(&out);
+            if m.status == MillPlan::SUCCESS {
+                let limits = robot_limits(planner);
+                if let Some(excess) = convert::first_limit_excess(&m.trajectory, &limits) {
+                    m.message.push_str(&format!(
+                        "; WARNING: the trajectory exceeds the robot's limits ({excess}): an \
+                         executor with these limits will reject it"
+                    ));
+                }
+            }
+            m
+        }
         Err(e) => convert::error_to_msg(&request.request_id, &request.planner, &e),
     }
+}
+
+/// The velocity and acceleration limits of the planner cell's robot.
+pub fn robot_limits(planner: &MillPlanner) -> Vec<convert::JointLimit> {
+    planner
+        .cell()
+        .robot()
+        .joints()
+        .iter()
+        .map(|j| convert::JointLimit {
+            name: j.name.clone(),
+            max_velocity: j.max_velocity,
+            max_acceleration: j.max_acceleration,
+        })
+        .collect()
 }
 
 /// The node's state. Fields drop in declaration order: DDS endpoints and the worker first,

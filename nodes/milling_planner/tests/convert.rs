@@ -396,3 +396,64 @@ fn ramps_double_the_first_and_last_half_segments() {
     let a1 = -6.0 * d / (t * t) + 4.0 * v / t;
     assert!((a0 - v / (2.0 * h)).abs() < 1e-12 && (a1 - v / (2.0 * h)).abs() < 1e-12);
 }
+
+#[test]
+fn limit_excess_of_the_interpolated_trajectory() {
+    use kerf_msgs::{
+        builtin_interfaces::Duration,
+        trajectory_msgs::{JointTrajectory, JointTrajectoryPoint},
+    };
+    // Rest to rest, 1 rad in 2 s (cubic): peak acceleration 6Δ/T² = 1.5 rad/s² at both ends,
+    // peak velocity 1.5Δ/T = 0.75 rad/s at the middle.
+    let point = |q: f64, sec: i32| JointTrajectoryPoint {
+        positions: vec![q, 0.0],
+        velocities: vec![0.0, 0.0],
+        time_from_start: Duration { sec, nanosec: 0 },
+        ..JointTrajectoryPoint::default()
+    };
+    let t = JointTrajectory {
+        joint_names: vec!["a".into(), "b".into()],
+        points: vec![point(0.0, 0), point(1.0, 2)],
+        ..JointTrajectory::default()
+    };
+    let limit = |v: f64, a: Option<f64>| {
+        vec![convert::JointLimit {
+            name: "a".into(),
+            max_velocity: v,
+            max_acceleration: a,
+        }]
+    };
+    assert_eq!(
+        convert::first_limit_excess(&t, &limit(0.76, Some(1.51))),
+        None
+    );
+    assert_eq!(convert::first_limit_excess(&t, &limit(0.76, None)), None);
+    let e = convert::first_limit_excess(&t, &limit(0.76, Some(1.49))).unwrap();
+    assert!(
+        e.contains("joint 'a'") && e.contains("acceleration 1.5000") && e.contains("t = 0.000 s"),
+        "{e}"
+    );
+    let e = convert::first_limit_excess(&t, &limit(0.74, Some(1.51))).unwrap();
+    assert!(
+        e.contains("velocity 0.7500") && e.contains("t = 1.000 s") && e.contains("limit 0.74"),
+        "{e}"
+    );
+    // A joint without limits is not checked.
+    assert_eq!(convert::first_limit_excess(&t, &[]), None);
+}
+
+#[test]
+fn the_naive_plan_is_within_the_robot_limits() {
+    let planner = MillPlanner::with_default_cell().expect("planner");
+    let limits = kerf_milling_planner::robot_limits(&planner);
+    let names: Vec<&str> = limits.iter().map(|l| l.name.as_str()).collect();
+    assert_eq!(
+        names,
+        ["joint_1", "joint_2", "joint_3", "joint_4", "joint_5", "joint_6"]
+    );
+    // urdf/irb6660_limits.yaml: joint_5 4 rad/s², URDF 120 deg/s.
+    assert_eq!(limits[4].max_acceleration, Some(4.0));
+    assert!((limits[4].max_velocity - 120f64.to_radians()).abs() < 1e-3);
+    let m = convert::output_to_msg(naive_output());
+    assert_eq!(convert::first_limit_excess(&m.trajectory, &limits), None);
+}
