@@ -233,7 +233,7 @@ struct Progress {
 }
 
 /// Width of the progress bar in characters.
-const BAR_WIDTH: usize = 28;
+const BAR_WIDTH: usize = 20;
 
 impl Progress {
     fn new(window: usize, terminal: bool, log_every: usize) -> Self {
@@ -583,10 +583,7 @@ mod tests {
     fn terminal_progress_is_a_bar_redrawn_in_place() {
         let mut p = Progress::new(10, true, 1);
         let s = p.update(&report(1, 4, -2.0));
-        assert!(
-            s.starts_with("\r\x1b[K[#######....................."),
-            "{s:?}"
-        );
+        assert!(s.starts_with("\r\x1b[K[#####...............] 1/4"), "{s:?}");
         assert!(s.contains("] 1/4 reward"), "{s:?}");
         assert!(!s.ends_with('\n'));
         for k in 2..4 {
