@@ -3,7 +3,9 @@
 //! * A tiny policy is trained in the test (3 episodes × 10 steps, batch 16, g fixed): the
 //!   saved file loads with the environment's sizes, the sidecar JSON holds the settings and the
 //!   command, the CSV and JSON histories have one row per episode with the same rewards, the
-//!   same seed gives the same weights byte for byte, and the training curve SVG has its series.
+//!   same seed gives the same weights byte for byte — equal to `kerf_millplan::train` called
+//!   with the same settings —, the greedy summary is the library's directly evaluated greedy
+//!   plan, and the training curve SVG has its series.
 //! * `kerf plan mill` with that policy (fixed_g) and with the naive planner: the printed totals,
 //!   a table row and the `--out` JSON equal the library's `MillPlanner` answer to the same
 //!   request; the SVG has the six panels of seed 004 Fig. 6 and the |μ| = 1 line; several
@@ -17,7 +19,13 @@ use std::{
     process::{Command, Output},
 };
 
-use kerf_millplan::{MillPlanner, MillRequest, Policy};
+use std::sync::Arc;
+
+use kerf_mill::MillCell;
+use kerf_millplan::{
+    plan::Plan, train, DdpgSettings, EnvConfig, IndicatorCache, MillEnv, MillPlanner, MillRequest,
+    Policy,
+};
 
 fn kerf(args: &[&str]) -> Output {
     Command::new(env!("CARGO_BIN_EXE_kerf"))
@@ -188,6 +196,53 @@ fn trains_a_policy_and_plans_with_it_as_the_library_does() {
     assert_eq!(json.len(), 3);
     for (r, x) in json.iter().zip(&rewards) {
         assert_eq!(r.total_reward, *x);
+    }
+
+    // The library trained the same way gives the same weights, and the CLI's greedy summary
+    // is the library's directly evaluated greedy plan.
+    let cell = Arc::new(MillCell::default_cell().expect("cell"));
+    let cache = IndicatorCache::load(&IndicatorCache::default_path(), &cell).expect("cache");
+    let config = EnvConfig {
+        fixed_g: true,
+        ..EnvConfig::default()
+    };
+    let mut env = MillEnv::new(cell.clone(), Some(Arc::new(cache)), config).expect("env");
+    let settings = DdpgSettings::default()
+        .with_episodes(3)
+        .with_steps_per_episode(10)
+        .with_batch_size(16)
+        .with_seed(3);
+    let agent = train(&mut env, &settings, &mut |_| {}).expect("library training");
+    let mut lib_policy = Policy::from_agent(&agent, "test").expect("policy");
+    lib_policy
+        .save(&dir.join("lib.safetensors"))
+        .expect("save library policy");
+    assert_eq!(
+        std::fs::read(&weights).expect("p"),
+        std::fs::read(dir.join("lib.safetensors")).expect("lib"),
+        "the CLI trains exactly as kerf_millplan::train with the same settings"
+    );
+    let rollout = env
+        .rollout(|obs, _| lib_policy.act(obs))
+        .expect("greedy rollout");
+    let summary = stdout
+        .lines()
+        .find(|l| l.starts_with("greedy rollout"))
+        .expect("summary line");
+    if rollout.completed {
+        let greedy = Plan::evaluate(&cell, &config.weights, &rollout.states(), "fixed_g")
+            .expect("direct evaluation");
+        for (key, v) in [
+            ("machining time ", greedy.total_time),
+            ("max |μ|max ", greedy.max_spectral_radius),
+            ("min 1/K ", greedy.min_condition_indicator),
+            ("total reward ", greedy.total_reward),
+        ] {
+            let printed = number_after(summary, key);
+            assert!((printed - v).abs() <= 5.1e-5, "{key}: {printed} vs {v}");
+        }
+    } else {
+        assert!(summary.contains("left the feasible set"), "{summary}");
     }
 
     let curve = std::fs::read_to_string(dir.join("plots/training_curve.svg")).expect("curve");
