@@ -3,6 +3,12 @@
 //! of issue 5 (machining time, chatter-free, max |μ|max, min condition
 //! indicator, total reward).
 //!
+//! The one exception is opt-in and reported: a planner set to
+//! [`IndicatorSource::Cache`] ([`crate::planner::MillPlanner::with_indicator_source`])
+//! takes |μ|max from the indicator cache where it applies, and its answer
+//! lists the cached segments and the cache's stated error bound
+//! ([`IndicatorProvenance`]); [`Plan::evaluate`] is always direct.
+//!
 //! * Machining time `Σ_i l_i / f_i` (seed 004 section 3: uniform arc-length
 //!   segments traversed at feed f_i).
 //! * Total reward `Σ_i r_i` over ALL segments, r of seed 004 eq. 12 — the
