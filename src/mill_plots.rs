@@ -53,6 +53,11 @@ fn padded_range(values: impl Iterator<Item = f64>) -> (f64, f64) {
     }
 }
 
+/// `(lo, hi)` with `frac` × its width added on top (room for a legend in the upper corner).
+fn with_headroom((lo, hi): (f64, f64), frac: f64) -> (f64, f64) {
+    (lo, hi + frac * (hi - lo))
+}
+
 /// Splits points into runs of consecutive finite values (a non-finite value breaks a curve).
 fn runs(points: impl Iterator<Item = (f64, f64)>) -> Vec<Vec<(f64, f64)>> {
     let mut out: Vec<Vec<(f64, f64)>> = vec![Vec::new()];
@@ -159,7 +164,7 @@ pub fn training_curve(
         .iter()
         .filter_map(|r| r.mean_actor_loss.map(|l| (r.episode as f64, l)))
         .collect();
-    let (l0, l1) = padded_range(losses.iter().map(|p| p.1));
+    let (l0, l1) = with_headroom(padded_range(losses.iter().map(|p| p.1)), 0.25);
     let mut chart = ChartBuilder::on(&bottom)
         .caption("actor loss", ("sans-serif", 18))
         .margin(12)
@@ -260,11 +265,16 @@ pub fn plan_panels(path: &Path, plans: &[(&str, &Plan)], title: &str) -> Result<
         let values = plans
             .iter()
             .flat_map(|(_, p)| p.segments.iter().map(panel.value));
-        let (y0, y1) = if panel.y_desc == "|mu|max" {
-            padded_range(values.chain(std::iter::once(1.0)))
-        } else {
-            padded_range(values)
-        };
+        // Room on top for the legend (one line per plan, plus the limit in panel (b)).
+        let headroom = 0.12 * (plans.len() + 1) as f64 + 0.1;
+        let (y0, y1) = with_headroom(
+            if panel.y_desc == "|mu|max" {
+                padded_range(values.chain(std::iter::once(1.0)))
+            } else {
+                padded_range(values)
+            },
+            headroom,
+        );
         let mut chart = ChartBuilder::on(area)
             .caption(panel.caption, ("sans-serif", 18))
             .margin(10)
@@ -274,6 +284,7 @@ pub fn plan_panels(path: &Path, plans: &[(&str, &Plan)], title: &str) -> Result<
             .map_err(&err)?;
         chart
             .configure_mesh()
+            .x_label_formatter(&|x| format!("{x:.0}"))
             .x_desc("segment")
             .y_desc(panel.y_desc)
             .draw()
