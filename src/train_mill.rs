@@ -27,6 +27,10 @@
 //!   path, evaluated directly ([`Plan::evaluate`]): machining time, max |μ|max, min 1/K and
 //!   total reward (eq. 12); or where it left the feasible set.
 //!
+//! `kerf train curve --history FILE --plots DIR [--window N]` draws the same training curve
+//! from a saved history (CSV or JSON, e.g. the `train_policy` example's `.history.json` of a
+//! committed policy) without training.
+//!
 //! Every output path is checked (created and writable) BEFORE training, so a long run never
 //! ends on an unwritable file. Invalid arguments (0 episodes, NaN or out-of-range settings,
 //! an unreadable cell or cache, an unwritable path) exit with code 2 and a message.
@@ -63,6 +67,23 @@ pub struct TrainArgs {
 enum TrainCommand {
     /// Train the DDPG milling policy (seed 004) and save it as safetensors + JSON.
     Mill(MillTrainArgs),
+    /// Draw the training curve (seed 004 Fig. 5) of a saved history (CSV or JSON).
+    Curve(CurveArgs),
+}
+
+/// Arguments of `kerf train curve`.
+#[derive(Args, Debug)]
+pub struct CurveArgs {
+    /// History file written by `kerf train mill --history` (CSV, or JSON: an array of
+    /// episode reports, as the `train_policy` example's `.history.json`).
+    #[arg(long)]
+    history: PathBuf,
+    /// Write training_curve.svg into this directory (created if missing).
+    #[arg(long)]
+    plots: PathBuf,
+    /// Episodes of the moving average.
+    #[arg(long, default_value_t = 50)]
+    window: usize,
 }
 
 /// Arguments of `kerf train mill`.
@@ -147,6 +168,7 @@ pub struct MillTrainArgs {
 pub fn run(a: TrainArgs) -> Result<(), String> {
     match a.command {
         TrainCommand::Mill(m) => mill(m),
+        TrainCommand::Curve(c) => curve(c),
     }
 }
 
@@ -314,6 +336,145 @@ pub fn history_csv(history: &[EpisodeReport], window: usize) -> String {
         );
     }
     s
+}
+
+/// Reads a history written by `kerf train mill --history`: CSV when `csv`, else a JSON array
+/// of [`EpisodeReport`].
+///
+/// # Errors
+/// A message naming the row and column: a missing column, a value that is not a number, a
+/// non-finite reward, noise or time (NaN never passes), or no episode at all.
+pub fn parse_history(text: &str, csv: bool) -> Result<Vec<EpisodeReport>, String> {
+    let history: Vec<EpisodeReport> = if csv {
+        let mut lines = text.lines().filter(|l| !l.trim().is_empty());
+        let header: Vec<&str> = lines
+            .next()
+            .ok_or("empty history")?
+            .split(',')
+            .map(str::trim)
+            .collect();
+        let col = |name: &str| {
+            header
+                .iter()
+                .position(|h| *h == name)
+                .ok_or_else(|| format!("the header has no column `{name}`"))
+        };
+        let idx = [
+            col("episode")?,
+            col("episodes")?,
+            col("steps")?,
+            col("total_reward")?,
+            col("mean_critic_loss")?,
+            col("mean_actor_loss")?,
+            col("noise_std")?,
+            col("elapsed_s")?,
+            col("remaining_s")?,
+        ];
+        let mut out = Vec::new();
+        for (row, line) in lines.enumerate() {
+            let cells: Vec<&str> = line.split(',').map(str::trim).collect();
+            let cell = |k: usize| -> Result<&str, String> {
+                cells
+                    .get(idx[k])
+                    .copied()
+                    .ok_or_else(|| format!("row {}: column `{}` missing", row + 1, header[idx[k]]))
+            };
+            let num = |k: usize| -> Result<f64, String> {
+                let c = cell(k)?;
+                c.parse::<f64>().map_err(|_| {
+                    format!(
+                        "row {}: `{}` = `{c}` is not a number",
+                        row + 1,
+                        header[idx[k]]
+                    )
+                })
+            };
+            let whole = |k: usize| -> Result<usize, String> {
+                let c = cell(k)?;
+                c.parse::<usize>().map_err(|_| {
+                    format!(
+                        "row {}: `{}` = `{c}` is not a whole number",
+                        row + 1,
+                        header[idx[k]]
+                    )
+                })
+            };
+            let opt = |k: usize| -> Result<Option<f64>, String> {
+                if cell(k)?.is_empty() {
+                    Ok(None)
+                } else {
+                    num(k).map(Some)
+                }
+            };
+            out.push(EpisodeReport {
+                episode: whole(0)?,
+                episodes: whole(1)?,
+                steps: whole(2)?,
+                total_reward: num(3)?,
+                mean_critic_loss: opt(4)?,
+                mean_actor_loss: opt(5)?,
+                noise_std: num(6)?,
+                elapsed_s: num(7)?,
+                remaining_s: num(8)?,
+            });
+        }
+        out
+    } else {
+        serde_json::from_str(text)
+            .map_err(|e| format!("not a JSON array of episode reports: {e}"))?
+    };
+    if history.is_empty() {
+        return Err("no episode in the history".to_string());
+    }
+    for r in &history {
+        for (name, v) in [
+            ("total_reward", Some(r.total_reward)),
+            ("noise_std", Some(r.noise_std)),
+            ("elapsed_s", Some(r.elapsed_s)),
+            ("remaining_s", Some(r.remaining_s)),
+            ("mean_critic_loss", r.mean_critic_loss),
+            ("mean_actor_loss", r.mean_actor_loss),
+        ] {
+            if let Some(v) = v.filter(|v| !v.is_finite()) {
+                return Err(format!(
+                    "episode {}: {name} is {v}, must be finite",
+                    r.episode
+                ));
+            }
+        }
+    }
+    Ok(history)
+}
+
+fn curve(a: CurveArgs) -> Result<(), String> {
+    if a.window == 0 {
+        return Err("--window 0: must be at least 1".to_string());
+    }
+    let text = std::fs::read_to_string(&a.history)
+        .map_err(|e| format!("cannot read {}: {e}", a.history.display()))?;
+    let csv = a
+        .history
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("csv"));
+    let history = parse_history(&text, csv).map_err(|e| format!("{}: {e}", a.history.display()))?;
+    check_dir_writable("--plots", &a.plots)?;
+    let file = a.plots.join("training_curve.svg");
+    let name = a
+        .history
+        .file_name()
+        .map_or_else(String::new, |n| n.to_string_lossy().into_owned());
+    mill_plots::training_curve(
+        &file,
+        &history,
+        a.window,
+        &format!("DDPG training, {name} ({} episodes)", history.len()),
+    )?;
+    println!(
+        "training curve of {} episodes written to {}",
+        history.len(),
+        file.display()
+    );
+    Ok(())
 }
 
 /// The DDPG settings of the arguments over Table 2's.
@@ -593,6 +754,32 @@ mod tests {
         assert!(
             s.contains(&"#".repeat(BAR_WIDTH)) && s.ends_with('\n'),
             "{s:?}"
+        );
+    }
+
+    #[test]
+    fn csv_and_json_histories_read_back_exactly_and_nan_is_refused() {
+        let h = vec![report(1, 2, -1.25), report(2, 2, 0.1 + 0.2)];
+        assert_eq!(parse_history(&history_csv(&h, 50), true), Ok(h.clone()));
+        let json = serde_json::to_string(&h).expect("json");
+        assert_eq!(parse_history(&json, false), Ok(h.clone()));
+        let mut bad = h.clone();
+        bad[1].total_reward = f64::NAN;
+        let e = parse_history(&history_csv(&bad, 50), true).unwrap_err();
+        assert_eq!(e, "episode 2: total_reward is NaN, must be finite");
+        assert!(parse_history("episode,steps\n1,2\n", true)
+            .unwrap_err()
+            .contains("no column `episodes`"));
+        let header = history_csv(&h, 50)
+            .lines()
+            .next()
+            .expect("header")
+            .to_string();
+        let e = parse_history(&format!("{header}\n1,2,10,x,1,,,0.1,2,2\n"), true).unwrap_err();
+        assert_eq!(e, "row 1: `total_reward` = `x` is not a number");
+        assert_eq!(
+            parse_history("[]", false).unwrap_err(),
+            "no episode in the history"
         );
     }
 

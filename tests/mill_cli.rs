@@ -256,6 +256,27 @@ fn trains_a_policy_and_plans_with_it_as_the_library_does() {
         assert!(curve.contains(label), "training curve lacks {label:?}");
     }
 
+    // The same curve from the saved JSON history, without training.
+    let out = kerf(&[
+        "train",
+        "curve",
+        "--history",
+        s(&dir.join("h.json")),
+        "--plots",
+        s(&dir.join("curve")),
+        "--window",
+        "2",
+    ]);
+    assert!(out.status.success(), "{}", text(&out).1);
+    let curve = std::fs::read_to_string(dir.join("curve/training_curve.svg")).expect("curve");
+    for label in [
+        "episode reward",
+        "moving average (2 episodes)",
+        "h.json (3 episodes)",
+    ] {
+        assert!(curve.contains(label), "history curve lacks {label:?}");
+    }
+
     // --- Planning with it (fixed_g), against the library.
     let request_path = write_request(
         &dir,
@@ -472,6 +493,11 @@ fn bad_inputs_exit_2_with_a_message() {
     );
     let good = req("good.yaml", &format!("{POINTS}planner: naive\n"));
     let missing = dir.join("missing.yaml");
+    let nan_history = req(
+        "nan.csv",
+        "episode,episodes,steps,total_reward,mean_critic_loss,mean_actor_loss,noise_std,\
+         elapsed_s,remaining_s\n1,2,10,-3.5,,,0.1,1,1\n2,2,10,NaN,0.2,0.3,0.1,2,0\n",
+    );
     fn plan(r: &Path) -> Vec<&str> {
         vec!["plan", "mill", "--request", s(r)]
     }
@@ -504,6 +530,17 @@ fn bad_inputs_exit_2_with_a_message() {
         (
             [plan(&good), vec!["--out", "plan.txt"]].concat(),
             &["--out plan.txt", "must end in .json, .yaml or .yml"],
+        ),
+        (
+            vec![
+                "train",
+                "curve",
+                "--history",
+                s(&nan_history),
+                "--plots",
+                "c",
+            ],
+            &["episode 2: total_reward is NaN, must be finite"],
         ),
         (
             vec!["train", "mill", "--out", "p.json"],
