@@ -66,7 +66,7 @@ pub struct TrainArgs {
 #[derive(Subcommand, Debug)]
 enum TrainCommand {
     /// Train the DDPG milling policy (seed 004) and save it as safetensors + JSON.
-    Mill(MillTrainArgs),
+    Mill(Box<MillTrainArgs>),
     /// Draw the training curve (seed 004 Fig. 5) of a saved history (CSV or JSON).
     Curve(CurveArgs),
 }
@@ -167,7 +167,7 @@ pub struct MillTrainArgs {
 /// The message to print; the caller exits with [`EXIT_FAILURE`].
 pub fn run(a: TrainArgs) -> Result<(), String> {
     match a.command {
-        TrainCommand::Mill(m) => mill(m),
+        TrainCommand::Mill(m) => mill(*m),
         TrainCommand::Curve(c) => curve(c),
     }
 }
