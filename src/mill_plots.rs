@@ -124,6 +124,7 @@ pub fn training_curve(
         .map_err(&err)?;
     chart
         .configure_mesh()
+        .x_label_formatter(&|x| format!("{x:.0}"))
         .x_desc("episode")
         .y_desc("episode reward")
         .draw()
@@ -174,6 +175,7 @@ pub fn training_curve(
         .map_err(&err)?;
     chart
         .configure_mesh()
+        .x_label_formatter(&|x| format!("{x:.0}"))
         .x_desc("episode")
         .y_desc("mean actor loss -Q")
         .draw()
