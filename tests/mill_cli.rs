@@ -23,8 +23,8 @@ use std::sync::Arc;
 
 use kerf_mill::MillCell;
 use kerf_millplan::{
-    plan::Plan, train, DdpgSettings, EnvConfig, IndicatorCache, MillEnv, MillPlanner, MillRequest,
-    Policy,
+    plan::{IndicatorSource, Plan},
+    train, DdpgSettings, EnvConfig, IndicatorCache, MillEnv, MillPlanner, MillRequest, Policy,
 };
 
 fn kerf(args: &[&str]) -> Output {
@@ -437,6 +437,31 @@ fn trains_a_policy_and_plans_with_it_as_the_library_does() {
         "overlay legend"
     );
     assert!(!plots.join("mill_plan_ddpg.svg").exists());
+
+    // --- --indicator cache: the library's cached evaluation, and the note says so.
+    let naive_path = write_request(&dir, "naive.yaml", &format!("{POINTS}planner: naive\n"));
+    let out = kerf(&[
+        "plan",
+        "mill",
+        "--request",
+        s(&naive_path),
+        "--indicator",
+        "cache",
+    ]);
+    let (stdout, stderr) = text(&out);
+    assert!(out.status.success(), "{stdout}\n{stderr}");
+    let cached = MillPlanner::with_default_cell()
+        .expect("planner")
+        .with_indicator_source(IndicatorSource::Cache)
+        .plan(&MillRequest::from_file(&naive_path).expect("request"))
+        .expect("library cached plan");
+    assert!(!cached.indicator.cached_segments.is_empty());
+    assert!(stdout.contains(&cached.indicator.note), "{stdout}");
+    let printed = totals(&stdout, 0);
+    assert!(
+        (printed[1] - cached.plan.max_spectral_radius).abs() <= 5.1e-7,
+        "{stdout}"
+    );
 
     // --- The fixed-g policy is refused by ddpg (3 actions): incompatible policy file.
     let out = kerf(&[
