@@ -18,6 +18,9 @@
 //!   several threads it is their sum). The load average is printed too.
 //! * The plans of 1 and of the default number of threads are checked to be
 //!   identical (bit for bit) before timing.
+//! * The evaluation step alone, 1 and the default number of threads
+//!   alternately (10 rounds; median wall, mean CPU), for a speed-up that
+//!   both sides measure under the same load.
 //! * A third configuration plans with [`IndicatorSource::Cache`]: |μ|max
 //!   interpolated from the indicator cache where it applies, with its
 //!   stated bound in the answer (printed): NOT the direct evaluation.
@@ -30,7 +33,7 @@ use std::time::Instant;
 
 use criterion::{criterion_group, Criterion};
 use kerf_millplan::cache::cell_fingerprint;
-use kerf_millplan::plan::{default_eval_threads, IndicatorSource};
+use kerf_millplan::plan::{default_eval_threads, IndicatorSource, Plan};
 use kerf_millplan::planner::PlanningPhases;
 use kerf_millplan::{
     default_policy_path, train, DdpgSettings, EnvConfig, MillEnv, MillPlanError, MillPlanOutput,
@@ -222,6 +225,47 @@ fn setup_parts(planner: &MillPlanner, n: usize) {
     );
 }
 
+/// The evaluation step alone ([`Plan::evaluate_with_threads`]) on the
+/// states of `out`, 1 thread and `threads` alternately (`rounds` each, so
+/// that both see the same changes of the machine's load): median wall ms
+/// and mean process-CPU ms of each.
+fn evaluation_ab(planner: &MillPlanner, out: &MillPlanOutput, threads: usize, rounds: usize) {
+    let states = out.plan.states();
+    let weights = planner.env_config().weights;
+    let cell = planner.cell();
+    let mut wall = [Vec::new(), Vec::new()];
+    let mut cpu = [0.0, 0.0];
+    for _ in 0..rounds {
+        for (k, t) in [1, threads].into_iter().enumerate() {
+            let c0 = process_cpu_time();
+            let start = Instant::now();
+            if let Err(e) = Plan::evaluate_with_threads(cell, &weights, &states, "ab", t) {
+                eprintln!("evaluation A/B failed: {e}");
+                return;
+            }
+            wall[k].push(start.elapsed().as_secs_f64());
+            if let Some(d) = c0.zip(process_cpu_time()).map(|(a, b)| b - a) {
+                cpu[k] += d;
+            }
+        }
+    }
+    let median = |v: &mut Vec<f64>| {
+        v.sort_by(f64::total_cmp);
+        v[v.len() / 2]
+    };
+    let (w1, wn) = (median(&mut wall[0]), median(&mut wall[1]));
+    eprintln!(
+        "evaluation step alone, {rounds} alternating rounds: 1 thread median {:.1} ms (CPU {:.1} \
+         ms), {threads} threads median {:.1} ms (CPU {:.1} ms): {:.2}x; load average {}",
+        w1 * 1e3,
+        cpu[0] / rounds as f64 * 1e3,
+        wn * 1e3,
+        cpu[1] / rounds as f64 * 1e3,
+        w1 / wn,
+        load_average()
+    );
+}
+
 /// Plans `request` with 1 thread and with `threads`; `true` when both
 /// succeed with identical plans and trajectories.
 fn same_plan(one: &MillPlanner, many: &MillPlanner, request: &MillRequest) -> bool {
@@ -323,6 +367,9 @@ fn bench(c: &mut Criterion) {
         if !same_plan(&one, &many, request) {
             eprintln!("{name}: 1-thread and {threads}-thread plans differ or failed; skipped");
             continue;
+        }
+        if let Ok(out) = many.plan(request) {
+            evaluation_ab(&many, &out, threads, 10);
         }
         for (planner, what) in &planners {
             let label = format!("plan {name}, {what}");
