@@ -589,14 +589,9 @@ impl MillEnv {
         if let Some(share) = self.config.joint_acceleration_share {
             // Finite difference: (v_new − v_prev) / mean interval.
             let mean = 0.5 * (self.previous_interval + dt);
-            for (j, ((m, v), amax)) in motion
-                .iter()
-                .zip(&self.velocity)
-                .zip(&self.acceleration_limits)
-                .enumerate()
-            {
-                let a = (m / dt - v) / mean;
-                let limit = share * amax;
+            for j in 0..6 {
+                let a = (motion[j] / dt - self.velocity[j]) / mean;
+                let limit = share * self.acceleration_limits[j];
                 if a.is_nan() || a.abs() > limit {
                     return Some(format!(
                         "joint {} would accelerate at {:.3} rad/s^2 at segment {} (limit {:.3} \

@@ -69,7 +69,7 @@ pub fn acceleration_limits(cell: &MillCell) -> Result<[f64; 6], MillPlanError> {
     let mut out = [f64::INFINITY; 6];
     for (o, j) in out.iter_mut().zip(joints) {
         if let Some(a) = j.max_acceleration {
-            if a.is_nan() || a <= 0.0 {
+            if !(a > 0.0) {
                 return Err(MillPlanError::InvalidConfig {
                     name: format!("acceleration limit of {}", j.name),
                     reason: format!("{a} rad/s^2 is not > 0"),
