@@ -58,18 +58,12 @@
 //!   default): a step whose joints move faster than the URDF's velocity
 //!   limits between the two segments' midpoints
 //!   ([`crate::joint_speed`]) is a terminal violation like an infeasible g.
-//! * **Joint accelerations** (kerf's, [`EnvConfig::joint_acceleration_share`],
-//!   on by default): the change of the joint velocities between consecutive
-//!   midpoint intervals (from rest at the path start) over their mean
-//!   duration stays within half the limits file's accelerations; a
-//!   violation is handled like a joint-speed violation.
 //! * **Projection of the g move** (kerf's, [`EnvConfig::project_g`], on by
 //!   default): a g move into an infeasible state is shortened to the
-//!   feasible move nearest to it on the way from the previous move (or from
-//!   no move) by bisection — the clip of eq. 11 extended from the state
-//!   range to the feasible set, so that exploring g does not end episodes
-//!   at the edge of the reachable band or at a joint speed/acceleration
-//!   limit; the step is terminal only when neither anchor is feasible.
+//!   largest feasible fraction (bisection) — the clip of eq. 11 extended
+//!   from the state range to the feasible set, so that exploring g does
+//!   not end episodes at the edge of the reachable band or at a joint-speed
+//!   limit; the step is terminal only when keeping g is infeasible too.
 //! * **IK branch continuity**: each state's joints are the IK solution
 //!   nearest the previous state's joints (`MillCell::evaluate` with the
 //!   previous joints as reference).
@@ -112,13 +106,11 @@ pub struct EnvConfig {
     /// violation ([`crate::joint_speed`]; kerf's constraint, default on).
     pub joint_speed_limits: bool,
     /// kerf's projection of the g move (default on): when the filtered move
-    /// leads to an infeasible state (IK, joint limit, joint speed or
-    /// acceleration), the move closest to it on the segment from an anchor
-    /// — the previous applied g move (joints keep their velocity), else no
-    /// g move — that keeps the state feasible is applied instead
-    /// (bisection, [`PROJECTION_BISECTIONS`] steps), and the filter state
-    /// takes the applied move. Only when both anchors are infeasible is the
-    /// step a terminal violation.
+    /// leads to an infeasible state (IK, joint limit, joint speed), the
+    /// largest fraction of its g part that keeps the state feasible is
+    /// applied instead (bisection, [`PROJECTION_BISECTIONS`] steps), and
+    /// the filter state takes the applied move. Only when g unchanged is
+    /// infeasible too is the step a terminal violation.
     pub project_g: bool,
     /// Lowest feed of the clip of eq. 11 [m/s] (default 0.01, kerf's): the
     /// transitions clip f to [max(f_min, min_feed), f_max]. Why: f = 0 is
@@ -130,16 +122,6 @@ pub struct EnvConfig {
     /// feed is then a terminal violation). The initial feed must be at least
     /// this.
     pub min_feed: f64,
-    /// Share of the joints' acceleration limits that the finite-difference
-    /// acceleration between consecutive segment midpoints may use
-    /// (default `Some(0.5)`, kerf's; `None` = no acceleration check): the
-    /// change of the joint velocity from one midpoint interval to the next
-    /// over their mean duration, from rest at the path start (the
-    /// trajectory starts at rest). Half the limit, because the executor's
-    /// interpolation between the points peaks above the finite difference.
-    /// A violation is handled like a joint-speed violation (projection of
-    /// the g move, else terminal).
-    pub joint_acceleration_share: Option<f64>,
 }
 
 /// Bisection steps of [`EnvConfig::project_g`] (resolution 2⁻⁸ of the move).
@@ -162,7 +144,6 @@ impl Default for EnvConfig {
             joint_speed_limits: true,
             project_g: true,
             min_feed: 0.01,
-            joint_acceleration_share: Some(0.5),
         }
     }
 }
@@ -253,14 +234,6 @@ pub struct MillEnv {
     done: bool,
     /// Joint velocity limits of the cell's robot \[rad/s\].
     velocity_limits: [f64; 6],
-    /// Joint acceleration limits \[rad/s²\] (+∞ where none).
-    acceleration_limits: [f64; 6],
-    /// Joint velocity over the last midpoint interval \[rad/s\] (0 at the
-    /// start: the path starts at rest).
-    velocity: [f64; 6],
-    /// Duration of that interval \[s\] (at the start: the segment-0 time,
-    /// the ramp from rest to the midpoint of segment 0).
-    previous_interval: f64,
 }
 
 fn check_range(name: &str, v: f64, lo: f64, hi: f64) -> Result<f64, MillPlanError> {
@@ -368,24 +341,11 @@ impl MillEnv {
             });
         }
         let velocity_limits = joint_speed::velocity_limits(&cell)?;
-        let acceleration_limits = joint_speed::acceleration_limits(&cell)?;
-        if let Some(share) = config.joint_acceleration_share {
-            if !(share > 0.0 && share <= 1.0) {
-                return Err(MillPlanError::InvalidParameter {
-                    name: "joint acceleration share [-]".to_string(),
-                    value: share,
-                    reason: "must be in (0, 1]".to_string(),
-                });
-            }
-        }
         Ok(Self {
             cell,
             cache,
             config,
             velocity_limits,
-            acceleration_limits,
-            velocity: [0.0; 6],
-            previous_interval: 1.0,
             current: None,
             initial: None,
             filter: [0.0; 3],
@@ -522,10 +482,29 @@ impl MillEnv {
         let Ok(e) = &eval else {
             return Ok(eval);
         };
-        Ok(match self.motion_violation(current, next, &e.joints) {
-            Some(reason) => Err(reason),
-            None => eval,
-        })
+        if !self.config.joint_speed_limits {
+            return Ok(eval);
+        }
+        let segments = self.cell.path().segments();
+        let lengths = [
+            segments.get(current.segment).map_or(0.0, |s| s.length),
+            segments.get(next.segment).map_or(0.0, |s| s.length),
+        ];
+        let dt = joint_speed::midpoint_interval(lengths, [current.feed, next.feed]);
+        let motion: [f64; 6] = std::array::from_fn(|j| e.joints[j] - self.joints[j]);
+        Ok(
+            match joint_speed::first_violation(&motion, dt, &self.velocity_limits) {
+                Some((j, speed)) => Err(format!(
+                    "joint {} would move at {speed:.3} rad/s between segments {} and {} \
+                     (limit {:.3} rad/s)",
+                    j + 1,
+                    current.segment,
+                    next.segment,
+                    self.velocity_limits.get(j).copied().unwrap_or(f64::NAN)
+                )),
+                None => eval,
+            },
+        )
     }
 
     /// Whether `next` is feasible from `current` (feed > 0, IK within the
@@ -548,63 +527,17 @@ impl MillEnv {
             Err(e) if is_infeasible(&e) => return Ok(false),
             Err(e) => return Err(e.into()),
         };
-        Ok(self.motion_violation(current, next, &cs.joints).is_none())
-    }
-
-    /// The time between the midpoints of `current` and `next` \[s\].
-    fn interval(&self, current: &PhysicalState, next: &PhysicalState) -> f64 {
+        if !self.config.joint_speed_limits {
+            return Ok(true);
+        }
         let segments = self.cell.path().segments();
         let lengths = [
             segments.get(current.segment).map_or(0.0, |s| s.length),
             segments.get(next.segment).map_or(0.0, |s| s.length),
         ];
-        joint_speed::midpoint_interval(lengths, [current.feed, next.feed])
-    }
-
-    /// The joint-speed ([`EnvConfig::joint_speed_limits`]) or acceleration
-    /// ([`EnvConfig::joint_acceleration_share`]) violation of moving from
-    /// the current joints to `joints` at `next`, if any.
-    fn motion_violation(
-        &self,
-        current: &PhysicalState,
-        next: &PhysicalState,
-        joints: &[f64; 6],
-    ) -> Option<String> {
-        let dt = self.interval(current, next);
-        let motion: [f64; 6] = std::array::from_fn(|j| joints[j] - self.joints[j]);
-        if self.config.joint_speed_limits {
-            if let Some((j, speed)) =
-                joint_speed::first_violation(&motion, dt, &self.velocity_limits)
-            {
-                return Some(format!(
-                    "joint {} would move at {speed:.3} rad/s between segments {} and {} \
-                     (limit {:.3} rad/s)",
-                    j + 1,
-                    current.segment,
-                    next.segment,
-                    self.velocity_limits.get(j).copied().unwrap_or(f64::NAN)
-                ));
-            }
-        }
-        if let Some(share) = self.config.joint_acceleration_share {
-            // Finite difference: (v_new − v_prev) / mean interval.
-            let mean = 0.5 * (self.previous_interval + dt);
-            for j in 0..6 {
-                let a = (motion[j] / dt - self.velocity[j]) / mean;
-                let limit = share * self.acceleration_limits[j];
-                if a.is_nan() || a.abs() > limit {
-                    return Some(format!(
-                        "joint {} would accelerate at {:.3} rad/s^2 at segment {} (limit {:.3} \
-                         rad/s^2 = {share} x the joint's limit)",
-                        j + 1,
-                        a.abs(),
-                        current.segment,
-                        limit
-                    ));
-                }
-            }
-        }
-        None
+        let dt = joint_speed::midpoint_interval(lengths, [current.feed, next.feed]);
+        let motion: [f64; 6] = std::array::from_fn(|j| cs.joints[j] - self.joints[j]);
+        Ok(joint_speed::first_violation(&motion, dt, &self.velocity_limits).is_none())
     }
 
     fn info_from(
@@ -726,8 +659,6 @@ impl Environment for MillEnv {
             reason,
         })?;
         self.joints = eval.joints;
-        self.velocity = [0.0; 6];
-        self.previous_interval = eval.segment_time;
         let info = self.info_from(state, [0.0; 3], Ok(eval));
         self.initial = Some(info.clone());
         self.current = Some(info);
@@ -797,42 +728,34 @@ impl Environment for MillEnv {
         // kerf's projection of the g move (EnvConfig::project_g): the
         // largest fraction of the filtered g move that keeps the state
         // feasible (IK, joint limits, joint speeds), by bisection.
-        if eval.is_err() && self.config.project_g && !self.config.fixed_g {
+        if eval.is_err() && self.config.project_g && !self.config.fixed_g && filter[2] != 0.0 {
             let full = filter[2];
-            let with_move = |m: f64| PhysicalState {
-                g: (current.g + m).clamp(lim.redundancy_angle[0], lim.redundancy_angle[1]),
+            let at = |fraction: f64| PhysicalState {
+                g: (current.g + fraction * full)
+                    .clamp(lim.redundancy_angle[0], lim.redundancy_angle[1]),
                 ..next
             };
-            // Anchors: the previous applied g move (the joints keep their
-            // velocity), then no g move; the first feasible one is joined
-            // to the proposed move by bisection on feasibility alone (IK,
-            // limits, joint speeds and accelerations: no chatter
-            // evaluation), then the result is evaluated once.
-            for anchor in [self.filter[2], 0.0] {
-                if anchor == full || !self.feasible(&current, &with_move(anchor))? {
-                    continue;
-                }
+            let still = at(0.0);
+            if self.feasible(&current, &still)? {
+                // Bisection on feasibility alone (IK, limits, joint speeds:
+                // no chatter evaluation), then one evaluation of the result.
                 let (mut good, mut bad) = (0.0, 1.0);
                 for _ in 0..PROJECTION_BISECTIONS {
                     let mid = 0.5 * (good + bad);
-                    if self.feasible(&current, &with_move(anchor + mid * (full - anchor)))? {
+                    if self.feasible(&current, &at(mid))? {
                         good = mid;
                     } else {
                         bad = mid;
                     }
                 }
-                next = with_move(anchor + good * (full - anchor));
+                next = at(good);
                 eval = self.checked_evaluation(&current, &next)?;
                 filter[2] = next.g - current.g;
-                break;
             }
         }
         self.filter = filter;
         let violated = eval.is_err();
         if let Ok(e) = &eval {
-            let dt = self.interval(&current, &next);
-            self.velocity = std::array::from_fn(|j| (e.joints[j] - self.joints[j]) / dt);
-            self.previous_interval = dt;
             self.joints = e.joints;
         }
         let info = self.info_from(next, self.filter, eval);

@@ -52,35 +52,6 @@ pub fn velocity_limits(cell: &MillCell) -> Result<[f64; 6], MillPlanError> {
     Ok(out)
 }
 
-/// The acceleration limits of the cell's six joints \[rad/s²\] (the limits
-/// file's `max_acceleration`; +∞ for a joint without one).
-///
-/// # Errors
-/// [`MillPlanError::InvalidConfig`] when the robot does not have six joints
-/// or a given limit is not > 0.
-pub fn acceleration_limits(cell: &MillCell) -> Result<[f64; 6], MillPlanError> {
-    let joints = cell.robot().joints();
-    if joints.len() != 6 {
-        return Err(MillPlanError::InvalidConfig {
-            name: "joint acceleration limits".to_string(),
-            reason: format!("the robot has {} joints, expected 6", joints.len()),
-        });
-    }
-    let mut out = [f64::INFINITY; 6];
-    for (o, j) in out.iter_mut().zip(joints) {
-        if let Some(a) = j.max_acceleration {
-            if !(a > 0.0) {
-                return Err(MillPlanError::InvalidConfig {
-                    name: format!("acceleration limit of {}", j.name),
-                    reason: format!("{a} rad/s^2 is not > 0"),
-                });
-            }
-            *o = a;
-        }
-    }
-    Ok(out)
-}
-
 /// Wraps `x` to the 2π-equivalent nearest `reference`.
 fn nearest_turn(x: f64, reference: f64) -> f64 {
     let two_pi = std::f64::consts::TAU;

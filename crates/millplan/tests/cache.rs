@@ -222,7 +222,6 @@ fn env_branch_continuity_gives_the_cache_reference_dynamics() {
             // The sweep crosses the wrist region fast; joint speeds are not
             // what this test is about.
             joint_speed_limits: false,
-            joint_acceleration_share: None,
             ..EnvConfig::default()
         },
     )

@@ -267,10 +267,6 @@ fn dp_plan_replayed_in_the_unfiltered_environment_gives_its_value() {
         Some(Arc::new(cache)),
         EnvConfig {
             alpha: 1.0,
-            // The DP has no joint velocities in its state: it does not
-            // check accelerations (a relaxation; its value stays an upper
-            // bound), so its plans are replayed without that check.
-            joint_acceleration_share: None,
             ..EnvConfig::default()
         },
     )

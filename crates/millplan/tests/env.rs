@@ -78,13 +78,8 @@ fn initial_value_problem_observation_and_reward() {
 
 #[test]
 fn inertial_filter_and_clip_by_hand() {
-    // alpha = 0.5: a_hat_{t+1} = 0.5 a_{t+1} + 0.5 a_hat_t (eq. 11). The
-    // filter arithmetic alone: no acceleration check (it would shorten the
-    // g moves from rest).
-    let mut e = env(EnvConfig {
-        joint_acceleration_share: None,
-        ..EnvConfig::default()
-    });
+    // alpha = 0.5: a_hat_{t+1} = 0.5 a_{t+1} + 0.5 a_hat_t (eq. 11).
+    let mut e = env(EnvConfig::default());
     e.reset().unwrap();
     e.step(&[1.0, 1.0, 0.5]).unwrap();
     // a = (20 rpm, 1e-3 m/s, 0.1 rad): a_hat_1 = (10, 5e-4, 0.05).
@@ -107,7 +102,6 @@ fn inertial_filter_and_clip_by_hand() {
     // alpha = 1, clip at the lower spindle bound: 2000 - 20 -> 2000.
     let mut e = env(EnvConfig {
         alpha: 1.0,
-        joint_acceleration_share: None,
         ..EnvConfig::default()
     });
     e.reset().unwrap();
@@ -226,8 +220,6 @@ fn infeasible_g_is_a_terminal_violation() {
     let mut e = env(EnvConfig {
         alpha: 1.0,
         project_g: false,
-        // A 0.2 rad g step from rest breaks the acceleration check first.
-        joint_acceleration_share: None,
         ..EnvConfig::default()
     });
     e.reset().unwrap();
@@ -373,9 +365,6 @@ fn projection_stops_g_at_the_edge_of_the_feasible_set() {
     // filter holds the applied (shortened) move.
     let mut e = env(EnvConfig {
         alpha: 1.0,
-        // Without the acceleration check (it would need braking ahead of
-        // the edge, which the projection does not look for).
-        joint_acceleration_share: None,
         ..EnvConfig::default()
     });
     e.reset().unwrap();
@@ -437,43 +426,4 @@ fn default_clip_keeps_the_feed_at_the_minimum_feed() {
         let cell = Arc::new(MillCell::default_cell().unwrap());
         assert!(MillEnv::new(cell, None, bad).is_err());
     }
-}
-
-#[test]
-fn acceleration_check_shortens_a_g_step_from_rest() {
-    // From the IVP (at rest) a full 0.2 rad g step in the first interval
-    // turns joint 5 faster than half its acceleration limit allows: the
-    // projection applies a shorter move, whose finite-difference
-    // acceleration (from rest, over the mean of the segment-0 time and the
-    // first interval) is within 0.5 x the limit, computed here from the
-    // joints and the robot's limits.
-    let mut e = env(EnvConfig {
-        alpha: 1.0,
-        ..EnvConfig::default()
-    });
-    e.reset().unwrap();
-    let q0 = e.last_info().unwrap().evaluation.unwrap().joints;
-    let t0 = e.last_info().unwrap().evaluation.unwrap().segment_time;
-    let tr = e.step(&[0.0, 0.0, -1.0]).unwrap();
-    assert!(!tr.done);
-    let s = e.state().unwrap();
-    assert!(s.g < 0.0 && s.g > -0.2 + 1e-6, "{s:?}");
-    let ev = e.last_info().unwrap().evaluation.unwrap();
-    let segs = e.cell().path().segments();
-    let dt = segs[0].length / (2.0 * 0.04) + segs[1].length / (2.0 * s.feed);
-    let mean = 0.5 * (t0 + dt);
-    for (j, joint) in e.cell().robot().joints().iter().enumerate() {
-        let a = (ev.joints[j] - q0[j]) / dt / mean;
-        let limit = 0.5 * joint.max_acceleration.unwrap_or(f64::INFINITY);
-        assert!(a.abs() <= limit + 1e-9, "joint {j}: {a} > {limit}");
-    }
-    // Without the check the whole step is taken.
-    let mut free = env(EnvConfig {
-        alpha: 1.0,
-        joint_acceleration_share: None,
-        ..EnvConfig::default()
-    });
-    free.reset().unwrap();
-    free.step(&[0.0, 0.0, -1.0]).unwrap();
-    assert!((free.state().unwrap().g + 0.2).abs() < 1e-12);
 }
