@@ -289,6 +289,27 @@ fn locate(times: &[f64], t: f64) -> usize {
     }
 }
 
+/// [`locate`] for a grid close to uniform: starts at the proportional
+/// index and walks (the same index as the binary search for a finite t
+/// and strictly increasing times).
+fn locate_guess(times: &[f64], t: f64) -> usize {
+    let len = times.len();
+    if len < 3 || !t.is_finite() {
+        return locate(times, t);
+    }
+    let n = len - 1;
+    let (first, last) = (times[0], times[n]);
+    let x = (t - first) / (last - first) * n as f64;
+    let mut k = if x > 0.0 { (x as usize).min(n) } else { 0 };
+    while k > 0 && times[k] > t {
+        k -= 1;
+    }
+    while k < n && times[k + 1] <= t {
+        k += 1;
+    }
+    k.min(n - 1)
+}
+
 fn hermite(
     s: f64,
     h: f64,
@@ -362,8 +383,16 @@ struct Traj<'a> {
 
 impl Traj<'_> {
     fn state(&self, t: f64) -> (Vector2<f64>, Vector2<f64>) {
-        let tt = t.rem_euclid(self.period);
-        let k = locate(self.times, tt);
+        // rem_euclid, without fmod on the two common cases (bit-identical:
+        // fmod(t, T) = t exactly for |t| < T).
+        let tt = if t >= 0.0 && t < self.period {
+            t
+        } else if t < 0.0 && t >= -self.period {
+            t + self.period
+        } else {
+            t.rem_euclid(self.period)
+        };
+        let k = locate_guess(self.times, tt);
         let (t0, t1) = (self.times[k], self.times[k + 1]);
         let h = t1 - t0;
         let s = ((tt - t0) / h).clamp(0.0, 1.0);
@@ -387,6 +416,15 @@ impl Traj<'_> {
     }
 }
 
+/// The tooth angle's sine, cosine and the state (position, velocity) at
+/// one time: shared by every delay and order evaluated at that time.
+struct Here {
+    s: f64,
+    c: f64,
+    p: Vector2<f64>,
+    v: Vector2<f64>,
+}
+
 struct Ctx<'a> {
     process: &'a MillingProcess,
     feed: f64,
@@ -399,14 +437,25 @@ impl Ctx<'_> {
         self.omega * t + 2.0 * PI * tooth as f64 / self.process.teeth as f64
     }
 
+    /// The tooth angle's sine and cosine and the state at time t.
+    fn here(&self, traj: &Traj, tooth: usize, t: f64) -> Here {
+        let (s, c) = self.phi(tooth, t).sin_cos();
+        let (p, v) = traj.state(t);
+        Here { s, c, p, v }
+    }
+
     /// Eq. 3 residual, eq. 4 chip and their partial derivatives (module doc).
     fn geometry(&self, traj: &Traj, tooth: usize, order: usize, t: f64, tau: f64) -> Geometry {
+        let here = self.here(traj, tooth, t);
+        self.geometry_at(traj, &here, order, t, tau)
+    }
+
+    /// [`Ctx::geometry`] with the quantities at t precomputed.
+    fn geometry_at(&self, traj: &Traj, here: &Here, order: usize, t: f64, tau: f64) -> Geometry {
         let r = self.process.radius;
-        let phi = self.phi(tooth, t);
-        let (s, c) = phi.sin_cos();
+        let (s, c, p, v) = (here.s, here.c, here.p, here.v);
         let delta = self.omega * tau - 2.0 * PI * order as f64 / self.process.teeth as f64;
         let (sd, cd) = delta.sin_cos();
-        let (p, v) = traj.state(t);
         let (pd, vd) = traj.state(t - tau);
         let dcx = self.feed * tau + pd.x - p.x;
         let dcy = pd.y - p.y;
@@ -428,11 +477,25 @@ impl Ctx<'_> {
         t: f64,
         guess: f64,
     ) -> Result<f64, ChatterError> {
+        let here = self.here(traj, tooth, t);
+        self.newton_at(traj, &here, tooth, order, t, guess)
+    }
+
+    /// [`Ctx::newton`] with the quantities at t precomputed.
+    fn newton_at(
+        &self,
+        traj: &Traj,
+        here: &Here,
+        tooth: usize,
+        order: usize,
+        t: f64,
+        guess: f64,
+    ) -> Result<f64, ChatterError> {
         let mut tau = guess;
         let nominal = order as f64 * self.period;
         let mut last = f64::NAN;
         for _ in 0..50 {
-            let geo = self.geometry(traj, tooth, order, t, tau);
+            let geo = self.geometry_at(traj, here, order, t, tau);
             if !(geo.g_tau.is_finite() && geo.g.is_finite()) {
                 return Err(ChatterError::NonFinite {
                     what: format!("eq. 3 Newton step (tooth {tooth}, order {order}, t = {t:e} s)"),
@@ -471,8 +534,8 @@ impl Ctx<'_> {
         })
     }
 
-    fn taudot(&self, traj: &Traj, tooth: usize, t: f64, tau: f64) -> f64 {
-        let geo = self.geometry(traj, tooth, 1, t, tau);
+    fn taudot_at(&self, traj: &Traj, here: &Here, t: f64, tau: f64) -> f64 {
+        let geo = self.geometry_at(traj, here, 1, t, tau);
         -geo.g_t / geo.g_tau
     }
 }
@@ -991,16 +1054,20 @@ fn build_tracks(
                 end += 1;
             }
             let t0 = times[first];
-            let mut tau = ctx.newton(traj, j, 1, t0, ctx.period)?;
+            let here0 = ctx.here(traj, j, t0);
+            let mut tau = ctx.newton_at(traj, &here0, j, 1, t0, ctx.period)?;
             let mut taus = vec![tau];
-            let mut dots = vec![ctx.taudot(traj, j, t0, tau)];
+            let mut dots = vec![ctx.taudot_at(traj, &here0, t0, tau)];
             for s in first..end {
                 let (ta, tb) = (times[s], times[s + 1]);
                 let h = tb - ta;
                 let k1 = dots[dots.len() - 1];
-                let k2 = ctx.taudot(traj, j, ta + 0.5 * h, tau + 0.5 * h * k1);
-                let k3 = ctx.taudot(traj, j, ta + 0.5 * h, tau + 0.5 * h * k2);
-                let k4 = ctx.taudot(traj, j, tb, tau + h * k3);
+                let tm = ta + 0.5 * h;
+                let mid = ctx.here(traj, j, tm);
+                let k2 = ctx.taudot_at(traj, &mid, tm, tau + 0.5 * h * k1);
+                let k3 = ctx.taudot_at(traj, &mid, tm, tau + 0.5 * h * k2);
+                let end_here = ctx.here(traj, j, tb);
+                let k4 = ctx.taudot_at(traj, &end_here, tb, tau + h * k3);
                 tau += h / 6.0 * (k1 + 2.0 * k2 + 2.0 * k3 + k4);
                 if !tau.is_finite() {
                     return Err(ChatterError::NonFinite {
@@ -1008,7 +1075,7 @@ fn build_tracks(
                     });
                 }
                 taus.push(tau);
-                dots.push(ctx.taudot(traj, j, tb, tau));
+                dots.push(ctx.taudot_at(traj, &end_here, tb, tau));
             }
             tracks.push(DelayTrack {
                 tooth: j,
@@ -1032,16 +1099,17 @@ fn chip_at(
     t: f64,
 ) -> Result<ChipState, ChatterError> {
     let phi = ctx.phi(tooth, t);
+    let here = ctx.here(traj, tooth, t);
     let tau1 = match track_delay(tracks, times, ctx.period, tooth, t) {
         Some(tau) => tau,
-        None => ctx.newton(traj, tooth, 1, t, ctx.period)?,
+        None => ctx.newton_at(traj, &here, tooth, 1, t, ctx.period)?,
     };
-    let mut best = (ctx.geometry(traj, tooth, 1, t, tau1), 1usize, tau1);
+    let mut best = (ctx.geometry_at(traj, &here, 1, t, tau1), 1usize, tau1);
     for order in 2..=settings.max_regeneration {
         // no-vibration scaling: τ^m − mT ≈ m (τ^1 − T), i.e. τ^m ≈ m τ^1
         let guess = order as f64 * tau1;
-        let tau = ctx.newton(traj, tooth, order, t, guess)?;
-        let geo = ctx.geometry(traj, tooth, order, t, tau);
+        let tau = ctx.newton_at(traj, &here, tooth, order, t, guess)?;
+        let geo = ctx.geometry_at(traj, &here, order, t, tau);
         if geo.h < best.0.h {
             best = (geo, order, tau);
         }
