@@ -482,8 +482,22 @@ impl MillEnv {
         let Ok(e) = &eval else {
             return Ok(eval);
         };
+        Ok(match self.speed_violation(current, next, &e.joints) {
+            Some(reason) => Err(reason),
+            None => eval,
+        })
+    }
+
+    /// The joint-speed violation of moving from the current joints to
+    /// `joints` at `next` ([`EnvConfig::joint_speed_limits`]), if any.
+    fn speed_violation(
+        &self,
+        current: &PhysicalState,
+        next: &PhysicalState,
+        joints: &[f64; 6],
+    ) -> Option<String> {
         if !self.config.joint_speed_limits {
-            return Ok(eval);
+            return None;
         }
         let segments = self.cell.path().segments();
         let lengths = [
@@ -491,20 +505,17 @@ impl MillEnv {
             segments.get(next.segment).map_or(0.0, |s| s.length),
         ];
         let dt = joint_speed::midpoint_interval(lengths, [current.feed, next.feed]);
-        let motion: [f64; 6] = std::array::from_fn(|j| e.joints[j] - self.joints[j]);
-        Ok(
-            match joint_speed::first_violation(&motion, dt, &self.velocity_limits) {
-                Some((j, speed)) => Err(format!(
-                    "joint {} would move at {speed:.3} rad/s between segments {} and {} \
-                     (limit {:.3} rad/s)",
-                    j + 1,
-                    current.segment,
-                    next.segment,
-                    self.velocity_limits.get(j).copied().unwrap_or(f64::NAN)
-                )),
-                None => eval,
-            },
-        )
+        let motion: [f64; 6] = std::array::from_fn(|j| joints[j] - self.joints[j]);
+        joint_speed::first_violation(&motion, dt, &self.velocity_limits).map(|(j, speed)| {
+            format!(
+                "joint {} would move at {speed:.3} rad/s between segments {} and {} (limit \
+                 {:.3} rad/s)",
+                j + 1,
+                current.segment,
+                next.segment,
+                self.velocity_limits.get(j).copied().unwrap_or(f64::NAN)
+            )
+        })
     }
 
     /// Whether `next` is feasible from `current` (feed > 0, IK within the
@@ -527,17 +538,7 @@ impl MillEnv {
             Err(e) if is_infeasible(&e) => return Ok(false),
             Err(e) => return Err(e.into()),
         };
-        if !self.config.joint_speed_limits {
-            return Ok(true);
-        }
-        let segments = self.cell.path().segments();
-        let lengths = [
-            segments.get(current.segment).map_or(0.0, |s| s.length),
-            segments.get(next.segment).map_or(0.0, |s| s.length),
-        ];
-        let dt = joint_speed::midpoint_interval(lengths, [current.feed, next.feed]);
-        let motion: [f64; 6] = std::array::from_fn(|j| cs.joints[j] - self.joints[j]);
-        Ok(joint_speed::first_violation(&motion, dt, &self.velocity_limits).is_none())
+        Ok(self.speed_violation(current, next, &cs.joints).is_none())
     }
 
     fn info_from(
