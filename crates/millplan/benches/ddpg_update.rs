@@ -33,39 +33,9 @@ use kerf_millplan::{Environment, MillPlanError, Transition};
 const OBS: usize = 4;
 const ACT: usize = 3;
 
-/// `struct timespec` of Linux (64-bit).
-#[cfg(target_os = "linux")]
-#[repr(C)]
-struct Timespec {
-    tv_sec: i64,
-    tv_nsec: i64,
-}
-
-#[cfg(target_os = "linux")]
-extern "C" {
-    /// POSIX `clock_gettime` (libc).
-    fn clock_gettime(clock: i32, tp: *mut Timespec) -> i32;
-}
-
-/// CPU time of the calling thread, s (`CLOCK_THREAD_CPUTIME_ID` = 3 on
-/// Linux): what the update costs on an otherwise idle core, independent of
-/// other jobs on the shared machine. `None` off Linux or on failure.
-fn thread_cpu_time() -> Option<f64> {
-    #[cfg(target_os = "linux")]
-    {
-        let mut ts = Timespec {
-            tv_sec: 0,
-            tv_nsec: 0,
-        };
-        // SAFETY: ts is a valid, writable timespec.
-        let rc = unsafe { clock_gettime(3, &mut ts) };
-        (rc == 0).then_some(ts.tv_sec as f64 + ts.tv_nsec as f64 * 1e-9)
-    }
-    #[cfg(not(target_os = "linux"))]
-    {
-        None
-    }
-}
+#[allow(dead_code)] // each bench uses some of the shared helpers
+mod common;
+use common::thread_cpu_time;
 
 /// Mean wall seconds and mean thread-CPU seconds per update over `n`
 /// updates after 20 warm-up updates.

@@ -42,38 +42,9 @@ use kerf_millplan::{
     MillPlanner, MillRequest, PlannerKind, Policy,
 };
 
-/// `struct timespec` of Linux (64-bit).
-#[cfg(target_os = "linux")]
-#[repr(C)]
-struct Timespec {
-    tv_sec: i64,
-    tv_nsec: i64,
-}
-
-#[cfg(target_os = "linux")]
-extern "C" {
-    /// POSIX `clock_gettime` (libc).
-    fn clock_gettime(clock: i32, tp: *mut Timespec) -> i32;
-}
-
-/// CPU time of the whole process, s (`CLOCK_PROCESS_CPUTIME_ID` = 2 on
-/// Linux: all threads). `None` off Linux or on failure.
-fn process_cpu_time() -> Option<f64> {
-    #[cfg(target_os = "linux")]
-    {
-        let mut ts = Timespec {
-            tv_sec: 0,
-            tv_nsec: 0,
-        };
-        // SAFETY: ts is a valid, writable timespec.
-        let rc = unsafe { clock_gettime(2, &mut ts) };
-        (rc == 0).then_some(ts.tv_sec as f64 + ts.tv_nsec as f64 * 1e-9)
-    }
-    #[cfg(not(target_os = "linux"))]
-    {
-        None
-    }
-}
+#[allow(dead_code)] // each bench uses some of the shared helpers
+mod common;
+use common::process_cpu_time;
 
 /// The 1-minute load average (Linux), for reading the wall times.
 fn load_average() -> String {
