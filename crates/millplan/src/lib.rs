@@ -17,6 +17,7 @@ pub mod joint_speed;
 pub mod naive;
 pub mod plan;
 pub mod reward;
+pub mod timing;
 
 // The planner node's ROS-free front half: requests and planning.
 pub mod planner;
@@ -43,7 +44,9 @@ pub use env::{EnvConfig, MillEnv, PhysicalState, Rollout, StepInfo};
 pub use naive::NaiveResult;
 pub use plan::{comparison_table, ComparisonRow, Plan};
 pub use planner::{
-    default_policy_path, status_of, JointTrajectory, MillPlanOutput, MillPlanner, TrajectoryPoint,
+    default_policy_path, status_of, Executed, JointTrajectory, MillPlanOutput, MillPlanner,
+    TrajectoryPoint,
 };
 pub use request::{MillRequest, PlannerKind};
 pub use reward::{RewardParts, RewardWeights};
+pub use timing::{time_scale, JointLimit, TimeScaling};

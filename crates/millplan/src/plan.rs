@@ -196,6 +196,141 @@ impl Plan {
         evaluate_impl(cell, weights, states, planner, threads, Some(cache))
     }
 
+    /// The plan with its totals from `segments` (in order): machining time
+    /// Σ time, chatter-free when every |μ|max + `margin(segment)` < 1 (the
+    /// margin: a cached value's error bound, 0 for a direct one), largest
+    /// |μ|max, smallest 1/K, Σ reward.
+    fn from_segments(
+        planner: &str,
+        segments: Vec<SegmentPlan>,
+        margin: impl Fn(usize) -> f64,
+    ) -> Self {
+        Plan {
+            planner: planner.to_string(),
+            total_time: segments.iter().map(|s| s.time).sum(),
+            chatter_free: segments
+                .iter()
+                .all(|s| s.spectral_radius + margin(s.segment) < 1.0),
+            max_spectral_radius: segments
+                .iter()
+                .map(|s| s.spectral_radius)
+                .fold(0.0, f64::max),
+            min_condition_indicator: segments
+                .iter()
+                .map(|s| s.condition_indicator)
+                .fold(f64::INFINITY, f64::min),
+            total_reward: segments.iter().map(|s| s.reward.total).sum(),
+            segments,
+        }
+    }
+
+    /// The plan as the robot runs it after [`crate::timing::time_scale`]:
+    /// segment i machined in `times[i]` at the feed `feeds[i]`. Segments
+    /// whose feed differs from the plan's (bit for bit) get |μ|max, reward
+    /// and feed re-evaluated DIRECTLY at the new feed (same Ω, g and cell
+    /// state: IK nearest the previous segment's joints, as
+    /// [`Plan::evaluate`]); the others keep their values. Every segment's
+    /// time is `times[i]` (a start or stop from rest included, so it may
+    /// exceed l/f at the two ends).
+    ///
+    /// # Arguments
+    /// * `cell`, `weights` — as the plan was evaluated with;
+    /// * `feeds`, `times` — one per segment, finite and > 0;
+    /// * `threads` — as [`Plan::evaluate_with_threads`];
+    /// * `cached` — the plan's provenance: a cached, unchanged segment keeps
+    ///   its error bound in the chatter-free test.
+    ///
+    /// # Errors
+    /// [`MillPlanError::InvalidConfig`] for wrong lengths;
+    /// [`MillPlanError::InvalidParameter`] for a non-positive or NaN feed or
+    /// time; cell-model and chatter-model errors of the re-evaluation. A
+    /// feed below the request's minimum is NOT an error: it is what the
+    /// robot's limits impose, and is reported by its |μ|max.
+    ///
+    /// # Performance
+    /// One direct indicator evaluation per changed segment, on up to
+    /// `threads` threads.
+    pub fn as_executed(
+        &self,
+        cell: &MillCell,
+        weights: &RewardWeights,
+        feeds: &[f64],
+        times: &[f64],
+        threads: usize,
+        cached: &IndicatorProvenance,
+    ) -> Result<Self, MillPlanError> {
+        let n = self.segments.len();
+        if feeds.len() != n || times.len() != n {
+            return Err(MillPlanError::InvalidConfig {
+                name: format!("executed plan `{}`", self.planner),
+                reason: format!(
+                    "{} feeds and {} times for {n} segments",
+                    feeds.len(),
+                    times.len()
+                ),
+            });
+        }
+        for (i, (f, t)) in feeds.iter().zip(times).enumerate() {
+            for (name, v) in [("feed [m/s]", f), ("time [s]", t)] {
+                if !(v.is_finite() && *v > 0.0) {
+                    return Err(MillPlanError::InvalidParameter {
+                        name: format!("executed {name} at segment {i}"),
+                        value: *v,
+                        reason: "must be finite and > 0".to_string(),
+                    });
+                }
+            }
+        }
+        if threads == 0 {
+            return Err(MillPlanError::InvalidParameter {
+                name: "evaluation threads".to_string(),
+                value: 0.0,
+                reason: "must be >= 1".to_string(),
+            });
+        }
+        let changed: Vec<usize> = (0..n)
+            .filter(|&i| feeds[i] != self.segments[i].feed)
+            .collect();
+        let mut states = Vec::with_capacity(changed.len());
+        let mut cell_states = Vec::with_capacity(changed.len());
+        for &i in &changed {
+            let s = &self.segments[i];
+            let reference = i.checked_sub(1).map(|p| self.segments[p].joints);
+            cell_states.push(cell.evaluate(i, s.g, reference.as_ref())?);
+            states.push(PhysicalState {
+                segment: i,
+                rpm: s.rpm,
+                feed: feeds[i],
+                g: s.g,
+            });
+        }
+        let all: Vec<usize> = (0..changed.len()).collect();
+        let mus = spectral_radii(cell, &states, &cell_states, &all, threads);
+        let max_feed = cell.state_limits().feed[1];
+        let mut segments = self.segments.clone();
+        for ((&i, cs), mu) in changed.iter().zip(&cell_states).zip(mus) {
+            let mu = mu?;
+            let seg = &mut segments[i];
+            seg.feed = feeds[i];
+            seg.spectral_radius = mu;
+            seg.reward = step_reward(weights, cs.condition_number, feeds[i], max_feed, mu)?;
+        }
+        for (seg, t) in segments.iter_mut().zip(times) {
+            seg.time = *t;
+        }
+        let bound = cached.error_bound.unwrap_or(0.0);
+        let margin = |i: usize| {
+            if changed.binary_search(&i).is_err()
+                && cached.cached_segments.binary_search(&i).is_ok()
+            {
+                bound
+            } else {
+                0.0
+            }
+        };
+        Ok(Self::from_segments(&self.planner, segments, margin))
+    }
+
     /// The plan's row of the comparison table.
     pub fn row(&self) -> ComparisonRow {
         ComparisonRow {
@@ -393,24 +528,7 @@ fn evaluate_impl(
     let cached_segments: Vec<usize> = (0..n).filter(|i| cached[*i].is_some()).collect();
     let margin = |i: usize| cached[i].map_or(0.0, |(_, b)| b);
     let bound = cached.iter().flatten().map(|(_, b)| *b).reduce(f64::max);
-    let max_mu = segments
-        .iter()
-        .map(|s| s.spectral_radius)
-        .fold(0.0, f64::max);
-    let plan = Plan {
-        planner: planner.to_string(),
-        total_time: segments.iter().map(|s| s.time).sum(),
-        chatter_free: segments
-            .iter()
-            .all(|s| s.spectral_radius + margin(s.segment) < 1.0),
-        max_spectral_radius: max_mu,
-        min_condition_indicator: segments
-            .iter()
-            .map(|s| s.condition_indicator)
-            .fold(f64::INFINITY, f64::min),
-        total_reward: segments.iter().map(|s| s.reward.total).sum(),
-        segments,
-    };
+    let plan = Plan::from_segments(planner, segments, margin);
     let provenance = match (cache, bound) {
         (None, _) => IndicatorProvenance::direct(IndicatorSource::Direct, n, ""),
         (Some(c), None) => IndicatorProvenance::direct(

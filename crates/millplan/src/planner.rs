@@ -30,6 +30,12 @@
 //!    threads (the same plan, bit for bit, for every thread count), the
 //!    totals.
 //! 6. The joint trajectory ([`JointTrajectory`]).
+//! 7. What the robot runs ([`MillPlanOutput::executed`]): the trajectory
+//!    from rest to rest, time-scaled to the joints' velocity and
+//!    acceleration limits ([`crate::timing::time_scale`]: slowed where
+//!    the planned timing asks too much of a joint, never sped up), and
+//!    the plan at the feeds that result, |μ|max re-evaluated directly
+//!    where a feed changed ([`Plan::as_executed`]).
 //!
 //! # When the indicator cache applies
 //! The cache ([`IndicatorCache`]) holds |μ|max of the DEFAULT cell. It
@@ -76,6 +82,7 @@ use crate::plan::{default_eval_threads, IndicatorProvenance, IndicatorSource, Pl
 use crate::policy::Policy;
 use crate::request::{MillRequest, PlannerKind, RequestProcess};
 use crate::rl::Environment;
+use crate::timing::{three_point_velocity, time_scale, JointLimit, TimeScaling};
 
 /// Status values of the planner's answer (the `MillPlan` message).
 pub mod status {
@@ -192,8 +199,13 @@ pub struct MillPlanOutput {
     /// Per-segment Ω, f, g, |μ|max, K, 1/K, joints, time, reward (direct
     /// evaluation) and the totals.
     pub plan: Plan,
-    /// The joint trajectory.
+    /// The joint trajectory as planned: timed by the planned feeds, not
+    /// from rest (module documentation, "Trajectory").
     pub trajectory: JointTrajectory,
+    /// What the robot runs: [`JointTrajectory`] from rest to rest,
+    /// time-scaled to the joint velocity and acceleration limits, and the
+    /// plan at the feeds that result ([`Executed`]).
+    pub executed: Executed,
     /// Joint steps above the branch-jump threshold between trajectory
     /// points (index = the later point).
     pub branch_jumps: Vec<BranchJump>,
@@ -208,6 +220,18 @@ pub struct MillPlanOutput {
     /// ([`MillPlanner::with_indicator_source`]); its `note` belongs in the
     /// answer's message.
     pub indicator: IndicatorProvenance,
+}
+
+/// The plan as the robot runs it (step 7 of [`MillPlanner::plan`]).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Executed {
+    /// The executable trajectory, its stretch per interval and the
+    /// segment times and feeds it runs ([`crate::timing::time_scale`]).
+    pub scaling: TimeScaling,
+    /// The plan at those feeds and times ([`Plan::as_executed`]): |μ|max
+    /// and reward re-evaluated directly where the feed changed; its
+    /// `total_time` is the trajectory's duration from rest to rest.
+    pub plan: Plan,
 }
 
 /// Wall-clock seconds of the steps of [`MillPlanner::plan`] (module
@@ -638,6 +662,14 @@ impl MillPlanner {
         phases.evaluation = step.elapsed().as_secs_f64();
         let step = Instant::now();
         let (trajectory, branch_jumps) = trajectory(&cell, &plan)?;
+        let executed = executed(
+            &cell,
+            &plan,
+            &trajectory,
+            weights,
+            self.eval_threads,
+            &indicator,
+        )?;
         phases.trajectory = step.elapsed().as_secs_f64();
         Ok(MillPlanOutput {
             request_id: request.request_id.clone(),
@@ -645,6 +677,7 @@ impl MillPlanner {
             policy_file,
             plan,
             trajectory,
+            executed,
             branch_jumps,
             cache_used: cache_applies,
             planning_seconds: start.elapsed().as_secs_f64(),
@@ -705,6 +738,47 @@ fn check_reachable(cell: &MillCell, g0: f64) -> Result<(), MillPlanError> {
         }
     }
     Ok(())
+}
+
+/// Step 7: the executable trajectory and the plan it runs.
+fn executed(
+    cell: &MillCell,
+    plan: &Plan,
+    trajectory: &JointTrajectory,
+    weights: &crate::reward::RewardWeights,
+    threads: usize,
+    indicator: &IndicatorProvenance,
+) -> Result<Executed, MillPlanError> {
+    let joints = cell.robot().joints();
+    let limits = trajectory
+        .joint_names
+        .iter()
+        .map(|name| {
+            joints
+                .iter()
+                .find(|j| &j.name == name)
+                .map(|j| JointLimit {
+                    max_velocity: j.max_velocity,
+                    max_acceleration: j.max_acceleration,
+                })
+                .ok_or_else(|| MillPlanError::InvalidConfig {
+                    name: "trajectory".to_string(),
+                    reason: format!("joint '{name}' is not a joint of the cell's robot"),
+                })
+        })
+        .collect::<Result<Vec<_>, _>>()?;
+    let times: Vec<f64> = plan.segments.iter().map(|s| s.time).collect();
+    let feeds: Vec<f64> = plan.segments.iter().map(|s| s.feed).collect();
+    let scaling = time_scale(trajectory, &times, &feeds, &limits)?;
+    let plan = plan.as_executed(
+        cell,
+        weights,
+        &scaling.segment_feeds,
+        &scaling.segment_times,
+        threads,
+        indicator,
+    )?;
+    Ok(Executed { scaling, plan })
 }
 
 /// The trajectory of the module documentation and its branch jumps.
@@ -769,9 +843,7 @@ fn trajectory(
             let (qp, tp) = (points[k + 1].0, points[k + 1].1);
             let (h1, h2) = (t - tm, tp - t);
             for (j, vj) in v.iter_mut().enumerate() {
-                *vj = -h2 / (h1 * (h1 + h2)) * qm[j]
-                    + (h2 - h1) / (h1 * h2) * q[j]
-                    + h1 / (h2 * (h1 + h2)) * qp[j];
+                *vj = three_point_velocity(h1, h2, qm[j], q[j], qp[j]);
             }
         }
         if v.iter().any(|x| !x.is_finite()) {
