@@ -217,6 +217,13 @@ pub fn time_scale(
             )));
         }
     }
+    for (k, p) in points.iter().enumerate() {
+        if let Some(j) = p.positions.iter().position(|q| !q.is_finite()) {
+            return Err(bad(format!(
+                "non-finite position of joint {j} at point {k}"
+            )));
+        }
+    }
     let planned_h: Vec<f64> = points
         .windows(2)
         .map(|w| w[1].time_from_start - w[0].time_from_start)
@@ -363,14 +370,18 @@ fn needs(
                     velocities[i][j],
                     velocities[i + 1][j],
                 );
-                r = r.max(e.peak_velocity.1.abs() / (l.max_velocity * (1.0 - MARGIN)));
+                let mut ratios = vec![e.peak_velocity.1.abs() / (l.max_velocity * (1.0 - MARGIN))];
                 if let Some(amax) = l.max_acceleration {
                     for (_, a) in e.accelerations {
-                        r = r.max((a.abs() / (amax * (1.0 - MARGIN))).sqrt());
+                        ratios.push((a.abs() / (amax * (1.0 - MARGIN))).sqrt());
                     }
                 }
-                if !r.is_finite() {
-                    return f64::NAN;
+                for x in ratios {
+                    // f64::max would drop a NaN.
+                    if !x.is_finite() {
+                        return f64::NAN;
+                    }
+                    r = r.max(x);
                 }
             }
             r

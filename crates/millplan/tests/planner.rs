@@ -108,6 +108,115 @@ fn check_plan(cell: &MillCell, out: &MillPlanOutput) {
     assert_eq!(plan.max_spectral_radius, max_mu);
     assert_eq!(plan.chatter_free, max_mu < 1.0);
     assert!(out.branch_jumps.is_empty(), "{:?}", out.branch_jumps);
+    check_executed(cell, out);
+}
+
+/// The executed trajectory and plan (step 7 of `MillPlanner::plan`): the
+/// planned points from rest to rest, no interval shorter than planned,
+/// within every joint's velocity and acceleration limit when sampled
+/// (positions from the Hermite basis functions, derivatives by central
+/// differences: independent of `timing::hermite_extremes`), and the plan
+/// at the executed feeds with |μ|max evaluated directly.
+fn check_executed(cell: &MillCell, out: &MillPlanOutput) {
+    let planned = &out.trajectory.points;
+    let exec = &out.executed.scaling.trajectory.points;
+    let n = planned.len();
+    assert_eq!(exec.len(), n);
+    assert_eq!(
+        out.executed.scaling.trajectory.joint_names,
+        out.trajectory.joint_names
+    );
+    assert_eq!(exec[0].time_from_start, 0.0);
+    assert_eq!(exec[0].velocities, [0.0; 6]);
+    assert_eq!(exec[n - 1].velocities, [0.0; 6]);
+    for k in 0..n - 1 {
+        assert_eq!(exec[k].positions, planned[k].positions);
+        let ramp = if k == 0 || k == n - 2 { 2.0 } else { 1.0 };
+        let h_plan = planned[k + 1].time_from_start - planned[k].time_from_start;
+        let h = exec[k + 1].time_from_start - exec[k].time_from_start;
+        assert!(
+            h >= ramp * h_plan * (1.0 - 1e-12),
+            "interval {k}: {h} < {ramp} x {h_plan}"
+        );
+    }
+    let joints = cell.robot().joints();
+    let hermite = |k: usize, j: usize, tau: f64| {
+        let (a, b) = (&exec[k], &exec[k + 1]);
+        let h = b.time_from_start - a.time_from_start;
+        let s = tau / h;
+        let (h00, h10) = (
+            2.0 * s.powi(3) - 3.0 * s * s + 1.0,
+            s.powi(3) - 2.0 * s * s + s,
+        );
+        let (h01, h11) = (-2.0 * s.powi(3) + 3.0 * s * s, s.powi(3) - s * s);
+        h00 * a.positions[j]
+            + h10 * h * a.velocities[j]
+            + h01 * b.positions[j]
+            + h11 * h * b.velocities[j]
+    };
+    let mut worst: f64 = 0.0;
+    for k in 0..n - 1 {
+        let h = exec[k + 1].time_from_start - exec[k].time_from_start;
+        let d = 1e-4 * h;
+        for (j, spec) in joints.iter().enumerate() {
+            for i in 0..=40 {
+                let tau = (d + (h - 2.0 * d) * f64::from(i) / 40.0).clamp(d, h - d);
+                let (pm, p0, pp) = (
+                    hermite(k, j, tau - d),
+                    hermite(k, j, tau),
+                    hermite(k, j, tau + d),
+                );
+                let v = (pp - pm) / (2.0 * d);
+                let a = (pp - 2.0 * p0 + pm) / (d * d);
+                worst = worst.max(v.abs() / spec.max_velocity);
+                if let Some(amax) = spec.max_acceleration {
+                    worst = worst.max(a.abs() / amax);
+                }
+            }
+        }
+    }
+    // Sampled derivatives: 1e-3 relative covers the central differences.
+    assert!(
+        worst <= 1.0 + 1e-3,
+        "executed trajectory at {worst} x a joint limit"
+    );
+    // The plan as executed.
+    let e = &out.executed.plan;
+    let sc = &out.executed.scaling;
+    assert_eq!(e.segments.len(), out.plan.segments.len());
+    let duration = exec[n - 1].time_from_start;
+    assert!((e.total_time - duration).abs() <= 1e-9 * duration);
+    assert!((sc.duration() - duration).abs() <= 1e-12 * duration);
+    let mut reference: Option<[f64; 6]> = None;
+    for (p, x) in out.plan.segments.iter().zip(&e.segments) {
+        assert!(x.feed <= p.feed, "segment {}: executed faster", p.segment);
+        assert_eq!((x.rpm, x.g, x.joints), (p.rpm, p.g, p.joints));
+        if x.feed == p.feed {
+            assert_eq!(x.spectral_radius, p.spectral_radius);
+        } else {
+            let mu = direct_indicator(cell, x.segment, x.rpm, x.feed, x.g, reference.as_ref())
+                .expect("direct")
+                .expect("feasible");
+            assert_eq!(mu, x.spectral_radius, "segment {}", x.segment);
+        }
+        reference = Some(p.joints);
+    }
+    let max_mu = e
+        .segments
+        .iter()
+        .map(|s| s.spectral_radius)
+        .fold(0.0, f64::max);
+    assert_eq!(e.max_spectral_radius, max_mu);
+    assert_eq!(e.chatter_free, max_mu < 1.0);
+    println!(
+        "{}: executed {:.3} s ({} of {} intervals stretched, {} rounds), max |mu| {:.4}",
+        out.planner.name(),
+        e.total_time,
+        sc.stretched_intervals(),
+        n - 1,
+        sc.rounds,
+        e.max_spectral_radius
+    );
 }
 
 #[test]
@@ -143,6 +252,10 @@ fn dp_on_the_default_request_and_with_narrower_limits() {
     let out = planner().plan(&request).expect("dp plan");
     assert!(out.cache_used);
     check_plan(planner().cell(), &out);
+    // The DP's g steps of up to 0.2 rad between segments ask the wrist for
+    // more than its acceleration limit at the planned feeds: slowed down.
+    assert!(out.executed.scaling.stretched_intervals() > 0);
+    assert!(out.executed.plan.total_time > out.plan.total_time);
     let segs = &out.plan.segments;
     assert_eq!((segs[0].rpm, segs[0].feed, segs[0].g), (2000.0, 0.04, 0.0));
     for w in segs.windows(2) {
