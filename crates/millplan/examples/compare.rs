@@ -6,6 +6,11 @@
 //! Also the DP of eq. 12 alone (no chatter margin, no joint-speed limits),
 //! the paper's objective without kerf's constraints.
 //!
+//! A second table gives every plan AS EXECUTED: its trajectory from rest to
+//! rest, time-scaled to the IRB 6660's joint velocity and acceleration
+//! limits (`kerf_millplan::timing`), with |μ|max re-evaluated directly at
+//! the feeds that result.
+//!
 //! ```sh
 //! cargo run --release -p kerf_millplan --example compare
 //! ```
@@ -13,9 +18,28 @@
 use kerf_mill::MillCell;
 use kerf_millplan::cache::IndicatorCache;
 use kerf_millplan::dp::{self, DpSpec};
+use kerf_millplan::plan::default_eval_threads;
 use kerf_millplan::plan::{comparison_table, Plan};
 use kerf_millplan::request::MillRequest;
-use kerf_millplan::{MillPlanError, MillPlanner};
+use kerf_millplan::{execute, Executed, MillPlanError, MillPlanner};
+
+/// One line on the time scaling of a plan.
+fn describe_executed(e: &Executed) {
+    let s = &e.scaling;
+    println!(
+        "  as executed: {:.3} s, {} of {} intervals slowed (largest stretch {:.2}, lowest feed \
+         {:.4} m/s), max |mu| {:.4}",
+        s.duration(),
+        s.stretched_intervals(),
+        s.interval_stretch.len(),
+        s.interval_stretch.iter().copied().fold(0.0, f64::max),
+        s.segment_feeds
+            .iter()
+            .copied()
+            .fold(f64::INFINITY, f64::min),
+        e.plan.max_spectral_radius
+    );
+}
 
 /// Prints where a plan chatters, its time, speed, feed and g every 10
 /// segments.
@@ -51,6 +75,7 @@ fn describe(plan: &Plan) {
 fn main() -> Result<(), MillPlanError> {
     let planner = MillPlanner::with_default_cell()?;
     let mut rows = Vec::new();
+    let mut executed_rows = Vec::new();
     for (kind, name) in [
         ("ddpg", "DDPG"),
         ("fixed_g", "DDPG, g = 0"),
@@ -67,7 +92,11 @@ fn main() -> Result<(), MillPlanError> {
                 plan.planner = name.to_string();
                 describe(&plan);
                 println!("  planning {:.3} s", out.planning_seconds);
+                describe_executed(&out.executed);
                 rows.push(plan.row());
+                let mut executed = out.executed.plan;
+                executed.planner = name.to_string();
+                executed_rows.push(executed.row());
             }
             Err(e) => println!("{name}: {e}"),
         }
@@ -90,8 +119,16 @@ fn main() -> Result<(), MillPlanError> {
         let plan = Plan::evaluate(cell, &weights, &r.states, name)?;
         describe(&plan);
         println!("  DP {:.2} s", r.seconds);
+        let e = execute(cell, &plan, &weights, default_eval_threads())?;
+        describe_executed(&e);
         rows.push(plan.row());
+        let mut executed = e.plan;
+        executed.planner = name.to_string();
+        executed_rows.push(executed.row());
     }
+    println!("As planned (timed by the planned feeds):");
     println!("{}", comparison_table(&rows));
+    println!("As executed (from rest to rest, time-scaled to the joint limits):");
+    println!("{}", comparison_table(&executed_rows));
     Ok(())
 }

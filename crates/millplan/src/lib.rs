@@ -44,8 +44,8 @@ pub use env::{EnvConfig, MillEnv, PhysicalState, Rollout, StepInfo};
 pub use naive::NaiveResult;
 pub use plan::{comparison_table, ComparisonRow, Plan};
 pub use planner::{
-    default_policy_path, status_of, Executed, JointTrajectory, MillPlanOutput, MillPlanner,
-    TrajectoryPoint,
+    default_policy_path, execute, status_of, Executed, JointTrajectory, MillPlanOutput,
+    MillPlanner, TrajectoryPoint,
 };
 pub use request::{MillRequest, PlannerKind};
 pub use reward::{RewardParts, RewardWeights};

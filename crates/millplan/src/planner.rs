@@ -740,6 +740,23 @@ fn check_reachable(cell: &MillCell, g0: f64) -> Result<(), MillPlanError> {
     Ok(())
 }
 
+/// The plan's trajectory (module documentation) and what the robot runs
+/// of it (step 7 of [`MillPlanner::plan`]), for a plan evaluated outside
+/// the planner (e.g. the DP variants of the comparison), |μ|max direct.
+///
+/// # Errors
+/// As [`MillPlanner::plan`]'s steps 6–7.
+pub fn execute(
+    cell: &MillCell,
+    plan: &Plan,
+    weights: &crate::reward::RewardWeights,
+    threads: usize,
+) -> Result<Executed, MillPlanError> {
+    let (trajectory, _) = trajectory(cell, plan)?;
+    let direct = IndicatorProvenance::direct(IndicatorSource::Direct, plan.segments.len(), "");
+    executed(cell, plan, &trajectory, weights, threads, &direct)
+}
+
 /// Step 7: the executable trajectory and the plan it runs.
 fn executed(
     cell: &MillCell,

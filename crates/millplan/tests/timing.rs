@@ -149,10 +149,14 @@ fn a_zig_zag_is_slowed_to_the_limits() {
         assert!((h - ramp * c * h_plan).abs() <= 1e-12 * h);
     }
     // Segment k: halves in intervals k and k + 1.
-    for k in 0..n {
-        let (c0, c1) = (s.interval_stretch[k], s.interval_stretch[k + 1]);
-        assert!((s.segment_feeds[k] - feeds[k] * 2.0 / (c0 + c1)).abs() < 1e-15);
-        assert!(s.segment_feeds[k] < feeds[k]);
+    for (k, (f, c)) in s
+        .segment_feeds
+        .iter()
+        .zip(s.interval_stretch.windows(2))
+        .enumerate()
+    {
+        assert!((f - feeds[k] * 2.0 / (c[0] + c[1])).abs() < 1e-15);
+        assert!(*f < feeds[k]);
     }
     assert!((s.machining_time() - s.duration()).abs() <= 1e-12 * s.duration());
     // The same zig-zag, slower to begin with, needs less stretch.
