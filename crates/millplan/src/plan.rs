@@ -227,7 +227,8 @@ impl Plan {
     /// The plan as the robot runs it after [`crate::timing::time_scale`]:
     /// segment i machined in `times[i]` at the feed `feeds[i]`. Segments
     /// whose feed differs from the plan's (bit for bit) get |μ|max, reward
-    /// and feed re-evaluated DIRECTLY at the new feed (same Ω, g and cell
+    /// and feed re-evaluated DIRECTLY at the new feed (from the cache only
+    /// through the crate's planner in [`IndicatorSource::Cache`] mode) (same Ω, g and cell
     /// state: IK nearest the previous segment's joints, as
     /// [`Plan::evaluate`]); the others keep their values. Every segment's
     /// time is `times[i]` (a start or stop from rest included, so it may
@@ -238,7 +239,10 @@ impl Plan {
     /// * `feeds`, `times` — one per segment, finite and > 0;
     /// * `threads` — as [`Plan::evaluate_with_threads`];
     /// * `cached` — the plan's provenance: a cached, unchanged segment keeps
-    ///   its error bound in the chatter-free test.
+    ///   its error bound in the chatter-free test;
+    ///
+    /// # Returns
+    /// The executed plan.
     ///
     /// # Errors
     /// [`MillPlanError::InvalidConfig`] for wrong lengths;
@@ -259,6 +263,31 @@ impl Plan {
         threads: usize,
         cached: &IndicatorProvenance,
     ) -> Result<Self, MillPlanError> {
+        self.as_executed_with(cell, weights, feeds, times, threads, cached, None)
+            .map(|(plan, _)| plan)
+    }
+
+    /// [`Plan::as_executed`], with `cache` `Some` when the plan was
+    /// evaluated with [`IndicatorSource::Cache`]: a changed segment then
+    /// takes the cache's value where it applies (as
+    /// [`Plan::evaluate_cached`], whose caller guarantees that the cache
+    /// belongs to the cell: hence crate-private), with its bound in the
+    /// chatter-free test.
+    ///
+    /// # Returns
+    /// The executed plan and its segments whose |μ|max is interpolated from
+    /// the cache (ascending; empty without a cache).
+    #[allow(clippy::too_many_arguments)]
+    pub(crate) fn as_executed_with(
+        &self,
+        cell: &MillCell,
+        weights: &RewardWeights,
+        feeds: &[f64],
+        times: &[f64],
+        threads: usize,
+        cached: &IndicatorProvenance,
+        cache: Option<&IndicatorCache>,
+    ) -> Result<(Self, Vec<usize>), MillPlanError> {
         let n = self.segments.len();
         if feeds.len() != n || times.len() != n {
             return Err(MillPlanError::InvalidConfig {
@@ -304,12 +333,40 @@ impl Plan {
                 g: s.g,
             });
         }
-        let all: Vec<usize> = (0..changed.len()).collect();
-        let mus = spectral_radii(cell, &states, &cell_states, &all, threads);
+        let cached_now = match cache {
+            Some(c) => cached_values(cell, &states, &cell_states, c)?,
+            None => vec![None; changed.len()],
+        };
+        let direct: Vec<usize> = (0..changed.len())
+            .filter(|j| cached_now[*j].is_none())
+            .collect();
+        let mut direct_mus =
+            spectral_radii(cell, &states, &cell_states, &direct, threads).into_iter();
         let max_feed = cell.state_limits().feed[1];
         let mut segments = self.segments.clone();
-        for ((&i, cs), mu) in changed.iter().zip(&cell_states).zip(mus) {
-            let mu = mu?;
+        let mut margins = vec![0.0; n];
+        for &i in &cached.cached_segments {
+            if let Some(m) = margins.get_mut(i) {
+                *m = cached.error_bound.unwrap_or(0.0);
+            }
+        }
+        for (j, (&i, cs)) in changed.iter().zip(&cell_states).enumerate() {
+            let mu = match cached_now[j] {
+                Some((v, bound)) => {
+                    margins[i] = bound;
+                    v
+                }
+                None => {
+                    margins[i] = 0.0;
+                    // The direct evaluations stop after the first error.
+                    direct_mus.next().unwrap_or_else(|| {
+                        Err(MillPlanError::InvalidConfig {
+                            name: format!("executed plan `{}`", self.planner),
+                            reason: format!("segment {i} was not evaluated"),
+                        })
+                    })?
+                }
+            };
             let seg = &mut segments[i];
             seg.feed = feeds[i];
             seg.spectral_radius = mu;
@@ -318,17 +375,15 @@ impl Plan {
         for (seg, t) in segments.iter_mut().zip(times) {
             seg.time = *t;
         }
-        let bound = cached.error_bound.unwrap_or(0.0);
-        let margin = |i: usize| {
-            if changed.binary_search(&i).is_err()
-                && cached.cached_segments.binary_search(&i).is_ok()
-            {
-                bound
-            } else {
-                0.0
-            }
-        };
-        Ok(Self::from_segments(&self.planner, segments, margin))
+        let cached_segments: Vec<usize> = (0..n)
+            .filter(|&i| {
+                margins[i] > 0.0
+                    || (cached.cached_segments.binary_search(&i).is_ok()
+                        && changed.binary_search(&i).is_err())
+            })
+            .collect();
+        let plan = Self::from_segments(&self.planner, segments, |i| margins[i]);
+        Ok((plan, cached_segments))
     }
 
     /// The plan's row of the comparison table.

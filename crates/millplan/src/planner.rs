@@ -232,6 +232,10 @@ pub struct Executed {
     /// and reward re-evaluated directly where the feed changed; its
     /// `total_time` is the trajectory's duration from rest to rest.
     pub plan: Plan,
+    /// Segments of `plan` whose |μ|max is the indicator cache's
+    /// interpolation (only with [`IndicatorSource::Cache`]; the bound of
+    /// [`MillPlanOutput::indicator`] applies), ascending.
+    pub cached_segments: Vec<usize>,
 }
 
 /// Wall-clock seconds of the steps of [`MillPlanner::plan`] (module
@@ -669,6 +673,10 @@ impl MillPlanner {
             weights,
             self.eval_threads,
             &indicator,
+            match self.indicator_source {
+                IndicatorSource::Cache => cache.as_deref(),
+                IndicatorSource::Direct => None,
+            },
         )?;
         phases.trajectory = step.elapsed().as_secs_f64();
         Ok(MillPlanOutput {
@@ -754,7 +762,7 @@ pub fn execute(
 ) -> Result<Executed, MillPlanError> {
     let (trajectory, _) = trajectory(cell, plan)?;
     let direct = IndicatorProvenance::direct(IndicatorSource::Direct, plan.segments.len(), "");
-    executed(cell, plan, &trajectory, weights, threads, &direct)
+    executed(cell, plan, &trajectory, weights, threads, &direct, None)
 }
 
 /// Step 7: the executable trajectory and the plan it runs.
@@ -765,6 +773,7 @@ fn executed(
     weights: &crate::reward::RewardWeights,
     threads: usize,
     indicator: &IndicatorProvenance,
+    cache: Option<&IndicatorCache>,
 ) -> Result<Executed, MillPlanError> {
     let joints = cell.robot().joints();
     let limits = trajectory
@@ -787,15 +796,20 @@ fn executed(
     let times: Vec<f64> = plan.segments.iter().map(|s| s.time).collect();
     let feeds: Vec<f64> = plan.segments.iter().map(|s| s.feed).collect();
     let scaling = time_scale(trajectory, &times, &feeds, &limits)?;
-    let plan = plan.as_executed(
+    let (plan, cached_segments) = plan.as_executed_with(
         cell,
         weights,
         &scaling.segment_feeds,
         &scaling.segment_times,
         threads,
         indicator,
+        cache,
     )?;
-    Ok(Executed { scaling, plan })
+    Ok(Executed {
+        scaling,
+        plan,
+        cached_segments,
+    })
 }
 
 /// The trajectory of the module documentation and its branch jumps.

@@ -372,3 +372,61 @@ fn request_cells_are_kept_per_path_without_mixing_paths() {
         );
     }
 }
+
+/// The plan as executed (time-scaled to the joint limits) in both modes:
+/// the committed DDPG policy's plan is slowed in most intervals; with the
+/// cache source the slowed segments take the cache's value where it applies
+/// (within its bound of the direct value) and are listed, and the
+/// chatter-free claim keeps the bound; with the direct source nothing is
+/// cached and the executed values are direct.
+#[test]
+fn executed_plan_in_cache_and_direct_modes() {
+    let direct = MillPlanner::with_default_cell().expect("planner");
+    let cache = direct
+        .cache()
+        .cloned()
+        .expect("the default cache must load");
+    let cached = MillPlanner::new(direct.cell().clone(), Some(cache))
+        .expect("planner")
+        .with_indicator_source(IndicatorSource::Cache);
+    let request = MillRequest {
+        planner: "ddpg".to_string(),
+        ..MillRequest::default()
+    };
+    let d = direct.plan(&request).expect("direct ddpg");
+    let c = cached.plan(&request).expect("cached ddpg");
+    assert!(d.executed.cached_segments.is_empty());
+    assert_eq!(d.executed.scaling, c.executed.scaling);
+    assert!(d.executed.scaling.stretched_intervals() > 0);
+    let bound = c.indicator.error_bound.expect("bound");
+    let mut changed_and_cached = 0;
+    for (a, b) in d
+        .executed
+        .plan
+        .segments
+        .iter()
+        .zip(&c.executed.plan.segments)
+    {
+        assert_eq!((a.rpm, a.feed, a.g, a.time), (b.rpm, b.feed, b.g, b.time));
+        if c.executed.cached_segments.contains(&a.segment) {
+            assert!((a.spectral_radius - b.spectral_radius).abs() <= bound);
+            let planned = &c.plan.segments[a.segment];
+            if planned.feed != b.feed {
+                changed_and_cached += 1;
+            }
+        } else {
+            assert_eq!(a.spectral_radius.to_bits(), b.spectral_radius.to_bits());
+        }
+    }
+    assert!(changed_and_cached > 0);
+    let claimed = c.executed.plan.segments.iter().all(|s| {
+        s.spectral_radius
+            + if c.executed.cached_segments.contains(&s.segment) {
+                bound
+            } else {
+                0.0
+            }
+            < 1.0
+    });
+    assert_eq!(c.executed.plan.chatter_free, claimed);
+}
