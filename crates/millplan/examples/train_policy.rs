@@ -8,6 +8,7 @@
 //! ```
 //!
 //! Options: `--episodes N` (default 1000), `--seed S` (default 1),
+//! `--acceleration-penalty W` ([`kerf_millplan::EnvConfig::acceleration_penalty`], default off),
 //! `--out FILE` (default `crates/millplan/policies/{ddpg,fixed_g}.safetensors`).
 //! Writes FILE, its JSON sidecar and `FILE` with `.history.json` (one
 //! [`kerf_millplan::ddpg::EpisodeReport`] per episode, for seed 004 Fig. 5),
@@ -43,6 +44,7 @@ fn main() -> Result<(), MillPlanError> {
     let fixed_g = args.iter().any(|a| a == "--fixed-g");
     let episodes: usize = value(&args, "--episodes")?.unwrap_or(1000);
     let seed: u64 = value(&args, "--seed")?.unwrap_or(1);
+    let acceleration_penalty: Option<f64> = value(&args, "--acceleration-penalty")?;
     let out: PathBuf = value::<String>(&args, "--out")?
         .map(PathBuf::from)
         .unwrap_or_else(|| {
@@ -59,6 +61,7 @@ fn main() -> Result<(), MillPlanError> {
     )?);
     let config = EnvConfig {
         fixed_g,
+        acceleration_penalty,
         ..EnvConfig::default()
     };
     let mut env = MillEnv::new(cell.clone(), Some(cache), config)?;
@@ -75,13 +78,16 @@ fn main() -> Result<(), MillPlanError> {
     })?;
     let environment = format!(
         "default cell (urdf/irb6660_milling.yaml), committed indicator cache; {config:?}; \
-         trained by `cargo run --release -p kerf_millplan --example train_policy --{}{}`",
+         trained by `cargo run --release -p kerf_millplan --example train_policy --{}{}{}`",
         if fixed_g { " --fixed-g" } else { "" },
         if episodes == 1000 && seed == 1 {
             String::new()
         } else {
             format!(" --episodes {episodes} --seed {seed}")
-        }
+        },
+        acceleration_penalty
+            .map(|w| format!(" --acceleration-penalty {w}"))
+            .unwrap_or_default()
     );
     let mut policy = Policy::from_agent(&agent, &environment)?;
     if let Some(dir) = out.parent() {

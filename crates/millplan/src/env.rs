@@ -122,6 +122,19 @@ pub struct EnvConfig {
     /// feed is then a terminal violation). The initial feed must be at least
     /// this.
     pub min_feed: f64,
+    /// kerf's joint-acceleration shaping (default `None`: off): with
+    /// `Some(w)`, w · Σ_j (|a_j| / a_max,j − 1)₊ is subtracted from the
+    /// step reward, a_j the acceleration of joint j at the current segment's
+    /// midpoint estimated from the joints at three consecutive midpoints
+    /// (second divided difference over the midpoint intervals, Fornberg
+    /// 1988 three-point formula), a_max,j the limits YAML's (joints
+    /// without one are not counted). Why: the plans are timed by the feed
+    /// and the executor interpolates the joints; a g that changes
+    /// direction from one segment to the next asks the wrist for several
+    /// times its acceleration limit and the trajectory must be slowed
+    /// ([`crate::timing`]). A soft term, not a constraint: a terminal
+    /// acceleration violation made training collapse (issue-5 note).
+    pub acceleration_penalty: Option<f64>,
 }
 
 /// Bisection steps of [`EnvConfig::project_g`] (resolution 2⁻⁸ of the move).
@@ -144,6 +157,7 @@ impl Default for EnvConfig {
             joint_speed_limits: true,
             project_g: true,
             min_feed: 0.01,
+            acceleration_penalty: None,
         }
     }
 }
@@ -234,6 +248,13 @@ pub struct MillEnv {
     done: bool,
     /// Joint velocity limits of the cell's robot \[rad/s\].
     velocity_limits: [f64; 6],
+    /// Joint acceleration limits \[rad/s²\] (infinite where the robot
+    /// states none).
+    acceleration_limits: [f64; 6],
+    /// The joints at the midpoint before the current one and the time
+    /// between the two midpoints \[s\] (for
+    /// [`EnvConfig::acceleration_penalty`]).
+    previous: Option<([f64; 6], f64)>,
 }
 
 fn check_range(name: &str, v: f64, lo: f64, hi: f64) -> Result<f64, MillPlanError> {
@@ -341,11 +362,28 @@ impl MillEnv {
             });
         }
         let velocity_limits = joint_speed::velocity_limits(&cell)?;
+        let mut acceleration_limits = [f64::INFINITY; 6];
+        for (a, j) in acceleration_limits.iter_mut().zip(cell.robot().joints()) {
+            if let Some(max) = j.max_acceleration {
+                *a = max;
+            }
+        }
+        if let Some(w) = config.acceleration_penalty {
+            if !(w.is_finite() && w >= 0.0) {
+                return Err(MillPlanError::InvalidParameter {
+                    name: "acceleration penalty weight".to_string(),
+                    value: w,
+                    reason: "must be finite and >= 0".to_string(),
+                });
+            }
+        }
         Ok(Self {
             cell,
             cache,
             config,
             velocity_limits,
+            acceleration_limits,
+            previous: None,
             current: None,
             initial: None,
             filter: [0.0; 3],
@@ -499,12 +537,7 @@ impl MillEnv {
         if !self.config.joint_speed_limits {
             return None;
         }
-        let segments = self.cell.path().segments();
-        let lengths = [
-            segments.get(current.segment).map_or(0.0, |s| s.length),
-            segments.get(next.segment).map_or(0.0, |s| s.length),
-        ];
-        let dt = joint_speed::midpoint_interval(lengths, [current.feed, next.feed]);
+        let dt = self.midpoint_time(current, next);
         let motion: [f64; 6] = std::array::from_fn(|j| joints[j] - self.joints[j]);
         joint_speed::first_violation(&motion, dt, &self.velocity_limits).map(|(j, speed)| {
             format!(
@@ -539,6 +572,41 @@ impl MillEnv {
             Err(e) => return Err(e.into()),
         };
         Ok(self.speed_violation(current, next, &cs.joints).is_none())
+    }
+
+    /// The time between the midpoints of two consecutive segments at their
+    /// feeds \[s\] ([`joint_speed::midpoint_interval`]).
+    fn midpoint_time(&self, current: &PhysicalState, next: &PhysicalState) -> f64 {
+        let segments = self.cell.path().segments();
+        let lengths = [
+            segments.get(current.segment).map_or(0.0, |s| s.length),
+            segments.get(next.segment).map_or(0.0, |s| s.length),
+        ];
+        joint_speed::midpoint_interval(lengths, [current.feed, next.feed])
+    }
+
+    /// Σ_j (|a_j| / a_max,j − 1)₊ at the middle of three midpoints (joints
+    /// `q0`, `q1`, `q2`, intervals `h1`, `h2`): a_j = 2 ((q2 − q1)/h2 −
+    /// (q1 − q0)/h1) / (h1 + h2), the second derivative of the parabola
+    /// through the three (Fornberg 1988). Non-finite values count as 0 (a
+    /// zero interval cannot occur: feeds are ≥ `min_feed` > 0).
+    fn acceleration_excess(
+        &self,
+        q0: &[f64; 6],
+        q1: &[f64; 6],
+        q2: &[f64; 6],
+        h1: f64,
+        h2: f64,
+    ) -> f64 {
+        let mut sum = 0.0;
+        for j in 0..6 {
+            let a = 2.0 * ((q2[j] - q1[j]) / h2 - (q1[j] - q0[j]) / h1) / (h1 + h2);
+            let excess = (a.abs() / self.acceleration_limits[j] - 1.0).max(0.0);
+            if excess.is_finite() {
+                sum += excess;
+            }
+        }
+        sum
     }
 
     fn info_from(
@@ -664,6 +732,7 @@ impl Environment for MillEnv {
         self.initial = Some(info.clone());
         self.current = Some(info);
         self.filter = [0.0; 3];
+        self.previous = None;
         self.done = false;
         Ok(self.observe(&state))
     }
@@ -756,10 +825,18 @@ impl Environment for MillEnv {
         }
         self.filter = filter;
         let violated = eval.is_err();
+        let before = self.joints;
+        let mut shaping = 0.0;
         if let Ok(e) = &eval {
+            let dt = self.midpoint_time(&current, &next);
+            if let (Some(w), Some((q0, dt0))) = (self.config.acceleration_penalty, self.previous) {
+                shaping = w * self.acceleration_excess(&q0, &before, &e.joints, dt0, dt);
+            }
+            self.previous = Some((before, dt));
             self.joints = e.joints;
         }
-        let info = self.info_from(next, self.filter, eval);
+        let mut info = self.info_from(next, self.filter, eval);
+        info.reward -= shaping;
         let reward = info.reward;
         self.current = Some(info);
         self.done = violated || next.segment + 1 >= self.segment_count();

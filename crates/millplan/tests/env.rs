@@ -427,3 +427,87 @@ fn default_clip_keeps_the_feed_at_the_minimum_feed() {
         assert!(MillEnv::new(cell, None, bad).is_err());
     }
 }
+
+/// EnvConfig::acceleration_penalty: the same dithering g actions (+1, −1,
+/// …) run with and without the shaping; the rewards differ exactly by
+/// w · Σ_j (|a_j|/a_max,j − 1)₊, recomputed here from the joints of the
+/// three midpoints (IK nearest the previous joints) and the midpoint times;
+/// the first step (no earlier midpoint) is not shaped; a NaN or negative
+/// weight is refused.
+#[test]
+fn acceleration_penalty_by_hand() {
+    let w = 0.7;
+    let base = EnvConfig::default();
+    let shaped_cfg = EnvConfig {
+        acceleration_penalty: Some(w),
+        ..base
+    };
+    let mut plain = env(base);
+    let mut shaped = env(shaped_cfg);
+    plain.reset().unwrap();
+    shaped.reset().unwrap();
+    let c = cell();
+    let limits: Vec<f64> = c
+        .robot()
+        .joints()
+        .iter()
+        .map(|j| j.max_acceleration.unwrap_or(f64::INFINITY))
+        .collect();
+    let lengths: Vec<f64> = c.path().segments().iter().map(|s| s.length).collect();
+    let mut states = vec![shaped.state().unwrap()];
+    let mut joints = vec![c.evaluate(0, 0.0, None).unwrap().joints];
+    let mut any_positive = false;
+    for k in 0..8 {
+        let a = [0.0, 1.0, if k % 2 == 0 { 1.0 } else { -1.0 }];
+        let tp = plain.step(&a).unwrap();
+        let ts = shaped.step(&a).unwrap();
+        let s = shaped.state().unwrap();
+        assert_eq!(s, plain.state().unwrap());
+        let q = c
+            .evaluate(s.segment, s.g, Some(joints.last().unwrap()))
+            .unwrap()
+            .joints;
+        states.push(s);
+        joints.push(q);
+        let expected = if k == 0 {
+            0.0
+        } else {
+            let mid = |i: usize| {
+                0.5 * lengths[states[i].segment] / states[i].feed
+                    + 0.5 * lengths[states[i + 1].segment] / states[i + 1].feed
+            };
+            let (h1, h2) = (mid(k - 1), mid(k));
+            let (q0, q1, q2) = (joints[k - 1], joints[k], joints[k + 1]);
+            (0..6)
+                .map(|j| {
+                    let acc = 2.0 * ((q2[j] - q1[j]) / h2 - (q1[j] - q0[j]) / h1) / (h1 + h2);
+                    (acc.abs() / limits[j] - 1.0).max(0.0)
+                })
+                .sum::<f64>()
+                * w
+        };
+        any_positive |= expected > 0.0;
+        assert_relative_eq!(
+            tp.reward - ts.reward,
+            expected,
+            epsilon = 1e-9,
+            max_relative = 1e-9
+        );
+    }
+    assert!(
+        any_positive,
+        "the dither must exceed some acceleration limit"
+    );
+    for bad in [f64::NAN, -1.0] {
+        let e = MillEnv::new(
+            cell(),
+            None,
+            EnvConfig {
+                acceleration_penalty: Some(bad),
+                ..base
+            },
+        )
+        .unwrap_err();
+        assert!(e.to_string().contains("acceleration penalty"), "{e}");
+    }
+}
