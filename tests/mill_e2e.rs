@@ -10,6 +10,11 @@
 //! * The seed 004 path planned by `naive` goes planner → executor (IRB 6660, trajectory topic
 //!   remapped) → `/joint_states`, which move along the plan and reach its last point: once
 //!   from the message form and, after a move back to the start, once from the text form.
+//!   Then, after a move to its start, the `ddpg` plan of the shipped policy (whose planned
+//!   timing exceeds joint_5's acceleration limit; the published trajectory is time-scaled to
+//!   the limits) is accepted by the executor and followed for its first 2 s (of about 23).
+//! * Every answer is the library's plan AS EXECUTED: the trajectory from rest to rest,
+//!   time-scaled to the joint limits, and the segments and totals at the feeds it runs.
 //! * A full queue is answered QUEUE_FULL, not dropped.
 //!
 //! * `kerf launch --robot irb6660 --with-planner` serves a request and feeds its executor.
@@ -528,44 +533,35 @@ fn bad_requests_get_their_status_and_the_node_keeps_serving() {
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
-/// The node's answer carries the library's plan: per-segment states, |μ|max, totals, and the
-/// trajectory (positions exact; times those of the planner with the ramps from and to rest,
-/// `convert::ramped_times`, to the nanosecond of a ROS Duration).
+/// The node's answer carries the library's plan as executed (`MillPlanOutput::executed`):
+/// per-segment states, |μ|max, totals of the executed plan, and the executed trajectory
+/// (from rest to rest, time-scaled to the joint limits: positions and velocities exact, times
+/// to the nanosecond of a ROS Duration).
 fn assert_same_plan(answer: &MillPlan, direct: &MillPlanOutput) {
-    assert_eq!(answer.segments.len(), direct.plan.segments.len());
-    for (a, b) in answer.segments.iter().zip(&direct.plan.segments) {
+    let executed = &direct.executed.plan;
+    assert_eq!(answer.segments.len(), executed.segments.len());
+    for (a, b) in answer.segments.iter().zip(&executed.segments) {
         assert_eq!(
-            (a.spindle_rpm, a.feed, a.redundancy_angle, a.mu_max),
-            (b.rpm, b.feed, b.g, b.spectral_radius),
+            (a.spindle_rpm, a.feed, a.redundancy_angle, a.mu_max, a.time),
+            (b.rpm, b.feed, b.g, b.spectral_radius, b.time),
             "segment {}",
             b.segment
         );
     }
-    assert_eq!(answer.machining_time, direct.plan.total_time);
-    assert_eq!(answer.max_mu, direct.plan.max_spectral_radius);
-    assert_eq!(answer.chatter_free, direct.plan.chatter_free);
+    assert_eq!(answer.machining_time, executed.total_time);
+    assert_eq!(answer.max_mu, executed.max_spectral_radius);
+    assert_eq!(answer.chatter_free, executed.chatter_free);
+    assert_eq!(answer.total_reward, executed.total_reward);
     assert_eq!(answer.trajectory.joint_names, JOINTS);
-    assert_eq!(
-        answer.trajectory.points.len(),
-        direct.trajectory.points.len()
-    );
-    let planned: Vec<f64> = direct
-        .trajectory
-        .points
-        .iter()
-        .map(|p| p.time_from_start)
-        .collect();
-    let times = kerf_milling_planner::convert::ramped_times(&planned);
-    for ((a, b), t) in answer
-        .trajectory
-        .points
-        .iter()
-        .zip(&direct.trajectory.points)
-        .zip(times)
-    {
+    let run = &direct.executed.scaling.trajectory;
+    assert_eq!(answer.trajectory.points.len(), run.points.len());
+    for (a, b) in answer.trajectory.points.iter().zip(&run.points) {
         assert_eq!(a.positions, b.positions.to_vec());
-        assert!((a.time_from_start.as_secs_f64() - t).abs() <= 1e-9);
+        assert_eq!(a.velocities, b.velocities.to_vec());
+        assert!((a.time_from_start.as_secs_f64() - b.time_from_start).abs() <= 1e-9);
     }
+    let end = answer.trajectory.points.last().expect("points");
+    assert!((end.time_from_start.as_secs_f64() - answer.machining_time).abs() <= 1e-9);
 }
 
 /// Starts an IRB 6660 executor at `initial` on `env`.
@@ -618,15 +614,7 @@ fn follow_to_the_end(
         }
         while let Ok(Some((s, _))) = states.take() {
             assert_eq!(s.name, JOINTS);
-            let off = points
-                .iter()
-                .map(|q| {
-                    q.iter()
-                        .zip(&s.position)
-                        .map(|(a, b)| (a - b).abs())
-                        .fold(0.0, f64::max)
-                })
-                .fold(f64::INFINITY, f64::min);
+            let off = off_plan(&points, &s.position);
             assert!(
                 off <= largest_step + 1e-6,
                 "{what}: state {:?} is {off} rad off the plan",
@@ -786,10 +774,143 @@ fn naive_plan_runs_from_planner_through_executor_by_message_and_by_text() {
     assert_same_plan(&plan, &direct);
     follow_to_the_end(&states, &statuses, &plan, "text form");
 
+    // 3. The ddpg plan of the shipped policy: its planned timing asks joint_5 for more than
+    // its acceleration limit, the published (time-scaled) trajectory does not, and the
+    // executor accepts it. Only its first seconds are watched: it lasts about 23 s.
+    let ddpg = offline
+        .plan(&MillRequest {
+            request_id: "run-ddpg".into(),
+            planner: "ddpg".into(),
+            ..MillRequest::default()
+        })
+        .expect("ddpg plan with the shipped policy");
+    let ddpg_first = ddpg.executed.scaling.trajectory.points[0].positions;
+    let home = JointTrajectory {
+        joint_names: JOINTS.iter().map(|s| s.to_string()).collect(),
+        points: vec![JointTrajectoryPoint {
+            positions: ddpg_first.to_vec(),
+            velocities: vec![0.0; 6],
+            time_from_start: RosDuration { sec: 4, nanosec: 0 },
+            ..JointTrajectoryPoint::default()
+        }],
+        ..JointTrajectory::default()
+    };
+    back.publish(home).unwrap();
+    wait_succeeded(&statuses, "move to the ddpg start");
+    std::thread::sleep(Duration::from_millis(200));
+    while let Ok(Some(_)) = states.take() {}
+    planner.send(request_msg("run-ddpg", "ddpg"));
+    let plan = planner.next_plan(PLANNING);
+    expect(
+        &plan,
+        "run-ddpg",
+        MillPlan::SUCCESS,
+        &[
+            "planned 100 segments with ddpg",
+            "as executed from rest to rest",
+        ],
+    );
+    assert!(
+        !plan.message.contains("exceeds the robot's limits"),
+        "{}",
+        plan.message
+    );
+    assert_same_plan(&plan, &ddpg);
+    println!("ddpg: {}", plan.message);
+    follow_the_start(
+        &states,
+        &statuses,
+        &plan,
+        Duration::from_secs(2),
+        "ddpg plan",
+    );
+
     planner.finish();
     drop((states, statuses, back, watch));
     exec_stop.stop();
     executor.join().unwrap().unwrap();
+}
+
+/// How far (largest joint difference) `position` is from the nearest of `points`.
+fn off_plan(points: &[&[f64]], position: &[f64]) -> f64 {
+    points
+        .iter()
+        .map(|q| {
+            q.iter()
+                .zip(position)
+                .map(|(a, b)| (a - b).abs())
+                .fold(0.0, f64::max)
+        })
+        .fold(f64::INFINITY, f64::min)
+}
+
+/// Waits for the executor to ACCEPT `plan` (fails on REJECTED or ABORTED), then watches it
+/// for `watch`: nothing is rejected or aborted, every measured state lies on the plan (within
+/// one trajectory step of a plan point) and the robot leaves the plan's first point.
+fn follow_the_start(
+    states: &Subscription<JointState>,
+    statuses: &Subscription<TrajectoryStatus>,
+    plan: &MillPlan,
+    watch: Duration,
+    what: &str,
+) {
+    let points: Vec<&[f64]> = plan
+        .trajectory
+        .points
+        .iter()
+        .map(|p| p.positions.as_slice())
+        .collect();
+    let first = points[0];
+    let largest_step = points
+        .windows(2)
+        .flat_map(|w| (0..6).map(move |j| (w[1][j] - w[0][j]).abs()))
+        .fold(0.0, f64::max);
+    let mut accepted_at = None;
+    let deadline = Instant::now() + QUICK;
+    let mut seen = 0usize;
+    let mut moved = 0.0_f64;
+    loop {
+        let now = Instant::now();
+        match accepted_at {
+            None => assert!(now < deadline, "{what}: not accepted within {QUICK:?}"),
+            Some(t) if now >= t + watch => break,
+            Some(_) => {}
+        }
+        while let Ok(Some((s, _))) = statuses.take() {
+            assert!(
+                s.status != TrajectoryStatus::REJECTED && s.status != TrajectoryStatus::ABORTED,
+                "{what}: executor {}: {}",
+                TrajectoryStatus::status_name(s.status).unwrap_or("?"),
+                s.message
+            );
+            if s.status == TrajectoryStatus::ACCEPTED && accepted_at.is_none() {
+                accepted_at = Some(Instant::now());
+            }
+        }
+        while let Ok(Some((s, _))) = states.take() {
+            assert_eq!(s.name, JOINTS);
+            let off = off_plan(&points, &s.position);
+            assert!(
+                off <= largest_step + 1e-6,
+                "{what}: state {:?} is {off} rad off the plan",
+                s.position
+            );
+            let from_first = first
+                .iter()
+                .zip(&s.position)
+                .map(|(a, b)| (a - b).abs())
+                .fold(0.0, f64::max);
+            moved = moved.max(from_first);
+            seen += 1;
+        }
+        std::thread::sleep(Duration::from_millis(5));
+    }
+    // 250 Hz, with slack for a busy machine.
+    assert!(
+        seen as f64 > 50.0 * watch.as_secs_f64(),
+        "{what}: {seen} joint states in {watch:?}"
+    );
+    assert!(moved > 1e-4, "{what}: the robot moved only {moved} rad");
 }
 
 /// Waits for the executor's next SUCCEEDED; fails on REJECTED or ABORTED.

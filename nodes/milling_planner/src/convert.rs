@@ -2,6 +2,13 @@
 //! (with the `has_*` flags of the `.msg` file), [`MillPlanOutput`] and [`MillPlanError`] →
 //! `kerf_msgs/msg/MillPlan`.
 //!
+//! A plan is published AS THE ROBOT RUNS IT ([`kerf_millplan::Executed`]): the trajectory is
+//! the planner's executed one (from rest to rest, time-scaled so that its cubic Hermite
+//! interpolation stays within every joint's velocity and acceleration limit), and the
+//! segments and totals of the `MillPlan` are those of the plan at the feeds that trajectory
+//! runs (|μ|max and reward re-evaluated where the joints' limits lowered a feed). The message
+//! text gives the totals at the planned feeds next to them ([`success_message`]).
+//!
 //! Nothing here checks the values themselves: [`kerf_millplan::MillRequest::validate_with`]
 //! (called by the planner) does that and names the field. The conversion only maps the
 //! message's groups onto the request's optional sections and refuses what the message
@@ -11,6 +18,7 @@
 use kerf_millplan::{
     planner::status,
     request::{RequestInitial, RequestLimits, RequestProcess, RequestStepBounds},
+    timing::hermite_extremes,
     MillPlanError, MillPlanOutput, MillRequest, PlannerKind,
 };
 use kerf_msgs::{
@@ -107,8 +115,10 @@ pub fn request_from_msg(m: &msg::MillRequest) -> Result<MillRequest, MillPlanErr
     })
 }
 
-/// Checks that a planned trajectory is usable: six joint names, one position and velocity
-/// per joint and point, finite values, times from 0 strictly increasing.
+/// Checks that a trajectory is publishable: six joint names, one position and velocity per
+/// joint and point, finite values, times from 0 strictly increasing, and at rest (every
+/// velocity zero) at the first and the last point (an executor cannot step the velocity at
+/// the start, and kerf's refuses a trajectory that does not end at rest).
 ///
 /// # Errors
 /// A sentence naming the first defect (a planner bug: the node answers INTERNAL_ERROR rather
@@ -151,69 +161,40 @@ pub fn check_trajectory(t: &kerf_millplan::JointTrajectory) -> Result<(), String
             }
         }
     }
+    let last = t.points.len() - 1;
+    for (k, end) in [(0, "first"), (last, "last")] {
+        let v = &t.points[k].velocities;
+        if let Some(j) = v.iter().position(|v| *v != 0.0) {
+            return Err(format!(
+                "the {end} point (t = {} s) is not at rest: velocity of {} is {} rad/s",
+                t.points[k].time_from_start,
+                t.joint_names.get(j).map(String::as_str).unwrap_or("?"),
+                v[j]
+            ));
+        }
+    }
     Ok(())
 }
 
-/// The times of the published trajectory for the planner's point times `t` (path start 0,
-/// the N segment midpoints, path end; at least 2): the first and the last half-segment take
-/// twice their planned time, every other interval is unchanged.
-///
-/// The robot starts the cut from rest and ends it at rest: an executor cannot step the
-/// velocity at the start, and kerf's refuses a trajectory that does not end at rest. The
-/// planner's trajectory passes the path start and end at the planned feed; here the first
-/// and the last point carry zero velocity instead, and the half-segments to and from them
-/// are ramps: a cubic from rest to the planned velocity at the first midpoint over twice the
-/// planned half-segment time is a constant acceleration when the joints move uniformly over
-/// that half-segment (and likewise the ramp down to rest at the end). Every point keeps its
-/// position; the tool passes every segment midpoint at the planned feed, `T0` later than
-/// planned (`T0` the planned time from the path start to the first midpoint), and reaches
-/// the path end `T0 + T1` after the machining time (`T1` the planned time from the last
-/// midpoint to the path end).
-pub fn ramped_times(t: &[f64]) -> Vec<f64> {
-    let n = t.len();
-    if n < 2 {
-        return t.to_vec();
-    }
-    let first = t[1] - t[0];
-    let last = t[n - 1] - t[n - 2];
-    let mut out: Vec<f64> = t.iter().map(|v| v + first).collect();
-    out[0] = t[0];
-    if n == 2 {
-        // One interval: it is both ramps.
-        out[1] = t[0] + 2.0 * first;
-    } else {
-        out[n - 1] += last;
-    }
-    out
-}
-
-/// The plan's trajectory as a `trajectory_msgs/JointTrajectory`: the planner's joint names
-/// (`joint_1` … `joint_6`), one point per trajectory point with its positions and velocities
-/// (no accelerations: the executor interpolates cubic Hermite segments), from rest and to
-/// rest: zero velocity at the first and the last point, times from [`ramped_times`].
-/// `header.stamp` is zero (the executor starts it on receipt).
+/// The trajectory the robot runs as a `trajectory_msgs/JointTrajectory`: the planner's
+/// executed trajectory ([`kerf_millplan::Executed`]: `out.executed.scaling.trajectory`, from
+/// rest to rest and time-scaled to the joints' velocity and acceleration limits) as it is —
+/// the planner's joint names (`joint_1` … `joint_6`), one point per trajectory point with its
+/// positions, velocities and time (no accelerations: the executor interpolates cubic Hermite
+/// segments). `header.stamp` is zero (the executor starts it on receipt).
 ///
 /// # Errors
 /// As [`check_trajectory`], or a time that does not fit a `Duration`.
 pub fn trajectory_msg(t: &kerf_millplan::JointTrajectory) -> Result<JointTrajectory, String> {
     check_trajectory(t)?;
-    let planned: Vec<f64> = t.points.iter().map(|p| p.time_from_start).collect();
-    let times = ramped_times(&planned);
-    let last = t.points.len().saturating_sub(1);
     let points = t
         .points
         .iter()
-        .zip(&times)
-        .enumerate()
-        .map(|(k, (p, &time))| {
-            let velocities = if k == 0 || k == last {
-                vec![0.0; p.velocities.len()]
-            } else {
-                p.velocities.to_vec()
-            };
+        .map(|p| {
+            let time = p.time_from_start;
             Ok(JointTrajectoryPoint {
                 positions: p.positions.to_vec(),
-                velocities,
+                velocities: p.velocities.to_vec(),
                 accelerations: Vec::new(),
                 effort: Vec::new(),
                 time_from_start: Duration::from_secs_f64(time)
@@ -248,9 +229,11 @@ const LIMIT_SLACK: f64 = 1e-9;
 /// acceleration limit, as a sentence; `None` when it stays within every limit. Joints of `t`
 /// without an entry in `limits` are not checked.
 ///
-/// On a segment of duration h from (p0, v0) to (p1, v1), with Δ = p1 − p0, the acceleration
-/// is linear, from 6Δ/h² − (4 v0 + 2 v1)/h to −6Δ/h² + (2 v0 + 4 v1)/h, and the velocity is a
-/// parabola, checked at both ends and at its vertex.
+/// Per interval and joint, the accelerations at both ends (it is linear in between) and the
+/// largest speed of the cubic are those of [`kerf_millplan::timing::hermite_extremes`], the
+/// formulas the planner time-scales its trajectory with. The node's guard: a planner answer
+/// (time-scaled to the same limits) never exceeds them, so an excess means a library bug or
+/// other limits.
 pub fn first_limit_excess(t: &JointTrajectory, limits: &[JointLimit]) -> Option<String> {
     let joints: Vec<(usize, &JointLimit)> = t
         .joint_names
@@ -269,11 +252,13 @@ pub fn first_limit_excess(t: &JointTrajectory, limits: &[JointLimit]) -> Option<
         }
         for &(j, l) in &joints {
             let value = |v: &Vec<f64>| v.get(j).copied().unwrap_or(0.0);
-            let (p0, p1) = (value(&w[0].positions), value(&w[1].positions));
-            let (v0, v1) = (value(&w[0].velocities), value(&w[1].velocities));
-            let d = p1 - p0;
-            let c2 = (3.0 * d / h - 2.0 * v0 - v1) / h;
-            let c3 = (-2.0 * d / h + v0 + v1) / (h * h);
+            let e = hermite_extremes(
+                h,
+                value(&w[0].positions),
+                value(&w[1].positions),
+                value(&w[0].velocities),
+                value(&w[1].velocities),
+            );
             let where_ = |tau: f64| {
                 format!(
                     "at t = {:.3} s (between point {k} and point {})",
@@ -281,8 +266,8 @@ pub fn first_limit_excess(t: &JointTrajectory, limits: &[JointLimit]) -> Option<
                     k + 1
                 )
             };
-            for (tau, a) in [(0.0, 2.0 * c2), (h, 2.0 * c2 + 6.0 * c3 * h)] {
-                if let Some(max) = l.max_acceleration {
+            if let Some(max) = l.max_acceleration {
+                for (tau, a) in e.accelerations {
                     if a.abs() > max * (1.0 + LIMIT_SLACK) {
                         return Some(format!(
                             "joint '{}': acceleration {a:.4} rad/s^2 {} exceeds its limit {max}",
@@ -292,32 +277,27 @@ pub fn first_limit_excess(t: &JointTrajectory, limits: &[JointLimit]) -> Option<
                     }
                 }
             }
-            let mut taus = vec![0.0, h];
-            if c3 != 0.0 {
-                let vertex = -c2 / (3.0 * c3);
-                if vertex > 0.0 && vertex < h {
-                    taus.push(vertex);
-                }
-            }
-            for tau in taus {
-                let v = v0 + 2.0 * c2 * tau + 3.0 * c3 * tau * tau;
-                if v.abs() > l.max_velocity * (1.0 + LIMIT_SLACK) {
-                    return Some(format!(
-                        "joint '{}': velocity {v:.4} rad/s {} exceeds its limit {}",
-                        l.name,
-                        where_(tau),
-                        l.max_velocity
-                    ));
-                }
+            let (tau, v) = e.peak_velocity;
+            if v.abs() > l.max_velocity * (1.0 + LIMIT_SLACK) {
+                return Some(format!(
+                    "joint '{}': velocity {v:.4} rad/s {} exceeds its limit {}",
+                    l.name,
+                    where_(tau),
+                    l.max_velocity
+                ));
             }
         }
     }
     None
 }
 
-/// The `MillSegment` messages of a plan, in path order.
+/// The `MillSegment` messages of a plan AS EXECUTED (`out.executed.plan`: the feed the robot
+/// runs each segment at, |μ|max and reward re-evaluated where that feed differs from the
+/// planned one, the segment's time on the published trajectory — the start and stop from rest
+/// included in the first and the last), in path order.
 pub fn segments_msg(out: &MillPlanOutput) -> Vec<msg::MillSegment> {
-    out.plan
+    out.executed
+        .plan
         .segments
         .iter()
         .map(|s| msg::MillSegment {
@@ -334,19 +314,48 @@ pub fn segments_msg(out: &MillPlanOutput) -> Vec<msg::MillSegment> {
         .collect()
 }
 
-/// A one-line summary of a successful plan, for the `message` field and logs.
+/// The chatter part of [`success_message`] for a plan as executed (`executed`) and as
+/// planned (`planned`).
+fn chatter_text(executed: &kerf_millplan::Plan, planned: &kerf_millplan::Plan) -> String {
+    if executed.chatter_free {
+        return "chatter-free".to_string();
+    }
+    let unstable: Vec<usize> = executed
+        .segments
+        .iter()
+        .filter(|s| s.spectral_radius >= 1.0)
+        .map(|s| s.segment)
+        .collect();
+    let which = match unstable.as_slice() {
+        [] => "some segment's |mu|max is within the indicator cache's error bound of 1".to_string(),
+        [only] => format!("segment {only} has |mu|max >= 1"),
+        [first, ..] => format!(
+            "{} segments have |mu|max >= 1 (first: segment {first})",
+            unstable.len()
+        ),
+    };
+    if planned.chatter_free {
+        format!(
+            "CHATTER as executed: {which}; WARNING: the plan is chatter-free at its planned feeds \
+             but NOT as executed: the joints' velocity/acceleration limits slow it to feeds where \
+             it chatters"
+        )
+    } else {
+        format!("CHATTER: {which}")
+    }
+}
+
+/// A one-line summary of a successful plan, for the `message` field and logs: the totals AS
+/// EXECUTED (`out.executed`: what the robot runs, the published trajectory and the `MillPlan`
+/// totals) next to those at the planned feeds (`out.plan`), how many trajectory intervals the
+/// joints' limits slowed, the indicator cache, the planning time and IK branch jumps.
 pub fn success_message(out: &MillPlanOutput) -> String {
-    let p = &out.plan;
+    let (p, e, scaling) = (&out.plan, &out.executed.plan, &out.executed.scaling);
     let policy = out
         .policy_file
         .as_ref()
         .map(|f| format!(" (policy {})", f.display()))
         .unwrap_or_default();
-    let chatter = if p.chatter_free {
-        "chatter-free"
-    } else {
-        "CHATTER: some segment has |mu|max >= 1"
-    };
     let jumps = if out.branch_jumps.is_empty() {
         String::new()
     } else {
@@ -361,23 +370,29 @@ pub fn success_message(out: &MillPlanOutput) -> String {
             list.join(", ")
         )
     };
-    let planned: Vec<f64> = out
-        .trajectory
-        .points
+    let lowest_feed = e
+        .segments
         .iter()
-        .map(|p| p.time_from_start)
-        .collect();
-    let duration = ramped_times(&planned).last().copied().unwrap_or(0.0);
+        .map(|s| s.feed)
+        .fold(f64::INFINITY, f64::min);
     format!(
-        "planned {} segments with {}{policy}: machining time {:.3} s (trajectory {:.3} s from \
-         rest to rest), max |mu| {:.4} ({chatter}), min condition indicator {:.3}, total reward \
-         {:.3}; indicator cache {} for planning; {}; planning took {:.3} s{jumps}",
-        p.segments.len(),
+        "planned {} segments with {}{policy}: machining time {:.3} s as executed from rest to \
+         rest ({:.3} s at the planned feeds; {} of {} trajectory intervals slowed to the joints' \
+         velocity/acceleration limits, lowest feed {:.4} m/s), max |mu| {:.4} as executed \
+         ({:.4} as planned) ({}), min condition indicator {:.3}, total reward {:.3} as executed \
+         ({:.3} as planned); indicator cache {} for planning; {}; planning took {:.3} s{jumps}",
+        e.segments.len(),
         out.planner.name(),
+        e.total_time,
         p.total_time,
-        duration,
+        scaling.stretched_intervals(),
+        scaling.interval_stretch.len(),
+        lowest_feed,
+        e.max_spectral_radius,
         p.max_spectral_radius,
-        p.min_condition_indicator,
+        chatter_text(e, p),
+        e.min_condition_indicator,
+        e.total_reward,
         p.total_reward,
         if out.cache_used { "used" } else { "not used" },
         out.indicator.note.trim_end_matches('.'),
@@ -385,13 +400,16 @@ pub fn success_message(out: &MillPlanOutput) -> String {
     )
 }
 
-/// The `MillPlan` message of a successful plan (status SUCCESS).
+/// The `MillPlan` message of a successful plan (status SUCCESS): the executed trajectory
+/// ([`trajectory_msg`]), and the segments and totals of the plan as executed
+/// (`out.executed.plan`, consistent with that trajectory: `machining_time` is its duration
+/// from rest to rest).
 ///
-/// A plan whose trajectory fails [`check_trajectory`] is answered INTERNAL_ERROR with the
-/// defect instead, so a planner bug never reaches the executor.
+/// A plan whose executed trajectory fails [`check_trajectory`] is answered INTERNAL_ERROR
+/// with the defect instead, so a planner bug never reaches the executor.
 pub fn output_to_msg(out: &MillPlanOutput) -> msg::MillPlan {
     let planner = out.planner.name();
-    let trajectory = match trajectory_msg(&out.trajectory) {
+    let trajectory = match trajectory_msg(&out.executed.scaling.trajectory) {
         Ok(t) => t,
         Err(reason) => {
             return failure_msg(
@@ -402,7 +420,7 @@ pub fn output_to_msg(out: &MillPlanOutput) -> msg::MillPlan {
             )
         }
     };
-    let p = &out.plan;
+    let p = &out.executed.plan;
     msg::MillPlan {
         request_id: out.request_id.clone(),
         status: status::SUCCESS,

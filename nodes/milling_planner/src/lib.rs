@@ -10,7 +10,7 @@
 //! | `~/mill_request_text` | `std_msgs/msg/String` | input: YAML of the `kerf_millplan::MillRequest` schema ([`text`]) |
 //! | `~/mill_plan` | `kerf_msgs/msg/MillPlan` | one answer per request (reliable, transient-local, keep-last 10) |
 //! | `~/mill_plan_text` | `std_msgs/msg/String` | the same answer as YAML |
-//! | `~/joint_trajectory` | `trajectory_msgs/msg/JointTrajectory` | the planned trajectory, on success only (reliable, volatile) |
+//! | `~/joint_trajectory` | `trajectory_msgs/msg/JointTrajectory` | the trajectory as executed (from rest to rest, time-scaled to the joint limits), on success only (reliable, volatile) |
 //!
 //! Parameters ([`NodeConfig::from_params`]): `cell_file`, `indicator_cache_file`,
 //! `ddpg_policy_file`, `fixed_g_policy_file`, `indicator_source`, `eval_threads`,
@@ -33,11 +33,16 @@
 //! -p queue_depth:=4`.
 //!
 //! # Behaviour
-//! The trajectory has the planner's N + 2 points (path start, the N segment midpoints, path
-//! end) with their joint positions and velocities, except that it starts and ends at rest:
-//! zero velocity at the path start and end, reached by ramps over twice the planned time of
-//! the first and the last half-segment ([`convert::ramped_times`]); every midpoint is passed
-//! at the planned feed. Its first point (time 0) is the robot at the start of the path and
+//! The trajectory is the plan as the robot runs it ([`kerf_millplan::Executed`], published as it
+//! is by [`convert::trajectory_msg`]): the planner's N + 2 points (path start, the N segment
+//! midpoints, path end) with their joint positions and velocities, from rest to rest (zero
+//! velocity at the path start and end, the first and the last half-segment ramps over twice
+//! their planned time), time-scaled by the planner so that its cubic Hermite interpolation
+//! stays within every joint's velocity and acceleration limit: an interval is slowed where
+//! the planned feeds ask too much of a joint, never sped up. The `MillPlan` segments and
+//! totals are those of that executed plan (the feeds run, |μ|max re-evaluated at them;
+//! `machining_time` is the trajectory's duration); its message also gives the values at the
+//! planned feeds. Its first point (time 0) is the robot at the start of the path and
 //! its `header.stamp` is zero, so an executor starts it on receipt and accepts it only when
 //! its commanded position is that first point (within its `start_tolerance`): move the robot
 //! there first, or start the executor with `initial_positions` at the plan's first point
@@ -158,10 +163,11 @@ pub fn run(args: &RosArgs, env: &RosEnv, stop: StopToken) -> Result<(), NodeErro
 }
 
 /// Plans one job (on the worker thread): the request with the node's default policy filled
-/// in when it names none, answered as a `MillPlan`. A successful plan whose trajectory
-/// exceeds the robot's velocity or acceleration limits ([`convert::first_limit_excess`]) is
-/// still SUCCESS (the plan itself is valid), with a WARNING in its message naming the joint,
-/// the value and the time. Jobs queued after the node began to stop are answered
+/// in when it names none, answered as a `MillPlan`. The published trajectory is time-scaled
+/// by the planner to the robot's velocity and acceleration limits; the node checks it again
+/// ([`convert::first_limit_excess`], its guard): a successful plan whose trajectory
+/// nevertheless exceeds them (a planner bug) is still SUCCESS, with a WARNING in its message
+/// naming the joint, the value and the time. Jobs queued after the node began to stop are answered
 /// INTERNAL_ERROR without planning; already-answered jobs pass through.
 pub fn work(
     planner: &MillPlanner,
@@ -197,7 +203,8 @@ pub fn work(
                 let limits = robot_limits(planner);
                 if let Some(excess) = convert::first_limit_excess(&m.trajectory, &limits) {
                     m.message.push_str(&format!(
-                        "; WARNING: the trajectory exceeds the robot's limits ({excess}): an \
+                        "; WARNING: the trajectory exceeds the robot's limits ({excess}) \
+                         although the planner time-scaled it to them (a planner bug): an \
                          executor with these limits will reject it"
                     ));
                 }
