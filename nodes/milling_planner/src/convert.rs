@@ -375,12 +375,20 @@ pub fn success_message(out: &MillPlanOutput) -> String {
         .iter()
         .map(|s| s.feed)
         .fold(f64::INFINITY, f64::min);
+    let executed_cache = match out.executed.cached_segments.len() {
+        0 => String::new(),
+        k => format!(
+            "; as executed, |mu|max of {k} of {} segments from the indicator cache",
+            e.segments.len()
+        ),
+    };
     format!(
         "planned {} segments with {}{policy}: machining time {:.3} s as executed from rest to \
          rest ({:.3} s at the planned feeds; {} of {} trajectory intervals slowed to the joints' \
          velocity/acceleration limits, lowest feed {:.4} m/s), max |mu| {:.4} as executed \
          ({:.4} as planned) ({}), min condition indicator {:.3}, total reward {:.3} as executed \
-         ({:.3} as planned); indicator cache {} for planning; {}; planning took {:.3} s{jumps}",
+         ({:.3} as planned); indicator cache {} for planning; {}{executed_cache}; planning took \
+         {:.3} s{jumps}",
         e.segments.len(),
         out.planner.name(),
         e.total_time,

@@ -414,6 +414,12 @@ fn assert_published_as_executed(m: &msg::MillPlan, out: &MillPlanOutput) {
         "{}",
         m.message
     );
+    assert_eq!(
+        m.message.contains("segments from the indicator cache"),
+        !out.executed.cached_segments.is_empty(),
+        "{}",
+        m.message
+    );
     // The text form is the same message.
     let back: msg::MillPlan = serde_yaml_ng::from_str(&text::plan_text(m)).unwrap();
     assert_eq!(&back, m);
@@ -502,6 +508,20 @@ fn chatter_only_as_executed_is_a_warning() {
     assert!(
         m.message.contains("CHATTER: 2 segments have |mu|max >= 1")
             && !m.message.contains("WARNING"),
+        "{}",
+        m.message
+    );
+}
+
+/// Executed |μ|max values taken from the indicator cache are counted in the message.
+#[test]
+fn cached_executed_values_are_said() {
+    let mut out = naive_output().clone();
+    out.executed.cached_segments = vec![3, 4, 90];
+    let m = convert::output_to_msg(&out);
+    assert!(
+        m.message
+            .contains("; as executed, |mu|max of 3 of 100 segments from the indicator cache;"),
         "{}",
         m.message
     );
