@@ -15,9 +15,16 @@
 //!   \[s\], reward (eq. 12) — every segment for paths of up to 20 segments (or with
 //!   `--all-rows`), else every 10th segment and the last;
 //! * the totals: machining time, chatter-free, max |μ|max, min 1/K, total reward;
+//! * the same totals AS EXECUTED ([`kerf_millplan::Executed`]): the trajectory the robot runs,
+//!   from rest to rest and time-scaled so that its cubic Hermite interpolation stays within
+//!   every joint's velocity and acceleration limit, and the plan at the feeds it runs (|μ|max
+//!   and reward re-evaluated where the limits lowered a feed; the machining time is the
+//!   trajectory's duration), with the number of trajectory intervals slowed, the lowest feed
+//!   and, with `--indicator cache`, how many executed |μ|max values are the cache's;
 //!
 //! and, with several planners, the comparison table of issue 5
-//! ([`kerf_millplan::comparison_table`]).
+//! ([`kerf_millplan::comparison_table`]) of the plans as planned, then the same table of the
+//! plans as executed.
 //!
 //! `--planners` plans the same request with each listed planner instead of the request's
 //! `planner`. The policy of `ddpg` is `--ddpg-policy`, else the request's `policy_file` when
@@ -27,8 +34,12 @@
 //!
 //! `--plots DIR` writes `mill_plan_<planner>.svg` per plan and, with two or more plans,
 //! `mill_plan_comparison.svg` overlaying them (seed 004 Fig. 6 / Fig. 8 panels,
-//! [`crate::mill_plots::plan_panels`]). `--out` writes every plan (segments, totals, joint
-//! trajectory) and every failure as JSON, or YAML when the name ends in `.yaml`/`.yml`.
+//! [`crate::mill_plots::plan_panels`]; the plans as planned). `--out` writes every plan and
+//! every failure as JSON, or YAML when the name ends in `.yaml`/`.yml`: per plan the
+//! `segments` and `totals` as planned, `executed` (its `totals` and `segments` as executed,
+//! and the time scaling: stretch per trajectory interval, intervals slowed, rounds), the
+//! `trajectory` the robot runs (executed: from rest to rest, time-scaled to the joint
+//! limits) and the `planned_trajectory` (timed by the planned feeds, not from rest).
 //!
 //! Exit code 0 when every planner succeeded; 2 otherwise (an unreadable or invalid request,
 //! any planner's failure — its status name, code and message are printed — or an output
@@ -41,7 +52,8 @@ use kerf_millplan::{
     comparison_table,
     plan::{IndicatorSource, Plan},
     planner::status_name,
-    status_of, MillPlanError, MillPlanOutput, MillPlanner, MillRequest, PlannerKind,
+    status_of, JointTrajectory, MillPlanError, MillPlanOutput, MillPlanner, MillRequest,
+    PlannerKind,
 };
 use serde_json::{json, Value};
 
@@ -229,6 +241,9 @@ pub fn run(a: MillArgs) -> Result<(), String> {
             kinds.len()
         );
         print!("{}", comparison_table(&rows));
+        let executed: Vec<_> = outputs.iter().map(|o| o.executed.plan.row()).collect();
+        println!("\nas executed (time-scaled to the joint limits, from rest to rest):");
+        print!("{}", comparison_table(&executed));
         for (kind, e) in &failures {
             println!("{}: failed: {}", kind.name(), describe(e));
         }
@@ -341,7 +356,36 @@ pub fn totals_line(p: &Plan) -> String {
     )
 }
 
-/// The printed report of one plan: header, table, totals, branch jumps.
+/// The totals line of a plan as executed (`o.executed`; parsed by `tests/mill_cli.rs`: keep
+/// the wording): the totals of [`totals_line`] and how much the joint limits slowed it.
+pub fn executed_line(o: &MillPlanOutput) -> String {
+    let (p, sc) = (&o.executed.plan, &o.executed.scaling);
+    let lowest_feed = p
+        .segments
+        .iter()
+        .map(|g| g.feed)
+        .fold(f64::INFINITY, f64::min);
+    let cached = match o.executed.cached_segments.len() {
+        0 => String::new(),
+        k => format!(", |μ|max of {k} segments from the indicator cache"),
+    };
+    format!(
+        "as executed (time-scaled to the joint limits, from rest to rest): machining time \
+         {:.6} s, chatter-free {}, max |μ|max {:.6}, min 1/K {:.6}, total reward {:.6}, {} of \
+         {} trajectory intervals slowed, lowest feed {:.5} m/s{cached}",
+        p.total_time,
+        if p.chatter_free { "yes" } else { "no" },
+        p.max_spectral_radius,
+        p.min_condition_indicator,
+        p.total_reward,
+        sc.stretched_intervals(),
+        sc.interval_stretch.len(),
+        lowest_feed
+    )
+}
+
+/// The printed report of one plan: header, table, totals as planned and as executed, branch
+/// jumps.
 fn plan_report(o: &MillPlanOutput, all_rows: bool) -> String {
     let mut s = String::new();
     let p = &o.plan;
@@ -396,6 +440,14 @@ fn plan_report(o: &MillPlanOutput, all_rows: bool) -> String {
         );
     }
     let _ = writeln!(s, "  {}", totals_line(p));
+    let _ = writeln!(s, "  {}", executed_line(o));
+    if o.plan.chatter_free && !o.executed.plan.chatter_free {
+        let _ = writeln!(
+            s,
+            "  warning: chatter-free as planned but NOT as executed: the joint limits slow it \
+             to feeds where |μ|max >= 1"
+        );
+    }
     for j in &o.branch_jumps {
         let _ = writeln!(
             s,
@@ -406,7 +458,33 @@ fn plan_report(o: &MillPlanOutput, all_rows: bool) -> String {
     s
 }
 
-/// The `--out` document: the request id, every plan and every failure.
+/// The totals of a plan in the `--out` document.
+fn totals_json(p: &Plan) -> Value {
+    json!({
+        "machining_time_s": p.total_time,
+        "chatter_free": p.chatter_free,
+        "max_spectral_radius": p.max_spectral_radius,
+        "min_condition_indicator": p.min_condition_indicator,
+        "total_reward": p.total_reward,
+    })
+}
+
+/// A joint trajectory in the `--out` document.
+fn trajectory_json(t: &JointTrajectory) -> Value {
+    json!({
+        "joint_names": t.joint_names,
+        "points": t.points.iter().map(|t| json!({
+            "time_from_start_s": t.time_from_start,
+            "positions_rad": t.positions,
+            "velocities_rad_per_s": t.velocities,
+            "arc_length_m": t.arc_length,
+            "segment": t.segment,
+        })).collect::<Vec<_>>(),
+    })
+}
+
+/// The `--out` document (module documentation): the request id, every plan and every
+/// failure.
 fn document(
     request: &MillRequest,
     outputs: &[MillPlanOutput],
@@ -416,6 +494,7 @@ fn document(
         .iter()
         .map(|o| {
             let p = &o.plan;
+            let (x, sc) = (&o.executed.plan, &o.executed.scaling);
             json!({
                 "planner": o.planner.name(),
                 "policy_file": o.policy_file.as_ref().map(|f| f.display().to_string()),
@@ -429,13 +508,7 @@ fn document(
                     "error_bound": o.indicator.error_bound,
                     "note": o.indicator.note,
                 },
-                "totals": {
-                    "machining_time_s": p.total_time,
-                    "chatter_free": p.chatter_free,
-                    "max_spectral_radius": p.max_spectral_radius,
-                    "min_condition_indicator": p.min_condition_indicator,
-                    "total_reward": p.total_reward,
-                },
+                "totals": totals_json(p),
                 "segments": p.segments.iter().map(|g| json!({
                     "segment": g.segment,
                     "spindle_rpm": g.rpm,
@@ -453,16 +526,26 @@ fn document(
                         "total": g.reward.total,
                     },
                 })).collect::<Vec<_>>(),
-                "trajectory": {
-                    "joint_names": o.trajectory.joint_names,
-                    "points": o.trajectory.points.iter().map(|t| json!({
-                        "time_from_start_s": t.time_from_start,
-                        "positions_rad": t.positions,
-                        "velocities_rad_per_s": t.velocities,
-                        "arc_length_m": t.arc_length,
-                        "segment": t.segment,
+                "executed": {
+                    "totals": totals_json(x),
+                    "segments": x.segments.iter().map(|g| json!({
+                        "segment": g.segment,
+                        "feed_m_per_s": g.feed,
+                        "spectral_radius": g.spectral_radius,
+                        "time_s": g.time,
+                        "reward": g.reward.total,
                     })).collect::<Vec<_>>(),
+                    "cached_segments": o.executed.cached_segments,
+                    "time_scaling": {
+                        "interval_stretch": sc.interval_stretch,
+                        "stretched_intervals": sc.stretched_intervals(),
+                        "rounds": sc.rounds,
+                        "uniform": sc.uniform,
+                        "duration_s": sc.duration(),
+                    },
                 },
+                "trajectory": trajectory_json(&sc.trajectory),
+                "planned_trajectory": trajectory_json(&o.trajectory),
                 "branch_jumps": o.branch_jumps.iter().map(|j| json!({
                     "index": j.index, "joint": j.joint, "step_rad": j.step,
                 })).collect::<Vec<_>>(),

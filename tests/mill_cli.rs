@@ -90,11 +90,16 @@ fn number_after(line: &str, key: &str) -> f64 {
 
 /// The totals of the `n`-th totals line of a `kerf plan mill` output.
 fn totals(stdout: &str, n: usize) -> [f64; 4] {
+    totals_of(stdout, "totals:", n)
+}
+
+/// The totals of the `n`-th line starting with `start` of a `kerf plan mill` output.
+fn totals_of(stdout: &str, start: &str, n: usize) -> [f64; 4] {
     let line = stdout
         .lines()
-        .filter(|l| l.trim_start().starts_with("totals:"))
+        .filter(|l| l.trim_start().starts_with(start))
         .nth(n)
-        .unwrap_or_else(|| panic!("totals line {n} in {stdout}"));
+        .unwrap_or_else(|| panic!("{start:?} line {n} in {stdout}"));
     [
         number_after(line, "machining time "),
         number_after(line, "max |μ|max "),
@@ -302,7 +307,8 @@ fn trains_a_policy_and_plans_with_it_as_the_library_does() {
     assert!(out.status.success(), "{stdout}\n{stderr}");
     let planner = MillPlanner::with_default_cell().expect("planner");
     let request = MillRequest::from_file(&request_path).expect("request");
-    let lib = planner.plan(&request).expect("library plan").plan;
+    let lib_out = planner.plan(&request).expect("library plan");
+    let lib = &lib_out.plan;
     assert_eq!(lib.segments.len(), 100);
     let printed = totals(&stdout, 0);
     let expected = [
@@ -314,6 +320,29 @@ fn trains_a_policy_and_plans_with_it_as_the_library_does() {
     for (p, e) in printed.iter().zip(expected) {
         assert!((p - e).abs() <= 5.1e-7, "printed {p}, library {e}");
     }
+    // The same totals as executed (time-scaled to the joint limits, from rest to rest).
+    let executed = &lib_out.executed.plan;
+    let printed = totals_of(&stdout, "as executed", 0);
+    let expected = [
+        executed.total_time,
+        executed.max_spectral_radius,
+        executed.min_condition_indicator,
+        executed.total_reward,
+    ];
+    for (p, e) in printed.iter().zip(expected) {
+        assert!(
+            (p - e).abs() <= 5.1e-7,
+            "printed {p}, library as executed {e}"
+        );
+    }
+    assert!(executed.total_time > lib.total_time, "at least the ramps");
+    assert!(
+        stdout.contains(&format!(
+            "{} of 101 trajectory intervals slowed",
+            lib_out.executed.scaling.stretched_intervals()
+        )),
+        "{stdout}"
+    );
     assert!(stdout.contains(&format!(
         "chatter-free {}",
         if lib.chatter_free { "yes" } else { "no" }
@@ -367,9 +396,48 @@ fn trains_a_policy_and_plans_with_it_as_the_library_does() {
         p0["segments"][37]["feed_m_per_s"].as_f64(),
         Some(lib.segments[37].feed)
     );
+    // The trajectory the robot runs (executed), and the planned one under its own key.
+    let f = |v: &serde_json::Value| v.as_f64().expect("number");
+    for (key, t) in [
+        ("trajectory", &lib_out.executed.scaling.trajectory),
+        ("planned_trajectory", &lib_out.trajectory),
+    ] {
+        let points = p0[key]["points"].as_array().expect(key);
+        assert_eq!(points.len(), 102, "{key}");
+        for (a, b) in points.iter().zip(&t.points) {
+            assert_eq!(f(&a["time_from_start_s"]), b.time_from_start, "{key}");
+            assert_eq!(f(&a["velocities_rad_per_s"][4]), b.velocities[4], "{key}");
+            assert_eq!(f(&a["positions_rad"][0]), b.positions[0], "{key}");
+        }
+    }
+    let run = p0["trajectory"]["points"].as_array().expect("trajectory");
     assert_eq!(
-        p0["trajectory"]["points"].as_array().map(Vec::len),
-        Some(102)
+        run.last().map(|p| f(&p["time_from_start_s"])),
+        Some(lib_out.executed.scaling.duration())
+    );
+    assert!(
+        (f(&p0["executed"]["totals"]["machining_time_s"]) - lib_out.executed.scaling.duration())
+            .abs()
+            <= 1e-9
+    );
+    for k in [0, 101] {
+        assert!(run[k]["velocities_rad_per_s"]
+            .as_array()
+            .expect("velocities")
+            .iter()
+            .all(|v| f(v) == 0.0));
+    }
+    assert_eq!(
+        p0["executed"]["totals"]["max_spectral_radius"].as_f64(),
+        Some(executed.max_spectral_radius)
+    );
+    assert_eq!(
+        p0["executed"]["segments"][37]["feed_m_per_s"].as_f64(),
+        Some(executed.segments[37].feed)
+    );
+    assert_eq!(
+        p0["executed"]["time_scaling"]["stretched_intervals"].as_u64(),
+        Some(lib_out.executed.scaling.stretched_intervals() as u64)
     );
     let svg = std::fs::read_to_string(plots.join("mill_plan_fixed_g.svg")).expect("plan svg");
     for label in [
@@ -418,18 +486,31 @@ fn trains_a_policy_and_plans_with_it_as_the_library_does() {
     let mut naive_request = request.clone();
     naive_request.planner = "naive".to_string();
     naive_request.policy_file = None;
-    let naive = planner.plan(&naive_request).expect("library naive").plan;
+    let naive_out = planner.plan(&naive_request).expect("library naive");
+    let naive = &naive_out.plan;
     let printed = totals(&stdout, 1);
     assert!((printed[0] - naive.total_time).abs() <= 5.1e-7, "{stdout}");
     assert!(
         (printed[3] - naive.total_reward).abs() <= 5.1e-7,
         "{stdout}"
     );
-    // Both Markdown rows, with the library's formatting.
-    for p in [&lib, &naive] {
-        let row = kerf_millplan::comparison_table(&[p.row()]);
-        let row = row.lines().nth(2).expect("row");
-        assert!(stdout.contains(row), "{row} in {stdout}");
+    // Both Markdown rows, with the library's formatting, as planned and (second table) as
+    // executed.
+    let (planned_table, executed_table) = stdout
+        .split_once("as executed (time-scaled to the joint limits, from rest to rest):\n")
+        .unwrap_or_else(|| panic!("no executed comparison table in {stdout}"));
+    for (table, plans) in [
+        (planned_table, [lib, naive]),
+        (
+            executed_table,
+            [&lib_out.executed.plan, &naive_out.executed.plan],
+        ),
+    ] {
+        for p in plans {
+            let row = kerf_millplan::comparison_table(&[p.row()]);
+            let row = row.lines().nth(2).expect("row");
+            assert!(table.contains(row), "{row} in {table}");
+        }
     }
     let cmp = std::fs::read_to_string(plots.join("mill_plan_comparison.svg")).expect("overlay");
     assert!(
@@ -460,6 +541,19 @@ fn trains_a_policy_and_plans_with_it_as_the_library_does() {
     let printed = totals(&stdout, 0);
     assert!(
         (printed[1] - cached.plan.max_spectral_radius).abs() <= 5.1e-7,
+        "{stdout}"
+    );
+    let printed = totals_of(&stdout, "as executed", 0);
+    assert!(
+        (printed[1] - cached.executed.plan.max_spectral_radius).abs() <= 5.1e-7,
+        "{stdout}"
+    );
+    assert!(!cached.executed.cached_segments.is_empty());
+    assert!(
+        stdout.contains(&format!(
+            "|μ|max of {} segments from the indicator cache",
+            cached.executed.cached_segments.len()
+        )),
         "{stdout}"
     );
 
