@@ -3,7 +3,8 @@
 //!
 //! ```sh
 //! kerf train mill --out policy.safetensors [--episodes 1000] [--steps N] [--seed 1]
-//!                 [--fixed-g] [--history FILE.csv|FILE.json] [--plots DIR]
+//!                 [--fixed-g] [--acceleration-penalty W] [--history FILE.csv|FILE.json]
+//!                 [--plots DIR]
 //!                 [--cell FILE] [--cache FILE | --no-cache] [DDPG and environment knobs]
 //! ```
 //!
@@ -152,6 +153,11 @@ pub struct MillTrainArgs {
     /// Inertia coefficient alpha in (0, 1] of the action filter (seed 004 eq. 11; default 0.5).
     #[arg(long, allow_hyphen_values = true)]
     alpha: Option<f64>,
+    /// Weight of kerf's joint-acceleration shaping (EnvConfig::acceleration_penalty; the
+    /// committed policy's 1.0 by default, 0 turns it off): w * sum_j (|a_j|/a_max_j - 1)+ at
+    /// each segment midpoint is subtracted from the step reward.
+    #[arg(long, default_value_t = 1.0, allow_hyphen_values = true)]
+    acceleration_penalty: f64,
     /// Episodes of the moving average of the progress line and the training curve.
     #[arg(long, default_value_t = 50)]
     window: usize,
@@ -569,6 +575,7 @@ fn mill(a: MillTrainArgs) -> Result<(), String> {
     let config = EnvConfig {
         fixed_g: a.fixed_g,
         alpha: a.alpha.unwrap_or(defaults.alpha),
+        acceleration_penalty: (a.acceleration_penalty != 0.0).then_some(a.acceleration_penalty),
         ..defaults
     };
     let mut env = MillEnv::new(cell.clone(), cache.clone(), config).map_err(|e| describe(&e))?;
