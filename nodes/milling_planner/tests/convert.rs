@@ -447,8 +447,7 @@ fn a_real_plan_becomes_its_mill_plan() {
 }
 
 /// The ddpg and dp plans of the default request are published as executed: the joint limits
-/// slowed them, so some segments run below their planned feed and |μ|max as executed is not
-/// the planned one.
+/// slowed them, so some segments run below their planned feed, with the |μ|max of that feed.
 #[test]
 fn ddpg_and_dp_plans_are_published_as_executed() {
     for out in [ddpg_output(), dp_output()] {
@@ -462,7 +461,11 @@ fn ddpg_and_dp_plans_are_published_as_executed() {
         let pairs = || m.segments.iter().zip(&out.plan.segments);
         assert!(pairs().any(|(s, p)| s.feed < p.feed), "{name}");
         assert!(pairs().all(|(s, p)| s.feed <= p.feed), "{name}");
-        assert_ne!(m.max_mu, out.plan.max_spectral_radius, "{name}");
+        // A slowed segment carries the |μ|max of its executed feed, not the planned one.
+        assert!(
+            pairs().any(|(s, p)| s.feed < p.feed && s.mu_max != p.spectral_radius),
+            "{name}"
+        );
         assert_eq!(m.max_mu, out.executed.plan.max_spectral_radius, "{name}");
         println!(
             "{name}: machining time {:.3} s as executed ({:.3} s planned), max |mu| {:.4} \
