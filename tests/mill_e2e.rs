@@ -11,8 +11,8 @@
 //!   remapped) → `/joint_states`, which move along the plan and reach its last point: once
 //!   from the message form and, after a move back to the start, once from the text form.
 //!   Then, after a move to its start, the `ddpg` plan of the shipped policy (whose planned
-//!   timing exceeds joint_5's acceleration limit; the published trajectory is time-scaled to
-//!   the limits) is accepted by the executor and followed for its first 2 s (of about 23).
+//!   timing exceeds a joint's acceleration limit; the published trajectory is time-scaled to
+//!   the limits) is accepted by the executor and followed for its first 2 s (of about 17).
 //! * Every answer is the library's plan AS EXECUTED: the trajectory from rest to rest,
 //!   time-scaled to the joint limits, and the segments and totals at the feeds it runs.
 //! * A full queue is answered QUEUE_FULL, not dropped.
@@ -742,17 +742,7 @@ fn naive_plan_runs_from_planner_through_executor_by_message_and_by_text() {
     follow_to_the_end(&states, &statuses, &plan, "message form");
 
     // Back to the start (rest to rest, 4 s), then 2. the text form.
-    let home = JointTrajectory {
-        joint_names: JOINTS.iter().map(|s| s.to_string()).collect(),
-        points: vec![JointTrajectoryPoint {
-            positions: first.to_vec(),
-            velocities: vec![0.0; 6],
-            time_from_start: RosDuration { sec: 4, nanosec: 0 },
-            ..JointTrajectoryPoint::default()
-        }],
-        ..JointTrajectory::default()
-    };
-    back.publish(home).unwrap();
+    back.publish(move_to(&first)).unwrap();
     wait_succeeded(&statuses, "move back");
     std::thread::sleep(Duration::from_millis(200));
     let mut end = take(&states, QUICK, "joint state at the start");
@@ -774,9 +764,9 @@ fn naive_plan_runs_from_planner_through_executor_by_message_and_by_text() {
     assert_same_plan(&plan, &direct);
     follow_to_the_end(&states, &statuses, &plan, "text form");
 
-    // 3. The ddpg plan of the shipped policy: its planned timing asks joint_5 for more than
+    // 3. The ddpg plan of the shipped policy: its planned timing asks a joint for more than
     // its acceleration limit, the published (time-scaled) trajectory does not, and the
-    // executor accepts it. Only its first seconds are watched: it lasts about 23 s.
+    // executor accepts it. Only its first seconds are watched: it lasts about 17 s.
     let ddpg = offline
         .plan(&MillRequest {
             request_id: "run-ddpg".into(),
@@ -785,17 +775,7 @@ fn naive_plan_runs_from_planner_through_executor_by_message_and_by_text() {
         })
         .expect("ddpg plan with the shipped policy");
     let ddpg_first = ddpg.executed.scaling.trajectory.points[0].positions;
-    let home = JointTrajectory {
-        joint_names: JOINTS.iter().map(|s| s.to_string()).collect(),
-        points: vec![JointTrajectoryPoint {
-            positions: ddpg_first.to_vec(),
-            velocities: vec![0.0; 6],
-            time_from_start: RosDuration { sec: 4, nanosec: 0 },
-            ..JointTrajectoryPoint::default()
-        }],
-        ..JointTrajectory::default()
-    };
-    back.publish(home).unwrap();
+    back.publish(move_to(&ddpg_first)).unwrap();
     wait_succeeded(&statuses, "move to the ddpg start");
     std::thread::sleep(Duration::from_millis(200));
     while let Ok(Some(_)) = states.take() {}
@@ -829,6 +809,20 @@ fn naive_plan_runs_from_planner_through_executor_by_message_and_by_text() {
     drop((states, statuses, back, watch));
     exec_stop.stop();
     executor.join().unwrap().unwrap();
+}
+
+/// A one-point trajectory to `positions`, reached at rest in 4 s.
+fn move_to(positions: &[f64]) -> JointTrajectory {
+    JointTrajectory {
+        joint_names: JOINTS.iter().map(|s| s.to_string()).collect(),
+        points: vec![JointTrajectoryPoint {
+            positions: positions.to_vec(),
+            velocities: vec![0.0; 6],
+            time_from_start: RosDuration { sec: 4, nanosec: 0 },
+            ..JointTrajectoryPoint::default()
+        }],
+        ..JointTrajectory::default()
+    }
 }
 
 /// How far (largest joint difference) `position` is from the nearest of `points`.
