@@ -667,15 +667,7 @@ fn greedy_summary(
     rollout: &kerf_millplan::Rollout,
 ) -> Result<String, String> {
     if !rollout.completed {
-        let why = rollout
-            .steps
-            .iter()
-            .find_map(|s| {
-                s.violation
-                    .as_ref()
-                    .map(|v| format!("segment {}: {v}", s.state.segment))
-            })
-            .unwrap_or_else(|| "the rollout ended early".to_string());
+        let why = rollout.stop_reason();
         return Ok(format!(
             "greedy rollout: left the feasible set after {} of {} segments ({why}); return {:.4}\n",
             rollout.steps.len() + 1,

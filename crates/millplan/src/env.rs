@@ -227,6 +227,19 @@ pub struct Rollout {
 }
 
 impl Rollout {
+    /// Why an incomplete rollout stopped: "segment i: <violation>" of the
+    /// first violating step, or "the rollout ended early".
+    pub fn stop_reason(&self) -> String {
+        self.steps
+            .iter()
+            .find_map(|s| {
+                s.violation
+                    .as_ref()
+                    .map(|v| format!("segment {}: {v}", s.state.segment))
+            })
+            .unwrap_or_else(|| "the rollout ended early".to_string())
+    }
+
     /// The state sequence s_0, s_1, ….
     pub fn states(&self) -> Vec<PhysicalState> {
         std::iter::once(self.initial.state)

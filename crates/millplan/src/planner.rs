@@ -588,15 +588,7 @@ impl MillPlanner {
                 policy.check_sizes(env.observation_dim(), env.action_dim())?;
                 let rollout = env.rollout(|obs, _| policy.act(obs))?;
                 if !rollout.completed {
-                    let why = rollout
-                        .steps
-                        .iter()
-                        .find_map(|s| {
-                            s.violation
-                                .as_ref()
-                                .map(|v| format!("segment {}: {v}", s.state.segment))
-                        })
-                        .unwrap_or_else(|| "the rollout ended early".to_string());
+                    let why = rollout.stop_reason();
                     return Err(MillPlanError::Policy {
                         path: path.display().to_string(),
                         reason: format!(

@@ -511,3 +511,28 @@ fn acceleration_penalty_by_hand() {
         assert!(e.to_string().contains("acceleration penalty"), "{e}");
     }
 }
+
+/// Rollout::stop_reason names the first violating step's segment and
+/// violation; a rollout without a violation gets the generic text.
+#[test]
+fn rollout_stop_reason_names_the_violation() {
+    let mut e = env(EnvConfig {
+        alpha: 1.0,
+        project_g: false,
+        ..EnvConfig::default()
+    });
+    let r = e.rollout(|_, _| Ok(vec![0.0, 0.0, -1.0])).unwrap();
+    assert!(!r.completed);
+    let last = r.steps.last().unwrap();
+    assert_eq!(
+        r.stop_reason(),
+        format!(
+            "segment {}: {}",
+            last.state.segment,
+            last.violation.as_deref().unwrap()
+        )
+    );
+    let r = e.rollout(|_, _| Ok(vec![0.0, 0.0, 0.0])).unwrap();
+    assert!(r.completed);
+    assert_eq!(r.stop_reason(), "the rollout ended early");
+}
