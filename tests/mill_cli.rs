@@ -93,6 +93,20 @@ fn totals(stdout: &str, n: usize) -> [f64; 4] {
     totals_of(stdout, "totals:", n)
 }
 
+/// The printed totals (time, max |μ|max, min 1/K, reward) are `plan`'s to the printed
+/// precision (5.1e-7).
+fn assert_totals(printed: [f64; 4], plan: &kerf_millplan::Plan, what: &str) {
+    let expected = [
+        plan.total_time,
+        plan.max_spectral_radius,
+        plan.min_condition_indicator,
+        plan.total_reward,
+    ];
+    for (p, e) in printed.iter().zip(expected) {
+        assert!((p - e).abs() <= 5.1e-7, "printed {p}, {what} {e}");
+    }
+}
+
 /// The totals of the `n`-th line starting with `start` of a `kerf plan mill` output.
 fn totals_of(stdout: &str, start: &str, n: usize) -> [f64; 4] {
     let line = stdout
@@ -310,31 +324,14 @@ fn trains_a_policy_and_plans_with_it_as_the_library_does() {
     let lib_out = planner.plan(&request).expect("library plan");
     let lib = &lib_out.plan;
     assert_eq!(lib.segments.len(), 100);
-    let printed = totals(&stdout, 0);
-    let expected = [
-        lib.total_time,
-        lib.max_spectral_radius,
-        lib.min_condition_indicator,
-        lib.total_reward,
-    ];
-    for (p, e) in printed.iter().zip(expected) {
-        assert!((p - e).abs() <= 5.1e-7, "printed {p}, library {e}");
-    }
+    assert_totals(totals(&stdout, 0), lib, "library");
     // The same totals as executed (time-scaled to the joint limits, from rest to rest).
     let executed = &lib_out.executed.plan;
-    let printed = totals_of(&stdout, "as executed", 0);
-    let expected = [
-        executed.total_time,
-        executed.max_spectral_radius,
-        executed.min_condition_indicator,
-        executed.total_reward,
-    ];
-    for (p, e) in printed.iter().zip(expected) {
-        assert!(
-            (p - e).abs() <= 5.1e-7,
-            "printed {p}, library as executed {e}"
-        );
-    }
+    assert_totals(
+        totals_of(&stdout, "as executed", 0),
+        executed,
+        "library as executed",
+    );
     assert!(executed.total_time > lib.total_time, "at least the ramps");
     assert!(
         stdout.contains(&format!(
