@@ -585,44 +585,21 @@ fn follow_to_the_end(
     plan: &MillPlan,
     what: &str,
 ) {
-    let points: Vec<&[f64]> = plan
-        .trajectory
-        .points
-        .iter()
-        .map(|p| p.positions.as_slice())
-        .collect();
+    let (points, largest_step) = plan_points(plan);
     let (first, last) = (points[0], points[points.len() - 1]);
-    let largest_step = points
-        .windows(2)
-        .flat_map(|w| (0..6).map(move |j| (w[1][j] - w[0][j]).abs()))
-        .fold(0.0, f64::max);
     let deadline = Instant::now() + Duration::from_secs_f64(plan.machining_time) + PLANNING;
     let mut accepted = false;
     let mut succeeded = false;
     let mut seen = 0usize;
     let mut moved = 0.0_f64;
     while Instant::now() < deadline && !succeeded {
-        while let Ok(Some((s, _))) = statuses.take() {
-            assert!(
-                s.status != TrajectoryStatus::REJECTED && s.status != TrajectoryStatus::ABORTED,
-                "{what}: executor {}: {}",
-                TrajectoryStatus::status_name(s.status).unwrap_or("?"),
-                s.message
-            );
-            accepted |= s.status == TrajectoryStatus::ACCEPTED;
-            succeeded |= s.status == TrajectoryStatus::SUCCEEDED;
+        for status in drain_statuses(statuses, what) {
+            accepted |= status == TrajectoryStatus::ACCEPTED;
+            succeeded |= status == TrajectoryStatus::SUCCEEDED;
         }
-        while let Ok(Some((s, _))) = states.take() {
-            assert_eq!(s.name, JOINTS);
-            let off = off_plan(&points, &s.position);
-            assert!(
-                off <= largest_step + 1e-6,
-                "{what}: state {:?} is {off} rad off the plan",
-                s.position
-            );
-            moved = moved.max((s.position[0] - first[0]).abs());
-            seen += 1;
-        }
+        seen += drain_on_plan(states, &points, largest_step, what, |q| {
+            moved = moved.max((q[0] - first[0]).abs());
+        });
         std::thread::sleep(Duration::from_millis(5));
     }
     assert!(accepted && succeeded, "{what}: the executor did not finish");
@@ -848,17 +825,8 @@ fn follow_the_start(
     watch: Duration,
     what: &str,
 ) {
-    let points: Vec<&[f64]> = plan
-        .trajectory
-        .points
-        .iter()
-        .map(|p| p.positions.as_slice())
-        .collect();
+    let (points, largest_step) = plan_points(plan);
     let first = points[0];
-    let largest_step = points
-        .windows(2)
-        .flat_map(|w| (0..6).map(move |j| (w[1][j] - w[0][j]).abs()))
-        .fold(0.0, f64::max);
     let mut accepted_at = None;
     let deadline = Instant::now() + QUICK;
     let mut seen = 0usize;
@@ -870,33 +838,18 @@ fn follow_the_start(
             Some(t) if now >= t + watch => break,
             Some(_) => {}
         }
-        while let Ok(Some((s, _))) = statuses.take() {
-            assert!(
-                s.status != TrajectoryStatus::REJECTED && s.status != TrajectoryStatus::ABORTED,
-                "{what}: executor {}: {}",
-                TrajectoryStatus::status_name(s.status).unwrap_or("?"),
-                s.message
-            );
-            if s.status == TrajectoryStatus::ACCEPTED && accepted_at.is_none() {
-                accepted_at = Some(Instant::now());
-            }
+        let received = drain_statuses(statuses, what);
+        if received.contains(&TrajectoryStatus::ACCEPTED) && accepted_at.is_none() {
+            accepted_at = Some(Instant::now());
         }
-        while let Ok(Some((s, _))) = states.take() {
-            assert_eq!(s.name, JOINTS);
-            let off = off_plan(&points, &s.position);
-            assert!(
-                off <= largest_step + 1e-6,
-                "{what}: state {:?} is {off} rad off the plan",
-                s.position
-            );
+        seen += drain_on_plan(states, &points, largest_step, what, |q| {
             let from_first = first
                 .iter()
-                .zip(&s.position)
+                .zip(q)
                 .map(|(a, b)| (a - b).abs())
                 .fold(0.0, f64::max);
             moved = moved.max(from_first);
-            seen += 1;
-        }
+        });
         std::thread::sleep(Duration::from_millis(5));
     }
     // 250 Hz, with slack for a busy machine.
@@ -907,20 +860,68 @@ fn follow_the_start(
     assert!(moved > 1e-4, "{what}: the robot moved only {moved} rad");
 }
 
+/// The statuses the executor sent since the last call, in order; fails on REJECTED or
+/// ABORTED.
+fn drain_statuses(statuses: &Subscription<TrajectoryStatus>, what: &str) -> Vec<u8> {
+    let mut out = Vec::new();
+    while let Ok(Some((s, _))) = statuses.take() {
+        assert!(
+            s.status != TrajectoryStatus::REJECTED && s.status != TrajectoryStatus::ABORTED,
+            "{what}: executor {}: {}",
+            TrajectoryStatus::status_name(s.status).unwrap_or("?"),
+            s.message
+        );
+        out.push(s.status);
+    }
+    out
+}
+
+/// A plan's trajectory points and the largest joint step between two consecutive ones.
+fn plan_points(plan: &MillPlan) -> (Vec<&[f64]>, f64) {
+    let points: Vec<&[f64]> = plan
+        .trajectory
+        .points
+        .iter()
+        .map(|p| p.positions.as_slice())
+        .collect();
+    let largest_step = points
+        .windows(2)
+        .flat_map(|w| (0..6).map(move |j| (w[1][j] - w[0][j]).abs()))
+        .fold(0.0, f64::max);
+    (points, largest_step)
+}
+
+/// The joint states received since the last call: each names the robot's joints and lies on
+/// the plan (within `largest_step` + 1e-6 rad of a plan point); `each` sees its positions.
+/// Returns how many were received.
+fn drain_on_plan(
+    states: &Subscription<JointState>,
+    points: &[&[f64]],
+    largest_step: f64,
+    what: &str,
+    mut each: impl FnMut(&[f64]),
+) -> usize {
+    let mut seen = 0;
+    while let Ok(Some((s, _))) = states.take() {
+        assert_eq!(s.name, JOINTS);
+        let off = off_plan(points, &s.position);
+        assert!(
+            off <= largest_step + 1e-6,
+            "{what}: state {:?} is {off} rad off the plan",
+            s.position
+        );
+        each(&s.position);
+        seen += 1;
+    }
+    seen
+}
+
 /// Waits for the executor's next SUCCEEDED; fails on REJECTED or ABORTED.
 fn wait_succeeded(statuses: &Subscription<TrajectoryStatus>, what: &str) {
     let deadline = Instant::now() + PLANNING;
     while Instant::now() < deadline {
-        while let Ok(Some((s, _))) = statuses.take() {
-            assert!(
-                s.status != TrajectoryStatus::REJECTED && s.status != TrajectoryStatus::ABORTED,
-                "{what}: executor {}: {}",
-                TrajectoryStatus::status_name(s.status).unwrap_or("?"),
-                s.message
-            );
-            if s.status == TrajectoryStatus::SUCCEEDED {
-                return;
-            }
+        if drain_statuses(statuses, what).contains(&TrajectoryStatus::SUCCEEDED) {
+            return;
         }
         std::thread::sleep(Duration::from_millis(5));
     }
