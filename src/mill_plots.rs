@@ -15,6 +15,7 @@
 use std::path::Path;
 
 use kerf_millplan::{plan::Plan, EpisodeReport};
+use plotters::coord::types::RangedCoordf64;
 use plotters::prelude::*;
 
 /// Colours of the planners' curves, in order.
@@ -74,6 +75,29 @@ fn runs(points: impl Iterator<Item = (f64, f64)>) -> Vec<Vec<(f64, f64)>> {
 /// The trailing moving average: entry k is the mean of `values[k + 1 − w ..= k]` with
 /// w = min(k + 1, `window`) (the first entries average what exists so far). A `window` of 0
 /// is treated as 1.
+/// Draws `points` as lines, one per run of finite points ([`runs`]), in `colour` and `width`
+/// pixels; the first run carries `label` in the legend. Returns whether any run was drawn.
+fn draw_runs<DB: DrawingBackend>(
+    chart: &mut ChartContext<'_, DB, Cartesian2d<RangedCoordf64, RangedCoordf64>>,
+    points: impl Iterator<Item = (f64, f64)>,
+    colour: RGBColor,
+    width: u32,
+    label: &str,
+) -> Result<bool, DrawingAreaErrorKind<DB::ErrorType>> {
+    let runs = runs(points);
+    for (i, run) in runs.iter().enumerate() {
+        let s = chart.draw_series(LineSeries::new(
+            run.iter().copied(),
+            colour.stroke_width(width),
+        ))?;
+        if i == 0 {
+            s.label(label)
+                .legend(move |(x, y)| PathElement::new([(x, y), (x + 20, y)], colour));
+        }
+    }
+    Ok(!runs.is_empty())
+}
+
 pub fn moving_average(values: &[f64], window: usize) -> Vec<f64> {
     let window = window.max(1);
     let mut out = Vec::with_capacity(values.len());
@@ -129,30 +153,22 @@ pub fn training_curve(
         .y_desc("episode reward")
         .draw()
         .map_err(&err)?;
-    for (i, run) in runs(episodes.iter().copied().zip(rewards.iter().copied()))
-        .into_iter()
-        .enumerate()
-    {
-        let s = chart
-            .draw_series(LineSeries::new(run, EPISODE_COLOR.stroke_width(1)))
-            .map_err(&err)?;
-        if i == 0 {
-            s.label("episode reward")
-                .legend(|(x, y)| PathElement::new([(x, y), (x + 20, y)], EPISODE_COLOR));
-        }
-    }
-    for (i, run) in runs(episodes.iter().copied().zip(average.iter().copied()))
-        .into_iter()
-        .enumerate()
-    {
-        let s = chart
-            .draw_series(LineSeries::new(run, PALETTE[0].stroke_width(3)))
-            .map_err(&err)?;
-        if i == 0 {
-            s.label(format!("moving average ({} episodes)", window.max(1)))
-                .legend(|(x, y)| PathElement::new([(x, y), (x + 20, y)], PALETTE[0]));
-        }
-    }
+    draw_runs(
+        &mut chart,
+        episodes.iter().copied().zip(rewards.iter().copied()),
+        EPISODE_COLOR,
+        1,
+        "episode reward",
+    )
+    .map_err(&err)?;
+    draw_runs(
+        &mut chart,
+        episodes.iter().copied().zip(average.iter().copied()),
+        PALETTE[0],
+        3,
+        &format!("moving average ({} episodes)", window.max(1)),
+    )
+    .map_err(&err)?;
     chart
         .configure_series_labels()
         .background_style(WHITE.mix(0.85))
@@ -180,21 +196,22 @@ pub fn training_curve(
         .y_desc("mean actor loss -Q")
         .draw()
         .map_err(&err)?;
-    for (i, run) in runs(losses.into_iter()).into_iter().enumerate() {
-        let s = chart
-            .draw_series(LineSeries::new(run, PALETTE[1].stroke_width(2)))
+    if draw_runs(
+        &mut chart,
+        losses.into_iter(),
+        PALETTE[1],
+        2,
+        "mean actor loss per episode",
+    )
+    .map_err(&err)?
+    {
+        chart
+            .configure_series_labels()
+            .background_style(WHITE.mix(0.85))
+            .border_style(BLACK)
+            .position(SeriesLabelPosition::UpperRight)
+            .draw()
             .map_err(&err)?;
-        if i == 0 {
-            s.label("mean actor loss per episode")
-                .legend(|(x, y)| PathElement::new([(x, y), (x + 20, y)], PALETTE[1]));
-            chart
-                .configure_series_labels()
-                .background_style(WHITE.mix(0.85))
-                .border_style(BLACK)
-                .position(SeriesLabelPosition::UpperRight)
-                .draw()
-                .map_err(&err)?;
-        }
     }
     root.present().map_err(&err)?;
     Ok(())
@@ -297,15 +314,7 @@ pub fn plan_panels(path: &Path, plans: &[(&str, &Plan)], title: &str) -> Result<
                 .segments
                 .iter()
                 .map(|s| (s.segment as f64, (panel.value)(s)));
-            for (i, run) in runs(points).into_iter().enumerate() {
-                let s = chart
-                    .draw_series(LineSeries::new(run, colour.stroke_width(2)))
-                    .map_err(&err)?;
-                if i == 0 {
-                    s.label(name.to_string())
-                        .legend(move |(x, y)| PathElement::new([(x, y), (x + 20, y)], colour));
-                }
-            }
+            draw_runs(&mut chart, points, colour, 2, name).map_err(&err)?;
         }
         if panel.y_desc == "|mu|max" {
             chart
