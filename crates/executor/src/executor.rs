@@ -122,6 +122,8 @@ pub struct Executor {
     active: Option<ActiveGoal>,
     next_id: u64,
     pending: Vec<GoalEvent>,
+    /// Replaced trajectories kept for the caller to drop, when drops are deferred.
+    retired: Option<Vec<ValidatedTrajectory>>,
 }
 
 impl Executor {
@@ -153,7 +155,35 @@ impl Executor {
             active: None,
             next_id: 1,
             pending: Vec::new(),
+            retired: None,
         })
+    }
+
+    /// From now on, trajectories replaced by a new goal, a cancel or an abort are kept for
+    /// [`Executor::take_retired`] instead of being dropped inside the call that replaced them.
+    ///
+    /// Dropping the last holder of a large trajectory frees its segments (O(points)); a
+    /// real-time loop takes them with [`Executor::take_retired`] and drops them on another
+    /// thread, so that no call on the control thread costs more than O(joints).
+    pub fn defer_drops(&mut self) {
+        if self.retired.is_none() {
+            self.retired = Some(Vec::with_capacity(4));
+        }
+    }
+
+    /// The next trajectory replaced since the last call, when drops are deferred
+    /// ([`Executor::defer_drops`]); `None` otherwise or when there is none.
+    pub fn take_retired(&mut self) -> Option<ValidatedTrajectory> {
+        self.retired.as_mut().and_then(Vec::pop)
+    }
+
+    /// Makes `motion` current; the replaced trajectory is kept for [`Executor::take_retired`]
+    /// when drops are deferred.
+    fn replace_motion(&mut self, motion: Motion) {
+        let old = std::mem::replace(&mut self.motion, motion);
+        if let (Motion::Trajectory(traj), Some(retired)) = (old, self.retired.as_mut()) {
+            retired.push(traj);
+        }
     }
 
     /// The robot model.
@@ -254,7 +284,11 @@ impl Executor {
 
     /// As [`Executor::submit`], for a trajectory already checked by [`prepare`] against this
     /// executor's limits and configuration: only the start (state- and clock-dependent part)
-    /// is validated here, in O(joints).
+    /// is validated here.
+    ///
+    /// # Performance
+    /// O(joints): the prepared segments are shared, not copied. The replaced trajectory is
+    /// dropped here unless drops are deferred ([`Executor::defer_drops`]).
     pub fn submit_prepared(
         &mut self,
         prepared: &PreparedTrajectory,
@@ -289,7 +323,7 @@ impl Executor {
             start_time: traj.start_time(),
             end_time: traj.end_time(),
         });
-        self.motion = Motion::Trajectory(traj);
+        self.replace_motion(Motion::Trajectory(traj));
         Ok(id)
     }
 
@@ -316,7 +350,7 @@ impl Executor {
 
     fn start_stop(&mut self, t: f64) {
         let state = self.commanded_at(t);
-        self.motion = Motion::Stop(StopProfile::new(&self.limits, &state, t));
+        self.replace_motion(Motion::Stop(StopProfile::new(&self.limits, &state, t)));
     }
 
     /// One control cycle: see [`Executor::update_into`].

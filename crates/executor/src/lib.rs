@@ -80,6 +80,7 @@ pub mod error;
 pub mod executor;
 pub mod mock;
 pub mod roots;
+pub mod slack;
 pub mod spline;
 pub mod stop;
 pub mod tolerance;
@@ -93,6 +94,7 @@ pub use error::{
 };
 pub use executor::{Cycle, Executor, Feedback, GoalEvent, GoalId, Outcome};
 pub use mock::MockHardware;
+pub use slack::LIMIT_SLACK;
 pub use stop::StopProfile;
 pub use tolerance::{resolve as resolve_tolerances, ResolvedTolerances};
 pub use trajectory::ValidatedTrajectory;
@@ -100,4 +102,4 @@ pub use types::{
     ExecutorConfig, GoalTolerances, JointLimits, JointSample, JointTolerance, TrajectoryPoint,
     TrajectoryRequest,
 };
-pub use validate::{prepare, validate, PreparedTrajectory, LIMIT_SLACK};
+pub use validate::{prepare, validate, PreparedTrajectory};

@@ -1,20 +1,27 @@
-//! A validated trajectory: segment polynomials on absolute time, sampled with a cursor.
+//! A validated trajectory: segment polynomials, sampled with a cursor.
+//!
+//! The waypoint segments ([`Body`]) are built once by [`crate::prepare`] on time relative to
+//! the trajectory's start time and shared (`Arc`) by every trajectory finished from them, so
+//! that finishing a prepared trajectory against the current state costs O(joints), never a
+//! copy of its segments.
 
 use std::cell::Cell;
+use std::sync::Arc;
 
-use crate::spline::{evaluate, Interpolation};
+use crate::spline::{evaluate, Interpolation, Knot};
 use crate::types::JointSample;
 
 /// Beyond this many forward steps of the cursor, [`ValidatedTrajectory::sample`] switches to
 /// binary search, which bounds the worst case of one call at O(log n).
 const MAX_LINEAR_STEPS: usize = 8;
 
-/// One segment of the interpolated motion, on absolute time `[t0, t1)`.
+/// One segment of the interpolated motion on `[t0, t1)`: absolute time for the start
+/// segment, time from the trajectory's start time for the waypoint segments.
 #[derive(Debug, Clone, PartialEq)]
 pub(crate) struct Segment {
-    /// Absolute start time (s).
+    /// Start time (s).
     pub t0: f64,
-    /// Absolute end time (s); equals the next segment's `t0`.
+    /// End time (s); equals the next segment's `t0`.
     pub t1: f64,
     /// Duration used for the coefficients (s); `t1 − t0` up to rounding.
     pub duration: f64,
@@ -41,28 +48,78 @@ impl Segment {
     }
 }
 
+/// One waypoint in model joint order.
+#[derive(Debug, Clone)]
+pub(crate) struct ModelPoint {
+    pub positions: Vec<f64>,
+    pub velocities: Option<Vec<f64>>,
+    pub accelerations: Option<Vec<f64>>,
+    pub time_from_start: f64,
+}
+
+impl ModelPoint {
+    /// Joint `j`'s state at this point; missing velocities or accelerations count as 0.
+    pub fn knot(&self, j: usize) -> Knot {
+        Knot {
+            p: self.positions[j],
+            v: self.velocities.as_ref().map_or(0.0, |v| v[j]),
+            a: self.accelerations.as_ref().map_or(0.0, |a| a[j]),
+        }
+    }
+}
+
+/// The request-only part of a trajectory: its waypoint segments on time from the start time.
+#[derive(Debug)]
+pub(crate) struct Body {
+    /// Number of joints.
+    pub n: usize,
+    /// Segments between consecutive waypoints, on time from the start time.
+    pub segments: Vec<Segment>,
+    /// `segments.len() * n` coefficient sets, segment-major.
+    pub coeffs: Vec<[f64; 6]>,
+    /// The first waypoint (the start segment runs to it).
+    pub first: ModelPoint,
+    /// Positions of the last waypoint, held after the end.
+    pub final_positions: Vec<f64>,
+    /// Number of waypoints.
+    pub point_count: usize,
+    /// `time_from_start` of the last waypoint (s).
+    pub duration: f64,
+}
+
+/// The start segment, from the state a trajectory started from to its first point, on
+/// absolute time, with its coefficients (one set per joint).
+#[derive(Debug, Clone)]
+pub(crate) struct Lead {
+    pub segment: Segment,
+    pub coeffs: Vec<[f64; 6]>,
+}
+
 /// A trajectory that passed [`crate::validate()`]: in robot-model joint order, on absolute time,
 /// within all limits on the whole interpolated curve.
 ///
 /// Before its first segment it holds the state it started from; after its last point it holds
 /// the last positions at zero velocity and acceleration.
+///
+/// Cloning and dropping cost O(joints) unless this is the last trajectory holding its
+/// waypoint segments; a real-time loop hands replaced trajectories to another thread to drop
+/// (see [`crate::Executor::defer_drops`]).
 #[derive(Debug, Clone)]
 pub struct ValidatedTrajectory {
     pub(crate) n: usize,
-    pub(crate) segments: Vec<Segment>,
-    /// `segments.len() * n` coefficient sets, segment-major.
-    pub(crate) coeffs: Vec<[f64; 6]>,
+    /// The start segment, if the first point is not due at the start.
+    pub(crate) lead: Option<Lead>,
+    /// The waypoint segments, on time from `start_time`.
+    pub(crate) body: Arc<Body>,
     /// State held before the first segment.
     pub(crate) initial: JointSample,
-    /// Positions held after the last point.
-    pub(crate) final_positions: Vec<f64>,
     /// Time at which the trajectory was validated (s).
     pub(crate) accepted_time: f64,
     /// Resolved start time (s): the header stamp, or the acceptance time.
     pub(crate) start_time: f64,
     /// Absolute time of the last point (s).
     pub(crate) end_time: f64,
-    /// Index of the segment last sampled.
+    /// Index of the waypoint segment last sampled.
     pub(crate) cursor: Cell<usize>,
 }
 
@@ -74,7 +131,12 @@ impl ValidatedTrajectory {
 
     /// Number of interpolated segments, including the start segment if there is one.
     pub fn segment_count(&self) -> usize {
-        self.segments.len()
+        usize::from(self.lead.is_some()) + self.body.segments.len()
+    }
+
+    /// Number of waypoints.
+    pub fn point_count(&self) -> usize {
+        self.body.point_count
     }
 
     /// Absolute time the trajectory was validated at (s).
@@ -99,7 +161,7 @@ impl ValidatedTrajectory {
 
     /// Positions held after the end, in model order.
     pub fn final_positions(&self) -> &[f64] {
-        &self.final_positions
+        &self.body.final_positions
     }
 
     /// The commanded state at absolute time `t`.
@@ -120,35 +182,46 @@ impl ValidatedTrajectory {
     ///
     /// # Performance
     /// O(1) amortized for non-decreasing `t` (a segment cursor moves forward); at most 8
-    /// cursor steps, else a binary search, so O(log n) worst case; any `t` is allowed. No allocation once `out` has the capacity.
+    /// cursor steps, else a binary search, so O(log n) worst case; any `t` is allowed. No
+    /// allocation once `out` has the capacity.
     pub fn sample_into(&self, t: f64, out: &mut JointSample) {
         out.resize_full(self.n);
         if t.is_nan() || t >= self.end_time {
             // NaN cannot come from the executor (times are checked); hold the end for safety.
-            out.positions.copy_from_slice(&self.final_positions);
+            out.positions.copy_from_slice(&self.body.final_positions);
             out.velocities.fill(0.0);
             out.accelerations.fill(0.0);
             return;
         }
-        let Some(first) = self.segments.first() else {
+        let body = &self.body;
+        let body_start = body
+            .segments
+            .first()
+            .map(|s| self.start_time + s.t0)
+            .unwrap_or(f64::INFINITY);
+        if let Some(lead) = &self.lead {
+            if t < lead.segment.t0 {
+                self.copy_initial(out);
+            } else if t < lead.segment.t1 || body.segments.is_empty() {
+                write_segment(&lead.coeffs, t - lead.segment.t0, out);
+            } else {
+                self.sample_body(t, out);
+            }
+        } else if t < body_start {
             self.copy_initial(out);
-            return;
-        };
-        if t < first.t0 {
-            self.copy_initial(out);
-            return;
+        } else {
+            self.sample_body(t, out);
         }
-        let k = self.find_segment(t);
+    }
+
+    /// Samples the waypoint segments at absolute `t` (at or after the first one's start).
+    fn sample_body(&self, t: f64, out: &mut JointSample) {
+        let rel = t - self.start_time;
+        let k = self.find_segment(rel);
         self.cursor.set(k);
-        let seg = &self.segments[k];
-        let tau = t - seg.t0;
-        let coeffs = &self.coeffs[k * self.n..(k + 1) * self.n];
-        for (j, c) in coeffs.iter().enumerate() {
-            let (p, v, a) = evaluate(c, tau);
-            out.positions[j] = p;
-            out.velocities[j] = v;
-            out.accelerations[j] = a;
-        }
+        let seg = &self.body.segments[k];
+        let n = self.n;
+        write_segment(&self.body.coeffs[k * n..(k + 1) * n], rel - seg.t0, out);
     }
 
     fn copy_initial(&self, out: &mut JointSample) {
@@ -158,28 +231,40 @@ impl ValidatedTrajectory {
             .copy_from_slice(&self.initial.accelerations);
     }
 
-    /// Index of the segment with `t0 <= t < t1`, for `segments[0].t0 <= t < end_time`.
-    fn find_segment(&self, t: f64) -> usize {
-        let last = self.segments.len() - 1;
+    /// Index of the waypoint segment with `t0 <= rel < t1` (time from the start time).
+    fn find_segment(&self, rel: f64) -> usize {
+        let segments = &self.body.segments;
+        let last = segments.len() - 1;
         let mut k = self.cursor.get().min(last);
-        if t < self.segments[k].t0 {
-            return self.search(t);
+        if rel < segments[k].t0 {
+            return self.search(rel);
         }
         for _ in 0..MAX_LINEAR_STEPS {
-            if k == last || t < self.segments[k].t1 {
+            if k == last || rel < segments[k].t1 {
                 return k;
             }
             k += 1;
         }
-        if k == last || t < self.segments[k].t1 {
+        if k == last || rel < segments[k].t1 {
             k
         } else {
-            self.search(t)
+            self.search(rel)
         }
     }
 
-    fn search(&self, t: f64) -> usize {
-        let idx = self.segments.partition_point(|s| s.t1 <= t);
-        idx.min(self.segments.len() - 1)
+    fn search(&self, rel: f64) -> usize {
+        let segments = &self.body.segments;
+        let idx = segments.partition_point(|s| s.t1 <= rel);
+        idx.min(segments.len() - 1)
+    }
+}
+
+/// Evaluates one segment's per-joint coefficients at local time `tau` into `out`.
+fn write_segment(coeffs: &[[f64; 6]], tau: f64, out: &mut JointSample) {
+    for (j, c) in coeffs.iter().enumerate() {
+        let (p, v, a) = evaluate(c, tau);
+        out.positions[j] = p;
+        out.velocities[j] = v;
+        out.accelerations[j] = a;
     }
 }

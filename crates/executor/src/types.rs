@@ -233,7 +233,7 @@ impl JointSample {
         limits: &[JointLimits],
     ) -> Result<(), ExecutorError> {
         for (p, l) in self.positions.iter().zip(limits) {
-            if !crate::validate::position_ok(*p, l) {
+            if !crate::slack::position_ok(*p, l) {
                 return Err(ExecutorError::StateOutOfLimits {
                     what,
                     joint: l.name.clone(),

@@ -1,52 +1,17 @@
 //! Validation of a trajectory request against the robot model and the current state.
 
 use std::cell::Cell;
+use std::sync::Arc;
 
 use crate::error::ExecutorError;
 use crate::roots::extrema;
+use crate::slack::{position_ok, rate_ok};
 use crate::spline::{
     acceleration_coefficients, coefficients, evaluate, velocity_coefficients, Interpolation, Knot,
 };
-use crate::trajectory::{Segment, ValidatedTrajectory};
+use crate::trajectory::{Body, Lead, ModelPoint, Segment, ValidatedTrajectory};
 use crate::types::{check_limits, joint_list, ExecutorConfig, JointLimits, JointSample};
 use crate::TrajectoryRequest;
-
-/// Relative slack on every limit check, so that trajectories generated exactly at a limit
-/// (and then rounded) are not rejected. A velocity `v` passes when
-/// `|v| <= max_velocity · (1 + LIMIT_SLACK)`; a position passes when it lies within the
-/// limits widened by `LIMIT_SLACK · max(1, |limit|)` joint units.
-pub const LIMIT_SLACK: f64 = 1e-9;
-
-/// Whether a position lies within the joint's limits, widened by [`LIMIT_SLACK`].
-pub(crate) fn position_ok(p: f64, l: &JointLimits) -> bool {
-    let lo = l.min_position - LIMIT_SLACK * l.min_position.abs().max(1.0);
-    let hi = l.max_position + LIMIT_SLACK * l.max_position.abs().max(1.0);
-    p >= lo && p <= hi
-}
-
-/// Whether `|value| <= limit · (1 + LIMIT_SLACK)`.
-fn rate_ok(value: f64, limit: f64) -> bool {
-    value.abs() <= limit * (1.0 + LIMIT_SLACK)
-}
-
-/// One point in model joint order.
-#[derive(Debug, Clone)]
-struct ModelPoint {
-    positions: Vec<f64>,
-    velocities: Option<Vec<f64>>,
-    accelerations: Option<Vec<f64>>,
-    time_from_start: f64,
-}
-
-impl ModelPoint {
-    fn knot(&self, j: usize) -> Knot {
-        Knot {
-            p: self.positions[j],
-            v: self.velocities.as_ref().map_or(0.0, |v| v[j]),
-            a: self.accelerations.as_ref().map_or(0.0, |a| a[j]),
-        }
-    }
-}
 
 /// A request checked against the robot model alone, on time relative to its start time.
 ///
@@ -58,14 +23,12 @@ impl ModelPoint {
 /// the start time, the start segment or first-point match, and the velocity steps into the
 /// trajectory and into the final hold — in O(joints), so a node can prepare on a worker thread
 /// and finish in its control loop without missing a cycle.
+///
+/// The segments are shared (`Arc`) with every trajectory finished from it: cloning is O(1),
+/// and dropping is O(1) unless it holds the last reference to them.
 #[derive(Debug, Clone)]
 pub struct PreparedTrajectory {
-    n: usize,
-    points: Vec<ModelPoint>,
-    /// Segments between waypoints, on time from the start (`t0 = time_from_start` of their
-    /// first point).
-    segments: Vec<Segment>,
-    coeffs: Vec<[f64; 6]>,
+    body: Arc<Body>,
     start_time: Option<f64>,
 }
 
@@ -142,11 +105,24 @@ pub fn prepare(
             &|| format!("point {k}"),
         )?;
     }
+    let last = points.len() - 1;
+    let duration = points[last].time_from_start;
+    let point_count = points.len();
+    let final_positions = points[last].positions.clone();
+    let first = points
+        .into_iter()
+        .next()
+        .ok_or(ExecutorError::EmptyTrajectory)?;
     Ok(PreparedTrajectory {
-        n,
-        points,
-        segments,
-        coeffs,
+        body: Arc::new(Body {
+            n,
+            segments,
+            coeffs,
+            first,
+            final_positions,
+            point_count,
+            duration,
+        }),
         start_time: req.start_time,
     })
 }
@@ -154,17 +130,17 @@ pub fn prepare(
 impl PreparedTrajectory {
     /// Number of joints (the robot model's).
     pub fn joint_count(&self) -> usize {
-        self.n
+        self.body.n
     }
 
     /// Number of waypoints.
     pub fn point_count(&self) -> usize {
-        self.points.len()
+        self.body.point_count
     }
 
     /// `time_from_start` of the last point (s).
     pub fn duration(&self) -> f64 {
-        self.points.last().map_or(0.0, |p| p.time_from_start)
+        self.body.duration
     }
 
     /// Completes validation against the current state at time `now` (see [`validate`]).
@@ -179,7 +155,7 @@ impl PreparedTrajectory {
     /// The trajectory on absolute time, or why it cannot start from `current` at `now`.
     ///
     /// # Performance
-    /// O(joints), plus a copy of the prepared segments.
+    /// O(joints): the waypoint segments are shared, not copied.
     pub fn finish(
         &self,
         limits: &[JointLimits],
@@ -187,11 +163,13 @@ impl PreparedTrajectory {
         current: &JointSample,
         now: f64,
     ) -> Result<ValidatedTrajectory, ExecutorError> {
-        if limits.len() != self.n {
+        let body = &self.body;
+        let n = body.n;
+        if limits.len() != n {
             return Err(ExecutorError::StateLength {
                 what: "prepared trajectory",
                 field: "joints",
-                actual: self.n,
+                actual: n,
                 expected: limits.len(),
                 empty_note: "",
             });
@@ -203,8 +181,7 @@ impl PreparedTrajectory {
             });
         }
         current.check("current state", limits, false)?;
-        let n = self.n;
-        let points = &self.points;
+        let p0 = &body.first;
 
         // Start time (JTC: header.stamp 0 = now).
         let start = match self.start_time {
@@ -212,7 +189,7 @@ impl PreparedTrajectory {
             Some(0.0) => now,
             Some(s) => s,
         };
-        let first_abs = start + points[0].time_from_start;
+        let first_abs = start + p0.time_from_start;
         if start < now && first_abs <= now {
             return Err(ExecutorError::OldHeaderTimestamp {
                 start_time: start,
@@ -232,10 +209,7 @@ impl PreparedTrajectory {
         // the start segment begins now, as in JTC.
         let t_begin = if start > now && at_rest { start } else { now };
 
-        let mut segments = Vec::with_capacity(self.segments.len() + 1);
-        let mut coeffs = Vec::with_capacity(self.coeffs.len() + n);
-        if first_abs > t_begin {
-            let p0 = &points[0];
+        let lead = if first_abs > t_begin {
             let kind = Interpolation::between(
                 true,
                 true,
@@ -243,51 +217,52 @@ impl PreparedTrajectory {
                 p0.accelerations.is_some(),
             );
             let duration = first_abs - t_begin;
-            for j in 0..n {
-                let k0 = Knot {
-                    p: initial.positions[j],
-                    v: initial.velocities[j],
-                    a: initial.accelerations[j],
-                };
-                coeffs.push(coefficients(kind, k0, p0.knot(j), duration));
-            }
-            segments.push(Segment {
+            let coeffs: Vec<[f64; 6]> = (0..n)
+                .map(|j| {
+                    let k0 = Knot {
+                        p: initial.positions[j],
+                        v: initial.velocities[j],
+                        a: initial.accelerations[j],
+                    };
+                    coefficients(kind, k0, p0.knot(j), duration)
+                })
+                .collect();
+            let segment = Segment {
                 t0: t_begin,
                 t1: first_abs,
                 duration,
                 kind,
                 from: None,
-            });
+            };
             // Times in errors are seconds from the start time, like the waypoints'.
-            check_segments(limits, &segments, &coeffs, n, start)?;
+            check_segments(limits, std::slice::from_ref(&segment), &coeffs, n, start)?;
+            Some(Lead { segment, coeffs })
         } else {
             // The first point is due now: it must be where the robot is commanded to be.
             for (j, l) in limits.iter().enumerate() {
-                let difference = (points[0].positions[j] - initial.positions[j]).abs();
+                let difference = (p0.positions[j] - initial.positions[j]).abs();
                 if difference > cfg.start_tolerance {
                     return Err(ExecutorError::StartMismatch {
                         joint: l.name.clone(),
                         current: initial.positions[j],
-                        first: points[0].positions[j],
+                        first: p0.positions[j],
                         difference,
                         tolerance: cfg.start_tolerance,
                     });
                 }
             }
-        }
-        let has_start_segment = !segments.is_empty();
-        segments.extend(self.segments.iter().map(|s| Segment {
-            t0: start + s.t0,
-            t1: start + s.t1,
-            ..s.clone()
-        }));
-        coeffs.extend_from_slice(&self.coeffs);
+            None
+        };
 
         // Velocity steps into the motion, from the start segment into the waypoint segments,
         // and into the final hold.
-        if let Some(first) = segments.first() {
-            let c = &coeffs[..n];
-            let location = || match first.from {
+        let first_segment = match (&lead, body.segments.first()) {
+            (Some(l), _) => Some((&l.coeffs[..], l.segment.t0 - start, l.segment.from)),
+            (None, Some(s)) => Some((&body.coeffs[..n], s.t0, s.from)),
+            (None, None) => None,
+        };
+        if let Some((c, time, from)) = first_segment {
+            let location = || match from {
                 None => "start of the start segment, current state → point 0".to_string(),
                 Some(_) => "point 0, due at the start time".to_string(),
             };
@@ -296,36 +271,38 @@ impl PreparedTrajectory {
                 cfg,
                 &|j| initial.velocities[j],
                 &|j| c[j][1],
-                first.t0 - start,
+                time,
                 &location,
             )?;
         }
-        if has_start_segment && segments.len() > 1 {
-            let (c0, c1) = (&coeffs[..n], &coeffs[n..2 * n]);
-            let duration = segments[0].duration;
+        if let (Some(l), false) = (&lead, body.segments.is_empty()) {
+            let c1 = &body.coeffs[..n];
+            let duration = l.segment.duration;
             check_velocity_step(
                 limits,
                 cfg,
-                &|j| evaluate(&c0[j], duration).1,
+                &|j| evaluate(&l.coeffs[j], duration).1,
                 &|j| c1[j][1],
-                points[0].time_from_start,
+                p0.time_from_start,
                 &|| "point 0".to_string(),
             )?;
         }
-        let last = points.len() - 1;
-        let end_time = start + points[last].time_from_start;
-        let end_velocity = |j: usize| match segments.last() {
-            Some(seg) => {
-                let k = segments.len() - 1;
-                evaluate(&coeffs[k * n + j], seg.duration).1
+        let last = body.point_count - 1;
+        let end_time = start + body.duration;
+        let has_segments = lead.is_some() || !body.segments.is_empty();
+        let end_velocity = |j: usize| match (body.segments.last(), &lead) {
+            (Some(seg), _) => {
+                let k = body.segments.len() - 1;
+                evaluate(&body.coeffs[k * n + j], seg.duration).1
             }
-            None => initial.velocities[j],
+            (None, Some(l)) => evaluate(&l.coeffs[j], l.segment.duration).1,
+            (None, None) => initial.velocities[j],
         };
         let location = || {
-            if segments.is_empty() {
-                "point 0, due at the start time; the trajectory ends there at rest".to_string()
-            } else {
+            if has_segments {
                 format!("last point {last}, where the trajectory ends at rest")
+            } else {
+                "point 0, due at the start time; the trajectory ends there at rest".to_string()
             }
         };
         check_velocity_step(
@@ -339,15 +316,22 @@ impl PreparedTrajectory {
 
         Ok(ValidatedTrajectory {
             n,
-            segments,
-            coeffs,
+            lead,
+            body: Arc::clone(body),
             initial,
-            final_positions: points[last].positions.clone(),
             accepted_time: now,
             start_time: start,
             end_time,
             cursor: Cell::new(0),
         })
+    }
+}
+
+impl ValidatedTrajectory {
+    /// Whether this trajectory runs the waypoint segments of `prepared` itself (shared by
+    /// [`PreparedTrajectory::finish`], not copied).
+    pub fn shares_segments_with(&self, prepared: &PreparedTrajectory) -> bool {
+        Arc::ptr_eq(&self.body, &prepared.body)
     }
 }
 

@@ -621,3 +621,58 @@ fn prepared_trajectories_start_from_the_state_at_submission() {
         "{err:?}"
     );
 }
+
+/// Finishing a prepared trajectory shares its segments (no copy proportional to its points),
+/// and with deferred drops a replaced trajectory is handed back to the caller instead of being
+/// freed inside the call that replaced it (preemption, cancel).
+#[test]
+fn finishing_shares_segments_and_replaced_trajectories_are_handed_back() {
+    let limits = limits6();
+    let cfg = ExecutorConfig::default();
+    let a = kerf_executor::prepare(&limits, &cfg, &min_jerk_request(&[0.0; 6], &TARGET, 4.0, 8))
+        .unwrap();
+    let z = [0.0; 6];
+    let b = kerf_executor::prepare(
+        &limits,
+        &cfg,
+        &request(&limits, vec![pt(2.0, &[-0.3; 6], &z, &z)]),
+    )
+    .unwrap();
+    let exec = executor(&limits, cfg.clone(), 0.0);
+    let dry = exec
+        .validate_prepared(&a, &GoalTolerances::default(), 0.0)
+        .unwrap();
+    assert!(dry.shares_segments_with(&a));
+    assert!(!dry.shares_segments_with(&b));
+    assert_eq!(dry.point_count(), a.point_count());
+
+    // Default: replaced trajectories are dropped in place, nothing is kept.
+    let mut plain = executor(&limits, cfg.clone(), 0.0);
+    plain
+        .submit_prepared(&a, &GoalTolerances::default(), 0.0)
+        .unwrap();
+    plain
+        .submit_prepared(&b, &GoalTolerances::default(), 0.0)
+        .unwrap();
+    assert!(plain.take_retired().is_none());
+
+    // Deferred: the preempted trajectory (A), then the canceled one (B) come back, in turn.
+    let mut exec = executor(&limits, cfg.clone(), 0.0);
+    exec.defer_drops();
+    let mut hw = MockHardware::new(vec![0.0; 6]);
+    exec.submit_prepared(&a, &GoalTolerances::default(), 0.0)
+        .unwrap();
+    assert!(exec.take_retired().is_none());
+    run(&mut exec, &mut hw, 0.0, 1.0);
+    let id_b = exec
+        .submit_prepared(&b, &GoalTolerances::default(), 1.0)
+        .unwrap();
+    let first = exec.take_retired().expect("the preempted trajectory");
+    assert!(first.shares_segments_with(&a));
+    assert!(exec.take_retired().is_none());
+    run(&mut exec, &mut hw, 1.0, 2.0);
+    exec.cancel(id_b, 2.0).unwrap();
+    let second = exec.take_retired().expect("the canceled trajectory");
+    assert!(second.shares_segments_with(&b));
+    assert!(exec.take_retired().is_none());
+}
