@@ -18,6 +18,7 @@ pub fn loopback(domain: u16, service_mapping: ServiceMapping) -> RosEnv {
 
 /// An executor for the shipped IRB 6660 running on its own thread (own Context), with
 /// `extra` parameters (`name:=value`). Stop it with the returned token, then join.
+#[allow(dead_code)] // not every crate including this module needs it
 pub fn spawn_executor(
     env: &RosEnv,
     extra: &[String],

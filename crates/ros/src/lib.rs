@@ -33,7 +33,7 @@ pub use inbox::{Inbox, INBOX_POLL};
 pub use logger::Logger;
 pub use node::{block_on_timeout, KerfNode, NodeSpec};
 pub use params::{ParamValue, Params};
-pub use realtime::set_realtime_priority;
+pub use realtime::{lock_memory, set_realtime_priority};
 pub use shutdown::StopToken;
 pub use streamer::Streamer;
 pub use worker::{Worker, WorkerError};

@@ -24,6 +24,29 @@ pub fn set_realtime_priority(priority: i64) -> Result<(), String> {
     }
 }
 
+/// Locks every page the process has mapped now into RAM (`mlockall(MCL_CURRENT)`), so that a
+/// real-time thread never takes a major page fault on code or data that was mapped but not
+/// yet read (a first-time code path of the control loop read from disk costs milliseconds).
+///
+/// Later mappings are not locked: with `MCL_FUTURE` an allocation beyond `RLIMIT_MEMLOCK`
+/// would fail, and a large request would abort the process.
+///
+/// # Returns
+/// An error naming the cause when the OS refuses (the process needs `CAP_IPC_LOCK` or a
+/// large enough `RLIMIT_MEMLOCK`, e.g. `ulimit -l unlimited`).
+pub fn lock_memory() -> Result<(), String> {
+    // SAFETY: mlockall takes only flags and has no memory-safety preconditions.
+    let rc = unsafe { libc::mlockall(libc::MCL_CURRENT) };
+    if rc == 0 {
+        Ok(())
+    } else {
+        Err(format!(
+            "mlockall(MCL_CURRENT) refused: {} (needs CAP_IPC_LOCK or a larger memlock limit)",
+            std::io::Error::last_os_error()
+        ))
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -26,6 +26,8 @@ pub struct ActionGoal {
     pub status: GoalStatusEnum,
     /// The executor goal that runs it, while it runs.
     pub exec_id: Option<ExecGoalId>,
+    /// Ticket of the goal's request (preparation, then the control thread).
+    pub ticket: Option<u64>,
     /// The result, once terminal.
     pub result: Option<FollowJointTrajectoryResult>,
 }
@@ -169,6 +171,7 @@ mod tests {
             accepted: RosTime::from_nanos(t),
             status,
             exec_id: None,
+            ticket: None,
             result: None,
         }
     }

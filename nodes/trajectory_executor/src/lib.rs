@@ -14,11 +14,20 @@
 //! | `~/joint_command` | `sensor_msgs/msg/JointState` | command stream for a hardware driver |
 //! | `~/trajectory_status` | `kerf_msgs/msg/TrajectoryStatus` | accepted / rejected / finished |
 //!
-//! Validating a trajectory costs O(points · joints) (about 3 ms for 1000 six-joint quintic
-//! points in a release build), more than a control period. The request-only part
-//! (`kerf_executor::prepare`) therefore runs on a worker thread (`kerf_ros::Worker`), in
-//! arrival order; the control loop finishes it against the current state in O(joints) and
-//! never misses a cycle for it.
+//! # Threads
+//! * **control** ([`control::ControlLoop`]): read → update → write every control period. It
+//!   does nothing whose cost depends on a trajectory's size: requests arrive prepared, are
+//!   finished against the commanded state in O(joints) (shared segments, no copy), and
+//!   everything large is freed on the request thread. It owns no DDS endpoint; its state
+//!   streams leave through bounded queues ([`kerf_ros::Streamer`]). With
+//!   `realtime_priority > 0` it runs `SCHED_FIFO`.
+//! * **requests** (the thread calling [`run`]): every DDS endpoint — the trajectory topic's
+//!   inbox, the action server (whose goals are deserialized here), the validate service — and
+//!   the goal book-keeping; it hands prepared requests to the control thread and publishes
+//!   what comes back (statuses, action results, feedback, log lines).
+//! * **prepare** ([`kerf_ros::Worker`]): validation against the robot model
+//!   (`kerf_executor::prepare`, O(points · joints), about 3 ms for 1000 six-joint quintic
+//!   points in a release build), one request at a time in arrival order.
 //!
 //! As in JTC, an empty `JointTrajectory` (no points) on `~/joint_trajectory` stops the current
 //! motion (here: a controlled stop within the acceleration limits) and the robot holds.
@@ -29,17 +38,23 @@
 
 pub mod action;
 pub mod config;
+pub mod control;
 pub mod convert;
 
 use std::{
     collections::HashMap,
-    time::{Duration as StdDuration, Instant},
+    sync::{
+        atomic::{AtomicBool, Ordering},
+        mpsc::{channel, Receiver, Sender},
+        Arc,
+    },
+    thread::JoinHandle,
+    time::Duration as StdDuration,
 };
 
 use kerf_executor::{
-    prepare, Cycle, Executor, ExecutorError, GoalId as ExecGoalId, GoalTolerances, JointSample,
-    MockHardware, Outcome, PreparedTrajectory, TrajectoryRequest, ValidatedTrajectory,
-    INVALID_GOAL, SUCCESSFUL,
+    prepare, Executor, ExecutorError, GoalId as ExecGoalId, GoalTolerances, MockHardware, Outcome,
+    PreparedTrajectory, TrajectoryRequest, INVALID_GOAL, SUCCESSFUL,
 };
 use kerf_msgs::{
     builtin_interfaces::Time,
@@ -76,6 +91,10 @@ pub const DEFAULT_NAME: &str = "trajectory_executor";
 
 /// Samples each outgoing stream may queue before new ones are dropped (0.25 s at 250 Hz).
 const STREAM_QUEUE: usize = 64;
+
+/// The request thread waits at most this long for a report of the control thread before it
+/// polls its DDS endpoints again.
+const REQUEST_POLL: StdDuration = StdDuration::from_millis(1);
 
 /// Why the node could not start.
 #[derive(Debug, thiserror::Error)]
@@ -151,7 +170,8 @@ impl Source {
 ///
 /// # Returns
 /// `Ok` after a clean shutdown; an error if the node could not start (bad parameter,
-/// unreadable robot description, DDS failure). Request errors never end the node.
+/// unreadable robot description, DDS failure, real-time priority refused) or if the control
+/// thread ended unexpectedly. Request errors never end the node.
 pub fn run(args: &RosArgs, env: &RosEnv, stop: StopToken) -> Result<(), NodeError> {
     let node = KerfNode::new(
         NodeSpec {
@@ -171,47 +191,36 @@ pub fn run(args: &RosArgs, env: &RosEnv, stop: StopToken) -> Result<(), NodeErro
             return Err(e);
         }
     };
-    let priority = cfg.realtime_priority;
     let mut n = ExecutorNode::new(node, cfg)?;
-    if priority > 0 {
-        // The control loop runs on this thread.
-        kerf_ros::set_realtime_priority(priority).map_err(|reason| {
-            log.error(&format!("cannot start: {reason}"));
-            NodeError::Config {
-                name: "realtime_priority".into(),
-                reason,
-            }
-        })?;
-        log.info(&format!(
-            "control thread runs SCHED_FIFO at priority {priority}"
-        ));
+    let result = n.spin();
+    if let Err(e) = &result {
+        log.error(&e.to_string());
     }
-    n.spin();
-    Ok(())
+    result
 }
 
-/// The node's state. Fields drop in declaration order: DDS endpoints first, `node` (and its
-/// Context) last.
+/// The node's request thread. Fields drop in declaration order: the control thread is
+/// stopped and joined in [`ExecutorNode::spin`] (its streams are DDS publishers of `node`),
+/// then the DDS endpoints drop, `node` (and its Context) last.
 struct ExecutorNode {
     traj_sub: Inbox<JointTrajectory>,
     action: FjtServer,
     validate_srv: Server<ValidateTrajectoryRequest, ValidateTrajectoryResponse>,
-    joint_states: Streamer<JointState>,
-    controller_state: Streamer<JointTrajectoryControllerState>,
-    command: Streamer<JointState>,
     status: Streamer<TrajectoryStatus>,
     goals: action::ActionGoals,
+    /// The request behind each running executor goal.
     sources: HashMap<ExecGoalId, Source>,
     /// Validation of incoming trajectories (O(points · joints)) runs here, off the control
     /// thread; one thread, so results come back in arrival order.
     prep: Worker<Incoming, Option<Prepared>>,
+    /// Requests being prepared, by ticket.
     jobs: HashMap<u64, Job>,
-    exec: Executor,
-    hw: MockHardware,
-    cfg: NodeConfig,
-    names: Vec<String>,
-    cycle: Cycle,
-    next_feedback: f64,
+    /// Requests handed to the control thread and not answered yet, by ticket.
+    dispatched: HashMap<u64, Job>,
+    commands: Sender<control::Command>,
+    reports: Receiver<control::Report>,
+    control_running: Arc<AtomicBool>,
+    control: Option<JoinHandle<()>>,
     statuses_changed: bool,
     publish_failures: u64,
     clock: Clock,
@@ -242,34 +251,23 @@ impl ExecutorNode {
         // Outgoing streams leave the control thread through bounded queues: a stalled
         // subscriber can cost samples but never blocks the control loop.
         let q = STREAM_QUEUE;
-        let joint_states = node.streamer("joint_states", JointState::ROS_TYPE, qos::state(), q)?;
-        let controller_state = node.streamer(
-            "~/controller_state",
-            JointTrajectoryControllerState::ROS_TYPE,
-            qos::state(),
-            q,
-        )?;
-        let command = node.streamer("~/joint_command", JointState::ROS_TYPE, qos::state(), q)?;
+        let streams = control::Streams {
+            joint_states: node.streamer("joint_states", JointState::ROS_TYPE, qos::state(), q)?,
+            controller_state: node.streamer(
+                "~/controller_state",
+                JointTrajectoryControllerState::ROS_TYPE,
+                qos::state(),
+                q,
+            )?,
+            command: node.streamer("~/joint_command", JointState::ROS_TYPE, qos::state(), q)?,
+        };
         let status = node.streamer(
             "~/trajectory_status",
             TrajectoryStatus::ROS_TYPE,
             qos::latched(),
             q,
         )?;
-        let names = cfg
-            .limits
-            .iter()
-            .map(|l| l.name.clone())
-            .collect::<Vec<_>>();
         let log = node.logger();
-        log.info(&format!(
-            "ready: robot '{}', joints [{}], {} Hz; trajectories on {}, action {}",
-            cfg.robot.name(),
-            names.join(", "),
-            cfg.control_rate,
-            node.resolve("~/joint_trajectory")?,
-            node.resolve("~/follow_joint_trajectory")?,
-        ));
         let clock = Clock::start();
         let (limits, exec_cfg) = (cfg.limits.clone(), cfg.executor.clone());
         let prep = Worker::spawn("prepare", 1, move |incoming: Incoming| {
@@ -291,24 +289,97 @@ impl ExecutorNode {
             what: "trajectory preparation thread".into(),
             reason: e.to_string(),
         })?;
+
+        let (commands, command_rx) = channel();
+        let (report_tx, reports) = channel();
+        let control_running = Arc::new(AtomicBool::new(true));
+        let loop_cfg = control::LoopConfig {
+            limits: cfg.limits.clone(),
+            control_rate: cfg.control_rate,
+            action_monitor_rate: cfg.action_monitor_rate,
+            control_period: cfg.executor.control_period,
+        };
+        let mut control_loop = control::ControlLoop::new(
+            exec,
+            hw,
+            loop_cfg,
+            streams,
+            command_rx,
+            report_tx,
+            Arc::clone(&control_running),
+            clock,
+        );
+        let priority = cfg.realtime_priority;
+        // Ok(a warning) once the loop runs, Err(why) if it cannot.
+        let (started_tx, started_rx) = channel::<Result<Option<String>, String>>();
+        let control = std::thread::Builder::new()
+            .name("control".into())
+            .spawn(move || {
+                let mut warning = None;
+                if priority > 0 {
+                    if let Err(reason) = kerf_ros::set_realtime_priority(priority) {
+                        let _ = started_tx.send(Err(reason));
+                        return;
+                    }
+                    // As ros2_control's `lock_memory`: no major page fault in the loop.
+                    warning = kerf_ros::lock_memory().err();
+                }
+                let _ = started_tx.send(Ok(warning));
+                control_loop.run();
+            })
+            .map_err(|e| RosError::Dds {
+                what: "control thread".into(),
+                reason: e.to_string(),
+            })?;
+        let refused = |reason: String| {
+            log.error(&format!("cannot start: {reason}"));
+            NodeError::Config {
+                name: "realtime_priority".into(),
+                reason,
+            }
+        };
+        match started_rx.recv() {
+            Ok(Ok(None)) => {}
+            Ok(Ok(Some(warning))) => log.warn(&format!(
+                "control thread: {warning}; it may take page faults"
+            )),
+            Ok(Err(reason)) => {
+                let _ = control.join();
+                return Err(refused(reason));
+            }
+            Err(_) => {
+                let _ = control.join();
+                return Err(refused("the control thread ended at start-up".into()));
+            }
+        }
+        if priority > 0 {
+            log.info(&format!(
+                "control thread runs SCHED_FIFO at priority {priority}, process memory locked"
+            ));
+        }
+        let names: Vec<&str> = cfg.limits.iter().map(|l| l.name.as_str()).collect();
+        log.info(&format!(
+            "ready: robot '{}', joints [{}], {} Hz; trajectories on {}, action {}",
+            cfg.robot.name(),
+            names.join(", "),
+            cfg.control_rate,
+            node.resolve("~/joint_trajectory")?,
+            node.resolve("~/follow_joint_trajectory")?,
+        ));
         Ok(Self {
             traj_sub,
             action,
             validate_srv,
-            joint_states,
-            controller_state,
-            command,
             status,
             goals: action::ActionGoals::default(),
             sources: HashMap::new(),
             prep,
             jobs: HashMap::new(),
-            exec,
-            hw,
-            cfg,
-            names,
-            cycle: Cycle::default(),
-            next_feedback: 0.0,
+            dispatched: HashMap::new(),
+            commands,
+            reports,
+            control_running,
+            control: Some(control),
             statuses_changed: false,
             publish_failures: 0,
             clock,
@@ -317,57 +388,117 @@ impl ExecutorNode {
         })
     }
 
-    fn spin(&mut self) {
-        let period = StdDuration::from_secs_f64(1.0 / self.cfg.control_rate);
-        let mut next = Instant::now();
-        let mut overruns = 0u64;
+    /// Serves requests until the node is stopped, then stops and joins the control thread.
+    fn spin(&mut self) -> Result<(), NodeError> {
+        let mut result = Ok(());
         while !self.node.should_stop() {
+            if self.control.as_ref().is_none_or(|h| h.is_finished()) {
+                result = Err(NodeError::Config {
+                    name: "control thread".into(),
+                    reason: "the control loop ended unexpectedly; the node stops".into(),
+                });
+                break;
+            }
             self.poll_trajectories();
             self.poll_goals();
             self.poll_cancels();
             self.poll_result_requests();
             self.poll_validate();
             self.poll_prepared();
-            self.control_cycle();
-            next += period;
-            let now = Instant::now();
-            if next > now {
-                std::thread::sleep(next - now);
-            } else if now - next > period * 10 {
-                overruns += 1;
-                if overruns.is_power_of_two() {
-                    self.log.warn(&format!(
-                        "control loop fell {:.1} ms behind; skipping ahead ({overruns} times so far)",
-                        (now - next).as_secs_f64() * 1e3
-                    ));
+            if let Ok(r) = self.reports.recv_timeout(REQUEST_POLL) {
+                self.on_report(r);
+            }
+            while let Ok(r) = self.reports.try_recv() {
+                self.on_report(r);
+            }
+            self.answer_results();
+            if self.statuses_changed {
+                self.statuses_changed = false;
+                if let Err(e) = self.action.send_goal_statuses(self.goals.status_array()) {
+                    self.log.warn(&format!("goal status not published: {e:?}"));
                 }
-                next = now;
             }
         }
         self.log.info("shutting down");
+        self.control_running.store(false, Ordering::Relaxed);
+        if let Some(h) = self.control.take() {
+            if h.join().is_err() && result.is_ok() {
+                result = Err(NodeError::Config {
+                    name: "control thread".into(),
+                    reason: "the control loop panicked".into(),
+                });
+            }
+        }
+        result
     }
 
-    fn publish<M: serde::Serialize + Send + 'static>(
-        stream: &Streamer<M>,
-        msg: M,
-        failures: &mut u64,
-        log: &Logger,
-        what: &str,
-    ) {
-        if !stream.publish(msg) {
-            *failures += 1;
-            if failures.is_power_of_two() {
-                log.warn(&format!(
-                    "{what}: sample dropped, a subscriber is not keeping up ({failures} drops so far)"
-                ));
-            }
+    /// Hands a command to the control thread.
+    fn dispatch(&mut self, tag: u64, job: Job, command: control::Command) {
+        if self.commands.send(command).is_ok() {
+            self.dispatched.insert(tag, job);
+        } else {
+            // Only after the control thread ended; `spin` stops the node then.
+            self.log
+                .error("the control thread is gone; a request was not executed");
         }
     }
 
-    fn header(&self, t: f64) -> Header {
-        Header {
-            stamp: self.clock.stamp(t),
-            frame_id: String::new(),
+    fn on_report(&mut self, report: control::Report) {
+        use control::Report;
+        match report {
+            Report::Started {
+                tag,
+                exec_id,
+                points,
+                duration,
+            } => {
+                let Some(Job::Run(source)) = self.dispatched.remove(&tag) else {
+                    return;
+                };
+                let what = source.describe();
+                self.log.info(&format!(
+                    "accepted {what}: {points} points over {duration:.3} s"
+                ));
+                self.trajectory_status(&source, TrajectoryStatus::ACCEPTED, SUCCESSFUL, "accepted");
+                if let Source::Action { id, .. } = &source {
+                    if let Some(g) = self.goals.get_mut(id) {
+                        g.exec_id = Some(exec_id);
+                    }
+                }
+                self.sources.insert(exec_id, source);
+            }
+            Report::Refused { tag, rejection } => {
+                if let Some(Job::Run(source)) = self.dispatched.remove(&tag) {
+                    self.rejected(&source, rejection);
+                }
+            }
+            Report::Validated { tag, result } => {
+                if let Some(Job::Validate(req_id)) = self.dispatched.remove(&tag) {
+                    self.answer_validate(req_id, result);
+                }
+            }
+            Report::Stopping { tag, message } => {
+                if let Some(Job::Stop(source)) = self.dispatched.remove(&tag) {
+                    self.log.info(&message);
+                    self.trajectory_status(
+                        &source,
+                        TrajectoryStatus::ACCEPTED,
+                        SUCCESSFUL,
+                        &message,
+                    );
+                }
+            }
+            Report::Finished { exec_id, outcome } => self.finish(exec_id, outcome),
+            Report::Feedback { exec_id, feedback } => {
+                if let Some(Source::Action { id, .. }) = self.sources.get(&exec_id) {
+                    if let Err(e) = self.action.send_feedback(*id, *feedback) {
+                        self.log.debug(&format!("feedback not sent: {e:?}"));
+                    }
+                }
+            }
+            Report::Log { level, message } => self.log.log(level, &message),
+            // Freed here, off the control thread.
+            Report::Trash(trash) => drop(trash),
         }
     }
 
@@ -381,7 +512,10 @@ impl ExecutorNode {
             ),
         };
         let msg = TrajectoryStatus {
-            header: self.header(self.clock.now()),
+            header: Header {
+                stamp: self.clock.stamp(self.clock.now()),
+                frame_id: String::new(),
+            },
             trajectory_stamp: stamp,
             source: src.to_string(),
             goal_id,
@@ -389,13 +523,15 @@ impl ExecutorNode {
             error_code: code,
             message: message.to_string(),
         };
-        Self::publish(
-            &self.status,
-            msg,
-            &mut self.publish_failures,
-            &self.log,
-            "trajectory status",
-        );
+        if !self.status.publish(msg) {
+            self.publish_failures += 1;
+            if self.publish_failures.is_power_of_two() {
+                self.log.warn(&format!(
+                    "trajectory status: sample dropped, a subscriber is not keeping up ({} drops so far)",
+                    self.publish_failures
+                ));
+            }
+        }
     }
 
     fn ros_now(&self) -> RosTime {
@@ -432,6 +568,11 @@ impl ExecutorNode {
     /// Hands a request to the preparation worker; results come back in order.
     fn enqueue(&mut self, job: Job, incoming: Incoming) {
         let ticket = self.prep.submit(incoming);
+        if let Job::Run(Source::Action { id, .. }) = &job {
+            if let Some(g) = self.goals.get_mut(id) {
+                g.ticket = Some(ticket);
+            }
+        }
         self.jobs.insert(ticket, job);
     }
 
@@ -452,7 +593,8 @@ impl ExecutorNode {
         }
     }
 
-    /// Finishes the requests the worker has prepared, in the order they arrived.
+    /// Hands the requests the worker has prepared to the control thread, in the order they
+    /// arrived; answers those that failed preparation.
     fn poll_prepared(&mut self) {
         while let Some((ticket, result)) = self.prep.try_recv() {
             let Some(job) = self.jobs.remove(&ticket) else {
@@ -469,23 +611,30 @@ impl ExecutorNode {
                     message: format!("internal error while validating: {e}"),
                 })),
             };
-            let now = self.clock.now();
             match job {
-                Job::Stop(source) => self.stop_on_empty_trajectory(&source),
-                Job::Validate(req_id) => {
-                    let checked = prepared
-                        .unwrap_or_else(|| Err(missing()))
-                        .and_then(|(p, tol)| Ok(self.exec.validate_prepared(&p, &tol, now)?));
-                    self.answer_validate(req_id, checked);
+                Job::Stop(source) => {
+                    let command = control::Command::Stop { tag: ticket };
+                    self.dispatch(ticket, Job::Stop(source), command);
                 }
+                Job::Validate(req_id) => match prepared.unwrap_or_else(|| Err(missing())) {
+                    Ok((prepared, tolerances)) => {
+                        let command = control::Command::Validate {
+                            tag: ticket,
+                            prepared,
+                            tolerances,
+                        };
+                        self.dispatch(ticket, Job::Validate(req_id), command);
+                    }
+                    Err(rej) => self.answer_validate(req_id, Err(rej)),
+                },
                 Job::Run(source) => {
-                    self.start(source, prepared.unwrap_or_else(|| Err(missing())), now);
+                    self.start(ticket, source, prepared.unwrap_or_else(|| Err(missing())));
                 }
             }
         }
     }
 
-    fn start(&mut self, source: Source, prepared: Prepared, now: f64) {
+    fn start(&mut self, ticket: u64, source: Source, prepared: Prepared) {
         if let Source::Action { id, .. } = &source {
             if self
                 .goals
@@ -507,41 +656,17 @@ impl ExecutorNode {
                 return;
             }
         }
-        let submitted = prepared.and_then(|(p, tol)| {
-            let id = self.exec.submit_prepared(&p, &tol, now)?;
-            Ok((id, p.point_count(), p.duration()))
-        });
-        match submitted {
-            Ok((exec_id, points, duration)) => {
-                let what = source.describe();
-                self.log.info(&format!(
-                    "accepted {what}: {points} points over {duration:.3} s"
-                ));
-                self.trajectory_status(&source, TrajectoryStatus::ACCEPTED, SUCCESSFUL, "accepted");
-                if let Source::Action { id, .. } = &source {
-                    if let Some(g) = self.goals.get_mut(id) {
-                        g.exec_id = Some(exec_id);
-                    }
-                }
-                self.sources.insert(exec_id, source);
+        match prepared {
+            Ok((prepared, tolerances)) => {
+                let command = control::Command::Start {
+                    tag: ticket,
+                    prepared,
+                    tolerances,
+                };
+                self.dispatch(ticket, Job::Run(source), command);
             }
             Err(rej) => self.rejected(&source, rej),
         }
-    }
-
-    /// JTC: an empty trajectory on the topic interface stops the current motion and holds.
-    /// Here the stop is the executor's controlled stop within the acceleration limits; the
-    /// stopped goal (topic or action) ends CANCELED.
-    fn stop_on_empty_trajectory(&mut self, source: &Source) {
-        let message = match self.exec.active_goal() {
-            Some(id) => match self.exec.cancel(id, self.clock.now()) {
-                Ok(()) => "empty trajectory: stopping the current motion".to_string(),
-                Err(e) => format!("empty trajectory: {e}"),
-            },
-            None => "empty trajectory: no active motion to stop".to_string(),
-        };
-        self.log.info(&message);
-        self.trajectory_status(source, TrajectoryStatus::ACCEPTED, SUCCESSFUL, &message);
     }
 
     fn poll_goals(&mut self) {
@@ -574,6 +699,7 @@ impl ExecutorNode {
                 accepted,
                 status: GoalStatusEnum::Executing,
                 exec_id: None,
+                ticket: None,
                 result: None,
             });
             self.statuses_changed = true;
@@ -608,8 +734,8 @@ impl ExecutorNode {
 
     fn cancel(&mut self, info: &GoalInfo) -> CancelGoalResponse {
         let selected = self.goals.select_for_cancel(info);
-        let now = self.clock.now();
         let mut canceling = Vec::new();
+        let mut to_control = Vec::new();
         for id in &selected {
             let Some(g) = self.goals.get_mut(id) else {
                 continue;
@@ -622,11 +748,15 @@ impl ExecutorNode {
                 goal_id: g.id,
                 stamp: g.accepted,
             });
-            // A goal still being prepared ends when its preparation comes back.
-            if let Some(exec_id) = g.exec_id {
-                if let Err(e) = self.exec.cancel(exec_id, now) {
-                    self.log.warn(&format!("cancel of goal {id:?}: {e}"));
-                }
+            // A goal still being prepared ends when its preparation comes back; one handed to
+            // the control thread is canceled there (after its start, if that is still queued).
+            if let Some(ticket) = g.ticket {
+                to_control.push(ticket);
+            }
+        }
+        for ticket in to_control {
+            if !self.jobs.contains_key(&ticket) {
+                let _ = self.commands.send(control::Command::Cancel { tag: ticket });
             }
         }
         if !canceling.is_empty() {
@@ -658,6 +788,13 @@ impl ExecutorNode {
         for (req_id, req) in requests {
             self.goals.pending_results.push((req.goal_id, req_id));
         }
+    }
+
+    /// Answers the result requests whose goal has ended.
+    fn answer_results(&mut self) {
+        if self.goals.pending_results.is_empty() {
+            return;
+        }
         for (req_id, status, result) in self.goals.take_ready_results() {
             if let Err(e) = self
                 .action
@@ -680,17 +817,13 @@ impl ExecutorNode {
         }
     }
 
-    fn answer_validate(
-        &mut self,
-        req_id: RmwRequestId,
-        checked: Result<ValidatedTrajectory, Rejection>,
-    ) {
+    fn answer_validate(&mut self, req_id: RmwRequestId, checked: Result<f64, Rejection>) {
         let resp = match checked {
-            Ok(traj) => ValidateTrajectoryResponse {
+            Ok(duration) => ValidateTrajectoryResponse {
                 valid: true,
                 error_code: SUCCESSFUL,
                 message: "valid".into(),
-                duration: traj.duration(),
+                duration,
             },
             Err(rej) => ValidateTrajectoryResponse {
                 valid: false,
@@ -703,95 +836,6 @@ impl ExecutorNode {
             self.log
                 .error(&format!("could not answer a validate request: {e:?}"));
         }
-    }
-
-    fn control_cycle(&mut self) {
-        let now = self.clock.now();
-        let measured = self.hw.state().clone();
-        let mut cycle = std::mem::take(&mut self.cycle);
-        if let Err(e) = self.exec.update_into(now, &measured, &mut cycle) {
-            self.log.error(&format!("control cycle failed: {e}"));
-            self.cycle = cycle;
-            return;
-        }
-        if let Err(e) = self.hw.write(
-            &self.cfg.limits,
-            &cycle.reference,
-            self.cfg.executor.control_period,
-        ) {
-            self.log
-                .error(&format!("hardware refused the command: {e}"));
-        }
-        let header = self.header(now);
-        let joint_state = |s: &JointSample| JointState {
-            header: header.clone(),
-            name: self.names.clone(),
-            position: s.positions.clone(),
-            velocity: s.velocities.clone(),
-            effort: Vec::new(),
-        };
-        let js = joint_state(&measured);
-        let cmd = joint_state(&cycle.reference);
-        let tfs = cycle.feedback.map_or(0.0, |f| f.time_from_start.max(0.0));
-        let state = JointTrajectoryControllerState {
-            header: header.clone(),
-            joint_names: self.names.clone(),
-            reference: convert::point(&cycle.reference, tfs),
-            feedback: convert::point(&measured, tfs),
-            error: convert::point(&cycle.error, tfs),
-            output: convert::point(&cycle.reference, tfs),
-            ..Default::default()
-        };
-        Self::publish(
-            &self.joint_states,
-            js,
-            &mut self.publish_failures,
-            &self.log,
-            "joint states",
-        );
-        Self::publish(
-            &self.command,
-            cmd,
-            &mut self.publish_failures,
-            &self.log,
-            "joint command",
-        );
-        Self::publish(
-            &self.controller_state,
-            state,
-            &mut self.publish_failures,
-            &self.log,
-            "controller state",
-        );
-
-        for ev in std::mem::take(&mut cycle.events) {
-            self.finish(ev.id, ev.outcome);
-        }
-        if let Some(fb) = cycle.feedback {
-            if now >= self.next_feedback {
-                self.next_feedback = now + 1.0 / self.cfg.action_monitor_rate;
-                if let Some(Source::Action { id, .. }) = self.sources.get(&fb.id) {
-                    let feedback = FollowJointTrajectoryFeedback {
-                        header,
-                        joint_names: self.names.clone(),
-                        desired: convert::point(&cycle.reference, tfs),
-                        actual: convert::point(&measured, tfs),
-                        error: convert::point(&cycle.error, tfs),
-                        ..Default::default()
-                    };
-                    if let Err(e) = self.action.send_feedback(*id, feedback) {
-                        self.log.debug(&format!("feedback not sent: {e:?}"));
-                    }
-                }
-            }
-        }
-        if self.statuses_changed {
-            self.statuses_changed = false;
-            if let Err(e) = self.action.send_goal_statuses(self.goals.status_array()) {
-                self.log.warn(&format!("goal status not published: {e:?}"));
-            }
-        }
-        self.cycle = cycle;
     }
 
     fn finish(&mut self, id: ExecGoalId, outcome: Outcome) {
