@@ -367,18 +367,11 @@ const STAMP_SLACK: f64 = 1e-6;
 const BIG_TIMEOUT: Duration = Duration::from_secs(300);
 const TIMEOUT: Duration = Duration::from_secs(20);
 
-fn duration(t: f64) -> RosDuration {
-    RosDuration {
-        sec: t.floor() as i32,
-        nanosec: ((t - t.floor()) * 1e9).round().min(999_999_999.0) as u32,
-    }
-}
-
 fn point(t: f64, q1: f64, v1: f64) -> JointTrajectoryPoint {
     JointTrajectoryPoint {
         positions: vec![q1, 0.0, 0.0, 0.0, 0.0, 0.0],
         velocities: vec![v1, 0.0, 0.0, 0.0, 0.0, 0.0],
-        time_from_start: duration(t),
+        time_from_start: RosDuration::from_secs_f64(t).unwrap(),
         ..Default::default()
     }
 }

@@ -193,24 +193,14 @@ impl ValidatedTrajectory {
             out.accelerations.fill(0.0);
             return;
         }
-        let body = &self.body;
-        let body_start = body
-            .segments
-            .first()
-            .map(|s| self.start_time + s.t0)
-            .unwrap_or(f64::INFINITY);
-        if let Some(lead) = &self.lead {
-            if t < lead.segment.t0 {
-                self.copy_initial(out);
-            } else if t < lead.segment.t1 || body.segments.is_empty() {
-                write_segment(&lead.coeffs, t - lead.segment.t0, out);
-            } else {
-                self.sample_body(t, out);
+        match (&self.lead, self.body.segments.first()) {
+            (Some(lead), _) if t < lead.segment.t0 => self.copy_initial(out),
+            (Some(lead), first) if t < lead.segment.t1 || first.is_none() => {
+                write_segment(&lead.coeffs, t - lead.segment.t0, out)
             }
-        } else if t < body_start {
-            self.copy_initial(out);
-        } else {
-            self.sample_body(t, out);
+            (Some(_), _) => self.sample_body(t, out),
+            (None, Some(first)) if t >= self.start_time + first.t0 => self.sample_body(t, out),
+            (None, _) => self.copy_initial(out),
         }
     }
 

@@ -142,6 +142,27 @@ pub enum Report {
     Trash(Trash),
 }
 
+/// Queues `msg` on `stream` without blocking; a dropped sample (full queue: a subscriber is
+/// not keeping up) is counted in `failures`, shared by the streams of a thread.
+///
+/// # Returns
+/// The warning to log when the count reaches a power of two, so that a persistent slow
+/// subscriber does not flood the log.
+pub fn publish_counted<M: serde::Serialize + Send + 'static>(
+    stream: &Streamer<M>,
+    msg: M,
+    failures: &mut u64,
+    what: &str,
+) -> Option<String> {
+    if stream.publish(msg) {
+        return None;
+    }
+    *failures += 1;
+    failures.is_power_of_two().then(|| {
+        format!("{what}: sample dropped, a subscriber is not keeping up ({failures} drops so far)")
+    })
+}
+
 /// The published state streams of the control thread.
 pub struct Streams {
     /// `joint_states`.
@@ -340,6 +361,8 @@ impl ControlLoop {
         }
     }
 
+    /// Queues `msg` on `stream`; a dropped sample is counted and logged (through a report) at
+    /// powers of two.
     fn publish<M: serde::Serialize + Send + 'static>(
         stream: &Streamer<M>,
         msg: M,
@@ -347,16 +370,11 @@ impl ControlLoop {
         reports: &Sender<Report>,
         what: &str,
     ) {
-        if !stream.publish(msg) {
-            *failures += 1;
-            if failures.is_power_of_two() {
-                let _ = reports.send(Report::Log {
-                    level: LogLevel::Warn,
-                    message: format!(
-                        "{what}: sample dropped, a subscriber is not keeping up ({failures} drops so far)"
-                    ),
-                });
-            }
+        if let Some(message) = publish_counted(stream, msg, failures, what) {
+            let _ = reports.send(Report::Log {
+                level: LogLevel::Warn,
+                message,
+            });
         }
     }
 

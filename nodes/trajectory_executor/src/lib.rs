@@ -523,14 +523,9 @@ impl ExecutorNode {
             error_code: code,
             message: message.to_string(),
         };
-        if !self.status.publish(msg) {
-            self.publish_failures += 1;
-            if self.publish_failures.is_power_of_two() {
-                self.log.warn(&format!(
-                    "trajectory status: sample dropped, a subscriber is not keeping up ({} drops so far)",
-                    self.publish_failures
-                ));
-            }
+        let f = &mut self.publish_failures;
+        if let Some(warning) = control::publish_counted(&self.status, msg, f, "trajectory status") {
+            self.log.warn(&warning);
         }
     }
 
