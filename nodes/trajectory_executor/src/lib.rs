@@ -432,14 +432,25 @@ impl ExecutorNode {
         result
     }
 
-    /// Hands a command to the control thread.
+    /// Hands a command to the control thread; if it has ended (`spin` then stops the node),
+    /// the request is answered with a rejection instead.
     fn dispatch(&mut self, tag: u64, job: Job, command: control::Command) {
         if self.commands.send(command).is_ok() {
             self.dispatched.insert(tag, job);
-        } else {
-            // Only after the control thread ended; `spin` stops the node then.
-            self.log
-                .error("the control thread is gone; a request was not executed");
+            return;
+        }
+        let rej = Rejection {
+            code: INVALID_GOAL,
+            message: "the control loop has ended; the executor is stopping".into(),
+        };
+        match job {
+            Job::Run(source) => self.rejected(&source, rej),
+            Job::Validate(req_id) => self.answer_validate(req_id, Err(rej)),
+            Job::Stop(source) => {
+                self.log.error(&rej.message);
+                let status = TrajectoryStatus::REJECTED;
+                self.trajectory_status(&source, status, rej.code, &rej.message);
+            }
         }
     }
 
