@@ -1,6 +1,6 @@
 //! The single error type of `kerf_robot`.
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 /// Everything that can go wrong while loading a robot description or
 /// evaluating its kinematics.
@@ -236,6 +236,30 @@ pub enum RobotError {
         value: f64,
     },
 
+    /// No kerf data directory was found (the search of `kerf_robot::data`).
+    #[error("{}", describe_data_search(variable, marker, env.as_deref(), share.as_deref(), source_tree.as_deref()))]
+    DataNotFound {
+        /// The environment variable searched first, `KERF_DATA_DIR`.
+        variable: &'static str,
+        /// The file, relative to a directory, that makes it a kerf data directory.
+        marker: &'static str,
+        /// The variable's directory when it is set (then it is the only place searched).
+        env: Option<PathBuf>,
+        /// The share directory beside the binary, when searched.
+        share: Option<PathBuf>,
+        /// The source tree, when searched.
+        source_tree: Option<PathBuf>,
+    },
+
+    /// A `package://` URI that does not name a path below the kerf data directory.
+    #[error("{uri}: {reason}")]
+    PackageUri {
+        /// The URI as given.
+        uri: String,
+        /// What is wrong with it.
+        reason: String,
+    },
+
     /// A joint value is outside the joint's position limits.
     #[error("position {value} of joint `{joint}` is outside its limits [{min}, {max}]")]
     OutOfRange {
@@ -248,4 +272,39 @@ pub enum RobotError {
         /// Upper limit (m or rad).
         max: f64,
     },
+}
+
+/// The message of [`RobotError::DataNotFound`]: every place searched and how to fix it.
+fn describe_data_search(
+    variable: &str,
+    marker: &str,
+    env: Option<&Path>,
+    share: Option<&Path>,
+    source_tree: Option<&Path>,
+) -> String {
+    if let Some(env) = env {
+        return format!(
+            "{variable} is set to {}, which is not a kerf data directory (it has no {marker}); \
+             only {variable} was searched: point it at a kerf data directory (PREFIX/share/kerf \
+             as installed by launch_scripts/install.sh, or the source tree) or unset it to \
+             search the share directory beside the binary and the source tree",
+            env.display()
+        );
+    }
+    let mut places = vec![format!("{variable} (unset)")];
+    if let Some(share) = share {
+        places.push(format!(
+            "{} (share directory beside the binary)",
+            share.display()
+        ));
+    }
+    if let Some(tree) = source_tree {
+        places.push(format!("{} (source tree)", tree.display()));
+    }
+    format!(
+        "no kerf data directory (a directory holding {marker}) found; searched {}: set \
+         {variable} to one, or install the data with launch_scripts/install.sh PREFIX \
+         --data-only beside PREFIX/bin/kerf",
+        places.join(", ")
+    )
 }

@@ -16,14 +16,17 @@
 //! The repository's `urdf/` directory holds the two machines of kerf: the
 //! 6-axis laser cutting machine of seed 001 (`laser_cutter.urdf`) and the
 //! ABB IRB 6660-130/3.1 (`irb6660.urdf`), each with its `*_limits.yaml`.
+//! [`data`] finds them, and every other shipped file, in the source tree or an installed
+//! kerf's share directory (`KERF_DATA_DIR`, then `<exe dir>/../share/kerf`, then the source
+//! tree).
 //!
 //! # Example
 //!
 //! ```
-//! use std::path::Path;
-//! use kerf_robot::{JointKind, RobotModel};
+//! use kerf_robot::{data, JointKind, RobotModel};
 //!
-//! let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../urdf");
+//! // The shipped descriptions, found by the data search of [`data`].
+//! let dir = data::path("urdf")?;
 //! let robot = RobotModel::from_files(
 //!     &dir.join("irb6660.urdf"),
 //!     Some(&dir.join("irb6660_limits.yaml")),
@@ -49,6 +52,7 @@
 //! ```
 
 mod chain;
+pub mod data;
 mod error;
 mod joint;
 mod limits;
