@@ -40,6 +40,23 @@ pub enum ChatterError {
         /// What is unsupported.
         reason: String,
     },
+    /// A computation over a grid of spindle speeds (a lobe, a feed map,
+    /// [`crate::lobe_map`]) failed: which one, at which speed when one
+    /// speed failed, and why.
+    #[error("{what}: {}{reason}", at_speed(.rpm))]
+    Grid {
+        /// The computation (e.g. "constant-delay lobes").
+        what: String,
+        /// The spindle speed [rpm] that failed, if one did.
+        rpm: Option<f64>,
+        /// The failure's message.
+        reason: String,
+    },
+}
+
+/// "3000 rpm: " or "" for [`ChatterError::Grid`].
+fn at_speed(rpm: &Option<f64>) -> String {
+    rpm.map_or(String::new(), |r| format!("{r} rpm: "))
 }
 
 impl ChatterError {

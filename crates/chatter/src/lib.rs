@@ -12,6 +12,9 @@
 //! | [`fdm`] | full discretization, precomputed per spindle speed; fractional and multiple delays | Ding et al. 2010 |
 //! | [`spectral`] | restarted Arnoldi (capped) with a dense Schur reference | Floquet theory |
 //! | [`lobes`] | critical depth per speed: coarse scan + bisection | Insperger & Stépán 2004 §5 |
+//! | [`lobe_map`] | one state's chart: both lobes and the feed × speed map over a speed grid | seed 004 Fig. 4, 7 |
+//! | [`feed_bound`] | the lowest feed from which every higher feed is stable | seed 004 Fig. 4, 7 |
+//! | [`modes`] | closed forms: stiffness eigenvalues, undamped natural frequencies | |
 //! | [`trochoid`] | exact tooth-path geometry: delay and chip | seed 004 eq. 2-4 |
 //! | [`equilibrium`] | periodic forced response with feed-dependent delays, loss of contact, multiple regeneration; optional power-law force | seed 004 eq. 1-7, Bachrathy et al. 2011 |
 //! | [`linearize`] | the variational system about it, with the workpiece-wall term | seed 004 eq. 8 |
@@ -70,6 +73,10 @@ pub mod model;
 pub mod directional;
 pub mod fdm;
 pub mod lobes;
+// The stability chart of one state (`kerf lobes`): lobes, feed map, feed bound, modes.
+pub mod feed_bound;
+pub mod lobe_map;
+pub mod modes;
 pub mod spectral;
 
 // State-dependent model (seed 004 section 2) and time-domain simulation.
@@ -88,15 +95,18 @@ pub use equilibrium::{
 };
 pub use error::ChatterError;
 pub use fdm::{CompiledDde, Discretization, DEFAULT_STEPS};
+pub use feed_bound::{feed_lower_bound, FeedBound};
 pub use indicator::{
     chatter_indicator, indicator_dde, indicator_map, DelayModel, Indicator, IndicatorSettings,
 };
 pub use linearize::{chip_sensitivity, linearize, tooth_gain, ChipSensitivity, LinearizeSettings};
+pub use lobe_map::{LobeGrid, LobeMap};
 pub use lobes::{critical_depth, stability_lobes, LobeOptions, LobePoint};
 pub use model::{
     chip_direction, force_direction, DdeSample, DelayTerm, MillingProcess, Modal2, Mode,
     PeriodicDde,
 };
+pub use modes::{natural_frequencies, symmetric_eigenvalues};
 pub use spectral::{
     eigenvalues_dense, spectral_radius_arnoldi, spectral_radius_dense, ArnoldiOptions,
 };
