@@ -21,7 +21,6 @@
 //! only parse, call [`planner::plan`] and publish.
 
 pub mod baseline;
-pub mod bpillar;
 pub mod collision;
 pub mod error;
 pub mod gfd;

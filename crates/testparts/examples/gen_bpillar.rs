@@ -1,8 +1,8 @@
 //! Generates the B-pillar-like test workpiece and the two cut requests of
-//! seed 001 section 3 ([`kerf_mjto::bpillar`]).
+//! seed 001 section 3 ([`kerf_testparts::bpillar`]).
 //!
 //! ```sh
-//! cargo run -p kerf_mjto --example gen_bpillar -- --out .
+//! cargo run -p kerf_testparts --example gen_bpillar -- --out .
 //! ```
 //!
 //! writes `urdf/meshes/bpillar.obj` and `crates/mjto/cases/case{1,2}.yaml`
@@ -14,8 +14,8 @@
 use std::path::PathBuf;
 use std::process::ExitCode;
 
-use kerf_mjto::bpillar::{self, Generated};
 use kerf_mjto::{CutRequest, LaserMachine};
+use kerf_testparts::bpillar::{self, Generated};
 
 fn main() -> ExitCode {
     let mut out = PathBuf::from(".");

@@ -1,13 +1,13 @@
 //! The B-pillar test workpiece and the two cut requests of seed 001
-//! section 3 (`kerf_mjto::bpillar`, `crates/mjto/cases/case{1,2}.yaml`,
+//! section 3 (`kerf_testparts::bpillar`, `crates/mjto/cases/case{1,2}.yaml`,
 //! `urdf/meshes/bpillar.obj`).
 
 use std::collections::HashMap;
 use std::path::PathBuf;
 
-use kerf_mjto::bpillar::{self, BPillar, BPillarParams};
 use kerf_mjto::mesh::{self, MeshData};
 use kerf_mjto::{CutRequest, LaserMachine};
+use kerf_testparts::bpillar::{self, BPillar, BPillarParams};
 use nalgebra::{Isometry3, Translation3, UnitQuaternion, Vector3};
 
 fn repo_root() -> PathBuf {

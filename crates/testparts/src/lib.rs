@@ -1,0 +1,13 @@
+//! Test parts for the kerf planners, kept out of the planner libraries.
+//!
+//! [`bpillar`] generates the B-pillar-like stamped workpiece
+//! (`urdf/meshes/bpillar.obj`) and the two cut requests of seed 001
+//! section 3 (`crates/mjto/cases/case{1,2}.yaml`) that the MJTO planner's
+//! tests, benchmarks and end-to-end tests run on. Regenerate the committed
+//! files with `cargo run -p kerf_testparts --example gen_bpillar -- --out .`
+//! from the repository root.
+
+pub mod bpillar;
+pub mod error;
+
+pub use error::TestPartError;
