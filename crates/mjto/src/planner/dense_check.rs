@@ -1,0 +1,231 @@
+//! The dense check of a trajectory (collisions and lead/tilt at every
+//! sample), RTO insertion against its violations, and the geometric
+//! metrics of a sampled trajectory.
+
+use super::{Context, Iterate, RtoState, Samples, ANGLE_TOLERANCE};
+use crate::collision::CollisionWorld;
+use crate::error::CollisionReport;
+use crate::kinematics::{forward, tool_axis};
+use crate::plan::Metrics;
+use crate::PlanError;
+
+impl Context<'_> {
+    /// Collision and lead/tilt check of every sample, on two threads.
+    pub(super) fn check(&self, world: &CollisionWorld, s: &Samples) -> Vec<CollisionReport> {
+        let n = s.times.len();
+        let half = n / 2;
+        let check_range = |range: std::ops::Range<usize>| -> Vec<CollisionReport> {
+            range
+                .filter_map(|k| self.check_sample(world, s.times[k], s.u[k], &s.q[k]))
+                .collect()
+        };
+        let (mut first, second) = std::thread::scope(|scope| {
+            let handle = scope.spawn(|| check_range(half..n));
+            let first = check_range(0..half);
+            // A panic in the worker is a bug; report it as a violation of
+            // every sample rather than unwinding through the planner.
+            let second = handle.join().unwrap_or_else(|_| {
+                vec![CollisionReport {
+                    u: 0.0,
+                    time: 0.0,
+                    cl_index: 0,
+                    links: Vec::new(),
+                    reason: "internal error: the collision-check thread panicked".into(),
+                }]
+            });
+            (first, second)
+        });
+        first.extend(second);
+        first
+    }
+
+    pub(super) fn check_sample(
+        &self,
+        world: &CollisionWorld,
+        time: f64,
+        u: f64,
+        q: &[f64; 6],
+    ) -> Option<CollisionReport> {
+        let links: Vec<String> = world
+            .colliding_links(q)
+            .into_iter()
+            .map(|l| l.to_string())
+            .collect();
+        let axis = tool_axis(q[3], q[4]);
+        let (lead, tilt) = self.frames.lead_tilt(u, &axis);
+        let r = self.request;
+        let mut reasons = Vec::new();
+        if !links.is_empty() {
+            reasons.push(format!(
+                "head links {} touch the workpiece",
+                links.join(", ")
+            ));
+        }
+        if lead.abs() > r.max_lead_angle * (1.0 + ANGLE_TOLERANCE) {
+            reasons.push(format!(
+                "lead angle {:.2}° exceeds {:.2}°",
+                lead.to_degrees(),
+                r.max_lead_angle.to_degrees()
+            ));
+        }
+        if tilt.abs() > r.max_tilt_angle * (1.0 + ANGLE_TOLERANCE) {
+            reasons.push(format!(
+                "tilt angle {:.2}° exceeds {:.2}°",
+                tilt.to_degrees(),
+                r.max_tilt_angle.to_degrees()
+            ));
+        }
+        if reasons.is_empty() {
+            return None;
+        }
+        Some(CollisionReport {
+            u,
+            time,
+            cl_index: self.frames.nearest_index(u),
+            links,
+            reason: reasons.join("; "),
+        })
+    }
+
+    /// Inserts one RTO per run of consecutive violating samples, at the CL
+    /// point nearest to the run's worst (middle) sample that is not yet an
+    /// RTO; its value is the free GFD candidate nearest (eq. 55) to the
+    /// current trajectory there. Returns how many were inserted.
+    pub(super) fn insert_rtos(
+        &self,
+        world: &CollisionWorld,
+        it: &Iterate,
+        violations: &[CollisionReport],
+        rtos: &mut Vec<RtoState>,
+        iteration: usize,
+    ) -> Result<usize, PlanError> {
+        let mut runs: Vec<(usize, usize)> = Vec::new();
+        let mut start = 0;
+        for k in 1..=violations.len() {
+            let split =
+                k == violations.len() || violations[k].cl_index > violations[k - 1].cl_index + 1;
+            if split {
+                runs.push((start, k - 1));
+                start = k;
+            }
+        }
+        let mut added = 0;
+        for (a, b) in runs {
+            let mid = &violations[(a + b) / 2];
+            let Some(i) = self.free_cl_index(
+                mid.cl_index,
+                violations[a].cl_index,
+                violations[b].cl_index,
+                rtos,
+            ) else {
+                continue;
+            };
+            let u = self.v.u[i];
+            let target = [it.q4.eval(u)[0], it.q5.eval(u)[0], it.w[i]];
+            // The grid is centred on the trajectory's orientation and spans
+            // the usual q6 range around the preferred standoff (a q6 at a
+            // stroke end would leave no q6 span); the candidate taken is the
+            // free one nearest (eq. 55) to the trajectory's (q4, q5, q6).
+            let centre = [
+                target[0],
+                target[1],
+                self.request.options.reference_standoff,
+            ];
+            let mut gfd = self.build_gfd(i, centre);
+            let weights = &self.request.options.weights;
+            let Some(p) = gfd.nearest_free(target, weights, world) else {
+                return Err(PlanError::NoFeasibleOrientation {
+                    index: i,
+                    u,
+                    reason: format!(
+                        "inserting an RTO against: {}; none of the {} GFD candidates around the trajectory is free ({} outside the lead/tilt limits or stroke)",
+                        mid.reason,
+                        gfd.total,
+                        gfd.total - gfd.candidates.len()
+                    ),
+                });
+            };
+            let pos = rtos.partition_point(|r| r.cl_index < i);
+            rtos.insert(
+                pos,
+                RtoState {
+                    cl_index: i,
+                    u,
+                    q: gfd.candidates[p].q,
+                    inserted_at: iteration,
+                },
+            );
+            added += 1;
+        }
+        Ok(added)
+    }
+
+    /// The CL index in [lo, hi] (widened by one on each side) nearest to
+    /// `preferred` that is not an RTO yet.
+    pub(super) fn free_cl_index(
+        &self,
+        preferred: usize,
+        lo: usize,
+        hi: usize,
+        rtos: &[RtoState],
+    ) -> Option<usize> {
+        let n = self.v.points.len();
+        let lo = lo.saturating_sub(1);
+        let hi = (hi + 1).min(n - 1);
+        let taken = |i: usize| rtos.iter().any(|r| r.cl_index == i);
+        (0..=(hi - lo))
+            .flat_map(|d| [preferred.checked_sub(d), preferred.checked_add(d)])
+            .flatten()
+            .find(|&i| i >= lo && i <= hi && !taken(i))
+    }
+
+    /// Largest distance between FK (eq. 2) of the splines at the CL
+    /// parameters u_i and the CL points C_i.
+    pub(super) fn cl_error_at_points(&self, it: &Iterate) -> f64 {
+        self.v
+            .u
+            .iter()
+            .zip(&self.v.points)
+            .map(|(&u, c)| {
+                let q = [
+                    it.m[0].eval(u)[0],
+                    it.m[1].eval(u)[0],
+                    it.m[2].eval(u)[0],
+                    it.q4.eval(u)[0],
+                    it.q5.eval(u)[0],
+                    it.q6.eval(u)[0],
+                ];
+                (forward(&q).0 - c).norm()
+            })
+            .fold(0.0, f64::max)
+    }
+
+    /// CL error against the reference path, lead/tilt extremes and (when a
+    /// world is given) the colliding samples of a sampled trajectory.
+    pub(super) fn fill_geometry(
+        &self,
+        m: &mut Metrics,
+        u: &[f64],
+        q: &[[f64; 6]],
+        world: Option<&CollisionWorld>,
+    ) {
+        for (&u, q) in u.iter().zip(q) {
+            let (c, o) = forward(q);
+            m.max_cl_error = m.max_cl_error.max((c - self.frames.cl_point(u)).norm());
+            let (lead, tilt) = self.frames.lead_tilt(u, &o);
+            m.max_lead_angle = m.max_lead_angle.max(lead.abs());
+            m.max_tilt_angle = m.max_tilt_angle.max(tilt.abs());
+        }
+        if let Some(w) = world {
+            // Two threads, as the dense check of the plan itself.
+            let half = q.len() / 2;
+            let count = |part: &[[f64; 6]]| part.iter().filter(|q| !w.is_free(q)).count();
+            m.colliding_samples = std::thread::scope(|scope| {
+                let second = scope.spawn(|| count(&q[half..]));
+                let first = count(&q[..half]);
+                // A panicking check thread counts every sample of its half.
+                first + second.join().unwrap_or(q.len() - half)
+            });
+        }
+    }
+}

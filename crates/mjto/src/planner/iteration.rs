@@ -1,0 +1,274 @@
+//! The loop of seed 001 Figure 6: RTO selection, both QPs, the dense
+//! samples and the check of the final plan against every limit.
+
+use std::time::Instant;
+
+use kerf_bspline::{BSpline, KnotVector};
+use nalgebra::Vector3;
+
+use super::{bspline_error, internal, Context, Iterate, RtoState, Samples, LIMIT_TOLERANCE};
+use crate::baseline::{quaternion_interpolation, Rto};
+use crate::collision::CollisionWorld;
+use crate::gfd::Gfd;
+use crate::kinematics::tool_axis;
+use crate::machine::JOINT_NAMES;
+use crate::metrics::{finite_differences, kinematic_metrics, limit_violations};
+use crate::plan::{RtoRecord, StageTimes};
+use crate::rotary::{JerkFactor, RotaryQp};
+use crate::selection::select_rtos;
+use crate::standoff::{solve_standoff, MPathProblem};
+use crate::timelaw::chain_rule;
+use crate::{CutPlan, PlanError};
+
+impl Context<'_> {
+    pub(super) fn run(
+        &self,
+        world: &CollisionWorld,
+        knots: &KnotVector,
+        factor: &JerkFactor,
+        mut times: StageTimes,
+        start: Instant,
+    ) -> Result<CutPlan, PlanError> {
+        let o = &self.request.options;
+        // 1. GFDs of the initial RTOs and their selection (eq. 55-56).
+        let t = Instant::now();
+        let indices = self.initial_rto_indices();
+        let mut gfds: Vec<Gfd> = indices
+            .iter()
+            .map(|&i| self.build_gfd(i, self.reference(i)))
+            .collect();
+        times.gfd += t.elapsed().as_secs_f64();
+        let t = Instant::now();
+        let lengths: Vec<f64> = indices
+            .windows(2)
+            .map(|w| self.v.arc_length[w[1]] - self.v.arc_length[w[0]])
+            .collect();
+        let chosen = select_rtos(&mut gfds, &lengths, &o.weights, world)?;
+        times.selection += t.elapsed().as_secs_f64();
+        let mut rtos: Vec<RtoState> = gfds
+            .iter()
+            .zip(&chosen)
+            .map(|(g, &p)| RtoState {
+                cl_index: g.cl_index,
+                u: g.u,
+                q: g.candidates[p].q,
+                inserted_at: 0,
+            })
+            .collect();
+
+        // 2. The loop of Figure 6.
+        let mut iteration = 0;
+        let (iterate, samples) = loop {
+            iteration += 1;
+            let iterate = self.solve(knots, factor, &rtos, &mut times)?;
+            let samples = self.sample(&iterate);
+            let t = Instant::now();
+            let violations = self.check(world, &samples);
+            times.collision += t.elapsed().as_secs_f64();
+            if violations.is_empty() {
+                break (iterate, samples);
+            }
+            if iteration >= o.max_iterations {
+                return Err(PlanError::Collision {
+                    iterations: iteration,
+                    collisions: violations,
+                });
+            }
+            let t = Instant::now();
+            let added = self.insert_rtos(world, &iterate, &violations, &mut rtos, iteration)?;
+            times.gfd += t.elapsed().as_secs_f64();
+            if added == 0 {
+                let mut collisions = violations;
+                for c in &mut collisions {
+                    c.reason
+                        .push_str("; no CL point left to insert an RTO next to it");
+                }
+                return Err(PlanError::Collision {
+                    iterations: iteration,
+                    collisions,
+                });
+            }
+        };
+
+        // 3. Limits (analytic, eq. 7), metrics, QI baseline.
+        let t = Instant::now();
+        let limits = self.limits();
+        let violations = limit_violations(
+            &samples.times,
+            &samples.q,
+            &samples.qd,
+            &samples.qdd,
+            &samples.qddd,
+            limits,
+            LIMIT_TOLERANCE,
+        );
+        if !violations.is_empty() {
+            return Err(PlanError::LimitViolation { violations });
+        }
+        let mut metrics = kinematic_metrics(
+            &samples.times,
+            &samples.q,
+            &samples.qd,
+            &samples.qdd,
+            &samples.qddd,
+            limits,
+        );
+        self.fill_geometry(&mut metrics, &samples.u, &samples.q, None);
+        metrics.max_cl_error = metrics.max_cl_error.max(self.cl_error_at_points(&iterate));
+
+        let qi_rtos: Vec<Rto> = rtos
+            .iter()
+            .map(|r| Rto {
+                u: r.u,
+                q4: r.q[0],
+                q5: r.q[1],
+                q6: r.q[2],
+            })
+            .collect();
+        let dt = self.request.sample_period;
+        let (qi_times, qi_q) =
+            quaternion_interpolation(&self.frames, &qi_rtos, &self.law, self.v.sigma, dt, limits)?;
+        let (qi_v, qi_a, qi_j) = finite_differences(&qi_times, &qi_q);
+        let mut qi_metrics = kinematic_metrics(&qi_times, &qi_q, &qi_v, &qi_a, &qi_j, limits);
+        let qi_u: Vec<f64> = qi_times.iter().map(|&t| self.u_at(t)).collect();
+        self.fill_geometry(&mut qi_metrics, &qi_u, &qi_q, Some(world));
+        times.evaluation += t.elapsed().as_secs_f64();
+        times.total = start.elapsed().as_secs_f64();
+
+        Ok(CutPlan {
+            request_id: self.request.request_id.clone(),
+            joint_names: JOINT_NAMES.iter().map(|s| s.to_string()).collect(),
+            times: samples.times,
+            positions: samples.q,
+            velocities: samples.qd,
+            accelerations: samples.qdd,
+            rtos: rtos
+                .iter()
+                .map(|r| RtoRecord {
+                    u: r.u,
+                    cl_index: r.cl_index,
+                    q4: r.q[0],
+                    q5: r.q[1],
+                    q6: r.q[2],
+                    inserted_at_iteration: r.inserted_at,
+                })
+                .collect(),
+            metrics,
+            qi_metrics,
+            iterations: iteration,
+            collision_queries: world.queries(),
+            control_points: knots.n_coeffs(),
+            path_length: self.v.sigma,
+            times_per_stage: times,
+        })
+    }
+
+    /// Both QPs for the current RTOs (eq. 61, then eq. 62 with the
+    /// optimized orientation).
+    pub(super) fn solve(
+        &self,
+        knots: &KnotVector,
+        factor: &JerkFactor,
+        rtos: &[RtoState],
+        times: &mut StageTimes,
+    ) -> Result<Iterate, PlanError> {
+        let limits = self.limits();
+        let t = Instant::now();
+        let mut rotary = Vec::with_capacity(2);
+        for (k, name) in [(3usize, "q4"), (4usize, "q5")] {
+            let via: Vec<(f64, f64)> = rtos.iter().map(|r| (r.u, r.q[k - 3])).collect();
+            let problem = RotaryQp {
+                axis_name: name,
+                knots,
+                factor,
+                limits: limits[k],
+                sigma: self.v.sigma,
+                feedrate: self.request.feedrate,
+                boundary: [0.0; 4],
+                via: &via,
+            };
+            let (coeffs, _) = problem.solve()?;
+            rotary.push(BSpline::new(knots.clone(), coeffs).map_err(bspline_error)?);
+        }
+        times.rotary_qp += t.elapsed().as_secs_f64();
+        let q5 = rotary
+            .pop()
+            .ok_or_else(|| internal("rotary QP result missing"))?;
+        let q4 = rotary
+            .pop()
+            .ok_or_else(|| internal("rotary QP result missing"))?;
+
+        let t = Instant::now();
+        let axes: Vec<Vector3<f64>> = self
+            .v
+            .u
+            .iter()
+            .map(|&u| tool_axis(q4.eval(u)[0], q5.eval(u)[0]))
+            .collect();
+        let via: Vec<(usize, f64)> = rtos.iter().map(|r| (r.cl_index, r.q[2])).collect();
+        let problem = MPathProblem {
+            knots,
+            factor,
+            params: &self.v.u,
+            points: &self.v.points,
+            axes: &axes,
+            stroke: (limits[5].min, limits[5].max),
+            via: &via,
+            reference: self.request.options.reference_standoff,
+        };
+        let sol = solve_standoff(&problem)?;
+        let [px, py, pz] = sol.control_points;
+        let m = [
+            BSpline::new(knots.clone(), px).map_err(bspline_error)?,
+            BSpline::new(knots.clone(), py).map_err(bspline_error)?,
+            BSpline::new(knots.clone(), pz).map_err(bspline_error)?,
+        ];
+        let q6 = BSpline::new(knots.clone(), sol.standoff_coeffs).map_err(bspline_error)?;
+        times.mpath_qp += t.elapsed().as_secs_f64();
+        Ok(Iterate {
+            q4,
+            q5,
+            m,
+            q6,
+            w: sol.w,
+        })
+    }
+
+    /// u at time t of the feed profile (eq. 1).
+    pub(super) fn u_at(&self, t: f64) -> f64 {
+        (self.law.eval(t)[0] / self.v.sigma).clamp(0.0, 1.0)
+    }
+
+    /// Samples every Δt: q1..q3 from the M path (eq. 47: M = (q1, q2, q3)),
+    /// q4, q5 from eq. 5, q6 from its spline; derivatives by eq. 7.
+    pub(super) fn sample(&self, it: &Iterate) -> Samples {
+        let times = self.sample_times.clone();
+        let n = times.len();
+        let mut s = Samples {
+            u: Vec::with_capacity(n),
+            q: Vec::with_capacity(n),
+            qd: Vec::with_capacity(n),
+            qdd: Vec::with_capacity(n),
+            qddd: Vec::with_capacity(n),
+            times,
+        };
+        let splines = [&it.m[0], &it.m[1], &it.m[2], &it.q4, &it.q5, &it.q6];
+        for &t in &s.times {
+            let law = self.law.eval(t);
+            let u = (law[0] / self.v.sigma).clamp(0.0, 1.0);
+            let mut row = [[0.0; 6]; 4];
+            for (j, spline) in splines.iter().enumerate() {
+                let d = chain_rule(spline.eval(u), law, self.v.sigma);
+                for (r, value) in d.iter().enumerate() {
+                    row[r][j] = *value;
+                }
+            }
+            s.u.push(u);
+            s.q.push(row[0]);
+            s.qd.push(row[1]);
+            s.qdd.push(row[2]);
+            s.qddd.push(row[3]);
+        }
+        s
+    }
+}
