@@ -25,6 +25,7 @@ pub mod request;
 
 // DDPG (seed 004 Algorithm 1, Table 2) on candle.
 pub mod ddpg;
+pub mod history;
 pub mod nets;
 pub mod policy;
 pub mod replay;
