@@ -283,7 +283,12 @@ fn identical(a: &MillPlanOutput, b: &MillPlanOutput) -> bool {
                     s.time,
                 ]
             })
-            .chain(o.trajectory.points.iter().flat_map(|p| p.positions))
+            .chain(
+                o.trajectory
+                    .points()
+                    .iter()
+                    .flat_map(|p| p.positions.iter().copied()),
+            )
             .map(f64::to_bits)
             .collect()
     };

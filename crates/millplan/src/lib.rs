@@ -19,9 +19,16 @@ pub mod plan;
 pub mod reward;
 pub mod timing;
 
+// The joint trajectory (the executor's type), as planned and as executed.
+pub mod executed;
+pub mod planned;
+pub mod trajectory;
+
 // The planner node's ROS-free front half: requests and planning.
+pub mod output;
 pub mod planner;
 pub mod request;
+pub mod status;
 
 // DDPG (seed 004 Algorithm 1, Table 2) on candle.
 pub mod ddpg;
@@ -42,12 +49,13 @@ pub use policy::{Policy, PolicyMetadata};
 pub use cache::{GridSpec, IndicatorCache};
 pub use dp::{DpResult, DpSpec};
 pub use env::{EnvConfig, MillEnv, PhysicalState, Rollout, StepInfo};
+pub use executed::{execute, Executed};
 pub use naive::NaiveResult;
+pub use output::{MillPlanOutput, PlanningPhases};
 pub use plan::{comparison_table, ComparisonRow, Plan};
-pub use planner::{
-    default_policy_path, execute, status_of, Executed, JointTrajectory, MillPlanOutput,
-    MillPlanner, TrajectoryPoint,
-};
+pub use planner::{default_policy_path, MillPlanner};
 pub use request::{MillRequest, PlannerKind};
 pub use reward::{RewardParts, RewardWeights};
+pub use status::status_of;
 pub use timing::{time_scale, JointLimit, TimeScaling};
+pub use trajectory::{JointTrajectory, TrajectoryPoint, TrajectoryRequest};

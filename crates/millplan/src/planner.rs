@@ -29,7 +29,8 @@
 //!    (|μ|max never from the cache) on [`MillPlanner::eval_threads`]
 //!    threads (the same plan, bit for bit, for every thread count), the
 //!    totals.
-//! 6. The joint trajectory ([`JointTrajectory`]).
+//! 6. The joint trajectory ([`crate::trajectory::JointTrajectory`],
+//!    [`crate::planned`]).
 //! 7. What the robot runs ([`MillPlanOutput::executed`]): the trajectory
 //!    from rest to rest, time-scaled to the joints' velocity and
 //!    acceleration limits ([`crate::timing::time_scale`]: slowed where
@@ -52,206 +53,46 @@
 //! minutes); `ddpg` and `fixed_g` evaluate directly (slower, same result).
 //!
 //! # Trajectory
-//! The environment and the plan place the tool at each segment's
-//! arc-length MIDPOINT. The trajectory has N + 2 points: the path start
-//! (t = 0, g of segment 0), the N midpoints with the plan's joints
-//! exactly (t = Σ_{j<i} l_j/f_j + l_i/(2 f_i): the time the tool reaches
-//! the midpoint at the planned feeds), and the path end
-//! (t = Σ l_i/f_i, the plan's machining time, g of the last segment). The
-//! end points' joints are the IK solutions nearest the adjacent midpoint's
-//! (continuous branch). Joint names are the URDF's (`joint_1` …
-//! `joint_6`). Velocities: the derivative of the parabola through each
-//! point and its two neighbours (non-uniform three-point finite
-//! difference, Fornberg 1988), one-sided differences at the two ends; no
-//! accelerations. Joint steps above the cell's branch-jump threshold are
-//! reported in [`MillPlanOutput::branch_jumps`], not hidden.
+//! Step 6 builds the planned joint trajectory ([`crate::planned`]: path
+//! start, segment midpoints, path end, in the executor's trajectory type
+//! [`crate::trajectory::JointTrajectory`]); step 7 time-scales it
+//! ([`crate::executed`]).
 
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 use std::sync::{Arc, Mutex};
 use std::time::{Instant, SystemTime};
 
-use kerf_mill::{BranchJump, MillCell, MillError, PathSpec, StateLimits};
+use kerf_mill::{MillCell, MillError, PathSpec, StateLimits};
 
 use crate::cache::{cell_fingerprint, is_infeasible, IndicatorCache};
 use crate::dp::{self, DpSpec};
 use crate::env::{EnvConfig, MillEnv, PhysicalState};
 use crate::error::MillPlanError;
+use crate::executed::executed;
 use crate::naive;
 use crate::plan::{default_eval_threads, IndicatorProvenance, IndicatorSource, Plan};
+use crate::planned::planned_trajectory;
 use crate::policy::Policy;
 use crate::request::{MillRequest, PlannerKind, RequestProcess};
 use crate::rl::Environment;
-use crate::timing::{three_point_velocity, time_scale, JointLimit, TimeScaling};
 
-/// Status values of the planner's answer (the `MillPlan` message).
-pub mod status {
-    /// The plan succeeded.
-    pub const SUCCESS: u8 = 0;
-    /// The request is malformed (field and index in the message).
-    pub const INVALID_REQUEST: u8 = 1;
-    /// A path point or segment is out of reach or beyond a joint limit.
-    pub const UNREACHABLE: u8 = 2;
-    /// The policy file is missing, unreadable or incompatible, or the
-    /// policy drove the state out of the feasible set.
-    pub const POLICY_ERROR: u8 = 3;
-    /// The chatter model failed (non-convergence, NaN).
-    pub const CHATTER_MODEL_ERROR: u8 = 4;
-    /// Anything else (I/O, learning backend, a numerical failure).
-    pub const INTERNAL_ERROR: u8 = 6;
-}
-
-/// The name of a status value, `None` for an unknown one.
-pub fn status_name(value: u8) -> Option<&'static str> {
-    match value {
-        status::SUCCESS => Some("SUCCESS"),
-        status::INVALID_REQUEST => Some("INVALID_REQUEST"),
-        status::UNREACHABLE => Some("UNREACHABLE"),
-        status::POLICY_ERROR => Some("POLICY_ERROR"),
-        status::CHATTER_MODEL_ERROR => Some("CHATTER_MODEL_ERROR"),
-        status::INTERNAL_ERROR => Some("INTERNAL_ERROR"),
-        _ => None,
-    }
-}
-
-/// The status category of an error:
-///
-/// | error | status |
-/// |---|---|
-/// | `InvalidParameter`, `InvalidConfig`; `Mill` of a bad parameter, configuration, non-coplanar points, a B-spline fit | INVALID_REQUEST 1 |
-/// | `Mill` of `Unreachable`, `JointLimit`, `Singular` | UNREACHABLE 2 |
-/// | `Policy` | POLICY_ERROR 3 |
-/// | `Chatter`, `Mill(Chatter)` | CHATTER_MODEL_ERROR 4 |
-/// | `Io`, `Backend`, `Mill` of a non-finite value, non-convergence, a file or robot-model failure | INTERNAL_ERROR 6 |
-///
-/// Value 5 (`QUEUE_FULL` of `kerf_msgs/msg/MillPlan`) belongs to the node
-/// (its request queue) and is not produced here.
-pub fn status_of(error: &MillPlanError) -> u8 {
-    match error {
-        MillPlanError::InvalidParameter { .. } | MillPlanError::InvalidConfig { .. } => {
-            status::INVALID_REQUEST
-        }
-        MillPlanError::Mill(e) => match e {
-            MillError::Unreachable { .. }
-            | MillError::JointLimit { .. }
-            | MillError::Singular { .. } => status::UNREACHABLE,
-            MillError::InvalidParameter { .. }
-            | MillError::InvalidConfig { .. }
-            | MillError::NotCoplanar { .. }
-            | MillError::Bspline(_) => status::INVALID_REQUEST,
-            MillError::Chatter(_) => status::CHATTER_MODEL_ERROR,
-            MillError::NonFinite { .. }
-            | MillError::NotConverged { .. }
-            | MillError::FileRead { .. }
-            | MillError::Yaml { .. }
-            | MillError::Robot(_) => status::INTERNAL_ERROR,
-        },
-        MillPlanError::Chatter(_) => status::CHATTER_MODEL_ERROR,
-        MillPlanError::Policy { .. } => status::POLICY_ERROR,
-        MillPlanError::Io { .. } | MillPlanError::Backend(_) => status::INTERNAL_ERROR,
-    }
-}
+pub use crate::executed::{execute, Executed};
+pub use crate::output::{MillPlanOutput, PlanningPhases};
+pub use crate::status::{self, status_name, status_of};
 
 /// The shipped policy of a planner: `crates/millplan/policies/ddpg.safetensors`
-/// and `…/fixed_g.safetensors`; `None` for `dp` and `naive`.
+/// and `…/fixed_g.safetensors` below the kerf data root ([`kerf_robot::data`]:
+/// `KERF_DATA_DIR`, the share directory beside the binary, the source tree); `None` for `dp`
+/// and `naive`. When the data search fails the path is below the place it failed at
+/// ([`kerf_robot::data::default_path`]) and reading it fails naming that path.
 pub fn default_policy_path(planner: PlannerKind) -> Option<PathBuf> {
-    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("policies");
+    let dir = kerf_robot::data::default_path("crates/millplan/policies");
     match planner {
         PlannerKind::Ddpg => Some(dir.join("ddpg.safetensors")),
         PlannerKind::FixedG => Some(dir.join("fixed_g.safetensors")),
         PlannerKind::Dp | PlannerKind::Naive => None,
     }
-}
-
-/// One point of the joint trajectory.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct TrajectoryPoint {
-    /// Joint positions \[rad\], joint_1 first.
-    pub positions: [f64; 6],
-    /// Joint velocities \[rad/s\] (module documentation).
-    pub velocities: [f64; 6],
-    /// Time from the start of the cut \[s\].
-    pub time_from_start: f64,
-    /// Arc length along the path \[m\].
-    pub arc_length: f64,
-    /// The segment whose planned state holds at this point.
-    pub segment: usize,
-}
-
-/// The IRB-6660 joint trajectory of a plan (module documentation).
-#[derive(Debug, Clone, PartialEq)]
-pub struct JointTrajectory {
-    /// `joint_1` … `joint_6`.
-    pub joint_names: Vec<String>,
-    /// Path start, segment midpoints, path end.
-    pub points: Vec<TrajectoryPoint>,
-}
-
-/// The answer to a request.
-#[derive(Debug, Clone, PartialEq)]
-pub struct MillPlanOutput {
-    /// The request's id.
-    pub request_id: String,
-    /// The planner that answered.
-    pub planner: PlannerKind,
-    /// The policy file used (`ddpg`, `fixed_g`).
-    pub policy_file: Option<PathBuf>,
-    /// Per-segment Ω, f, g, |μ|max, K, 1/K, joints, time, reward (direct
-    /// evaluation) and the totals.
-    pub plan: Plan,
-    /// The joint trajectory as planned: timed by the planned feeds, not
-    /// from rest (module documentation, "Trajectory").
-    pub trajectory: JointTrajectory,
-    /// What the robot runs: [`JointTrajectory`] from rest to rest,
-    /// time-scaled to the joint velocity and acceleration limits, and the
-    /// plan at the feeds that result ([`Executed`]).
-    pub executed: Executed,
-    /// Joint steps above the branch-jump threshold between trajectory
-    /// points (index = the later point).
-    pub branch_jumps: Vec<BranchJump>,
-    /// Whether the default cell's indicator cache applied to the request.
-    pub cache_used: bool,
-    /// Wall-clock planning time \[s\].
-    pub planning_seconds: f64,
-    /// Wall-clock time of each step of [`MillPlanner::plan`] \[s\].
-    pub phases: PlanningPhases,
-    /// Where the plan's |μ|max values come from: all direct (the default),
-    /// or partly the indicator cache with its stated error bound
-    /// ([`MillPlanner::with_indicator_source`]); its `note` belongs in the
-    /// answer's message.
-    pub indicator: IndicatorProvenance,
-}
-
-/// The plan as the robot runs it (step 7 of [`MillPlanner::plan`]).
-#[derive(Debug, Clone, PartialEq)]
-pub struct Executed {
-    /// The executable trajectory, its stretch per interval and the
-    /// segment times and feeds it runs ([`crate::timing::time_scale`]).
-    pub scaling: TimeScaling,
-    /// The plan at those feeds and times ([`Plan::as_executed`]): |μ|max
-    /// and reward re-evaluated directly where the feed changed; its
-    /// `total_time` is the trajectory's duration from rest to rest.
-    pub plan: Plan,
-    /// Segments of `plan` whose |μ|max is the indicator cache's
-    /// interpolation (only with [`IndicatorSource::Cache`]; the bound of
-    /// [`MillPlanOutput::indicator`] applies), ascending.
-    pub cached_segments: Vec<usize>,
-}
-
-/// Wall-clock seconds of the steps of [`MillPlanner::plan`] (module
-/// documentation); their sum is at most
-/// [`MillPlanOutput::planning_seconds`].
-#[derive(Debug, Clone, Copy, PartialEq, Default)]
-pub struct PlanningPhases {
-    /// Steps 1–3: request validation, the request's cell, reachability.
-    pub setup: f64,
-    /// Step 4: the planner (policy rollout, DP or naive), including the
-    /// policy's loading when not already loaded.
-    pub planner: f64,
-    /// Step 5: [`Plan::evaluate`] (direct |μ|max of every segment).
-    pub evaluation: f64,
-    /// Step 6: the joint trajectory.
-    pub trajectory: f64,
 }
 
 /// Distinct (path, process) pairs of requests whose cells
@@ -657,7 +498,7 @@ impl MillPlanner {
         };
         phases.evaluation = step.elapsed().as_secs_f64();
         let step = Instant::now();
-        let (trajectory, branch_jumps) = trajectory(&cell, &plan)?;
+        let (trajectory, branch_jumps) = planned_trajectory(&cell, &plan)?;
         let executed = executed(
             &cell,
             &plan,
@@ -738,180 +579,4 @@ fn check_reachable(cell: &MillCell, g0: f64) -> Result<(), MillPlanError> {
         }
     }
     Ok(())
-}
-
-/// The plan's trajectory (module documentation) and what the robot runs
-/// of it (step 7 of [`MillPlanner::plan`]), for a plan evaluated outside
-/// the planner (e.g. the DP variants of the comparison), |μ|max direct.
-///
-/// # Errors
-/// As [`MillPlanner::plan`]'s steps 6–7.
-pub fn execute(
-    cell: &MillCell,
-    plan: &Plan,
-    weights: &crate::reward::RewardWeights,
-    threads: usize,
-) -> Result<Executed, MillPlanError> {
-    let (trajectory, _) = trajectory(cell, plan)?;
-    let direct = IndicatorProvenance::direct(IndicatorSource::Direct, plan.segments.len(), "");
-    executed(cell, plan, &trajectory, weights, threads, &direct, None)
-}
-
-/// Step 7: the executable trajectory and the plan it runs.
-fn executed(
-    cell: &MillCell,
-    plan: &Plan,
-    trajectory: &JointTrajectory,
-    weights: &crate::reward::RewardWeights,
-    threads: usize,
-    indicator: &IndicatorProvenance,
-    cache: Option<&IndicatorCache>,
-) -> Result<Executed, MillPlanError> {
-    let joints = cell.robot().joints();
-    let limits = trajectory
-        .joint_names
-        .iter()
-        .map(|name| {
-            joints
-                .iter()
-                .find(|j| &j.name == name)
-                .map(|j| JointLimit {
-                    max_velocity: j.max_velocity,
-                    max_acceleration: j.max_acceleration,
-                })
-                .ok_or_else(|| MillPlanError::InvalidConfig {
-                    name: "trajectory".to_string(),
-                    reason: format!("joint '{name}' is not a joint of the cell's robot"),
-                })
-        })
-        .collect::<Result<Vec<_>, _>>()?;
-    let times: Vec<f64> = plan.segments.iter().map(|s| s.time).collect();
-    let feeds: Vec<f64> = plan.segments.iter().map(|s| s.feed).collect();
-    let scaling = time_scale(trajectory, &times, &feeds, &limits)?;
-    let (plan, cached_segments) = plan.as_executed_with(
-        cell,
-        weights,
-        &scaling.segment_feeds,
-        &scaling.segment_times,
-        threads,
-        indicator,
-        cache,
-    )?;
-    Ok(Executed {
-        scaling,
-        plan,
-        cached_segments,
-    })
-}
-
-/// The trajectory of the module documentation and its branch jumps.
-fn trajectory(
-    cell: &MillCell,
-    plan: &Plan,
-) -> Result<(JointTrajectory, Vec<BranchJump>), MillPlanError> {
-    let path = cell.path();
-    let (Some(first), Some(last)) = (plan.segments.first(), plan.segments.last()) else {
-        return Err(MillPlanError::InvalidConfig {
-            name: "plan".to_string(),
-            reason: "no segments".to_string(),
-        });
-    };
-    let total_length = path.total_length();
-    let mut points = Vec::with_capacity(plan.segments.len() + 2);
-    let start = cell.joints_at(0.0, first.g, Some(&first.joints))?;
-    points.push((start, 0.0, 0.0, 0usize));
-    let mut elapsed = 0.0;
-    let mut s = 0.0;
-    for seg in &plan.segments {
-        let length = path.segment(seg.segment)?.length;
-        points.push((
-            seg.joints,
-            elapsed + 0.5 * seg.time,
-            s + 0.5 * length,
-            seg.segment,
-        ));
-        elapsed += seg.time;
-        s += length;
-    }
-    let end = cell.joints_at(total_length, last.g, Some(&last.joints))?;
-    points.push((end, elapsed, total_length, last.segment));
-    for w in points.windows(2) {
-        if w[1].1.partial_cmp(&w[0].1) != Some(std::cmp::Ordering::Greater) {
-            return Err(MillPlanError::InvalidConfig {
-                name: "trajectory".to_string(),
-                reason: format!(
-                    "times not increasing ({} then {} s): a zero segment time",
-                    w[0].1, w[1].1
-                ),
-            });
-        }
-    }
-    let n = points.len();
-    let mut out = Vec::with_capacity(n);
-    for k in 0..n {
-        let (q, t, arc, segment) = points[k];
-        let mut v = [0.0; 6];
-        if k == 0 || k + 1 == n {
-            let (a, b) = if k == 0 {
-                (points[0], points[1])
-            } else {
-                (points[n - 2], points[n - 1])
-            };
-            for (j, vj) in v.iter_mut().enumerate() {
-                *vj = (b.0[j] - a.0[j]) / (b.1 - a.1);
-            }
-        } else {
-            // Fornberg 1988: derivative of the parabola through 3 points.
-            let (qm, tm) = (points[k - 1].0, points[k - 1].1);
-            let (qp, tp) = (points[k + 1].0, points[k + 1].1);
-            let (h1, h2) = (t - tm, tp - t);
-            for (j, vj) in v.iter_mut().enumerate() {
-                *vj = three_point_velocity(h1, h2, qm[j], q[j], qp[j]);
-            }
-        }
-        if v.iter().any(|x| !x.is_finite()) {
-            return Err(MillError::NonFinite {
-                what: format!("joint velocity at trajectory point {k}"),
-            }
-            .into());
-        }
-        out.push(TrajectoryPoint {
-            positions: q,
-            velocities: v,
-            time_from_start: t,
-            arc_length: arc,
-            segment,
-        });
-    }
-    let names: Vec<String> = cell
-        .kinematics()
-        .joints()
-        .iter()
-        .map(|j| j.name.clone())
-        .collect();
-    let threshold = cell.branch_jump_threshold();
-    let mut jumps = Vec::new();
-    for (k, w) in out.windows(2).enumerate() {
-        let (j, step) = w[1]
-            .positions
-            .iter()
-            .zip(&w[0].positions)
-            .map(|(a, b)| (a - b).abs())
-            .enumerate()
-            .fold((0, 0.0), |acc, (j, s)| if s > acc.1 { (j, s) } else { acc });
-        if step > threshold {
-            jumps.push(BranchJump {
-                index: k + 1,
-                joint: names.get(j).cloned().unwrap_or_default(),
-                step,
-            });
-        }
-    }
-    Ok((
-        JointTrajectory {
-            joint_names: names,
-            points: out,
-        },
-        jumps,
-    ))
 }

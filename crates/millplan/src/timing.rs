@@ -3,7 +3,7 @@
 //! trajectory executor runs: positions and velocities at every point) stays
 //! within every joint's velocity and acceleration limit.
 //!
-//! The plan is timed by its feeds ([`crate::planner`], "Trajectory"); the
+//! The plan is timed by its feeds ([`crate::planned`]); the
 //! environment and the DP bound joint SPEEDS between segment midpoints, not
 //! accelerations, and a change of g from one segment to the next can ask a
 //! wrist joint for several times its acceleration limit. Such a trajectory
@@ -39,7 +39,7 @@
 //! piecewise-constant jerk and acceleration steps at the points).
 
 use crate::error::MillPlanError;
-use crate::planner::{JointTrajectory, TrajectoryPoint};
+use crate::trajectory::{JointTrajectory, TrajectoryPoint, TrajectoryRequest};
 
 /// Local stretching rounds before the uniform round of step 4.
 pub const LOCAL_ROUNDS: usize = 200;
@@ -119,7 +119,8 @@ pub fn three_point_velocity(h1: f64, h2: f64, qm: f64, q: f64, qp: f64) -> f64 {
 #[derive(Debug, Clone, PartialEq)]
 pub struct TimeScaling {
     /// The executable trajectory: the planned points, from rest to rest,
-    /// at the scaled times, with the three-point velocities at those times.
+    /// at the scaled times, with the three-point velocities at those times
+    /// (the arc lengths and segments of the planned one).
     pub trajectory: JointTrajectory,
     /// Per interval between consecutive points: the factor on its planned
     /// duration (≥ 1), the ramps' factor 2 not included.
@@ -146,10 +147,7 @@ impl TimeScaling {
 
     /// The executable trajectory's duration, from rest to rest \[s\].
     pub fn duration(&self) -> f64 {
-        self.trajectory
-            .points
-            .last()
-            .map_or(0.0, |p| p.time_from_start)
+        self.trajectory.duration()
     }
 
     /// Σ of [`TimeScaling::segment_times`]: the machining time as run \[s\].
@@ -173,8 +171,10 @@ impl TimeScaling {
 /// The executable trajectory and the segment times and feeds it runs.
 ///
 /// # Errors
-/// [`MillPlanError::InvalidConfig`] for fewer than 3 points, a point count
-/// other than N + 2, intervals that are not the segments' halves, a limit count other than the joint count, a
+/// [`MillPlanError::InvalidConfig`] for a trajectory whose side tables or
+/// points do not match its joints ([`JointTrajectory::check`]), fewer than
+/// 3 points, a point count other than N + 2, intervals that are not the
+/// segments' halves, a limit count other than the joint count, a
 /// non-positive or NaN limit, times not strictly increasing, or a
 /// non-finite value on the way.
 ///
@@ -191,7 +191,8 @@ pub fn time_scale(
         name: "trajectory time scaling".to_string(),
         reason,
     };
-    let points = &planned.points;
+    planned.check()?;
+    let points = planned.points();
     let m = points.len();
     let n = segment_times_planned.len();
     if m < 3 || m != n + 2 || segment_feeds_planned.len() != n {
@@ -201,11 +202,11 @@ pub fn time_scale(
             segment_feeds_planned.len()
         )));
     }
-    if limits.len() != planned.joint_names.len() {
+    if limits.len() != planned.joint_names().len() {
         return Err(bad(format!(
             "{} joint limits for {} joints",
             limits.len(),
-            planned.joint_names.len()
+            planned.joint_names().len()
         )));
     }
     for (j, l) in limits.iter().enumerate() {
@@ -256,7 +257,7 @@ pub fn time_scale(
     let mut uniform = false;
     let (times, velocities) = loop {
         let h: Vec<f64> = base.iter().zip(&stretch).map(|(b, c)| b * c).collect();
-        let (times, velocities) = timed(points, &h);
+        let (times, velocities) = timed(points, &h, limits.len());
         let need = needs(points, &h, &velocities, limits);
         if let Some(i) = need.iter().position(|r| !r.is_finite()) {
             return Err(bad(format!(
@@ -306,17 +307,21 @@ pub fn time_scale(
         .iter()
         .zip(times.iter().zip(&velocities))
         .map(|(p, (&t, v))| TrajectoryPoint {
-            positions: p.positions,
-            velocities: *v,
+            positions: p.positions.clone(),
+            velocities: v.clone(),
             time_from_start: t,
-            arc_length: p.arc_length,
-            segment: p.segment,
+            ..TrajectoryPoint::default()
         })
         .collect();
     Ok(TimeScaling {
         trajectory: JointTrajectory {
-            joint_names: planned.joint_names.clone(),
-            points: out_points,
+            request: TrajectoryRequest {
+                joint_names: planned.joint_names().to_vec(),
+                points: out_points,
+                start_time: planned.request.start_time,
+            },
+            arc_length: planned.arc_length.clone(),
+            segment: planned.segment.clone(),
         },
         interval_stretch: stretch,
         segment_times,
@@ -327,8 +332,8 @@ pub fn time_scale(
 }
 
 /// Times from the interval durations `h` and the velocities of step 1–2
-/// (zero at the ends, three-point in between).
-fn timed(points: &[TrajectoryPoint], h: &[f64]) -> (Vec<f64>, Vec<[f64; 6]>) {
+/// (zero at the ends, three-point in between) of `joints` joints.
+fn timed(points: &[TrajectoryPoint], h: &[f64], joints: usize) -> (Vec<f64>, Vec<Vec<f64>>) {
     let m = points.len();
     let mut times = Vec::with_capacity(m);
     let mut t = 0.0;
@@ -337,7 +342,7 @@ fn timed(points: &[TrajectoryPoint], h: &[f64]) -> (Vec<f64>, Vec<[f64; 6]>) {
         t += d;
         times.push(t);
     }
-    let mut velocities = vec![[0.0; 6]; m];
+    let mut velocities = vec![vec![0.0; joints]; m];
     for k in 1..m - 1 {
         for (j, v) in velocities[k].iter_mut().enumerate() {
             *v = three_point_velocity(
@@ -356,7 +361,7 @@ fn timed(points: &[TrajectoryPoint], h: &[f64]) -> (Vec<f64>, Vec<[f64; 6]>) {
 fn needs(
     points: &[TrajectoryPoint],
     h: &[f64],
-    velocities: &[[f64; 6]],
+    velocities: &[Vec<f64>],
     limits: &[JointLimit],
 ) -> Vec<f64> {
     (0..h.len())

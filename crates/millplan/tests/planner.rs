@@ -39,35 +39,38 @@ fn check_plan(cell: &MillCell, out: &MillPlanOutput) {
     // 0 to the machining time Σ l/f (recomputed here from the path).
     let traj = &out.trajectory;
     let names: Vec<String> = (1..=6).map(|i| format!("joint_{i}")).collect();
-    assert_eq!(traj.joint_names, names);
-    assert_eq!(traj.points.len(), n + 2);
-    assert_eq!(traj.points[0].time_from_start, 0.0);
-    for w in traj.points.windows(2) {
+    assert_eq!(traj.joint_names(), names);
+    assert_eq!(traj.points().len(), n + 2);
+    assert_eq!(traj.points()[0].time_from_start, 0.0);
+    for w in traj.points().windows(2) {
         assert!(w[1].time_from_start > w[0].time_from_start);
-        assert!(w[1].arc_length > w[0].arc_length);
+    }
+    for w in traj.arc_length.windows(2) {
+        assert!(w[1] > w[0]);
     }
     let sum: f64 = plan
         .segments
         .iter()
         .map(|s| cell.path().segments()[s.segment].length / s.feed)
         .sum();
-    let end = traj.points[n + 1].time_from_start;
+    let end = traj.points()[n + 1].time_from_start;
     assert!((end - sum).abs() < 1e-9 * sum, "{end} vs {sum}");
     assert!((plan.total_time - sum).abs() < 1e-9 * sum);
     // Midpoint k reached at Σ_{j<k} l_j/f_j + l_k/(2 f_k).
     let mut elapsed = 0.0;
     for (k, s) in plan.segments.iter().enumerate() {
         let l = cell.path().segments()[k].length;
-        let t = traj.points[k + 1].time_from_start;
+        let t = traj.points()[k + 1].time_from_start;
         assert!((t - (elapsed + 0.5 * l / s.feed)).abs() < 1e-9);
         elapsed += l / s.feed;
-        assert_eq!(traj.points[k + 1].positions, s.joints);
+        assert_eq!(traj.points()[k + 1].positions, s.joints);
     }
     // The tool tip follows the path: FK at the midpoints, start and end.
     let kin = cell.kinematics();
     let mut worst = 0.0f64;
-    for (k, p) in traj.points.iter().enumerate() {
-        let tip = kin.tcp_pose(&p.positions).expect("fk").translation.vector;
+    for (k, p) in traj.points().iter().enumerate() {
+        let q: [f64; 6] = p.positions.as_slice().try_into().expect("6 joints");
+        let tip = kin.tcp_pose(&q).expect("fk").translation.vector;
         let expected = if k == 0 {
             cell.path().point(0.0).expect("start")
         } else if k == n + 1 {
@@ -81,7 +84,11 @@ fn check_plan(cell: &MillCell, out: &MillPlanOutput) {
     // Velocities: the three-point derivative is the h-weighted mean of the
     // two one-sided slopes (an equivalent closed form).
     for k in 1..=n {
-        let (a, b, c) = (&traj.points[k - 1], &traj.points[k], &traj.points[k + 1]);
+        let (a, b, c) = (
+            &traj.points()[k - 1],
+            &traj.points()[k],
+            &traj.points()[k + 1],
+        );
         let (h1, h2) = (
             b.time_from_start - a.time_from_start,
             c.time_from_start - b.time_from_start,
@@ -118,13 +125,13 @@ fn check_plan(cell: &MillCell, out: &MillPlanOutput) {
 /// differences: independent of `timing::hermite_extremes`), and the plan
 /// at the executed feeds with |μ|max evaluated directly.
 fn check_executed(cell: &MillCell, out: &MillPlanOutput) {
-    let planned = &out.trajectory.points;
-    let exec = &out.executed.scaling.trajectory.points;
+    let planned = out.trajectory.points();
+    let exec = out.executed.scaling.trajectory.points();
     let n = planned.len();
     assert_eq!(exec.len(), n);
     assert_eq!(
-        out.executed.scaling.trajectory.joint_names,
-        out.trajectory.joint_names
+        out.executed.scaling.trajectory.joint_names(),
+        out.trajectory.joint_names()
     );
     assert_eq!(exec[0].time_from_start, 0.0);
     assert_eq!(exec[0].velocities, [0.0; 6]);

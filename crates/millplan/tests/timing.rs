@@ -5,7 +5,7 @@
 //! that must not, and every refused input.
 
 use kerf_millplan::timing::{hermite_extremes, three_point_velocity, time_scale, JointLimit};
-use kerf_millplan::{JointTrajectory, MillPlanError, TrajectoryPoint};
+use kerf_millplan::{JointTrajectory, MillPlanError, TrajectoryPoint, TrajectoryRequest};
 
 fn names() -> Vec<String> {
     (1..=6).map(|i| format!("joint_{i}")).collect()
@@ -24,18 +24,23 @@ fn planned(t: &[f64], q5: &[f64]) -> JointTrajectory {
     }
     times.push(elapsed);
     JointTrajectory {
-        joint_names: names(),
-        points: times
-            .iter()
-            .zip(q5)
-            .enumerate()
-            .map(|(k, (&time, &q))| TrajectoryPoint {
-                positions: [0.1, -0.2, 0.3, 0.0, q, 0.5],
-                velocities: [0.0; 6],
-                time_from_start: time,
-                arc_length: k as f64,
-                segment: k.saturating_sub(1).min(t.len() - 1),
-            })
+        request: TrajectoryRequest {
+            joint_names: names(),
+            points: times
+                .iter()
+                .zip(q5)
+                .map(|(&time, &q)| TrajectoryPoint {
+                    positions: vec![0.1, -0.2, 0.3, 0.0, q, 0.5],
+                    velocities: vec![0.0; 6],
+                    time_from_start: time,
+                    ..TrajectoryPoint::default()
+                })
+                .collect(),
+            start_time: None,
+        },
+        arc_length: (0..times.len()).map(|k| k as f64).collect(),
+        segment: (0..times.len())
+            .map(|k| k.saturating_sub(1).min(t.len() - 1))
             .collect(),
     }
 }
@@ -53,7 +58,7 @@ fn limits(v: f64, a: Option<f64>) -> Vec<JointLimit> {
 /// Largest |v|/v_max and |a|/a_max of joint 5 over the Hermite cubics,
 /// sampled (Hermite basis, central differences).
 fn sampled_worst(t: &JointTrajectory, vmax: f64, amax: f64) -> f64 {
-    let p = &t.points;
+    let p = t.points();
     let mut worst: f64 = 0.0;
     for k in 0..p.len() - 1 {
         let h = p[k + 1].time_from_start - p[k].time_from_start;
@@ -130,21 +135,24 @@ fn a_zig_zag_is_slowed_to_the_limits() {
     let plan = planned(&t, &q5);
     let lim = limits(2.0, Some(4.0));
     let s = time_scale(&plan, &t, &feeds, &lim).expect("scaled");
-    let p = &s.trajectory.points;
+    let p = s.trajectory.points();
     assert_eq!(p.len(), n + 2);
     assert_eq!(p[0].velocities, [0.0; 6]);
     assert_eq!(p[n + 1].velocities, [0.0; 6]);
-    for (a, b) in p.iter().zip(&plan.points) {
+    for (a, b) in p.iter().zip(plan.points()) {
         assert_eq!(a.positions, b.positions);
-        assert_eq!((a.arc_length, a.segment), (b.arc_length, b.segment));
     }
+    assert_eq!(
+        (&s.trajectory.arc_length, &s.trajectory.segment),
+        (&plan.arc_length, &plan.segment)
+    );
     let worst = sampled_worst(&s.trajectory, 2.0, 4.0);
     assert!(worst <= 1.0 + 1e-3, "{worst}");
     assert!(s.stretched_intervals() > 0 && s.rounds > 0);
     for (k, c) in s.interval_stretch.iter().enumerate() {
         assert!(*c >= 1.0, "interval {k}");
         let ramp = if k == 0 || k == n { 2.0 } else { 1.0 };
-        let h_plan = plan.points[k + 1].time_from_start - plan.points[k].time_from_start;
+        let h_plan = plan.points()[k + 1].time_from_start - plan.points()[k].time_from_start;
         let h = p[k + 1].time_from_start - p[k].time_from_start;
         assert!((h - ramp * c * h_plan).abs() <= 1e-12 * h);
     }
@@ -231,14 +239,23 @@ fn bad_inputs_are_refused_with_a_reason() {
     }
     // Times not increasing; intervals that are not the segments' halves.
     let mut p = plan.clone();
-    p.points[2].time_from_start = p.points[1].time_from_start;
+    p.request.points[2].time_from_start = p.request.points[1].time_from_start;
     let e = time_scale(&p, &t, &feeds, &lim).unwrap_err();
     assert!(reason(e).contains("not strictly increasing between points 1 and 2"));
     let e = time_scale(&plan, &[0.1, 0.2, 0.1], &feeds, &lim).unwrap_err();
     assert!(reason(e).contains("interval 1 lasts 0.1"));
     // A NaN position.
     let mut p = plan.clone();
-    p.points[3].positions[4] = f64::NAN;
+    p.request.points[3].positions[4] = f64::NAN;
     let e = time_scale(&p, &t, &feeds, &lim).unwrap_err();
     assert!(reason(e).contains("non-finite position of joint 4 at point 3"));
+    // Side tables and points that do not match the joints.
+    let mut p = plan.clone();
+    p.segment.pop();
+    let e = time_scale(&p, &t, &feeds, &lim).unwrap_err();
+    assert!(reason(e).contains("5 points, 5 arc lengths and 4 segments"));
+    let mut p = plan.clone();
+    p.request.points[1].velocities.pop();
+    let e = time_scale(&p, &t, &feeds, &lim).unwrap_err();
+    assert!(reason(e).contains("point 1 has 6 positions and 5 velocities for 6 joints"));
 }
