@@ -15,6 +15,8 @@
 //! * [`validate()`] checks a request against the robot model ([`JointLimits`]) and a current
 //!   state, and builds a [`ValidatedTrajectory`]: segment polynomials in model joint order on
 //!   absolute time, sampled in O(1) amortized per cycle.
+//! * [`check_executable`] is that validation from rest at the first point: what a planner
+//!   runs on its output before publishing it.
 //! * [`prepare`] does the request-only part of validation (nearly all its cost) so that it
 //!   can run off the control thread; [`Executor::submit_prepared`] finishes it in O(joints).
 //! * [`Executor`] runs one goal at a time: preemption, cancel with a controlled stop
@@ -77,6 +79,7 @@
 //!   are timed at no earlier than the last update.
 
 pub mod error;
+pub mod executable;
 pub mod executor;
 pub mod mock;
 pub mod roots;
@@ -92,6 +95,7 @@ pub use error::{
     ExecutorError, GOAL_TOLERANCE_VIOLATED, INVALID_GOAL, INVALID_JOINTS, OLD_HEADER_TIMESTAMP,
     PATH_TOLERANCE_VIOLATED, SUCCESSFUL,
 };
+pub use executable::check_executable;
 pub use executor::{Cycle, Executor, Feedback, GoalEvent, GoalId, Outcome};
 pub use mock::MockHardware;
 pub use slack::LIMIT_SLACK;

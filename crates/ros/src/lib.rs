@@ -10,6 +10,7 @@
 //! * [`Inbox`] reads (and deserializes) a subscription on its own thread.
 //! * [`Streamer`] publishes high-rate streams from a thread, so a control loop never blocks.
 //! * [`Worker`] runs slow requests in the background so a node keeps serving.
+//! * [`planner`] is the planner-node harness every planner node is built on.
 //! * [`KerfNode`] ties these together: one Context per node, names resolved and remapped.
 
 mod args;
@@ -20,6 +21,7 @@ mod logger;
 pub mod names;
 mod node;
 mod params;
+pub mod planner;
 pub mod qos;
 mod realtime;
 pub mod shutdown;

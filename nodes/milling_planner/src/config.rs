@@ -22,8 +22,7 @@ pub const KNOWN_PARAMS: &[&str] = &[
     "queue_depth",
 ];
 
-/// Default of `queue_depth`: requests waiting or being planned.
-pub const DEFAULT_QUEUE_DEPTH: usize = 10;
+pub use kerf_ros::planner::DEFAULT_QUEUE_DEPTH;
 
 /// Everything the node needs, checked.
 #[derive(Debug)]
@@ -139,11 +138,7 @@ impl NodeConfig {
                     })?)
                 }
             };
-        let depth = params.i64_or("queue_depth", DEFAULT_QUEUE_DEPTH as i64)?;
-        let queue_depth = usize::try_from(depth)
-            .ok()
-            .filter(|d| *d >= 1)
-            .ok_or_else(|| param_err("queue_depth", format!("must be >= 1, got {depth}")))?;
+        let queue_depth = kerf_ros::planner::queue_depth(params)?;
 
         let (planner, cell_source, cache_note) = match (cell_file, cache_file) {
             (None, None) => {

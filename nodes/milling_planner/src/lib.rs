@@ -49,6 +49,12 @@
 //! (`MillPlan.trajectory.points[0].positions`). The trajectory topic is volatile on purpose: a
 //! restarted executor must not receive an old cut.
 //!
+//! The node is a [`kerf_ros::planner::PlanningService`] ([`MillService`]) run by the
+//! planner-node harness [`kerf_ros::planner::run`]: request → convert and validate → plan
+//! (worker thread) → executability check (the trajectory executor's own validation, a pure
+//! function of the trajectory and the robot model: a plan it would refuse is answered
+//! INTERNAL_ERROR and its trajectory is not published) → publish.
+//!
 //! Planning takes from a fraction of a second (a policy) to seconds (`dp`), so it runs on a
 //! worker thread ([`kerf_ros::Worker`]) and the node keeps reading requests meanwhile.
 //! Requests are answered in arrival order, each by exactly one `MillPlan` with its
@@ -63,35 +69,20 @@ pub mod config;
 pub mod convert;
 pub mod text;
 
-use std::{
-    collections::BTreeMap,
-    path::PathBuf,
-    sync::{
-        atomic::{AtomicBool, Ordering},
-        Arc,
-    },
-    time::Duration as StdDuration,
-};
+use std::path::PathBuf;
 
+use kerf_executor::JointLimits;
 use kerf_millplan::{planner::status, MillPlanError, MillPlanner, MillRequest, PlannerKind};
-use kerf_msgs::{
-    msg::{self, MillPlan},
-    std_msgs::StringMsg,
-    trajectory_msgs::JointTrajectory,
-    RosType,
-};
+use kerf_msgs::msg::{self, MillPlan};
 use kerf_ros::{
-    qos, ros2_client::Publisher, Inbox, KerfNode, Logger, NodeSpec, RosArgs, RosEnv, RosError,
-    StopToken, Worker, WorkerError,
+    planner::{self, AnswerKey, Failure, PlanningService, Topics},
+    NodeSpec, RosArgs, RosEnv, RosError, StopToken,
 };
 
 pub use config::{NodeConfig, KNOWN_PARAMS};
 
 /// Default node name.
 pub const DEFAULT_NAME: &str = "milling_planner";
-
-/// How long the node loop sleeps when there is nothing to do.
-const POLL: StdDuration = StdDuration::from_millis(2);
 
 /// Why the node could not start.
 #[derive(Debug, thiserror::Error)]
@@ -115,15 +106,6 @@ pub enum NodeError {
     },
 }
 
-/// Work for the planner thread. Failed requests travel through it too, so that every answer
-/// leaves in arrival order.
-pub enum Job {
-    /// Plan this request.
-    Plan(Box<MillRequest>),
-    /// Already answered (conversion or parse error): pass the answer through.
-    Answer(Box<MillPlan>),
-}
-
 /// The policies used by `ddpg` / `fixed_g` requests that name none.
 #[derive(Debug, Clone, PartialEq)]
 pub struct DefaultPolicies {
@@ -139,357 +121,159 @@ pub struct DefaultPolicies {
 /// `Ok` after a clean shutdown; an error if the node could not start (bad parameter,
 /// unreadable cell, DDS failure). Request errors never end the node.
 pub fn run(args: &RosArgs, env: &RosEnv, stop: StopToken) -> Result<(), NodeError> {
-    let node = KerfNode::new(
-        NodeSpec {
-            default_name: DEFAULT_NAME,
-            default_namespace: "/",
-            known_params: KNOWN_PARAMS,
-        },
-        args,
-        env,
-        stop,
-    )?;
-    let log = node.logger();
-    let cfg = match NodeConfig::from_params(node.params()) {
-        Ok(c) => c,
-        Err(e) => {
-            log.error(&format!("cannot start: {e}"));
-            return Err(e);
-        }
+    let spec = NodeSpec {
+        default_name: DEFAULT_NAME,
+        default_namespace: "/",
+        known_params: KNOWN_PARAMS,
     };
-    let mut n = PlannerNode::new(node, cfg)?;
-    n.spin();
-    Ok(())
-}
-
-/// Plans one job (on the worker thread): the request with the node's default policy filled
-/// in when it names none, answered as a `MillPlan`. The published trajectory is time-scaled
-/// by the planner to the robot's velocity and acceleration limits; the node checks it again
-/// ([`convert::first_limit_excess`], its guard): a successful plan whose trajectory
-/// nevertheless exceeds them (a planner bug) is still SUCCESS, with a WARNING in its message
-/// naming the joint, the value and the time. Jobs queued after the node began to stop are answered
-/// INTERNAL_ERROR without planning; already-answered jobs pass through.
-pub fn work(
-    planner: &MillPlanner,
-    policies: &DefaultPolicies,
-    stopping: &AtomicBool,
-    job: Job,
-) -> MillPlan {
-    let mut request = match job {
-        Job::Answer(m) => return *m,
-        Job::Plan(r) => r,
-    };
-    if stopping.load(Ordering::Relaxed) {
-        // Queued when the node stopped: skipped, so that shutdown waits for one plan at most.
-        return convert::failure_msg(
-            &request.request_id,
-            convert::answer_planner(&request.planner),
-            status::INTERNAL_ERROR,
-            "the planner node stopped before planning this request",
-        );
-    }
-    if request.policy_file.is_none() {
-        let default = match PlannerKind::parse(&request.planner) {
-            Ok(PlannerKind::Ddpg) => Some(&policies.ddpg),
-            Ok(PlannerKind::FixedG) => Some(&policies.fixed_g),
-            _ => None,
-        };
-        request.policy_file = default.map(|p| p.display().to_string());
-    }
-    match planner.plan(&request) {
-        Ok(out) => {
-            let mut m = convert::output_to_msg(&out);
-            if m.status == MillPlan::SUCCESS {
-                let limits = robot_limits(planner);
-                if let Some(excess) = convert::first_limit_excess(&m.trajectory, &limits) {
-                    m.message.push_str(&format!(
-                        "; WARNING: the trajectory exceeds the robot's limits ({excess}) \
-                         although the planner time-scaled it to them (a planner bug): an \
-                         executor with these limits will reject it"
-                    ));
-                }
-            }
-            m
-        }
-        Err(e) => convert::error_to_msg(&request.request_id, &request.planner, &e),
-    }
-}
-
-/// The velocity and acceleration limits of the planner cell's robot.
-pub fn robot_limits(planner: &MillPlanner) -> Vec<convert::JointLimit> {
-    planner
-        .cell()
-        .robot()
-        .joints()
-        .iter()
-        .map(|j| convert::JointLimit {
-            name: j.name.clone(),
-            max_velocity: j.max_velocity,
-            max_acceleration: j.max_acceleration,
-        })
-        .collect()
-}
-
-/// The node's state. Fields drop in declaration order: DDS endpoints and the worker first,
-/// `node` (and its Context) last.
-struct PlannerNode {
-    requests: Inbox<msg::MillRequest>,
-    text_requests: Inbox<StringMsg>,
-    plans: Publisher<MillPlan>,
-    plan_texts: Publisher<StringMsg>,
-    trajectories: Publisher<JointTrajectory>,
-    worker: Worker<Job, MillPlan>,
-    /// Set when the node stops: queued plans are skipped.
-    stopping: Arc<AtomicBool>,
-    /// Ticket → (request id, planner field) of every job submitted and not yet answered.
-    pending: BTreeMap<u64, (String, String)>,
-    queue_depth: usize,
-    log: Logger,
-    node: KerfNode,
-}
-
-impl PlannerNode {
-    fn new(mut node: KerfNode, cfg: NodeConfig) -> Result<Self, NodeError> {
-        let requests = node.inbox(
-            "~/mill_request",
-            msg::MillRequest::ROS_TYPE,
-            qos::commands(),
-        )?;
-        let text_requests =
-            node.inbox("~/mill_request_text", StringMsg::ROS_TYPE, qos::commands())?;
-        // Latched, so `kerf echo --transient-local` shows the last answers.
-        let plans = node.publisher("~/mill_plan", MillPlan::ROS_TYPE, qos::latched())?;
-        let plan_texts = node.publisher("~/mill_plan_text", StringMsg::ROS_TYPE, qos::latched())?;
-        // Volatile: a late (restarted) executor must never receive an old cut.
-        let trajectories = node.publisher(
-            "~/joint_trajectory",
-            JointTrajectory::ROS_TYPE,
-            qos::commands(),
-        )?;
-        let log = node.logger();
+    planner::run(spec, args, env, stop, |node| {
+        let cfg = NodeConfig::from_params(node.params())?;
         let policies = DefaultPolicies {
             ddpg: cfg.ddpg_policy_file.clone(),
             fixed_g: cfg.fixed_g_policy_file.clone(),
         };
         for (kind, path) in [("ddpg", &policies.ddpg), ("fixed_g", &policies.fixed_g)] {
             if !path.is_file() {
-                log.warn(&format!(
+                node.logger().warn(&format!(
                     "default {kind} policy {} does not exist (yet): {kind} requests without \
                      policy_file will be answered POLICY_ERROR until it does",
                     path.display()
                 ));
             }
         }
-        log.info(&format!(
-            "serving mill requests on {} and {}; plans on {}, trajectories on {}; cell: {}; {}; \
-             |mu|max: {}; default policies: ddpg {}, fixed_g {}; queue_depth {}",
-            node.resolve("~/mill_request")?,
-            node.resolve("~/mill_request_text")?,
-            node.resolve("~/mill_plan")?,
-            node.resolve("~/joint_trajectory")?,
+        let note = format!(
+            "cell: {}; {}; |mu|max: {}; default policies: ddpg {}, fixed_g {}",
             cfg.cell_source,
             cfg.cache_note,
             cfg.indicator_source.name(),
             policies.ddpg.display(),
             policies.fixed_g.display(),
-            cfg.queue_depth,
-        ));
-        let planner = Arc::new(cfg.planner);
-        let stopping = Arc::new(AtomicBool::new(false));
-        let stopping_w = Arc::clone(&stopping);
-        let worker = Worker::spawn("millplan", 1, move |job: Job| {
-            work(&planner, &policies, &stopping_w, job)
-        })
-        .map_err(|e| RosError::Dds {
-            what: "planner thread".into(),
-            reason: e.to_string(),
+        );
+        let depth = cfg.queue_depth;
+        Ok((MillService::new(cfg.planner, policies, note)?, depth))
+    })
+}
+
+/// The milling planner as a planning service: mill requests in, `MillPlan` answers out.
+pub struct MillService {
+    planner: MillPlanner,
+    policies: DefaultPolicies,
+    limits: Vec<JointLimits>,
+    note: String,
+}
+
+impl MillService {
+    /// A service planning with `planner`; `policies` fill `ddpg` / `fixed_g` requests that
+    /// name no policy file; `note` describes the set-up in the start-up log.
+    ///
+    /// # Errors
+    /// [`NodeError::Config`] (`joint_limits`) when a joint of the cell's robot has no
+    /// acceleration limit: the executability check needs it.
+    pub fn new(
+        planner: MillPlanner,
+        policies: DefaultPolicies,
+        note: String,
+    ) -> Result<Self, NodeError> {
+        let limits = planner::executor_limits(planner.cell().robot()).map_err(|joint| {
+            NodeError::Config {
+                name: "cell_file".into(),
+                reason: format!(
+                    "the cell's robot gives no max_acceleration for joint '{joint}'; the \
+                     executability check needs it"
+                ),
+            }
         })?;
         Ok(Self {
-            requests,
-            text_requests,
-            plans,
-            plan_texts,
-            trajectories,
-            worker,
-            stopping,
-            pending: BTreeMap::new(),
-            queue_depth: cfg.queue_depth,
-            log,
-            node,
+            planner,
+            policies,
+            limits,
+            note,
         })
     }
 
-    fn spin(&mut self) {
-        while !self.node.should_stop() {
-            let mut busy = self.poll_requests();
-            busy |= self.poll_text_requests();
-            busy |= self.poll_results();
-            if !busy {
-                std::thread::sleep(POLL);
-            }
+    /// The planner.
+    pub fn planner(&self) -> &MillPlanner {
+        &self.planner
+    }
+}
+
+impl PlanningService for MillService {
+    type RequestMsg = msg::MillRequest;
+    type Request = MillRequest;
+    type Answer = MillPlan;
+
+    fn topics(&self) -> Topics {
+        Topics {
+            noun: "mill",
+            request: "~/mill_request",
+            request_text: "~/mill_request_text",
+            plan: "~/mill_plan",
+            plan_text: "~/mill_plan_text",
         }
-        // Queued requests are answered "stopped" without planning; the plan in progress (if
-        // any) is awaited and published, so no request is left without an answer.
-        self.stopping.store(true, Ordering::Relaxed);
-        if !self.pending.is_empty() {
-            self.log.warn(&format!(
-                "shutting down: answering {} queued request(s); waiting for the plan in progress",
-                self.pending.len()
-            ));
-        }
-        while !self.pending.is_empty() {
-            match self.worker.recv_timeout(StdDuration::from_secs(1)) {
-                Some(done) => self.answer(done),
-                None => continue,
-            }
-        }
-        self.log.info("shutting down");
     }
 
-    /// Reads `~/mill_request`; `true` if anything was read.
-    fn poll_requests(&mut self) -> bool {
-        let mut any = false;
-        while let Some(received) = self.requests.try_recv() {
-            any = true;
-            let job = match received {
-                Ok(m) => match convert::request_from_msg(&m) {
-                    Ok(r) => Job::Plan(Box::new(r)),
-                    Err(e) => Job::Answer(Box::new(convert::error_to_msg(
-                        &m.request_id,
-                        &m.planner,
-                        &e,
-                    ))),
-                },
-                Err(e) => Job::Answer(Box::new(convert::failure_msg(
-                    "",
-                    "",
-                    status::INVALID_REQUEST,
-                    format!("could not read a MillRequest sample: {e}"),
-                ))),
+    fn from_msg(&self, m: &msg::MillRequest) -> Result<MillRequest, Box<MillPlan>> {
+        convert::request_from_msg(m)
+            .map_err(|e| Box::new(convert::error_to_msg(&m.request_id, &m.planner, &e)))
+    }
+
+    fn from_text(&self, text: &str) -> Result<MillRequest, Box<MillPlan>> {
+        text::parse_request(text)
+            .map_err(|e| Box::new(convert::error_to_msg(&e.request_id, &e.planner, &e.error)))
+    }
+
+    fn key(&self, request: &MillRequest) -> AnswerKey {
+        AnswerKey {
+            request_id: request.request_id.clone(),
+            label: request.planner.clone(),
+        }
+    }
+
+    fn describe(&self, request: &MillRequest) -> String {
+        format!(
+            "{} path points, planner {}",
+            request.points.len(),
+            request.planner
+        )
+    }
+
+    /// Plans one request with the node's default policy filled in when it names none.
+    fn plan(&self, mut request: MillRequest) -> MillPlan {
+        if request.policy_file.is_none() {
+            let default = match PlannerKind::parse(&request.planner) {
+                Ok(PlannerKind::Ddpg) => Some(&self.policies.ddpg),
+                Ok(PlannerKind::FixedG) => Some(&self.policies.fixed_g),
+                _ => None,
             };
-            self.submit(job, "message");
+            request.policy_file = default.map(|p| p.display().to_string());
         }
-        any
+        match self.planner.plan(&request) {
+            Ok(out) => convert::output_to_msg(&out),
+            Err(e) => convert::error_to_msg(&request.request_id, &request.planner, &e),
+        }
     }
 
-    /// Reads `~/mill_request_text`; `true` if anything was read.
-    fn poll_text_requests(&mut self) -> bool {
-        let mut any = false;
-        while let Some(received) = self.text_requests.try_recv() {
-            any = true;
-            let job = match received {
-                Ok(m) => match text::parse_request(&m.data) {
-                    Ok(r) => Job::Plan(Box::new(r)),
-                    Err(e) => Job::Answer(Box::new(convert::error_to_msg(
-                        &e.request_id,
-                        &e.planner,
-                        &e.error,
-                    ))),
-                },
-                Err(e) => Job::Answer(Box::new(convert::failure_msg(
-                    "",
-                    "",
-                    status::INVALID_REQUEST,
-                    format!("could not read a text request sample: {e}"),
-                ))),
-            };
-            self.submit(job, "text");
-        }
-        any
-    }
-
-    /// Queues a job, or answers at once when the queue is full.
-    fn submit(&mut self, job: Job, source: &str) {
-        let (id, planner) = match &job {
-            Job::Plan(r) => (r.request_id.clone(), r.planner.clone()),
-            Job::Answer(m) => (m.request_id.clone(), m.planner.clone()),
+    /// Busy is QUEUE_FULL; unreadable samples INVALID_REQUEST (no planner named); stopped,
+    /// panicked and not executable INTERNAL_ERROR.
+    fn failure(&self, key: &AnswerKey, failure: Failure, message: String) -> MillPlan {
+        let code = match failure {
+            Failure::Unreadable => status::INVALID_REQUEST,
+            Failure::Busy => convert::QUEUE_FULL,
+            Failure::Stopped | Failure::Panicked | Failure::NotExecutable => status::INTERNAL_ERROR,
         };
-        if self.pending.len() >= self.queue_depth {
-            let answer = match job {
-                // Already failed: its own status says more than "busy".
-                Job::Answer(m) => *m,
-                Job::Plan(_) => convert::failure_msg(
-                    &id,
-                    convert::answer_planner(&planner),
-                    convert::QUEUE_FULL,
-                    format!(
-                        "planner busy: {} request(s) waiting or being planned (queue_depth {}); \
-                         request refused, send it again later",
-                        self.pending.len(),
-                        self.queue_depth
-                    ),
-                ),
-            };
-            self.publish(answer);
-            return;
-        }
-        if let Job::Plan(r) = &job {
-            self.log.info(&format!(
-                "request '{id}' ({source}): {} path points, planner {}, queued behind {} other(s)",
-                r.points.len(),
-                r.planner,
-                self.pending.len()
-            ));
-        }
-        let ticket = self.worker.submit(job);
-        self.pending.insert(ticket, (id, planner));
-    }
-
-    /// Publishes finished answers; `true` if any.
-    fn poll_results(&mut self) -> bool {
-        let mut any = false;
-        while let Some(done) = self.worker.try_recv() {
-            any = true;
-            self.answer(done);
-        }
-        any
-    }
-
-    /// Publishes the answer of one finished job (a panic becomes INTERNAL_ERROR).
-    fn answer(&mut self, (ticket, result): (u64, Result<MillPlan, WorkerError>)) {
-        let (id, planner) = self.pending.remove(&ticket).unwrap_or_default();
-        let answer = match result {
-            Ok(plan) => plan,
-            Err(WorkerError::Panicked { message, .. }) => convert::failure_msg(
-                &id,
-                convert::answer_planner(&planner),
-                status::INTERNAL_ERROR,
-                format!("the planner failed unexpectedly (panic: {message})"),
-            ),
+        // An unreadable sample names no planner (not even the default one).
+        let planner = match failure {
+            Failure::Unreadable => "",
+            _ => convert::answer_planner(&key.label),
         };
-        self.publish(answer);
+        convert::failure_msg(&key.request_id, planner, code, message)
     }
 
-    /// Publishes one answer on `~/mill_plan`, `~/mill_plan_text` and, on success,
-    /// `~/joint_trajectory`; logs it.
-    fn publish(&self, plan: MillPlan) {
-        let name = MillPlan::status_name(plan.status).unwrap_or("?");
-        if plan.status == MillPlan::SUCCESS {
-            self.log
-                .info(&format!("request '{}': {}", plan.request_id, plan.message));
-            if let Err(e) = self.trajectories.publish(plan.trajectory.clone()) {
-                self.log.error(&format!(
-                    "request '{}': trajectory not published: {e}",
-                    plan.request_id
-                ));
-            }
-        } else {
-            self.log.warn(&format!(
-                "request '{}' {name}: {}",
-                plan.request_id, plan.message
-            ));
-        }
-        let text = StringMsg {
-            data: text::plan_text(&plan),
-        };
-        let id = plan.request_id.clone();
-        if let Err(e) = self.plans.publish(plan) {
-            self.log
-                .error(&format!("request '{id}': MillPlan not published: {e}"));
-        }
-        if let Err(e) = self.plan_texts.publish(text) {
-            self.log
-                .error(&format!("request '{id}': plan text not published: {e}"));
-        }
+    fn joint_limits(&self) -> &[JointLimits] {
+        &self.limits
+    }
+
+    fn startup_note(&self) -> String {
+        self.note.clone()
     }
 }

@@ -20,26 +20,12 @@
 
 use kerf_millplan::{MillPlanError, MillRequest};
 use kerf_msgs::msg;
+use kerf_ros::planner::yaml_field;
 
-/// A text request that could not be turned into a [`MillRequest`].
-#[derive(Debug)]
-pub struct TextRequestError {
-    /// The request id if the text names one (empty otherwise), so the answer can carry it.
-    pub request_id: String,
-    /// The `planner` field if the text names one (empty otherwise).
-    pub planner: String,
-    /// What is wrong ([`MillPlanError::InvalidConfig`] naming `request` with the parser's
-    /// message, line and column); boxed to keep the `Result` small.
-    pub error: Box<MillPlanError>,
-}
-
-impl std::fmt::Display for TextRequestError {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        self.error.fmt(f)
-    }
-}
-
-impl std::error::Error for TextRequestError {}
+/// A text request that could not be turned into a [`MillRequest`]: its request id and
+/// planner when the text names them, and the error ([`MillPlanError::InvalidConfig`] naming
+/// `request` with the parser's message, line and column).
+pub type TextRequestError = kerf_ros::planner::TextRequestError<MillPlanError>;
 
 /// Parses a text request.
 ///
@@ -60,29 +46,14 @@ pub fn parse_request(text: &str) -> Result<MillRequest, TextRequestError> {
         });
     }
     MillRequest::from_yaml_str(text).map_err(|error| TextRequestError {
-        request_id: yaml_string(text, "request_id"),
-        planner: yaml_string(text, "planner"),
+        request_id: yaml_field(text, "request_id"),
+        planner: yaml_field(text, "planner"),
         error: Box::new(error),
     })
 }
 
-/// The string value of the top-level `key` of a YAML document that may not parse as a
-/// request (empty if none).
-fn yaml_string(text: &str, key: &str) -> String {
-    serde_yaml_ng::from_str::<serde_yaml_ng::Value>(text)
-        .ok()
-        .and_then(|v| v.get(key).and_then(|r| r.as_str()).map(String::from))
-        .unwrap_or_default()
-}
-
 /// The YAML text of a `MillPlan` message, as published on `~/mill_plan_text` (serde's YAML of
-/// the message: every field, in `.msg` order).
+/// the message: every field, in `.msg` order): [`kerf_ros::planner::answer_text`].
 pub fn plan_text(plan: &msg::MillPlan) -> String {
-    serde_yaml_ng::to_string(plan).unwrap_or_else(|e| {
-        // Only reachable if serde_yaml_ng refused a value; keep the essentials readable.
-        format!(
-            "request_id: {:?}\nstatus: {}\nmessage: {:?}\n# full plan not rendered: {e}\n",
-            plan.request_id, plan.status, plan.message
-        )
-    })
+    kerf_ros::planner::answer_text(plan)
 }

@@ -1,17 +1,21 @@
-//! The worker's job function: already-answered jobs pass through, jobs queued when the node
+//! The harness's job function with the milling service: already-answered jobs pass through, jobs queued when the node
 //! stops are answered without planning, and `ddpg` / `fixed_g` requests without a policy file
 //! get the node's default policy (a missing one is that request's POLICY_ERROR, naming it).
 
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::OnceLock;
 
-use kerf_milling_planner::{convert, work, DefaultPolicies, Job};
+use kerf_milling_planner::{convert, DefaultPolicies, MillService};
 use kerf_millplan::{MillPlanner, MillRequest};
 use kerf_msgs::msg::MillPlan;
+use kerf_ros::planner::{work, Job};
 
-fn planner() -> &'static MillPlanner {
-    static P: OnceLock<MillPlanner> = OnceLock::new();
-    P.get_or_init(|| MillPlanner::with_default_cell().expect("planner"))
+fn service() -> &'static MillService {
+    static S: OnceLock<MillService> = OnceLock::new();
+    S.get_or_init(|| {
+        let planner = MillPlanner::with_default_cell().expect("planner");
+        MillService::new(planner, policies(), String::new()).expect("service")
+    })
 }
 
 fn policies() -> DefaultPolicies {
@@ -34,17 +38,11 @@ fn request(id: &str, planner: &str, policy_file: Option<&str>) -> Box<MillReques
 fn answers_pass_through_and_stopping_skips_planning() {
     let stopping = AtomicBool::new(false);
     let failed = convert::failure_msg("w1", "dp", MillPlan::POLICY_ERROR, "gone");
-    let m = work(
-        planner(),
-        &policies(),
-        &stopping,
-        Job::Answer(Box::new(failed.clone())),
-    );
+    let m = work(service(), &stopping, Job::Answer(Box::new(failed.clone())));
     assert_eq!(m, failed);
     stopping.store(true, Ordering::Relaxed);
     let m = work(
-        planner(),
-        &policies(),
+        service(),
         &stopping,
         Job::Plan(request("w2", "naive", None)),
     );
@@ -65,8 +63,7 @@ fn default_policies_fill_requests_without_one() {
         ("fixed_g", "/nonexistent/default_fixed_g.safetensors"),
     ] {
         let m = work(
-            planner(),
-            &policies(),
+            service(),
             &stopping,
             Job::Plan(request("p1", planner_name, None)),
         );
@@ -79,8 +76,7 @@ fn default_policies_fill_requests_without_one() {
         );
         // The request's own file wins over the default.
         let m = work(
-            planner(),
-            &policies(),
+            service(),
             &stopping,
             Job::Plan(request(
                 "p2",
@@ -97,8 +93,7 @@ fn default_policies_fill_requests_without_one() {
     }
     // Planners without a policy are planned as they are.
     let m = work(
-        planner(),
-        &policies(),
+        service(),
         &stopping,
         Job::Plan(request("p3", "naive", None)),
     );

@@ -10,8 +10,7 @@ use crate::NodeError;
 /// Parameter names this node reads; others are refused at start-up.
 pub const KNOWN_PARAMS: &[&str] = &["urdf_file", "joint_limits_file", "queue_depth"];
 
-/// Default of `queue_depth`: requests waiting or being planned.
-pub const DEFAULT_QUEUE_DEPTH: usize = 10;
+pub use kerf_ros::planner::DEFAULT_QUEUE_DEPTH;
 
 /// Everything the node needs, checked.
 #[derive(Debug, Clone)]
@@ -69,11 +68,7 @@ impl NodeConfig {
                     "the shipped laser_cutter.urdf".to_string(),
                 ),
             };
-        let depth = params.i64_or("queue_depth", DEFAULT_QUEUE_DEPTH as i64)?;
-        let queue_depth = usize::try_from(depth)
-            .ok()
-            .filter(|d| *d >= 1)
-            .ok_or_else(|| param_err("queue_depth", format!("must be >= 1, got {depth}")))?;
+        let queue_depth = kerf_ros::planner::queue_depth(params)?;
         Ok(Self {
             machine,
             machine_source,

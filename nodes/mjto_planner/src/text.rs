@@ -43,24 +43,13 @@ use kerf_msgs::{
     msg,
 };
 
+use kerf_ros::planner::yaml_field;
+
 use crate::convert::request_from_msg;
 
-/// A text request that could not be turned into a [`CutRequest`].
-#[derive(Debug)]
-pub struct TextRequestError {
-    /// The request id if the text names one (empty otherwise), so the answer can carry it.
-    pub request_id: String,
-    /// What is wrong ([`PlanError::InvalidRequest`] naming the line or field).
-    pub error: PlanError,
-}
-
-impl std::fmt::Display for TextRequestError {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        self.error.fmt(f)
-    }
-}
-
-impl std::error::Error for TextRequestError {}
+/// A text request that could not be turned into a [`CutRequest`] (its `planner` is always
+/// empty: cut requests have none).
+pub type TextRequestError = kerf_ros::planner::TextRequestError<PlanError>;
 
 /// Whether `text` is read as YAML/JSON (else as the line format); see the module docs.
 pub fn is_yaml(text: &str) -> bool {
@@ -75,29 +64,19 @@ pub fn is_yaml(text: &str) -> bool {
 pub fn parse_request(text: &str) -> Result<CutRequest, TextRequestError> {
     if is_yaml(text) {
         CutRequest::from_yaml(text).map_err(|error| TextRequestError {
-            request_id: yaml_request_id(text),
-            error,
+            request_id: yaml_field(text, "request_id"),
+            planner: String::new(),
+            error: Box::new(error),
         })
     } else {
         parse_lines(text)
             .and_then(|m| request_from_msg(&m))
             .map_err(|error| TextRequestError {
                 request_id: line_request_id(text),
-                error,
+                planner: String::new(),
+                error: Box::new(error),
             })
     }
-}
-
-/// `request_id` of a YAML document that may not parse as a request (empty if none).
-fn yaml_request_id(text: &str) -> String {
-    serde_yaml_ng::from_str::<serde_yaml_ng::Value>(text)
-        .ok()
-        .and_then(|v| {
-            v.get("request_id")
-                .and_then(|r| r.as_str())
-                .map(String::from)
-        })
-        .unwrap_or_default()
 }
 
 /// `request_id` of a line-format text (empty if none).
@@ -263,15 +242,9 @@ pub fn parse_lines(text: &str) -> Result<msg::CutRequest, PlanError> {
 }
 
 /// The YAML text of a `CutPlan` message, as published on `~/cut_plan_text` (the same document
-/// `kerf echo /mjto_planner/cut_plan` prints).
+/// `kerf echo /mjto_planner/cut_plan` prints): [`kerf_ros::planner::answer_text`].
 pub fn plan_text(plan: &msg::CutPlan) -> String {
-    serde_yaml_ng::to_string(plan).unwrap_or_else(|e| {
-        // Only reachable if serde_yaml_ng refused a value; keep the essentials readable.
-        format!(
-            "request_id: {:?}\nstatus: {}\nmessage: {:?}\n# full plan not rendered: {e}\n",
-            plan.request_id, plan.status, plan.message
-        )
-    })
+    kerf_ros::planner::answer_text(plan)
 }
 
 #[cfg(test)]

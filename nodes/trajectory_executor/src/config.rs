@@ -85,27 +85,16 @@ impl NodeConfig {
         let limits_file = PathBuf::from(params.required_string("joint_limits_file")?);
         let robot = RobotModel::from_files(&urdf, Some(&limits_file))?;
 
-        let mut limits = Vec::with_capacity(robot.dof());
-        for j in robot.joints() {
-            let max_acceleration = j.max_acceleration.ok_or_else(|| {
-                param_err(
-                    "joint_limits_file",
-                    format!(
-                        "{} gives no max_acceleration for joint '{}'; the executor needs it to \
-                         check trajectories",
-                        limits_file.display(),
-                        j.name
-                    ),
-                )
-            })?;
-            limits.push(JointLimits {
-                name: j.name.clone(),
-                min_position: j.min_position,
-                max_position: j.max_position,
-                max_velocity: j.max_velocity,
-                max_acceleration,
-            });
-        }
+        let limits = kerf_ros::planner::executor_limits(&robot).map_err(|joint| {
+            param_err(
+                "joint_limits_file",
+                format!(
+                    "{} gives no max_acceleration for joint '{joint}'; the executor needs it to \
+                     check trajectories",
+                    limits_file.display(),
+                ),
+            )
+        })?;
 
         let control_rate = positive(params, "control_rate", 250.0)?;
         let action_monitor_rate = positive(params, "action_monitor_rate", 20.0)?;

@@ -1,8 +1,8 @@
 //! Conversions between ROS messages and the executor core's plain types.
 
 use kerf_executor::{
-    ExecutorError, GoalTolerances, JointSample, JointTolerance, TrajectoryPoint, TrajectoryRequest,
-    INVALID_GOAL, INVALID_JOINTS,
+    ExecutorError, GoalTolerances, JointSample, JointTolerance, TrajectoryRequest, INVALID_GOAL,
+    INVALID_JOINTS,
 };
 use kerf_msgs::{
     builtin_interfaces::{Duration, Time},
@@ -77,42 +77,18 @@ fn duration_secs(d: &Duration, what: &str) -> Result<f64, Rejection> {
     Ok(d.as_secs_f64())
 }
 
-/// Converts a `trajectory_msgs/JointTrajectory` (stamp 0 = start now).
+/// Converts a `trajectory_msgs/JointTrajectory` (stamp 0 = start now) with the one
+/// conversion every kerf node uses ([`kerf_ros::planner::trajectory_request`]: the planners'
+/// executability check converts their plans the same way).
 pub fn trajectory_request(
     msg: &JointTrajectory,
     clock: &Clock,
 ) -> Result<TrajectoryRequest, Rejection> {
-    if msg.header.stamp.nanosec >= 1_000_000_000 {
-        return Err(Rejection {
+    kerf_ros::planner::trajectory_request(msg, |stamp| clock.from_stamp(stamp)).map_err(|message| {
+        Rejection {
             code: INVALID_GOAL,
-            message: format!(
-                "header.stamp.nanosec {} is not below 1e9",
-                msg.header.stamp.nanosec
-            ),
-        });
-    }
-    let start_time = (!msg.header.stamp.is_zero()).then(|| clock.from_stamp(&msg.header.stamp));
-    let points = msg
-        .points
-        .iter()
-        .enumerate()
-        .map(|(i, p)| {
-            Ok(TrajectoryPoint {
-                positions: p.positions.clone(),
-                velocities: p.velocities.clone(),
-                accelerations: p.accelerations.clone(),
-                effort: p.effort.clone(),
-                time_from_start: duration_secs(
-                    &p.time_from_start,
-                    &format!("point {i} time_from_start"),
-                )?,
-            })
-        })
-        .collect::<Result<Vec<_>, Rejection>>()?;
-    Ok(TrajectoryRequest {
-        joint_names: msg.joint_names.clone(),
-        points,
-        start_time,
+            message,
+        }
     })
 }
 

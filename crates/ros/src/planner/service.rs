@@ -1,0 +1,114 @@
+//! [`PlanningService`]: what a planner gives the planner-node harness ([`super::run`]).
+
+use kerf_executor::JointLimits;
+use kerf_msgs::{trajectory_msgs::JointTrajectory, RosType};
+use serde::{de::DeserializeOwned, Serialize};
+
+/// The topics of one planner node, relative to the node (`~/…`).
+///
+/// Every planner node also publishes the planned trajectory on `~/joint_trajectory` (reliable,
+/// volatile: a restarted executor must never receive an old plan).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Topics {
+    /// What the node plans, for log lines ("cut", "mill").
+    pub noun: &'static str,
+    /// The request message topic, e.g. `~/cut_request` (reliable, keep-last 10).
+    pub request: &'static str,
+    /// The text request topic (`std_msgs/String`), e.g. `~/cut_request_text`.
+    pub request_text: &'static str,
+    /// The answer topic, e.g. `~/cut_plan` (reliable, transient-local, keep-last 10).
+    pub plan: &'static str,
+    /// The answer as YAML text (`std_msgs/String`), e.g. `~/cut_plan_text` (latched too).
+    pub plan_text: &'static str,
+}
+
+/// The topic every planner node publishes its successful trajectories on.
+pub const TRAJECTORY_TOPIC: &str = "~/joint_trajectory";
+
+/// Who answers a request: its id and a service-defined label (the milling planner's
+/// `planner` field; empty where a service has none). Failures the harness answers carry it.
+#[derive(Debug, Clone, Default, PartialEq, Eq)]
+pub struct AnswerKey {
+    /// The request's `request_id` (empty when unknown).
+    pub request_id: String,
+    /// The service's label for the request (e.g. `"ddpg"`), passed back to
+    /// [`PlanningService::failure`].
+    pub label: String,
+}
+
+/// The failures the harness itself answers; the service picks the status of each
+/// ([`PlanningService::failure`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Failure {
+    /// A sample could not be read (deserialized) at all.
+    Unreadable,
+    /// `queue_depth` requests are waiting or being planned.
+    Busy,
+    /// The node stopped before planning the request.
+    Stopped,
+    /// The planner panicked.
+    Panicked,
+    /// The planned trajectory fails the executor's own validation
+    /// ([`crate::planner::check_executable`]): never published as a success.
+    NotExecutable,
+}
+
+/// An answer message (`kerf_msgs/msg/CutPlan`, `MillPlan`, …): what the harness reads of it.
+pub trait PlanAnswer: RosType + Serialize + Clone + Send + 'static {
+    /// The request id it answers.
+    fn request_id(&self) -> &str;
+    /// The key of failures derived from this answer (request id, service label).
+    fn key(&self) -> AnswerKey;
+    /// Whether the status is SUCCESS.
+    fn is_success(&self) -> bool;
+    /// The status code.
+    fn status(&self) -> u8;
+    /// The status constant's name (`"SUCCESS"`, `"INVALID_REQUEST"`, …; `"?"` if unknown).
+    fn status_name(&self) -> &'static str;
+    /// The human-readable message.
+    fn message(&self) -> &str;
+    /// The planned trajectory (empty on failure).
+    fn trajectory(&self) -> &JointTrajectory;
+}
+
+/// A planning service: turns requests into answers; the harness ([`super::run`]) does the
+/// rest (topics, queue, busy answers, panics, executability check, publishing, shutdown).
+///
+/// `plan` runs on the harness's worker thread; everything else on the node thread.
+pub trait PlanningService: Send + Sync + 'static {
+    /// The request message (`kerf_msgs/msg/CutRequest`, …).
+    type RequestMsg: RosType + DeserializeOwned + Send + 'static;
+    /// A request as the planner takes it (converted, not yet planned).
+    type Request: Send + 'static;
+    /// The answer message.
+    type Answer: PlanAnswer;
+
+    /// The node's topics.
+    fn topics(&self) -> Topics;
+
+    /// Converts a request message; a request that cannot be converted is answered with the
+    /// returned answer (its status and message).
+    fn from_msg(&self, msg: &Self::RequestMsg) -> Result<Self::Request, Box<Self::Answer>>;
+
+    /// Parses a text request (the `data` of a `std_msgs/String`); as [`Self::from_msg`].
+    fn from_text(&self, text: &str) -> Result<Self::Request, Box<Self::Answer>>;
+
+    /// The key of a request (for the answers the harness gives it).
+    fn key(&self, request: &Self::Request) -> AnswerKey;
+
+    /// A short description of a request for the log, e.g. `"12 CL points"`.
+    fn describe(&self, request: &Self::Request) -> String;
+
+    /// Plans a request (on the worker thread). Panics are contained by the harness and
+    /// answered [`Failure::Panicked`].
+    fn plan(&self, request: Self::Request) -> Self::Answer;
+
+    /// An answer carrying only a status and a message, for a failure of the harness.
+    fn failure(&self, key: &AnswerKey, failure: Failure, message: String) -> Self::Answer;
+
+    /// The robot model the executor runs plans on: the executability check's limits.
+    fn joint_limits(&self) -> &[JointLimits];
+
+    /// The service's part of the start-up log line (machine, cell, policies …).
+    fn startup_note(&self) -> String;
+}
