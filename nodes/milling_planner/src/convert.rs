@@ -124,6 +124,7 @@ pub fn request_from_msg(m: &msg::MillRequest) -> Result<MillRequest, MillPlanErr
 /// A sentence naming the first defect (a planner bug: the node answers INTERNAL_ERROR rather
 /// than publish it).
 pub fn check_trajectory(t: &kerf_millplan::JointTrajectory) -> Result<(), String> {
+    let t = &t.request;
     if t.joint_names.len() != 6 {
         return Err(format!(
             "{} joint names {:?}, expected 6",
@@ -151,6 +152,14 @@ pub fn check_trajectory(t: &kerf_millplan::JointTrajectory) -> Result<(), String
     }
     for (k, p) in t.points.iter().enumerate() {
         for (what, values) in [("position", &p.positions), ("velocity", &p.velocities)] {
+            if values.len() != t.joint_names.len() {
+                return Err(format!(
+                    "{} {what} value(s) at point {k} (t = {} s) for {} joints",
+                    values.len(),
+                    p.time_from_start,
+                    t.joint_names.len()
+                ));
+            }
             if let Some(j) = values.iter().position(|v| !v.is_finite()) {
                 return Err(format!(
                     "{what} of {} at point {k} (t = {} s) is {}",
@@ -179,24 +188,28 @@ pub fn check_trajectory(t: &kerf_millplan::JointTrajectory) -> Result<(), String
 /// The trajectory the robot runs as a `trajectory_msgs/JointTrajectory`: the planner's
 /// executed trajectory ([`kerf_millplan::Executed`]: `out.executed.scaling.trajectory`, from
 /// rest to rest and time-scaled to the joints' velocity and acceleration limits) as it is —
-/// the planner's joint names (`joint_1` … `joint_6`), one point per trajectory point with its
-/// positions, velocities and time (no accelerations: the executor interpolates cubic Hermite
-/// segments). `header.stamp` is zero (the executor starts it on receipt).
+/// its executor form ([`kerf_millplan::JointTrajectory::request`], a
+/// `kerf_executor::TrajectoryRequest`) field by field: the planner's joint names (`joint_1` …
+/// `joint_6`), one point per trajectory point with its positions, velocities and time (the
+/// planner gives no accelerations: the executor interpolates cubic Hermite segments).
+/// `header.stamp` is zero (the planner's `start_time` is `None`: the executor starts it on
+/// receipt).
 ///
 /// # Errors
 /// As [`check_trajectory`], or a time that does not fit a `Duration`.
 pub fn trajectory_msg(t: &kerf_millplan::JointTrajectory) -> Result<JointTrajectory, String> {
     check_trajectory(t)?;
+    let t = &t.request;
     let points = t
         .points
         .iter()
         .map(|p| {
             let time = p.time_from_start;
             Ok(JointTrajectoryPoint {
-                positions: p.positions.to_vec(),
-                velocities: p.velocities.to_vec(),
-                accelerations: Vec::new(),
-                effort: Vec::new(),
+                positions: p.positions.clone(),
+                velocities: p.velocities.clone(),
+                accelerations: p.accelerations.clone(),
+                effort: p.effort.clone(),
                 time_from_start: Duration::from_secs_f64(time)
                     .map_err(|e| format!("time {time} s: {e}"))?,
             })

@@ -257,14 +257,14 @@ fn dp_output() -> &'static MillPlanOutput {
 fn planned_msg(out: &MillPlanOutput) -> kerf_msgs::trajectory_msgs::JointTrajectory {
     use kerf_msgs::{builtin_interfaces::Duration, trajectory_msgs};
     trajectory_msgs::JointTrajectory {
-        joint_names: out.trajectory.joint_names.clone(),
+        joint_names: out.trajectory.joint_names().to_vec(),
         points: out
             .trajectory
-            .points
+            .points()
             .iter()
             .map(|p| trajectory_msgs::JointTrajectoryPoint {
-                positions: p.positions.to_vec(),
-                velocities: p.velocities.to_vec(),
+                positions: p.positions.clone(),
+                velocities: p.velocities.clone(),
                 time_from_start: Duration::from_secs_f64(p.time_from_start).unwrap(),
                 ..trajectory_msgs::JointTrajectoryPoint::default()
             })
@@ -287,37 +287,37 @@ fn assert_published_as_executed(m: &msg::MillPlan, out: &MillPlanOutput) {
         t.joint_names,
         ["joint_1", "joint_2", "joint_3", "joint_4", "joint_5", "joint_6"]
     );
-    assert_eq!(t.joint_names, executed.joint_names);
+    assert_eq!(t.joint_names, executed.joint_names());
     assert!(t.header.stamp.sec == 0 && t.header.stamp.nanosec == 0);
     let n = out.plan.segments.len();
     assert_eq!(t.points.len(), n + 2);
-    assert_eq!(t.points.len(), executed.points.len());
-    for (k, (a, b)) in t.points.iter().zip(&executed.points).enumerate() {
-        assert_eq!(a.positions, b.positions.to_vec(), "point {k}");
-        assert_eq!(a.velocities, b.velocities.to_vec(), "point {k}");
+    assert_eq!(t.points.len(), executed.points().len());
+    for (k, (a, b)) in t.points.iter().zip(executed.points()).enumerate() {
+        assert_eq!(a.positions, b.positions, "point {k}");
+        assert_eq!(a.velocities, b.velocities, "point {k}");
         assert!(a.accelerations.is_empty() && a.effort.is_empty());
         let dt = a.time_from_start.as_secs_f64() - b.time_from_start;
         assert!(dt.abs() <= 1e-9, "point {k}: {dt} s off");
     }
     // The planned points, at the executed times.
-    for (a, b) in t.points.iter().zip(&out.trajectory.points) {
-        assert_eq!(a.positions, b.positions.to_vec());
+    for (a, b) in t.points.iter().zip(out.trajectory.points()) {
+        assert_eq!(a.positions, b.positions);
     }
     // From rest to rest (the planner's one-sided differences at the ends are not zero).
     let last = t.points.len() - 1;
     for k in [0, last] {
         assert_eq!(t.points[k].velocities, vec![0.0; 6], "point {k}");
         assert!(
-            out.trajectory.points[k]
+            out.trajectory.points()[k]
                 .velocities
                 .iter()
                 .any(|v| v.abs() > 1e-3),
             "{k}: {:?}",
-            out.trajectory.points[k].velocities
+            out.trajectory.points()[k].velocities
         );
     }
     // Never faster than planned: the ramps at least double the first and last intervals.
-    let (p, e) = (&out.trajectory.points, &executed.points);
+    let (p, e) = (out.trajectory.points(), executed.points());
     for k in 0..last {
         let planned = p[k + 1].time_from_start - p[k].time_from_start;
         let run = e[k + 1].time_from_start - e[k].time_from_start;
@@ -536,24 +536,31 @@ fn a_defective_trajectory_is_an_internal_error_not_a_plan() {
     type Defect = (&'static str, fn(&mut MillPlanOutput));
     let defects: [Defect; 6] = [
         ("is NaN", |o| {
-            o.executed.scaling.trajectory.points[5].velocities[2] = f64::NAN
+            o.executed.scaling.trajectory.request.points[5].velocities[2] = f64::NAN
         }),
         ("times do not increase at point 3", |o| {
-            let p = &mut o.executed.scaling.trajectory.points;
+            let p = &mut o.executed.scaling.trajectory.request.points;
             p[3].time_from_start = p[2].time_from_start
         }),
         ("5 joint names", |o| {
-            o.executed.scaling.trajectory.joint_names.pop();
+            o.executed.scaling.trajectory.request.joint_names.pop();
         }),
         ("not at time 0", |o| {
-            o.executed.scaling.trajectory.points[0].time_from_start = 0.1
+            o.executed.scaling.trajectory.request.points[0].time_from_start = 0.1
         }),
         (
             "the first point (t = 0 s) is not at rest: velocity of joint_2",
-            |o| o.executed.scaling.trajectory.points[0].velocities[1] = 1e-3,
+            |o| o.executed.scaling.trajectory.request.points[0].velocities[1] = 1e-3,
         ),
         ("the last point", |o| {
-            let p = o.executed.scaling.trajectory.points.last_mut().unwrap();
+            let p = o
+                .executed
+                .scaling
+                .trajectory
+                .request
+                .points
+                .last_mut()
+                .unwrap();
             p.velocities[5] = -0.2
         }),
     ];
