@@ -38,7 +38,8 @@ pub struct LaunchArgs {
     #[arg(long)]
     with_planner: bool,
     /// Directory holding the robot descriptions (default: `$KERF_URDF_DIR`, else the `urdf/`
-    /// of the source tree kerf was built from).
+    /// of the kerf data directory: `$KERF_DATA_DIR`, the share directory beside the binary,
+    /// the source tree kerf was built from).
     #[arg(long)]
     urdf_dir: Option<PathBuf>,
     /// ROS arguments, as for any ROS 2 node: `--ros-args -r __ns:=/cell -p control_rate:=100.0
@@ -48,9 +49,17 @@ pub struct LaunchArgs {
     ros_args: Vec<String>,
 }
 
-fn urdf_dir(arg: Option<PathBuf>) -> PathBuf {
-    arg.or_else(|| std::env::var_os("KERF_URDF_DIR").map(PathBuf::from))
-        .unwrap_or_else(|| PathBuf::from(concat!(env!("CARGO_MANIFEST_DIR"), "/urdf")))
+/// The directory of the robot descriptions: `--urdf-dir`, else `$KERF_URDF_DIR`, else `urdf/`
+/// of the kerf data directory ([`kerf_robot::data`]).
+///
+/// # Errors
+/// The data search's message (every place searched) when neither is given and no kerf data
+/// directory is found.
+fn urdf_dir(arg: Option<PathBuf>) -> Result<PathBuf, String> {
+    match arg.or_else(|| std::env::var_os("KERF_URDF_DIR").map(PathBuf::from)) {
+        Some(dir) => Ok(dir),
+        None => kerf_robot::data::path("urdf").map_err(|e| e.to_string()),
+    }
 }
 
 /// Whether `name` is one of `known` (`prefix.*` admits a group), as `Params::reject_unknown`
@@ -110,7 +119,7 @@ pub fn run(a: LaunchArgs) -> Result<(), String> {
             "unexpected argument {extra:?}; ROS arguments go after --ros-args"
         ));
     }
-    let dir = urdf_dir(a.urdf_dir);
+    let dir = urdf_dir(a.urdf_dir)?;
     let stem = a.robot.stem();
     // Defaults first: later sources (the user's -p and --params-file) override them.
     let defaults = [

@@ -21,6 +21,9 @@ use crate::ik::Kinematics;
 use crate::jacobian::condition_number;
 use crate::path::{MillingPath, PathSpec};
 
+/// The shipped cell file, relative to the kerf data root.
+const DEFAULT_CELL: &str = "urdf/irb6660_milling.yaml";
+
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 struct CellFile {
@@ -171,18 +174,25 @@ pub struct MillCell {
 }
 
 impl MillCell {
-    /// The default cell file, `urdf/irb6660_milling.yaml` of the repository.
+    /// The default cell file, `urdf/irb6660_milling.yaml` below the kerf data root
+    /// ([`kerf_robot::data`]: `KERF_DATA_DIR`, the share directory beside the binary, the
+    /// source tree).
+    ///
+    /// # Returns
+    /// The path; when the data search fails, below the place it failed at
+    /// ([`kerf_robot::data::default_path`]), and [`MillCell::default_cell`] reports why.
     pub fn default_path() -> PathBuf {
-        Path::new(env!("CARGO_MANIFEST_DIR")).join("../../urdf/irb6660_milling.yaml")
+        kerf_robot::data::default_path(DEFAULT_CELL)
     }
 
     /// Loads [`MillCell::default_path`] (with `urdf/irb6660.urdf` and
     /// `urdf/irb6660_limits.yaml`).
     ///
     /// # Errors
-    /// As [`MillCell::load`].
+    /// [`MillError::Robot`] when no kerf data root is found (the message names every place
+    /// searched); else as [`MillCell::load`].
     pub fn default_cell() -> Result<Self, MillError> {
-        Self::load(&Self::default_path())
+        Self::load(&kerf_robot::data::path(DEFAULT_CELL)?)
     }
 
     /// Loads and validates a cell file.

@@ -935,9 +935,15 @@ impl IndicatorCache {
     }
 
     /// The default cache file of the default cell,
-    /// `crates/millplan/data/indicator_cache.bin`.
+    /// `crates/millplan/data/indicator_cache.bin` below the kerf data root
+    /// ([`kerf_robot::data`]: `KERF_DATA_DIR`, the share directory beside the binary, the
+    /// source tree).
+    ///
+    /// # Returns
+    /// The path; when the data search fails, below the place it failed at
+    /// ([`kerf_robot::data::default_path`]).
     pub fn default_path() -> std::path::PathBuf {
-        Path::new(env!("CARGO_MANIFEST_DIR")).join("data/indicator_cache.bin")
+        kerf_robot::data::default_path("crates/millplan/data/indicator_cache.bin")
     }
 }
 

@@ -33,14 +33,25 @@ pub struct LaserMachine {
 }
 
 impl LaserMachine {
-    /// The repository's `urdf/` directory (compile-time location).
+    /// The shipped `urdf/` directory, found by the data search of [`kerf_robot::data`]
+    /// (`KERF_DATA_DIR`, the share directory beside the binary, the source tree).
+    ///
+    /// # Returns
+    /// `urdf/` below the data root; when the search fails, below the place it failed at
+    /// ([`kerf_robot::data::default_path`]), and [`LaserMachine::default_machine`] reports why.
     pub fn urdf_dir() -> PathBuf {
-        Path::new(env!("CARGO_MANIFEST_DIR")).join("../../urdf")
+        kerf_robot::data::default_path("urdf")
     }
 
-    /// Loads `urdf/laser_cutter.urdf` with `urdf/laser_cutter_limits.yaml`.
+    /// Loads `urdf/laser_cutter.urdf` with `urdf/laser_cutter_limits.yaml` from the kerf data
+    /// root ([`kerf_robot::data::root`]).
+    ///
+    /// # Errors
+    /// [`PlanError::InvalidRequest`] (field `machine`) when no data root is found (the message
+    /// names every place searched) or as [`LaserMachine::from_files`].
     pub fn default_machine() -> Result<Self, PlanError> {
-        let dir = Self::urdf_dir();
+        let dir = kerf_robot::data::path("urdf")
+            .map_err(|e| PlanError::invalid("machine", e.to_string()))?;
         Self::from_files(
             &dir.join("laser_cutter.urdf"),
             Some(&dir.join("laser_cutter_limits.yaml")),

@@ -25,6 +25,8 @@
 
 use std::path::{Path, PathBuf};
 
+use kerf_robot::RobotError;
+
 use crate::PlanError;
 
 mod cache;
@@ -42,9 +44,15 @@ use parse::{parse_obj, parse_stl};
 /// mesh is almost certainly in millimetres.
 pub const MAX_EXTENT: f64 = 20.0;
 
-/// The repository root, the directory `package://kerf/` refers to.
+/// The directory `package://kerf/` refers to: the kerf data root of
+/// [`kerf_robot::data`] (`KERF_DATA_DIR`, the share directory beside the binary, the
+/// source tree — the repository root).
+///
+/// # Returns
+/// The data root; when the search fails, the place it failed at
+/// ([`kerf_robot::data::default_root`]), and [`resolve`] reports why.
 pub fn package_root() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("../..")
+    kerf_robot::data::default_root()
 }
 
 /// Resolves a mesh reference to a file path.
@@ -55,14 +63,15 @@ pub fn package_root() -> PathBuf {
 ///     directory),
 ///   * a `file://` URI (`file:///abs/path`, `file://localhost/abs/path`;
 ///     `%XX` escapes are decoded),
-///   * `package://kerf/<relative path>`, relative to the repository root
-///     ([`package_root`]).
+///   * `package://kerf/<relative path>`, relative to the kerf data root
+///     ([`package_root`], [`kerf_robot::data::resolve_package_uri`]).
 ///
 /// # Errors
 /// [`PlanError::Mesh`] for an empty reference, another package
 /// (`package://kerf_msgs/...` and every package but `kerf`), another URI
-/// scheme (`http://`, ...), a `file://` URI with a remote host, or a
-/// `package://kerf/` path that leaves the repository (`..`).
+/// scheme (`http://`, ...), a `file://` URI with a remote host, a
+/// `package://kerf/` path that leaves the repository (`..`), or a
+/// `package://kerf/` URI when no kerf data root is found.
 pub fn resolve(reference: &str) -> Result<PathBuf, PlanError> {
     let err = |reason: String| PlanError::Mesh {
         source_name: reference.to_owned(),
@@ -72,29 +81,11 @@ pub fn resolve(reference: &str) -> Result<PathBuf, PlanError> {
     if r.is_empty() {
         return Err(err("empty mesh reference".into()));
     }
-    if let Some(rest) = r.strip_prefix("package://") {
-        let (package, rel) = rest.split_once('/').unwrap_or((rest, ""));
-        if package != "kerf" {
-            return Err(err(format!(
-                "package '{package}' is not supported: only package://kerf/<path> (the kerf \
-                 repository root) is resolved"
-            )));
-        }
-        let rel = Path::new(rel);
-        if rel.as_os_str().is_empty() {
-            return Err(err("package://kerf/ needs a file path".into()));
-        }
-        if rel.components().any(|c| {
-            !matches!(
-                c,
-                std::path::Component::Normal(_) | std::path::Component::CurDir
-            )
-        }) {
-            return Err(err(
-                "a package://kerf/ path must be relative and stay inside the repository".into(),
-            ));
-        }
-        return Ok(package_root().join(rel));
+    if r.starts_with("package://") {
+        return kerf_robot::data::resolve_package_uri(r).map_err(|e| match e {
+            RobotError::PackageUri { reason, .. } => err(reason),
+            other => err(other.to_string()),
+        });
     }
     if let Some(rest) = r.strip_prefix("file://") {
         let path = if rest.starts_with('/') {

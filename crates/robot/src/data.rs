@@ -219,10 +219,21 @@ pub fn path(rel: impl AsRef<Path>) -> Result<PathBuf, RobotError> {
     Ok(root()?.join(rel))
 }
 
-/// A shipped file for a default that cannot report an error: [`path`] when the search
-/// succeeds, else the path below the place the search failed at ([`DATA_DIR_VAR`]'s
-/// directory when set, else the source tree), so that reading it fails naming that path.
-/// Loaders report the search's own error ([`path`]) before reading such a default.
+/// The data root for a default that cannot report an error: [`root`] when the search
+/// succeeds, else the place the search failed at ([`DATA_DIR_VAR`]'s directory when set,
+/// else the source tree), so that reading below it fails naming that path. Loaders report the
+/// search's own error ([`root`], [`path`]) before reading such a default.
+///
+/// # Returns
+/// The data root's path, or the place the search failed at.
+pub fn default_root() -> PathBuf {
+    match root() {
+        Ok(root) => root.path,
+        Err(_) => std::env::var_os(DATA_DIR_VAR).map_or_else(source_tree, PathBuf::from),
+    }
+}
+
+/// A shipped file for a default that cannot report an error: `rel` below [`default_root`].
 ///
 /// # Arguments
 /// * `rel` - the path relative to the data root, as in the source tree.
@@ -230,12 +241,7 @@ pub fn path(rel: impl AsRef<Path>) -> Result<PathBuf, RobotError> {
 /// # Returns
 /// The path below the data root, or below the place the search failed at.
 pub fn default_path(rel: impl AsRef<Path>) -> PathBuf {
-    match root() {
-        Ok(root) => root.join(rel),
-        Err(_) => std::env::var_os(DATA_DIR_VAR)
-            .map_or_else(source_tree, PathBuf::from)
-            .join(rel),
-    }
+    default_root().join(rel)
 }
 
 /// Resolves a `package://kerf/<path>` URI to `<path>` below the data root of this process.
