@@ -401,7 +401,7 @@ fn trains_a_policy_and_plans_with_it_as_the_library_does() {
     ] {
         let points = p0[key]["points"].as_array().expect(key);
         assert_eq!(points.len(), 102, "{key}");
-        for (a, b) in points.iter().zip(&t.points) {
+        for (a, b) in points.iter().zip(t.points()) {
             assert_eq!(f(&a["time_from_start_s"]), b.time_from_start, "{key}");
             assert_eq!(f(&a["velocities_rad_per_s"][4]), b.velocities[4], "{key}");
             assert_eq!(f(&a["positions_rad"][0]), b.positions[0], "{key}");
