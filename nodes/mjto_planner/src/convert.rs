@@ -13,12 +13,7 @@ use kerf_mjto::{
     request::{CutOptions, PoseSpec},
     CutRequest, PlanError,
 };
-use kerf_msgs::{
-    builtin_interfaces::Duration,
-    msg,
-    std_msgs::Header,
-    trajectory_msgs::{JointTrajectory, JointTrajectoryPoint},
-};
+use kerf_msgs::{msg, trajectory_msgs::JointTrajectory};
 
 /// Path acceleration limit of the feed ramps used when the message says 0 (m/s²); seed 001
 /// Table 1, both cases. Equal to the default of the YAML request form (tested).
@@ -215,36 +210,16 @@ pub fn check_samples(plan: &kerf_mjto::CutPlan) -> Result<(), String> {
     Ok(())
 }
 
-/// The plan's samples as a `JointTrajectory`: joints q1..q6, one point per sample with
-/// positions, velocities and accelerations, `header.stamp` zero (the executor starts it on
-/// receipt).
+/// The plan's samples as a `JointTrajectory` ([`kerf_mjto::CutPlan::joint_trajectory`]
+/// converted by [`kerf_ros::planner::trajectory_msg`]): joints q1..q6, one point per sample
+/// with positions, velocities and accelerations, `header.stamp` zero (the executor starts it
+/// on receipt).
 ///
 /// # Errors
 /// As [`check_samples`], or a sample time that does not fit a `Duration`.
 pub fn trajectory_msg(plan: &kerf_mjto::CutPlan) -> Result<JointTrajectory, String> {
     check_samples(plan)?;
-    let mut points = Vec::with_capacity(plan.times.len());
-    for (((t, p), v), a) in plan
-        .times
-        .iter()
-        .zip(&plan.positions)
-        .zip(&plan.velocities)
-        .zip(&plan.accelerations)
-    {
-        points.push(JointTrajectoryPoint {
-            positions: p.to_vec(),
-            velocities: v.to_vec(),
-            accelerations: a.to_vec(),
-            effort: Vec::new(),
-            time_from_start: Duration::from_secs_f64(*t)
-                .map_err(|e| format!("sample time {t} s: {e}"))?,
-        });
-    }
-    Ok(JointTrajectory {
-        header: Header::default(),
-        joint_names: JOINT_NAMES.iter().map(|s| s.to_string()).collect(),
-        points,
-    })
+    kerf_ros::planner::trajectory_msg(&plan.joint_trajectory())
 }
 
 /// A one-line summary of a successful plan, for the `message` field and logs.
@@ -356,6 +331,7 @@ mod tests {
         error::LimitViolation,
         plan::{CutPlan, StageTimes},
     };
+    use kerf_msgs::builtin_interfaces::Duration;
     use kerf_msgs::geometry_msgs::{Point, Pose, Quaternion, Vector3};
 
     fn message() -> msg::CutRequest {

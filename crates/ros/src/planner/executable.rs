@@ -7,7 +7,8 @@ use kerf_executor::{
 };
 use kerf_msgs::{
     builtin_interfaces::{Duration, Time},
-    trajectory_msgs::JointTrajectory,
+    std_msgs::Header,
+    trajectory_msgs::{JointTrajectory, JointTrajectoryPoint},
 };
 use kerf_robot::RobotModel;
 
@@ -63,6 +64,41 @@ pub fn trajectory_request(
         joint_names: msg.joint_names.clone(),
         points,
         start_time,
+    })
+}
+
+/// Converts the executor's ROS-free trajectory into a `trajectory_msgs/JointTrajectory` with
+/// `header.stamp` zero (an executor starts it on receipt); the inverse of
+/// [`trajectory_request`] for a trajectory without a start time.
+///
+/// # Errors
+/// A point time that does not fit a `builtin_interfaces/Duration` (negative, NaN, too large),
+/// naming the point; a trajectory with a `start_time` (a planner's output starts on receipt).
+pub fn trajectory_msg(trajectory: &TrajectoryRequest) -> Result<JointTrajectory, String> {
+    if let Some(t) = trajectory.start_time {
+        return Err(format!(
+            "the trajectory has a start time ({t} s); a planned trajectory starts on receipt"
+        ));
+    }
+    let points = trajectory
+        .points
+        .iter()
+        .enumerate()
+        .map(|(i, p)| {
+            Ok(JointTrajectoryPoint {
+                positions: p.positions.clone(),
+                velocities: p.velocities.clone(),
+                accelerations: p.accelerations.clone(),
+                effort: p.effort.clone(),
+                time_from_start: Duration::from_secs_f64(p.time_from_start)
+                    .map_err(|e| format!("point {i}: time {} s: {e}", p.time_from_start))?,
+            })
+        })
+        .collect::<Result<Vec<_>, String>>()?;
+    Ok(JointTrajectory {
+        header: Header::default(),
+        joint_names: trajectory.joint_names.clone(),
+        points,
     })
 }
 

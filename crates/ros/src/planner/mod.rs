@@ -29,7 +29,7 @@ mod main;
 mod service;
 mod text;
 
-pub use executable::{check_trajectory_msg, executor_limits, trajectory_request};
+pub use executable::{check_trajectory_msg, executor_limits, trajectory_msg, trajectory_request};
 pub use harness::{answer_text, run, work, Job};
 pub use main::node_main;
 pub use service::{AnswerKey, Failure, PlanAnswer, PlanningService, Topics, TRAJECTORY_TOPIC};
