@@ -14,9 +14,10 @@
 mod echo;
 mod launch;
 mod lobes;
-mod mill_plots;
+mod output_paths;
 mod plan_cut;
 mod plan_mill;
+mod plots;
 mod train_mill;
 
 use std::process::ExitCode;

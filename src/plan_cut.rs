@@ -8,17 +8,16 @@
 //! `~/cut_request_text`), plans it with [`kerf_mjto::planner::Planner`] for the shipped laser
 //! cutter (or `--urdf` / `--limits`), prints a summary (status, RTOs, metrics against the QI
 //! baseline of seed 001), writes the plan as JSON to `--out` (every sample, the RTOs, the
-//! metrics and stage times) and SVG plots per axis to `--plots` ([`plots`]). Any failure
+//! metrics and stage times) and SVG plots per axis to `--plots` ([`crate::plots::joints`],
+//! of [`kerf_mjto::series::JointSeries`]). Any failure
 //! exits with code 2 and the planner's message (status name and code first).
-
-mod plots;
 
 use std::{fmt::Write as _, path::PathBuf};
 
 use clap::{Args, Subcommand};
 use kerf_mjto::{
-    machine::JOINT_NAMES, plan::Metrics, planner::Planner, CutPlan, CutRequest, LaserMachine,
-    PlanError,
+    machine::JOINT_NAMES, plan::Metrics, planner::Planner, series::JointSeries, CutPlan,
+    CutRequest, LaserMachine, PlanError,
 };
 use kerf_msgs::msg::CutPlan as CutPlanMsg;
 
@@ -114,14 +113,19 @@ fn cut(a: CutArgs) -> Result<(), String> {
         println!("plan written to {}", out.display());
     }
     if let Some(dir) = &a.plots {
-        let qi = match plots::qi_series(&request, &plan, &limits) {
+        let qi = match JointSeries::qi_baseline(&request, &plan, &limits) {
             Ok(s) => Some(s),
             Err(e) => {
                 eprintln!("kerf: QI baseline not plotted: {e}");
                 None
             }
         };
-        let files = plots::write_plots(dir, &plots::mjto_series(&plan), qi.as_ref(), &limits)?;
+        let files = crate::plots::joints::write_plots(
+            dir,
+            &JointSeries::of_plan(&plan),
+            qi.as_ref(),
+            &limits,
+        )?;
         println!("{} plots written to {}", files.len(), dir.display());
     }
     Ok(())

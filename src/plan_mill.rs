@@ -34,7 +34,7 @@
 //!
 //! `--plots DIR` writes `mill_plan_<planner>.svg` per plan and, with two or more plans,
 //! `mill_plan_comparison.svg` overlaying them (seed 004 Fig. 6 / Fig. 8 panels,
-//! [`crate::mill_plots::plan_panels`]; the plans as planned). `--out` writes every plan and
+//! [`crate::plots::mill_plan::plan_panels`]; the plans as planned). `--out` writes every plan and
 //! every failure as JSON, or YAML when the name ends in `.yaml`/`.yml`: per plan the
 //! `segments` and `totals` as planned, `executed` (its `totals` and `segments` as executed,
 //! and the time scaling: stretch per trajectory interval, intervals slowed, rounds), the
@@ -45,25 +45,23 @@
 //! any planner's failure — its status name, code and message are printed — or an output
 //! that cannot be written).
 
-use std::{fmt::Write as _, path::PathBuf};
+mod document;
+mod report;
+
+use std::path::PathBuf;
 
 use clap::{Args, ValueEnum};
 use kerf_millplan::{
     comparison_table,
     plan::{IndicatorSource, Plan},
     planner::status_name,
-    status_of, JointTrajectory, MillPlanError, MillPlanOutput, MillPlanner, MillRequest,
-    PlannerKind,
+    status_of, MillPlanError, MillPlanOutput, MillPlanner, MillRequest, PlannerKind,
 };
-use serde_json::{json, Value};
 
-use crate::{mill_plots, train_mill};
+use crate::{output_paths, plots::mill_plan};
 
-/// Paths with at most this many segments print every row of the table.
-const ALL_ROWS_UP_TO: usize = 20;
-
-/// Row stride of the table of longer paths.
-const ROW_STRIDE: usize = 10;
+pub use report::describe;
+use report::{plan_report, request_label, totals_title};
 
 /// Where the plans' |μ|max values come from.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
@@ -103,13 +101,6 @@ pub struct MillArgs {
     /// Print every segment of the table (default: every 10th for paths over 20 segments).
     #[arg(long)]
     all_rows: bool,
-}
-
-/// "STATUS (code): message" of a planner error.
-pub fn describe(e: &MillPlanError) -> String {
-    let code = status_of(e);
-    let name = status_name(code).unwrap_or("?");
-    format!("{name} ({code}): {e}")
 }
 
 /// Output format of `--out`.
@@ -182,10 +173,10 @@ fn request_for(a: &MillArgs, request: &MillRequest, kind: PlannerKind) -> MillRe
 pub fn run(a: MillArgs) -> Result<(), String> {
     let format = a.out.as_deref().map(out_format).transpose()?;
     if let Some(o) = &a.out {
-        train_mill::check_writable("--out", o)?;
+        output_paths::check_writable("--out", o)?;
     }
     if let Some(d) = &a.plots {
-        train_mill::check_dir_writable("--plots", d)?;
+        output_paths::check_dir_writable("--plots", d)?;
     }
     let text = std::fs::read_to_string(&a.request)
         .map_err(|e| format!("cannot read {}: {e}", a.request.display()))?;
@@ -250,7 +241,7 @@ pub fn run(a: MillArgs) -> Result<(), String> {
     }
 
     if let (Some(path), Some(format)) = (&a.out, format) {
-        let doc = document(&request, &outputs, &failures);
+        let doc = document::document(&request, &outputs, &failures);
         let text = match format {
             OutFormat::Json => serde_json::to_string_pretty(&doc)
                 .map_err(|e| format!("cannot serialize the plans: {e}"))?,
@@ -267,7 +258,7 @@ pub fn run(a: MillArgs) -> Result<(), String> {
         for o in &outputs {
             let name = o.planner.name();
             let file = dir.join(format!("mill_plan_{name}.svg"));
-            mill_plots::plan_panels(
+            mill_plan::plan_panels(
                 &file,
                 &[(name, &o.plan)],
                 &format!("{id}planner {name}: {}", totals_title(&o.plan)),
@@ -280,7 +271,7 @@ pub fn run(a: MillArgs) -> Result<(), String> {
                 .iter()
                 .map(|o| (o.planner.name(), &o.plan))
                 .collect();
-            mill_plots::plan_panels(&file, &plans, &format!("{id}planners compared"))?;
+            mill_plan::plan_panels(&file, &plans, &format!("{id}planners compared"))?;
             files.push(file);
         }
         if !files.is_empty() {
@@ -313,280 +304,9 @@ pub fn run(a: MillArgs) -> Result<(), String> {
     }
 }
 
-/// `request 'ID', ` for a request with an id, nothing otherwise.
-fn request_label(id: &str) -> String {
-    if id.is_empty() {
-        String::new()
-    } else {
-        format!("request '{id}', ")
-    }
-}
-
-/// Short totals for a plot title.
-fn totals_title(p: &Plan) -> String {
-    format!(
-        "time {:.2} s, max |mu|max {:.3}, min 1/K {:.3}, reward {:.2}",
-        p.total_time, p.max_spectral_radius, p.min_condition_indicator, p.total_reward
-    )
-}
-
-/// The segments a table shows: all when `all` or the path is short, else every
-/// [`ROW_STRIDE`]th and the last.
-pub fn table_rows(n: usize, all: bool) -> Vec<usize> {
-    if all || n <= ALL_ROWS_UP_TO {
-        return (0..n).collect();
-    }
-    let mut rows: Vec<usize> = (0..n).step_by(ROW_STRIDE).collect();
-    if rows.last() != Some(&(n - 1)) {
-        rows.push(n - 1);
-    }
-    rows
-}
-
-/// The totals line of a plan (parsed by `tests/mill_cli.rs`: keep the wording).
-pub fn totals_line(p: &Plan) -> String {
-    format!(
-        "totals: machining time {:.6} s, chatter-free {}, max |μ|max {:.6}, min 1/K {:.6}, \
-         total reward {:.6}",
-        p.total_time,
-        if p.chatter_free { "yes" } else { "no" },
-        p.max_spectral_radius,
-        p.min_condition_indicator,
-        p.total_reward
-    )
-}
-
-/// The totals line of a plan as executed (`o.executed`; parsed by `tests/mill_cli.rs`: keep
-/// the wording): the totals of [`totals_line`] and how much the joint limits slowed it.
-pub fn executed_line(o: &MillPlanOutput) -> String {
-    let (p, sc) = (&o.executed.plan, &o.executed.scaling);
-    let lowest_feed = p
-        .segments
-        .iter()
-        .map(|g| g.feed)
-        .fold(f64::INFINITY, f64::min);
-    let cached = match o.executed.cached_segments.len() {
-        0 => String::new(),
-        k => format!(", |μ|max of {k} segments from the indicator cache"),
-    };
-    format!(
-        "as executed (time-scaled to the joint limits, from rest to rest): machining time \
-         {:.6} s, chatter-free {}, max |μ|max {:.6}, min 1/K {:.6}, total reward {:.6}, {} of \
-         {} trajectory intervals slowed, lowest feed {:.5} m/s{cached}",
-        p.total_time,
-        if p.chatter_free { "yes" } else { "no" },
-        p.max_spectral_radius,
-        p.min_condition_indicator,
-        p.total_reward,
-        sc.stretched_intervals(),
-        sc.interval_stretch.len(),
-        lowest_feed
-    )
-}
-
-/// The printed report of one plan: header, table, totals as planned and as executed, branch
-/// jumps.
-fn plan_report(o: &MillPlanOutput, all_rows: bool) -> String {
-    let mut s = String::new();
-    let p = &o.plan;
-    let _ = writeln!(
-        s,
-        "{}planner {}: SUCCESS (0): {} segments, planned in {:.3} s{}",
-        request_label(&o.request_id),
-        o.planner.name(),
-        p.segments.len(),
-        o.planning_seconds,
-        o.policy_file
-            .as_ref()
-            .map_or(String::new(), |f| format!(", policy {}", f.display()))
-    );
-    let _ = writeln!(
-        s,
-        "  indicator: {}; default cell's cache {}",
-        o.indicator.note,
-        if o.cache_used {
-            "applied"
-        } else {
-            "not applied"
-        }
-    );
-    let _ = writeln!(
-        s,
-        "  {:>7} {:>9} {:>9} {:>8} {:>8} {:>7} {:>8} {:>8}",
-        "segment", "Ω [rpm]", "f [m/s]", "g [rad]", "|μ|max", "1/K", "time [s]", "reward"
-    );
-    let rows = table_rows(p.segments.len(), all_rows);
-    for &i in &rows {
-        let g = &p.segments[i];
-        let _ = writeln!(
-            s,
-            "  {:>7} {:>9.2} {:>9.5} {:>8.4} {:>8.4} {:>7.4} {:>8.4} {:>8.4}",
-            g.segment,
-            g.rpm,
-            g.feed,
-            g.g,
-            g.spectral_radius,
-            g.condition_indicator,
-            g.time,
-            g.reward.total
-        );
-    }
-    if rows.len() < p.segments.len() {
-        let _ = writeln!(
-            s,
-            "  ({} of {} segments shown; --all-rows shows every one)",
-            rows.len(),
-            p.segments.len()
-        );
-    }
-    let _ = writeln!(s, "  {}", totals_line(p));
-    let _ = writeln!(s, "  {}", executed_line(o));
-    if o.plan.chatter_free && !o.executed.plan.chatter_free {
-        let _ = writeln!(
-            s,
-            "  warning: chatter-free as planned but NOT as executed: the joint limits slow it \
-             to feeds where |μ|max >= 1"
-        );
-    }
-    for j in &o.branch_jumps {
-        let _ = writeln!(
-            s,
-            "  warning: {} jumps {:.4} rad at trajectory point {} (IK branch change?)",
-            j.joint, j.step, j.index
-        );
-    }
-    s
-}
-
-/// The totals of a plan in the `--out` document.
-fn totals_json(p: &Plan) -> Value {
-    json!({
-        "machining_time_s": p.total_time,
-        "chatter_free": p.chatter_free,
-        "max_spectral_radius": p.max_spectral_radius,
-        "min_condition_indicator": p.min_condition_indicator,
-        "total_reward": p.total_reward,
-    })
-}
-
-/// A joint trajectory in the `--out` document.
-fn trajectory_json(t: &JointTrajectory) -> Value {
-    json!({
-        "joint_names": t.joint_names,
-        "points": t.points.iter().map(|t| json!({
-            "time_from_start_s": t.time_from_start,
-            "positions_rad": t.positions,
-            "velocities_rad_per_s": t.velocities,
-            "arc_length_m": t.arc_length,
-            "segment": t.segment,
-        })).collect::<Vec<_>>(),
-    })
-}
-
-/// The `--out` document (module documentation): the request id, every plan and every
-/// failure.
-fn document(
-    request: &MillRequest,
-    outputs: &[MillPlanOutput],
-    failures: &[(PlannerKind, MillPlanError)],
-) -> Value {
-    let plans: Vec<Value> = outputs
-        .iter()
-        .map(|o| {
-            let p = &o.plan;
-            let (x, sc) = (&o.executed.plan, &o.executed.scaling);
-            json!({
-                "planner": o.planner.name(),
-                "policy_file": o.policy_file.as_ref().map(|f| f.display().to_string()),
-                "status": 0,
-                "status_name": "SUCCESS",
-                "planning_seconds": o.planning_seconds,
-                "cache_used": o.cache_used,
-                "indicator": {
-                    "requested": o.indicator.requested.name(),
-                    "cached_segments": o.indicator.cached_segments,
-                    "error_bound": o.indicator.error_bound,
-                    "note": o.indicator.note,
-                },
-                "totals": totals_json(p),
-                "segments": p.segments.iter().map(|g| json!({
-                    "segment": g.segment,
-                    "spindle_rpm": g.rpm,
-                    "feed_m_per_s": g.feed,
-                    "g_rad": g.g,
-                    "spectral_radius": g.spectral_radius,
-                    "condition_number": g.condition_number,
-                    "condition_indicator": g.condition_indicator,
-                    "joints_rad": g.joints,
-                    "time_s": g.time,
-                    "reward": {
-                        "operational": g.reward.operational,
-                        "efficiency": g.reward.efficiency,
-                        "stability": g.reward.stability,
-                        "total": g.reward.total,
-                    },
-                })).collect::<Vec<_>>(),
-                "executed": {
-                    "totals": totals_json(x),
-                    "segments": x.segments.iter().map(|g| json!({
-                        "segment": g.segment,
-                        "feed_m_per_s": g.feed,
-                        "spectral_radius": g.spectral_radius,
-                        "time_s": g.time,
-                        "reward": g.reward.total,
-                    })).collect::<Vec<_>>(),
-                    "cached_segments": o.executed.cached_segments,
-                    "time_scaling": {
-                        "interval_stretch": sc.interval_stretch,
-                        "stretched_intervals": sc.stretched_intervals(),
-                        "rounds": sc.rounds,
-                        "uniform": sc.uniform,
-                        "duration_s": sc.duration(),
-                    },
-                },
-                "trajectory": trajectory_json(&sc.trajectory),
-                "planned_trajectory": trajectory_json(&o.trajectory),
-                "branch_jumps": o.branch_jumps.iter().map(|j| json!({
-                    "index": j.index, "joint": j.joint, "step_rad": j.step,
-                })).collect::<Vec<_>>(),
-            })
-        })
-        .collect();
-    let failed: Vec<Value> = failures
-        .iter()
-        .map(|(k, e)| {
-            let code = status_of(e);
-            json!({
-                "planner": k.name(),
-                "status": code,
-                "status_name": status_name(code).unwrap_or("?"),
-                "message": e.to_string(),
-            })
-        })
-        .collect();
-    json!({
-        "request_id": request.request_id,
-        "plans": plans,
-        "failures": failed,
-    })
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    fn long_tables_show_every_tenth_segment_and_the_last() {
-        assert_eq!(table_rows(5, false), vec![0, 1, 2, 3, 4]);
-        assert_eq!(table_rows(20, false).len(), 20);
-        assert_eq!(
-            table_rows(100, false),
-            vec![0, 10, 20, 30, 40, 50, 60, 70, 80, 90, 99]
-        );
-        assert_eq!(table_rows(91, false).last(), Some(&90));
-        assert_eq!(table_rows(91, false).len(), 10);
-        assert_eq!(table_rows(100, true).len(), 100);
-    }
 
     #[test]
     fn out_names_choose_the_format() {
@@ -597,17 +317,5 @@ mod tests {
         assert!(out_format(Path::new("p.txt"))
             .unwrap_err()
             .contains("must end in .json, .yaml or .yml"));
-    }
-
-    #[test]
-    fn errors_name_status_and_code() {
-        let e = MillPlanError::Policy {
-            path: "p.safetensors".into(),
-            reason: "weights file not found".into(),
-        };
-        assert_eq!(
-            describe(&e),
-            "POLICY_ERROR (3): policy p.safetensors: weights file not found"
-        );
     }
 }

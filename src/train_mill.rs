@@ -23,7 +23,7 @@
 //!   the sizes, every DDPG setting, the environment — cell, cache, [`EnvConfig`] — and the
 //!   exact command line) by [`Policy::save`]; `--history`: one row per episode (CSV when
 //!   the name ends in `.csv`, else a JSON array of [`EpisodeReport`]); `--plots DIR`:
-//!   `training_curve.svg` (seed 004 Fig. 5, [`crate::mill_plots::training_curve`]).
+//!   `training_curve.svg` (seed 004 Fig. 5, [`crate::plots::training::training_curve`]).
 //! * Summary on stdout: the greedy (noise-free) rollout of the trained policy over the whole
 //!   path, evaluated directly ([`Plan::evaluate`]): machining time, max |μ|max, min 1/K and
 //!   total reward (eq. 12); or where it left the feasible set.
@@ -37,9 +37,8 @@
 //! an unreadable cell or cache, an unwritable path) exit with code 2 and a message.
 
 use std::{
-    fmt::Write as _,
     io::{IsTerminal, Write as _},
-    path::{Path, PathBuf},
+    path::PathBuf,
     sync::Arc,
     time::Instant,
 };
@@ -47,11 +46,19 @@ use std::{
 use clap::{Args, Subcommand};
 use kerf_mill::MillCell;
 use kerf_millplan::{
-    plan::Plan, policy::metadata_path, status_of, train, DdpgSettings, EnvConfig, Environment,
-    EpisodeReport, IndicatorCache, MillEnv, MillPlanError, Policy,
+    history::history_csv, plan::Plan, policy::metadata_path, train, DdpgSettings, EnvConfig,
+    Environment, IndicatorCache, MillEnv, Policy,
 };
 
-use crate::mill_plots;
+use crate::{
+    output_paths::{check_dir_writable, check_writable},
+    plan_mill::describe,
+    plots::training,
+};
+use progress::{format_duration, Progress};
+
+mod curve;
+mod progress;
 
 /// Exit code of every `kerf train` failure (as `kerf plan`).
 pub const EXIT_FAILURE: u8 = 2;
@@ -174,313 +181,8 @@ pub struct MillTrainArgs {
 pub fn run(a: TrainArgs) -> Result<(), String> {
     match a.command {
         TrainCommand::Mill(m) => mill(*m),
-        TrainCommand::Curve(c) => curve(c),
+        TrainCommand::Curve(c) => curve::curve(c),
     }
-}
-
-/// "STATUS (code): message" of a library error (the planner's status names).
-fn describe(e: &MillPlanError) -> String {
-    let code = status_of(e);
-    let name = kerf_millplan::planner::status_name(code).unwrap_or("?");
-    format!("{name} ({code}): {e}")
-}
-
-/// Checks that `path` can be written as a file: creates its parent directories, refuses a
-/// directory, and opens it for appending (a file created by the check is removed again, an
-/// existing one is left untouched).
-///
-/// # Errors
-/// A message naming the option and the path.
-pub fn check_writable(option: &str, path: &Path) -> Result<(), String> {
-    let fail =
-        |e: &dyn std::fmt::Display| format!("{option} {}: cannot write: {e}", path.display());
-    if path.as_os_str().is_empty() {
-        return Err(format!("{option}: empty path"));
-    }
-    if path.is_dir() {
-        return Err(fail(&"is a directory"));
-    }
-    if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
-        std::fs::create_dir_all(dir).map_err(|e| fail(&e))?;
-    }
-    let existed = path.exists();
-    std::fs::OpenOptions::new()
-        .append(true)
-        .create(true)
-        .open(path)
-        .map_err(|e| fail(&e))?;
-    if !existed {
-        let _ = std::fs::remove_file(path);
-    }
-    Ok(())
-}
-
-/// Creates the directory `dir` (and parents) and checks that a file can be written in it.
-///
-/// # Errors
-/// A message naming the option and the directory.
-pub fn check_dir_writable(option: &str, dir: &Path) -> Result<(), String> {
-    std::fs::create_dir_all(dir).map_err(|e| {
-        format!(
-            "{option} {}: cannot create the directory: {e}",
-            dir.display()
-        )
-    })?;
-    let probe = dir.join(format!(".kerf_write_check_{}", std::process::id()));
-    std::fs::write(&probe, b"")
-        .map_err(|e| format!("{option} {}: cannot write in it: {e}", dir.display()))?;
-    let _ = std::fs::remove_file(&probe);
-    Ok(())
-}
-
-/// `12s`, `4m50s`, `1h02m03s` (rounded to the second; `?` for a non-finite or negative
-/// time).
-pub fn format_duration(seconds: f64) -> String {
-    if !(seconds.is_finite() && seconds >= 0.0) {
-        return "?".to_string();
-    }
-    let s = seconds.round() as u64;
-    let (h, m, s) = (s / 3600, (s / 60) % 60, s % 60);
-    if h > 0 {
-        format!("{h}h{m:02}m{s:02}s")
-    } else if m > 0 {
-        format!("{m}m{s:02}s")
-    } else {
-        format!("{s}s")
-    }
-}
-
-/// The progress display of a run (module documentation).
-struct Progress {
-    rewards: Vec<f64>,
-    /// Running sum over the last `window` rewards.
-    window_sum: f64,
-    window: usize,
-    terminal: bool,
-    log_every: usize,
-}
-
-/// Width of the progress bar in characters.
-const BAR_WIDTH: usize = 20;
-
-impl Progress {
-    fn new(window: usize, terminal: bool, log_every: usize) -> Self {
-        Self {
-            rewards: Vec::new(),
-            window_sum: 0.0,
-            window: window.max(1),
-            terminal,
-            log_every: log_every.max(1),
-        }
-    }
-
-    /// Records an episode and returns the text to print (empty when nothing is due).
-    fn update(&mut self, r: &EpisodeReport) -> String {
-        self.rewards.push(r.total_reward);
-        self.window_sum += r.total_reward;
-        let n = self.rewards.len();
-        if n > self.window {
-            self.window_sum -= self.rewards[n - 1 - self.window];
-        }
-        let average = self.window_sum / n.min(self.window) as f64;
-        let last = r.episode >= r.episodes;
-        let stats = format!(
-            "reward {:>9.3}, average({}) {:>9.3}, σ {:.4}, {} elapsed, {} left",
-            r.total_reward,
-            self.window,
-            average,
-            r.noise_std,
-            format_duration(r.elapsed_s),
-            format_duration(r.remaining_s)
-        );
-        if self.terminal {
-            let filled = (BAR_WIDTH * r.episode)
-                .checked_div(r.episodes)
-                .unwrap_or(BAR_WIDTH)
-                .min(BAR_WIDTH);
-            let bar: String = std::iter::repeat_n('#', filled)
-                .chain(std::iter::repeat_n('.', BAR_WIDTH - filled))
-                .collect();
-            // \r + clear to the end of the line (ANSI), then the bar.
-            let mut s = format!("\r\x1b[K[{bar}] {}/{} {stats}", r.episode, r.episodes);
-            if last {
-                s.push('\n');
-            }
-            s
-        } else if r.episode.is_multiple_of(self.log_every) || last || r.episode == 1 {
-            format!("episode {}/{}: {stats}\n", r.episode, r.episodes)
-        } else {
-            String::new()
-        }
-    }
-}
-
-/// The history as CSV: a header and one row per episode (empty loss cells in the warm-up).
-pub fn history_csv(history: &[EpisodeReport], window: usize) -> String {
-    let rewards: Vec<f64> = history.iter().map(|r| r.total_reward).collect();
-    let average = mill_plots::moving_average(&rewards, window);
-    let mut s = format!(
-        "episode,episodes,steps,total_reward,moving_average_{},mean_critic_loss,\
-         mean_actor_loss,noise_std,elapsed_s,remaining_s\n",
-        window.max(1)
-    );
-    let opt = |v: Option<f64>| v.map_or(String::new(), |v| v.to_string());
-    for (r, avg) in history.iter().zip(&average) {
-        let _ = writeln!(
-            s,
-            "{},{},{},{},{},{},{},{},{},{}",
-            r.episode,
-            r.episodes,
-            r.steps,
-            r.total_reward,
-            avg,
-            opt(r.mean_critic_loss),
-            opt(r.mean_actor_loss),
-            r.noise_std,
-            r.elapsed_s,
-            r.remaining_s
-        );
-    }
-    s
-}
-
-/// Reads a history written by `kerf train mill --history`: CSV when `csv`, else a JSON array
-/// of [`EpisodeReport`].
-///
-/// # Errors
-/// A message naming the row and column: a missing column, a value that is not a number, a
-/// non-finite reward, noise or time (NaN never passes), or no episode at all.
-pub fn parse_history(text: &str, csv: bool) -> Result<Vec<EpisodeReport>, String> {
-    let history: Vec<EpisodeReport> = if csv {
-        let mut lines = text.lines().filter(|l| !l.trim().is_empty());
-        let header: Vec<&str> = lines
-            .next()
-            .ok_or("empty history")?
-            .split(',')
-            .map(str::trim)
-            .collect();
-        let col = |name: &str| {
-            header
-                .iter()
-                .position(|h| *h == name)
-                .ok_or_else(|| format!("the header has no column `{name}`"))
-        };
-        let idx = [
-            col("episode")?,
-            col("episodes")?,
-            col("steps")?,
-            col("total_reward")?,
-            col("mean_critic_loss")?,
-            col("mean_actor_loss")?,
-            col("noise_std")?,
-            col("elapsed_s")?,
-            col("remaining_s")?,
-        ];
-        let mut out = Vec::new();
-        for (row, line) in lines.enumerate() {
-            let cells: Vec<&str> = line.split(',').map(str::trim).collect();
-            let cell = |k: usize| -> Result<&str, String> {
-                cells
-                    .get(idx[k])
-                    .copied()
-                    .ok_or_else(|| format!("row {}: column `{}` missing", row + 1, header[idx[k]]))
-            };
-            let num = |k: usize| -> Result<f64, String> {
-                let c = cell(k)?;
-                c.parse::<f64>().map_err(|_| {
-                    format!(
-                        "row {}: `{}` = `{c}` is not a number",
-                        row + 1,
-                        header[idx[k]]
-                    )
-                })
-            };
-            let whole = |k: usize| -> Result<usize, String> {
-                let c = cell(k)?;
-                c.parse::<usize>().map_err(|_| {
-                    format!(
-                        "row {}: `{}` = `{c}` is not a whole number",
-                        row + 1,
-                        header[idx[k]]
-                    )
-                })
-            };
-            let opt = |k: usize| -> Result<Option<f64>, String> {
-                if cell(k)?.is_empty() {
-                    Ok(None)
-                } else {
-                    num(k).map(Some)
-                }
-            };
-            out.push(EpisodeReport {
-                episode: whole(0)?,
-                episodes: whole(1)?,
-                steps: whole(2)?,
-                total_reward: num(3)?,
-                mean_critic_loss: opt(4)?,
-                mean_actor_loss: opt(5)?,
-                noise_std: num(6)?,
-                elapsed_s: num(7)?,
-                remaining_s: num(8)?,
-            });
-        }
-        out
-    } else {
-        serde_json::from_str(text)
-            .map_err(|e| format!("not a JSON array of episode reports: {e}"))?
-    };
-    if history.is_empty() {
-        return Err("no episode in the history".to_string());
-    }
-    for r in &history {
-        for (name, v) in [
-            ("total_reward", Some(r.total_reward)),
-            ("noise_std", Some(r.noise_std)),
-            ("elapsed_s", Some(r.elapsed_s)),
-            ("remaining_s", Some(r.remaining_s)),
-            ("mean_critic_loss", r.mean_critic_loss),
-            ("mean_actor_loss", r.mean_actor_loss),
-        ] {
-            if let Some(v) = v.filter(|v| !v.is_finite()) {
-                return Err(format!(
-                    "episode {}: {name} is {v}, must be finite",
-                    r.episode
-                ));
-            }
-        }
-    }
-    Ok(history)
-}
-
-fn curve(a: CurveArgs) -> Result<(), String> {
-    if a.window == 0 {
-        return Err("--window 0: must be at least 1".to_string());
-    }
-    let text = std::fs::read_to_string(&a.history)
-        .map_err(|e| format!("cannot read {}: {e}", a.history.display()))?;
-    let csv = a
-        .history
-        .extension()
-        .is_some_and(|e| e.eq_ignore_ascii_case("csv"));
-    let history = parse_history(&text, csv).map_err(|e| format!("{}: {e}", a.history.display()))?;
-    check_dir_writable("--plots", &a.plots)?;
-    let file = a.plots.join("training_curve.svg");
-    let name = a
-        .history
-        .file_name()
-        .map_or_else(String::new, |n| n.to_string_lossy().into_owned());
-    mill_plots::training_curve(
-        &file,
-        &history,
-        a.window,
-        &format!("DDPG training, {name} ({} episodes)", history.len()),
-    )?;
-    println!(
-        "training curve of {} episodes written to {}",
-        history.len(),
-        file.display()
-    );
-    Ok(())
 }
 
 /// The DDPG settings of the arguments over Table 2's.
@@ -647,7 +349,7 @@ fn mill(a: MillTrainArgs) -> Result<(), String> {
             agent.history().len(),
             settings.seed
         );
-        mill_plots::training_curve(&file, agent.history(), a.window, &title)?;
+        training::training_curve(&file, agent.history(), a.window, &title)?;
         println!("training curve written to {}", file.display());
     }
 
@@ -692,104 +394,4 @@ fn greedy_summary(
         plan.min_condition_indicator,
         plan.total_reward
     ))
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    fn report(episode: usize, episodes: usize, reward: f64) -> EpisodeReport {
-        EpisodeReport {
-            episode,
-            episodes,
-            steps: 10,
-            total_reward: reward,
-            mean_critic_loss: (episode > 1).then_some(0.5),
-            mean_actor_loss: (episode > 1).then_some(-1.5),
-            noise_std: 0.1,
-            elapsed_s: 2.0 * episode as f64,
-            remaining_s: 2.0 * (episodes - episode) as f64,
-        }
-    }
-
-    #[test]
-    fn durations_read_as_hours_minutes_seconds() {
-        assert_eq!(format_duration(12.4), "12s");
-        assert_eq!(format_duration(290.0), "4m50s");
-        assert_eq!(format_duration(3723.0), "1h02m03s");
-        assert_eq!(format_duration(f64::NAN), "?");
-        assert_eq!(format_duration(-1.0), "?");
-    }
-
-    #[test]
-    fn progress_lines_every_n_episodes_with_the_moving_average() {
-        let mut p = Progress::new(2, false, 2);
-        let first = p.update(&report(1, 4, 1.0));
-        assert!(
-            first.starts_with("episode 1/4: reward     1.000, average(2)     1.000"),
-            "{first}"
-        );
-        assert!(first.contains("2s elapsed, 6s left"), "{first}");
-        assert!(p
-            .update(&report(2, 4, 3.0))
-            .contains("average(2)     2.000"));
-        assert!(p.update(&report(3, 4, 5.0)).is_empty());
-        let last = p.update(&report(4, 4, 7.0));
-        // Average of the last two: (5 + 7) / 2.
-        assert!(last.contains("average(2)     6.000"), "{last}");
-    }
-
-    #[test]
-    fn terminal_progress_is_a_bar_redrawn_in_place() {
-        let mut p = Progress::new(10, true, 1);
-        let s = p.update(&report(1, 4, -2.0));
-        assert!(s.starts_with("\r\x1b[K[#####...............] 1/4"), "{s:?}");
-        assert!(s.contains("] 1/4 reward"), "{s:?}");
-        assert!(!s.ends_with('\n'));
-        for k in 2..4 {
-            p.update(&report(k, 4, -2.0));
-        }
-        let s = p.update(&report(4, 4, -2.0));
-        assert!(
-            s.contains(&"#".repeat(BAR_WIDTH)) && s.ends_with('\n'),
-            "{s:?}"
-        );
-    }
-
-    #[test]
-    fn csv_and_json_histories_read_back_exactly_and_nan_is_refused() {
-        let h = vec![report(1, 2, -1.25), report(2, 2, 0.1 + 0.2)];
-        assert_eq!(parse_history(&history_csv(&h, 50), true), Ok(h.clone()));
-        let json = serde_json::to_string(&h).expect("json");
-        assert_eq!(parse_history(&json, false), Ok(h.clone()));
-        let mut bad = h.clone();
-        bad[1].total_reward = f64::NAN;
-        let e = parse_history(&history_csv(&bad, 50), true).unwrap_err();
-        assert_eq!(e, "episode 2: total_reward is NaN, must be finite");
-        assert!(parse_history("episode,steps\n1,2\n", true)
-            .unwrap_err()
-            .contains("no column `episodes`"));
-        let header = history_csv(&h, 50)
-            .lines()
-            .next()
-            .expect("header")
-            .to_string();
-        let e = parse_history(&format!("{header}\n1,2,10,x,1,,,0.1,2,2\n"), true).unwrap_err();
-        assert_eq!(e, "row 1: `total_reward` = `x` is not a number");
-        assert_eq!(
-            parse_history("[]", false).unwrap_err(),
-            "no episode in the history"
-        );
-    }
-
-    #[test]
-    fn history_csv_has_a_row_per_episode_and_empty_warm_up_losses() {
-        let h = [report(1, 2, 1.0), report(2, 2, 3.0)];
-        let csv = history_csv(&h, 50);
-        let lines: Vec<&str> = csv.lines().collect();
-        assert_eq!(lines.len(), 3);
-        assert!(lines[0].starts_with("episode,episodes,steps,total_reward,moving_average_50,"));
-        assert_eq!(lines[1], "1,2,10,1,1,,,0.1,2,2");
-        assert_eq!(lines[2], "2,2,10,3,2,0.5,-1.5,0.1,4,0");
-    }
 }
