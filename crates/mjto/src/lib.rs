@@ -34,6 +34,7 @@ pub mod planner;
 pub mod request;
 pub mod rotary;
 pub mod selection;
+pub mod series;
 pub mod standoff;
 pub mod timelaw;
 
