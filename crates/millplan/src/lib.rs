@@ -31,6 +31,8 @@ pub mod request;
 pub mod status;
 
 // DDPG (seed 004 Algorithm 1, Table 2) on candle.
+pub mod adamw;
+pub mod cpu_tuning;
 pub mod ddpg;
 pub mod history;
 pub mod nets;

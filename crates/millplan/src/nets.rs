@@ -1,6 +1,7 @@
 //! The actor and critic networks of DDPG (seed 004 Algorithm 1, Table 2:
-//! "2×256 ReLU") on candle, initialized from the crate's seeded generator,
-//! and the CPU settings that make small-batch training fast.
+//! "2×256 ReLU") on candle, initialized from the crate's seeded generator.
+//! Their optimizer is in [`crate::adamw`], the CPU settings that make
+//! small-batch training fast in [`crate::cpu_tuning`] (both reached here too).
 //!
 //! # Networks
 //! * Actor A(s | wᵃ): observation → hidden ReLU layers → action dimension,
@@ -26,12 +27,14 @@
 
 use std::collections::HashMap;
 
-use candle_core::backprop::GradStore;
 use candle_core::{DType, Device, Tensor, Var};
-use candle_nn::{Linear, Module, ParamsAdamW};
+use candle_nn::{Linear, Module};
 
 use crate::error::MillPlanError;
 use crate::rng::Rng;
+
+pub use crate::adamw::FusedAdamW;
+pub use crate::cpu_tuning::{CpuTuning, CpuTuningReport, MMAP_THRESHOLD_BYTES};
 
 /// Bound of the uniform initialization of the output layers (Lillicrap et
 /// al. 2016, section 7).
@@ -531,311 +534,10 @@ pub(crate) fn scalar(t: &Tensor) -> Result<f64, MillPlanError> {
 }
 
 /// The values of a tensor as a flat `f32` vector (a copy).
-fn flat(t: &Tensor) -> Result<Vec<f32>, MillPlanError> {
+pub(crate) fn flat(t: &Tensor) -> Result<Vec<f32>, MillPlanError> {
     t.flatten_all()
         .and_then(|t| t.to_vec1::<f32>())
         .map_err(backend)
-}
-
-/// AdamW (Loshchilov & Hutter, "Decoupled weight decay regularization",
-/// ICLR 2019, Algorithm 2; Kingma & Ba, ICLR 2015, Algorithm 1 for the
-/// moments and bias correction) with exactly the update of
-/// `candle_nn::AdamW` and its [`ParamsAdamW`], fused into one pass per
-/// variable over plain vectors:
-///
-/// m ← β₁ m + (1 − β₁) g, v ← β₂ v + (1 − β₂) g²,
-/// m̂ = m / (1 − β₁ᵗ), v̂ = v / (1 − β₂ᵗ),
-/// θ ← θ (1 − lr λ) − lr m̂ / (√v̂ + ε).
-///
-/// Same arithmetic as candle's (f32, the scalars rounded to f32, the same
-/// operation order; the test compares both), but candle's version runs a
-/// dozen tensor operations per variable, each allocating and traversing a
-/// 256×256 buffer; this one reads the gradient and the weights once and
-/// writes the weights once, which makes a DDPG update markedly faster
-/// (`benches/ddpg_update.rs`).
-#[derive(Debug)]
-pub struct FusedAdamW {
-    vars: Vec<Var>,
-    first_moment: Vec<Vec<f32>>,
-    second_moment: Vec<Vec<f32>>,
-    step_t: i32,
-    params: ParamsAdamW,
-}
-
-impl FusedAdamW {
-    /// An optimizer over `vars` with zero moments.
-    ///
-    /// # Errors
-    /// [`MillPlanError::InvalidParameter`] for a learning rate that is not
-    /// finite and positive, β outside [0, 1), ε or λ negative or not finite.
-    pub fn new(vars: Vec<Var>, params: ParamsAdamW) -> Result<Self, MillPlanError> {
-        let bad = |name: &str, value: f64, reason: &str| {
-            Err(MillPlanError::InvalidParameter {
-                name: name.to_string(),
-                value,
-                reason: reason.to_string(),
-            })
-        };
-        if !(params.lr.is_finite() && params.lr > 0.0) {
-            return bad(
-                "AdamW learning rate",
-                params.lr,
-                "must be finite and positive",
-            );
-        }
-        for (name, b) in [("AdamW beta1", params.beta1), ("AdamW beta2", params.beta2)] {
-            if !(0.0..1.0).contains(&b) {
-                return bad(name, b, "must be in [0, 1)");
-            }
-        }
-        for (name, x) in [
-            ("AdamW eps", params.eps),
-            ("AdamW weight decay", params.weight_decay),
-        ] {
-            if !(x.is_finite() && x >= 0.0) {
-                return bad(name, x, "must be finite and ≥ 0");
-            }
-        }
-        let first_moment = vars.iter().map(|v| vec![0f32; v.elem_count()]).collect();
-        let second_moment = vars.iter().map(|v| vec![0f32; v.elem_count()]).collect();
-        Ok(Self {
-            vars,
-            first_moment,
-            second_moment,
-            step_t: 0,
-            params,
-        })
-    }
-
-    /// One AdamW step with the gradients in `grads` (variables without a
-    /// gradient are left unchanged, as in candle).
-    ///
-    /// # Errors
-    /// [`MillPlanError::Backend`] when candle fails or the step count
-    /// overflows.
-    pub fn step(&mut self, grads: &GradStore) -> Result<(), MillPlanError> {
-        let list: Vec<Option<Tensor>> = self
-            .vars
-            .iter()
-            .map(|v| grads.get(v.as_tensor()).cloned())
-            .collect();
-        self.apply(&list)
-    }
-
-    /// One AdamW step with one gradient per variable, in the order of the
-    /// variables given to [`FusedAdamW::new`] (e.g. from
-    /// [`Mlp::backward`]).
-    ///
-    /// # Errors
-    /// [`MillPlanError::InvalidConfig`] for a wrong number of gradients or
-    /// a gradient whose size differs from its variable's;
-    /// [`MillPlanError::Backend`] when candle fails.
-    pub fn step_gradients(&mut self, grads: &[Tensor]) -> Result<(), MillPlanError> {
-        if grads.len() != self.vars.len() {
-            return Err(MillPlanError::InvalidConfig {
-                name: "AdamW gradients".to_string(),
-                reason: format!(
-                    "{} gradients for {} variables",
-                    grads.len(),
-                    self.vars.len()
-                ),
-            });
-        }
-        let list: Vec<Option<Tensor>> = grads.iter().cloned().map(Some).collect();
-        self.apply(&list)
-    }
-
-    fn apply(&mut self, grads: &[Option<Tensor>]) -> Result<(), MillPlanError> {
-        self.step_t = self
-            .step_t
-            .checked_add(1)
-            .ok_or_else(|| MillPlanError::Backend("AdamW step count overflow".to_string()))?;
-        let p = &self.params;
-        let lr = p.lr as f32;
-        let decay = (1.0 - p.lr * p.weight_decay) as f32;
-        let (beta1, beta2) = (p.beta1 as f32, p.beta2 as f32);
-        let (one_m_beta1, one_m_beta2) = ((1.0 - p.beta1) as f32, (1.0 - p.beta2) as f32);
-        let scale_m = (1.0 / (1.0 - p.beta1.powi(self.step_t))) as f32;
-        let scale_v = (1.0 / (1.0 - p.beta2.powi(self.step_t))) as f32;
-        let eps = p.eps as f32;
-        for (((var, m), v), g) in self
-            .vars
-            .iter()
-            .zip(self.first_moment.iter_mut())
-            .zip(self.second_moment.iter_mut())
-            .zip(grads)
-        {
-            let Some(g) = g else {
-                continue;
-            };
-            let g = flat(g)?;
-            if g.len() != m.len() {
-                return Err(MillPlanError::InvalidConfig {
-                    name: "AdamW gradient".to_string(),
-                    reason: format!("{} entries for a variable of {}", g.len(), m.len()),
-                });
-            }
-            let mut theta = flat(var.as_tensor())?;
-            for (((theta, m), v), g) in theta.iter_mut().zip(m.iter_mut()).zip(v.iter_mut()).zip(&g)
-            {
-                *m = *m * beta1 + g * one_m_beta1;
-                *v = *v * beta2 + (g * g) * one_m_beta2;
-                let m_hat = *m * scale_m;
-                let v_hat = *v * scale_v;
-                *theta = *theta * decay - (m_hat / (v_hat.sqrt() + eps)) * lr;
-            }
-            let next = Tensor::from_vec(theta, var.shape(), &Device::Cpu).map_err(backend)?;
-            var.set(&next).map_err(backend)?;
-        }
-        Ok(())
-    }
-
-    /// Backpropagates `loss` and takes one step.
-    ///
-    /// # Errors
-    /// As [`FusedAdamW::step`].
-    pub fn backward_step(&mut self, loss: &Tensor) -> Result<(), MillPlanError> {
-        let grads = loss.backward().map_err(backend)?;
-        self.step(&grads)
-    }
-}
-
-// ---------------------------------------------------------------------------
-// CPU settings for small-batch training
-// ---------------------------------------------------------------------------
-
-/// `M_TRIM_THRESHOLD` of glibc's `mallopt` (malloc.h).
-#[cfg(all(target_os = "linux", target_env = "gnu"))]
-const M_TRIM_THRESHOLD: std::os::raw::c_int = -1;
-/// `M_MMAP_THRESHOLD` of glibc's `mallopt` (malloc.h).
-#[cfg(all(target_os = "linux", target_env = "gnu"))]
-const M_MMAP_THRESHOLD: std::os::raw::c_int = -3;
-
-#[cfg(all(target_os = "linux", target_env = "gnu"))]
-extern "C" {
-    /// glibc's `int mallopt(int param, int value)`; returns 1 on success.
-    fn mallopt(param: std::os::raw::c_int, value: std::os::raw::c_int) -> std::os::raw::c_int;
-}
-
-/// The malloc mmap threshold [`CpuTuning::apply`] sets: 16 MiB (glibc's
-/// maximum is 32 MiB on 64-bit targets).
-pub const MMAP_THRESHOLD_BYTES: i32 = 16 << 20;
-
-/// MXCSR bits: flush-to-zero (bit 15) and denormals-are-zero (bit 6)
-/// (Intel SDM vol. 1, §10.2.3).
-#[cfg(target_arch = "x86_64")]
-const MXCSR_FTZ_DAZ: u32 = (1 << 15) | (1 << 6);
-
-/// What [`CpuTuning::apply`] changed.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub struct CpuTuningReport {
-    /// `RAYON_NUM_THREADS` was set to 1 by this call.
-    pub single_thread: bool,
-    /// The MXCSR FTZ and DAZ bits were set on the calling thread (x86_64).
-    pub flush_to_zero: bool,
-    /// glibc's mmap and trim thresholds were raised.
-    pub malloc_tuned: bool,
-}
-
-/// CPU settings that make DDPG's small matrix products about twice as fast
-/// on a 2-core machine (measured in issue 5), active while the guard lives.
-///
-/// 1. **One thread**: sets the environment variable `RAYON_NUM_THREADS=1`,
-///    which candle reads before every matrix product (`gemm` then runs
-///    without its thread pool) and when it creates its element-wise pool.
-///    For batch 64 × 256 the fork/join cost exceeds the gain. The variable
-///    stays set after the guard is dropped (candle's pool, once created,
-///    keeps its size). Call this before anything else uses candle, from the
-///    main thread of a program; a caller who wants several threads sets
-///    `single_thread = false` and its own `RAYON_NUM_THREADS`.
-/// 2. **Flush-to-zero** (x86_64 only; no-op elsewhere): sets the FTZ and
-///    DAZ bits of the calling thread's MXCSR, so denormal results and inputs
-///    are treated as 0 instead of taking the slow microcode path (weights
-///    and Adam moments decay into the denormal range). The previous MXCSR is
-///    restored when the guard is dropped. Only the calling thread is
-///    affected, which with one thread is every thread that computes. Note:
-///    Rust assumes the default floating-point environment; code that
-///    depends on denormals must not run on this thread while the guard
-///    lives.
-/// 3. **Malloc thresholds** (glibc only; no-op elsewhere): `mallopt`
-///    `M_MMAP_THRESHOLD` and `M_TRIM_THRESHOLD` = [`MMAP_THRESHOLD_BYTES`].
-///    A 256×256 f32 tensor (256 KiB) is above glibc's default 128 KiB
-///    threshold, so every temporary of that size would be a fresh
-///    `mmap`/`munmap` pair with page faults; raised, they are recycled from
-///    the heap. Process-wide and not undone (it only changes which memory
-///    is reused).
-#[derive(Debug)]
-pub struct CpuTuning {
-    report: CpuTuningReport,
-    #[cfg(target_arch = "x86_64")]
-    saved_mxcsr: u32,
-}
-
-impl CpuTuning {
-    /// Applies the settings (see the type documentation).
-    ///
-    /// # Arguments
-    /// * `single_thread` — set `RAYON_NUM_THREADS=1`.
-    pub fn apply(single_thread: bool) -> Self {
-        if single_thread {
-            std::env::set_var("RAYON_NUM_THREADS", "1");
-        }
-        #[cfg(all(target_os = "linux", target_env = "gnu"))]
-        // SAFETY: mallopt only changes allocator tuning parameters; glibc
-        // takes its arena lock.
-        let malloc_tuned = unsafe {
-            mallopt(M_MMAP_THRESHOLD, MMAP_THRESHOLD_BYTES) == 1
-                && mallopt(M_TRIM_THRESHOLD, MMAP_THRESHOLD_BYTES) == 1
-        };
-        #[cfg(not(all(target_os = "linux", target_env = "gnu")))]
-        let malloc_tuned = false;
-        #[cfg(target_arch = "x86_64")]
-        {
-            // SAFETY: SSE is part of the x86_64 baseline; reading and
-            // writing MXCSR only changes this thread's rounding/denormal
-            // modes (restored on drop).
-            #[allow(deprecated)]
-            let saved_mxcsr = unsafe { std::arch::x86_64::_mm_getcsr() };
-            #[allow(deprecated)]
-            unsafe {
-                std::arch::x86_64::_mm_setcsr(saved_mxcsr | MXCSR_FTZ_DAZ)
-            };
-            Self {
-                report: CpuTuningReport {
-                    single_thread,
-                    flush_to_zero: true,
-                    malloc_tuned,
-                },
-                saved_mxcsr,
-            }
-        }
-        #[cfg(not(target_arch = "x86_64"))]
-        {
-            Self {
-                report: CpuTuningReport {
-                    single_thread,
-                    flush_to_zero: false,
-                    malloc_tuned,
-                },
-            }
-        }
-    }
-
-    /// What was changed.
-    pub fn report(&self) -> CpuTuningReport {
-        self.report
-    }
-}
-
-impl Drop for CpuTuning {
-    fn drop(&mut self) {
-        #[cfg(target_arch = "x86_64")]
-        // SAFETY: restores the MXCSR value read in `apply` on this thread.
-        #[allow(deprecated)]
-        unsafe {
-            std::arch::x86_64::_mm_setcsr(self.saved_mxcsr)
-        };
-    }
 }
 
 #[cfg(test)]
@@ -898,7 +600,7 @@ mod tests {
     /// data), with nonzero weight decay to cover that term too.
     #[test]
     fn fused_adamw_matches_candle() {
-        use candle_nn::{AdamW, Optimizer};
+        use candle_nn::{AdamW, Optimizer, ParamsAdamW};
         let mut rng = Rng::new(21);
         let a = Mlp::new(&[3, 16, 16, 2], OutputActivation::Tanh, &mut rng).expect("valid");
         let b = a.deep_copy().expect("copy");
