@@ -78,17 +78,7 @@ impl Cell {
         let states = client
             .subscription("/joint_states", JointState::ROS_TYPE, qos::state())
             .unwrap();
-        let topic = client
-            .publisher(
-                "/trajectory_executor/joint_trajectory",
-                JointTrajectory::ROS_TYPE,
-                qos::commands(),
-            )
-            .unwrap();
-        assert!(
-            client.wait_for_subscriber(&topic, TIMEOUT),
-            "trajectory topic not matched"
-        );
+        let topic = support::executor_input(&mut client);
         assert!(
             client.wait_for_action_server(&action, TIMEOUT),
             "action server not discovered"

@@ -27,9 +27,8 @@
 //! with "needs the default cell's indicator cache"; rerun them when it is back.
 
 use std::{
-    path::{Path, PathBuf},
+    path::Path,
     sync::Arc,
-    thread::JoinHandle,
     time::{Duration, Instant},
 };
 
@@ -49,14 +48,12 @@ use kerf_msgs::{
     trajectory_msgs::{JointTrajectory, JointTrajectoryPoint},
     RosType,
 };
-use kerf_ros::{qos, KerfNode, RosEnv, StopToken};
+use kerf_ros::qos;
 use ros2_client::{Publisher, ServiceMapping, Subscription};
 
 #[allow(dead_code)] // shared with the other end-to-end tests
 mod support;
-
-/// Waiting for an answer that needs no planning (validation, parsing) or a quick plan.
-const QUICK: Duration = Duration::from_secs(30);
+use support::{expect, planner::mill, take, PlannerClient, QUICK};
 /// Waiting for an answer that runs a planner on a busy machine.
 const PLANNING: Duration = Duration::from_secs(120);
 /// Joint names of the IRB 6660 (urdf/irb6660.urdf).
@@ -100,172 +97,6 @@ fn request_text(id: &str, planner: &str) -> String {
         "request_id: {id}\nplanner: {planner}\npoints: [{}]\n",
         points.join(", ")
     )
-}
-
-fn scratch(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("kerf_mill_e2e_{}_{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
-}
-
-/// A milling planner node plus a client node talking to it.
-struct PlannerClient {
-    requests: Publisher<msg::MillRequest>,
-    texts: Publisher<StringMsg>,
-    plans: Subscription<MillPlan>,
-    plan_texts: Subscription<StringMsg>,
-    trajectories: Subscription<JointTrajectory>,
-    /// Keeps the client node (and its Context) alive; dropped after the endpoints above.
-    _client: KerfNode,
-    stop: StopToken,
-    planner: Option<JoinHandle<Result<(), String>>>,
-}
-
-impl PlannerClient {
-    /// Starts a milling planner on `env` with extra ROS arguments, and a client matched to it.
-    fn start(env: &RosEnv, extra: &[&str]) -> Self {
-        let mut words: Vec<String> = vec!["--ros-args".into(), "--disable-rosout-logs".into()];
-        words.extend(extra.iter().map(|s| s.to_string()));
-        let (stop, planner) = support::spawn_node(env, words, |a, e, s| {
-            kerf_milling_planner::run(a, e, s).map_err(|e| e.to_string())
-        });
-        let mut client = support::client_node("mill_client", env);
-        let requests = client
-            .publisher(
-                "/milling_planner/mill_request",
-                msg::MillRequest::ROS_TYPE,
-                qos::commands(),
-            )
-            .unwrap();
-        let texts = client
-            .publisher(
-                "/milling_planner/mill_request_text",
-                StringMsg::ROS_TYPE,
-                qos::commands(),
-            )
-            .unwrap();
-        let plans = client
-            .subscription(
-                "/milling_planner/mill_plan",
-                MillPlan::ROS_TYPE,
-                qos::latched(),
-            )
-            .unwrap();
-        let plan_texts = client
-            .subscription(
-                "/milling_planner/mill_plan_text",
-                StringMsg::ROS_TYPE,
-                qos::latched(),
-            )
-            .unwrap();
-        let trajectories = client
-            .subscription(
-                "/milling_planner/joint_trajectory",
-                JointTrajectory::ROS_TYPE,
-                qos::commands(),
-            )
-            .unwrap();
-        assert!(
-            client.wait_for_subscriber(&requests, QUICK),
-            "mill_request not matched"
-        );
-        assert!(
-            client.wait_for_subscriber(&texts, QUICK),
-            "mill_request_text not matched"
-        );
-        PlannerClient {
-            requests,
-            texts,
-            plans,
-            plan_texts,
-            trajectories,
-            _client: client,
-            stop,
-            planner: Some(planner),
-        }
-    }
-
-    fn send(&self, m: msg::MillRequest) {
-        self.requests.publish(m).expect("publish MillRequest");
-    }
-
-    fn send_text(&self, text: &str) {
-        self.texts
-            .publish(StringMsg { data: text.into() })
-            .expect("publish text request");
-    }
-
-    fn next_plan(&self, timeout: Duration) -> MillPlan {
-        take(&self.plans, timeout, "MillPlan")
-    }
-
-    fn next_plan_text(&self) -> MillPlan {
-        let text = take(&self.plan_texts, QUICK, "plan text");
-        serde_yaml_ng::from_str(&text.data).expect("plan text is a MillPlan as YAML")
-    }
-
-    fn trajectories_received(&self) -> usize {
-        let mut n = 0;
-        while let Ok(Some(_)) = self.trajectories.take() {
-            n += 1;
-        }
-        n
-    }
-
-    fn assert_running(&self) {
-        let h = self.planner.as_ref().expect("planner handle");
-        assert!(!h.is_finished(), "the milling planner node stopped");
-    }
-
-    /// Stops the planner; it must end cleanly.
-    fn finish(mut self) {
-        self.stop.stop();
-        let h = self.planner.take().expect("planner handle");
-        h.join()
-            .expect("planner thread")
-            .expect("planner ends cleanly");
-    }
-}
-
-fn take<M: serde::de::DeserializeOwned + 'static>(
-    sub: &Subscription<M>,
-    timeout: Duration,
-    what: &str,
-) -> M {
-    let deadline = Instant::now() + timeout;
-    while Instant::now() < deadline {
-        match sub.take() {
-            Ok(Some((m, _))) => return m,
-            Ok(None) => std::thread::sleep(Duration::from_millis(2)),
-            Err(e) => panic!("reading {what}: {e:?}"),
-        }
-    }
-    panic!("no {what} within {timeout:?}");
-}
-
-/// Checks status, request id and that `message` contains every needle.
-fn expect(plan: &MillPlan, id: &str, status: u8, needles: &[&str]) {
-    let name = |s| MillPlan::status_name(s).unwrap_or("?");
-    assert_eq!(
-        (plan.request_id.as_str(), name(plan.status)),
-        (id, name(status)),
-        "{}",
-        plan.message
-    );
-    for n in needles {
-        assert!(
-            plan.message.contains(n),
-            "{id}: {:?} lacks {n:?}",
-            plan.message
-        );
-    }
-    if status != MillPlan::SUCCESS {
-        assert!(
-            plan.trajectory.points.is_empty() && plan.segments.is_empty(),
-            "{id}: a failure carries no plan"
-        );
-    }
 }
 
 /// Writes a valid actor with 5 observations and 2 actions (the milling environment has 4 and
@@ -315,13 +146,13 @@ fn write_trained_policy(planner: &MillPlanner, path: &Path) {
 
 #[test]
 fn bad_requests_get_their_status_and_the_node_keeps_serving() {
-    let dir = scratch("bad");
+    let dir = support::scratch("mill_e2e", "bad");
     let incompatible = dir.join("incompatible.safetensors");
     write_incompatible_policy(&incompatible);
     let missing = dir.join("no_such_policy.safetensors");
 
     let env = support::loopback(71, ServiceMapping::Enhanced);
-    let planner = PlannerClient::start(&env, &[]);
+    let planner = PlannerClient::start(&mill(), &env, &[]);
     type Case = (
         &'static str,
         u8,
@@ -429,14 +260,8 @@ fn bad_requests_get_their_status_and_the_node_keeps_serving() {
     }
     // One topic, one worker: answers come back in the order the requests were sent.
     for (id, status, _, needles) in &cases {
-        let plan = planner.next_plan(PLANNING);
         let needles: Vec<&str> = needles.iter().map(String::as_str).collect();
-        expect(&plan, id, *status, &needles);
-        assert_eq!(
-            planner.next_plan_text(),
-            plan,
-            "{id}: text form of the same answer"
-        );
+        let plan = planner.expect_in_both_forms(PLANNING, id, *status, &needles);
         println!("{id}: {}", plan.message);
     }
 
@@ -554,26 +379,14 @@ fn assert_same_plan(answer: &MillPlan, direct: &MillPlanOutput) {
     assert_eq!(answer.total_reward, executed.total_reward);
     assert_eq!(answer.trajectory.joint_names, JOINTS);
     let run = &direct.executed.scaling.trajectory;
-    assert_eq!(answer.trajectory.points.len(), run.points.len());
-    for (a, b) in answer.trajectory.points.iter().zip(&run.points) {
+    assert_eq!(answer.trajectory.points.len(), run.points().len());
+    for (a, b) in answer.trajectory.points.iter().zip(run.points()) {
         assert_eq!(a.positions, b.positions.to_vec());
         assert_eq!(a.velocities, b.velocities.to_vec());
         assert!((a.time_from_start.as_secs_f64() - b.time_from_start).abs() <= 1e-9);
     }
     let end = answer.trajectory.points.last().expect("points");
     assert!((end.time_from_start.as_secs_f64() - answer.machining_time).abs() <= 1e-9);
-}
-
-/// Starts an IRB 6660 executor at `initial` on `env`.
-fn spawn_irb6660_executor(
-    env: &RosEnv,
-    initial: &[f64],
-) -> (StopToken, JoinHandle<Result<(), String>>) {
-    let initial: Vec<String> = initial.iter().map(|v| format!("{v:?}")).collect();
-    support::spawn_executor(
-        env,
-        &[format!("initial_positions:=[{}]", initial.join(", "))],
-    )
 }
 
 /// Watches the executor until `SUCCEEDED`: every measured state lies on the plan (within
@@ -593,7 +406,7 @@ fn follow_to_the_end(
     let mut seen = 0usize;
     let mut moved = 0.0_f64;
     while Instant::now() < deadline && !succeeded {
-        for status in drain_statuses(statuses, what) {
+        for status in support::drain_statuses(statuses, what) {
             accepted |= status == TrajectoryStatus::ACCEPTED;
             succeeded |= status == TrajectoryStatus::SUCCEEDED;
         }
@@ -613,23 +426,7 @@ fn follow_to_the_end(
         "{what}: {seen} joint states during {} s",
         plan.machining_time
     );
-    std::thread::sleep(Duration::from_millis(200));
-    let mut end = take(states, QUICK, "joint state after the cut");
-    while let Ok(Some((s, _))) = states.take() {
-        end = s;
-    }
-    for (j, (got, want)) in end.position.iter().zip(last).enumerate() {
-        assert!(
-            (got - want).abs() < 1e-6,
-            "{what}: {} ends at {got}, plan {want}",
-            JOINTS[j]
-        );
-    }
-    assert!(
-        end.velocity.iter().all(|v| v.abs() < 1e-6),
-        "{what}: {:?}",
-        end.velocity
-    );
+    support::assert_rests_at(states, last, 1e-6, what);
 }
 
 #[test]
@@ -644,65 +441,18 @@ fn naive_plan_runs_from_planner_through_executor_by_message_and_by_text() {
     let direct = offline.plan(&request).unwrap_or_else(|e| {
         panic!("naive plan failed ({e}); is the indicator cache being rebuilt? retry later")
     });
-    let first = direct.trajectory.points[0].positions;
+    let first = direct.trajectory.points()[0].positions.clone();
 
     let env = support::loopback(73, ServiceMapping::Enhanced);
     // The executor starts where the cut starts: the plan's first point is due at once and must
     // equal the commanded position.
-    let (exec_stop, executor) = spawn_irb6660_executor(&env, &first);
-    let planner = PlannerClient::start(
-        &env,
-        &[
-            "-r",
-            "~/joint_trajectory:=/trajectory_executor/joint_trajectory",
-        ],
-    );
-    let mut watch = support::client_node("mill_watch", &env);
-    let states: Subscription<JointState> = watch
-        .subscription("/joint_states", JointState::ROS_TYPE, qos::state())
-        .unwrap();
-    let statuses: Subscription<TrajectoryStatus> = watch
-        .subscription(
-            "/trajectory_executor/trajectory_status",
-            TrajectoryStatus::ROS_TYPE,
-            qos::latched(),
-        )
-        .unwrap();
-    let back: Publisher<JointTrajectory> = watch
-        .publisher(
-            "/trajectory_executor/joint_trajectory",
-            JointTrajectory::ROS_TYPE,
-            qos::commands(),
-        )
-        .unwrap();
-    let start = take(&states, QUICK, "first joint state");
-    for (got, want) in start.position.iter().zip(first) {
-        assert!(
-            (got - want).abs() < 1e-12,
-            "{:?} vs {first:?}",
-            start.position
-        );
-    }
+    let (exec_stop, executor) =
+        support::spawn_executor(&env, &[support::initial_positions(&first)]);
+    let planner = PlannerClient::start_feeding_executor(&mill(), &env);
     // The planner's (remapped) trajectory writer must be matched by the executor before
     // planning: the topic is volatile.
-    let deadline = Instant::now() + QUICK;
-    while watch
-        .discovered_topics()
-        .iter()
-        .filter(|(t, _)| t == "/trajectory_executor/joint_trajectory")
-        .count()
-        == 0
-    {
-        assert!(
-            Instant::now() < deadline,
-            "the planner's remapped trajectory writer was not discovered"
-        );
-        std::thread::sleep(Duration::from_millis(20));
-    }
-    assert!(
-        watch.wait_for_subscriber(&back, QUICK),
-        "executor input not matched"
-    );
+    let (mut watch, states, statuses) = support::watch_cell(&env, "mill_watch", &first);
+    let back = support::executor_input(&mut watch);
     std::thread::sleep(Duration::from_millis(500));
 
     // 1. The message form.
@@ -722,11 +472,8 @@ fn naive_plan_runs_from_planner_through_executor_by_message_and_by_text() {
     back.publish(move_to(&first)).unwrap();
     wait_succeeded(&statuses, "move back");
     std::thread::sleep(Duration::from_millis(200));
-    let mut end = take(&states, QUICK, "joint state at the start");
-    while let Ok(Some((s, _))) = states.take() {
-        end = s;
-    }
-    for (got, want) in end.position.iter().zip(first) {
+    let end = support::take_newest(&states, QUICK, "joint state at the start");
+    for (got, want) in end.position.iter().zip(&first) {
         assert!((got - want).abs() < 1e-9, "back at {:?}", end.position);
     }
 
@@ -751,7 +498,9 @@ fn naive_plan_runs_from_planner_through_executor_by_message_and_by_text() {
             ..MillRequest::default()
         })
         .expect("ddpg plan with the shipped policy");
-    let ddpg_first = ddpg.executed.scaling.trajectory.points[0].positions;
+    let ddpg_first = ddpg.executed.scaling.trajectory.points()[0]
+        .positions
+        .clone();
     back.publish(move_to(&ddpg_first)).unwrap();
     wait_succeeded(&statuses, "move to the ddpg start");
     std::thread::sleep(Duration::from_millis(200));
@@ -802,19 +551,6 @@ fn move_to(positions: &[f64]) -> JointTrajectory {
     }
 }
 
-/// How far (largest joint difference) `position` is from the nearest of `points`.
-fn off_plan(points: &[&[f64]], position: &[f64]) -> f64 {
-    points
-        .iter()
-        .map(|q| {
-            q.iter()
-                .zip(position)
-                .map(|(a, b)| (a - b).abs())
-                .fold(0.0, f64::max)
-        })
-        .fold(f64::INFINITY, f64::min)
-}
-
 /// Waits for the executor to ACCEPT `plan` (fails on REJECTED or ABORTED), then watches it
 /// for `watch`: nothing is rejected or aborted, every measured state lies on the plan (within
 /// one trajectory step of a plan point) and the robot leaves the plan's first point.
@@ -838,7 +574,7 @@ fn follow_the_start(
             Some(t) if now >= t + watch => break,
             Some(_) => {}
         }
-        let received = drain_statuses(statuses, what);
+        let received = support::drain_statuses(statuses, what);
         if received.contains(&TrajectoryStatus::ACCEPTED) && accepted_at.is_none() {
             accepted_at = Some(Instant::now());
         }
@@ -860,22 +596,6 @@ fn follow_the_start(
     assert!(moved > 1e-4, "{what}: the robot moved only {moved} rad");
 }
 
-/// The statuses the executor sent since the last call, in order; fails on REJECTED or
-/// ABORTED.
-fn drain_statuses(statuses: &Subscription<TrajectoryStatus>, what: &str) -> Vec<u8> {
-    let mut out = Vec::new();
-    while let Ok(Some((s, _))) = statuses.take() {
-        assert!(
-            s.status != TrajectoryStatus::REJECTED && s.status != TrajectoryStatus::ABORTED,
-            "{what}: executor {}: {}",
-            TrajectoryStatus::status_name(s.status).unwrap_or("?"),
-            s.message
-        );
-        out.push(s.status);
-    }
-    out
-}
-
 /// A plan's trajectory points and the largest joint step between two consecutive ones.
 fn plan_points(plan: &MillPlan) -> (Vec<&[f64]>, f64) {
     let points: Vec<&[f64]> = plan
@@ -884,10 +604,7 @@ fn plan_points(plan: &MillPlan) -> (Vec<&[f64]>, f64) {
         .iter()
         .map(|p| p.positions.as_slice())
         .collect();
-    let largest_step = points
-        .windows(2)
-        .flat_map(|w| (0..6).map(move |j| (w[1][j] - w[0][j]).abs()))
-        .fold(0.0, f64::max);
+    let largest_step = support::largest_step(&points);
     (points, largest_step)
 }
 
@@ -904,7 +621,7 @@ fn drain_on_plan(
     let mut seen = 0;
     while let Ok(Some((s, _))) = states.take() {
         assert_eq!(s.name, JOINTS);
-        let off = off_plan(points, &s.position);
+        let off = support::off_plan(points, &s.position);
         assert!(
             off <= largest_step + 1e-6,
             "{what}: state {:?} is {off} rad off the plan",
@@ -920,7 +637,7 @@ fn drain_on_plan(
 fn wait_succeeded(statuses: &Subscription<TrajectoryStatus>, what: &str) {
     let deadline = Instant::now() + PLANNING;
     while Instant::now() < deadline {
-        if drain_statuses(statuses, what).contains(&TrajectoryStatus::SUCCEEDED) {
+        if support::drain_statuses(statuses, what).contains(&TrajectoryStatus::SUCCEEDED) {
             return;
         }
         std::thread::sleep(Duration::from_millis(5));
@@ -931,36 +648,19 @@ fn wait_succeeded(statuses: &Subscription<TrajectoryStatus>, what: &str) {
 #[test]
 fn full_queue_is_answered_not_dropped() {
     let env = support::loopback(72, ServiceMapping::Enhanced);
-    let planner = PlannerClient::start(&env, &["-p", "queue_depth:=1"]);
+    let planner = PlannerClient::start(&mill(), &env, &["-p", "queue_depth:=1"]);
     // A burst of six naive requests against a queue of one: the first is planned (about half
     // a second), and the ones arriving meanwhile are refused at once.
-    let ids: Vec<String> = (0..6).map(|i| format!("burst-{i}")).collect();
-    for id in &ids {
-        planner.send(request_msg(id, "naive"));
-    }
-    let mut answers: Vec<MillPlan> = (0..ids.len())
-        .map(|_| planner.next_plan(PLANNING))
-        .collect();
-    answers.sort_by(|a, b| a.request_id.cmp(&b.request_id));
     // Every request is answered exactly once: nothing is dropped.
-    let answered: Vec<&str> = answers.iter().map(|a| a.request_id.as_str()).collect();
-    assert_eq!(answered, ids.iter().map(String::as_str).collect::<Vec<_>>());
-    expect(&answers[0], "burst-0", MillPlan::SUCCESS, &[]);
-    let mut busy = 0;
-    for a in &answers[1..] {
-        if a.status == MillPlan::SUCCESS {
-            continue;
-        }
-        expect(
-            a,
-            &a.request_id,
-            MillPlan::QUEUE_FULL,
-            &["planner busy", "queue_depth 1"],
-        );
+    let busy = planner.burst_against_a_queue_of_one(
+        6,
+        |id| request_msg(id, "naive"),
+        MillPlan::QUEUE_FULL,
+        PLANNING,
+    );
+    for a in &busy {
         assert_eq!(a.planner, "naive");
-        busy += 1;
     }
-    assert!(busy >= 1, "no request of the burst found the queue full");
     planner.assert_running();
     planner.finish();
 }
@@ -991,11 +691,7 @@ fn kerf_launch_irb6660_with_planner_serves_mill_requests() {
             ..MillRequest::default()
         })
         .unwrap_or_else(|e| panic!("naive plan failed ({e}); retry when the cache is back"));
-    let first: Vec<String> = direct.trajectory.points[0]
-        .positions
-        .iter()
-        .map(|v| format!("{v:?}"))
-        .collect();
+    let first = &direct.trajectory.points()[0].positions;
     let child = Command::new(env!("CARGO_BIN_EXE_kerf"))
         .env("ROS_DOMAIN_ID", "74")
         .env("ROS_AUTOMATIC_DISCOVERY_RANGE", "LOCALHOST")
@@ -1008,7 +704,7 @@ fn kerf_launch_irb6660_with_planner_serves_mill_requests() {
             "--ros-args",
         ])
         .args(["-p", "queue_depth:=2", "-p"])
-        .arg(format!("initial_positions:=[{}]", first.join(", ")))
+        .arg(support::initial_positions(first))
         .args([
             "-r",
             "milling_planner:~/joint_trajectory:=/trajectory_executor/joint_trajectory",

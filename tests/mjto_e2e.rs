@@ -13,7 +13,7 @@
 //! Each DDS test runs its own nodes (in this process, own Contexts) on its own domain (61-64).
 
 use std::{
-    path::{Path, PathBuf},
+    path::Path,
     process::Command,
     thread::JoinHandle,
     time::{Duration, Instant},
@@ -23,21 +23,15 @@ use kerf_mjto::{planner::Planner, CutRequest, LaserMachine};
 use kerf_msgs::{
     geometry_msgs::{Point, Pose, Quaternion, Vector3},
     msg::{self, CutPlan, TrajectoryStatus},
-    sensor_msgs::JointState,
-    std_msgs::StringMsg,
-    trajectory_msgs::JointTrajectory,
-    RosType,
 };
-use kerf_ros::{qos, KerfNode, RosEnv, StopToken};
-use ros2_client::{Publisher, ServiceMapping, Subscription};
+use kerf_ros::{RosEnv, StopToken};
+use ros2_client::ServiceMapping;
 
-// Shared with the other end-to-end tests; spawn_executor (the IRB 6660) is not used here.
-#[allow(dead_code)]
+#[allow(dead_code)] // shared with the other end-to-end tests
 mod support;
+use support::{expect, planner::mjto, take, PlannerClient, QUICK};
 
 const ROOT: &str = env!("CARGO_MANIFEST_DIR");
-/// Waiting for an answer that needs no planning (validation, parsing).
-const QUICK: Duration = Duration::from_secs(30);
 /// Waiting for an answer that runs the planner (debug builds are slow).
 const PLANNING: Duration = Duration::from_secs(300);
 const MESH: &str = "package://kerf/urdf/meshes/bpillar.obj";
@@ -155,157 +149,10 @@ fn small_request(id: &str) -> msg::CutRequest {
     }
 }
 
-/// A planner node plus a client node talking to it.
-struct PlannerClient {
-    requests: Publisher<msg::CutRequest>,
-    texts: Publisher<StringMsg>,
-    plans: Subscription<CutPlan>,
-    plan_texts: Subscription<StringMsg>,
-    trajectories: Subscription<JointTrajectory>,
-    /// Keeps the client node (and its Context) alive; dropped after the endpoints above.
-    _client: KerfNode,
-    stop: StopToken,
-    planner: Option<JoinHandle<Result<(), String>>>,
-}
-
-impl PlannerClient {
-    /// Starts a planner on `env` with extra ROS arguments, and a client matched to it.
-    fn start(env: &RosEnv, extra: &[&str]) -> Self {
-        let mut words: Vec<String> = vec!["--ros-args".into(), "--disable-rosout-logs".into()];
-        words.extend(extra.iter().map(|s| s.to_string()));
-        let (stop, planner) = support::spawn_node(env, words, |a, e, s| {
-            kerf_mjto_planner::run(a, e, s).map_err(|e| e.to_string())
-        });
-        let mut client = support::client_node("cut_client", env);
-        let requests = client
-            .publisher(
-                "/mjto_planner/cut_request",
-                msg::CutRequest::ROS_TYPE,
-                qos::commands(),
-            )
-            .unwrap();
-        let texts = client
-            .publisher(
-                "/mjto_planner/cut_request_text",
-                StringMsg::ROS_TYPE,
-                qos::commands(),
-            )
-            .unwrap();
-        let plans = client
-            .subscription("/mjto_planner/cut_plan", CutPlan::ROS_TYPE, qos::commands())
-            .unwrap();
-        let plan_texts = client
-            .subscription(
-                "/mjto_planner/cut_plan_text",
-                StringMsg::ROS_TYPE,
-                qos::commands(),
-            )
-            .unwrap();
-        let trajectories = client
-            .subscription(
-                "/mjto_planner/joint_trajectory",
-                JointTrajectory::ROS_TYPE,
-                qos::commands(),
-            )
-            .unwrap();
-        assert!(
-            client.wait_for_subscriber(&requests, QUICK),
-            "cut_request not matched"
-        );
-        assert!(
-            client.wait_for_subscriber(&texts, QUICK),
-            "cut_request_text not matched"
-        );
-        PlannerClient {
-            requests,
-            texts,
-            plans,
-            plan_texts,
-            trajectories,
-            _client: client,
-            stop,
-            planner: Some(planner),
-        }
-    }
-
-    fn send(&self, m: msg::CutRequest) {
-        self.requests.publish(m).expect("publish CutRequest");
-    }
-
-    fn send_text(&self, text: &str) {
-        self.texts
-            .publish(StringMsg { data: text.into() })
-            .expect("publish text request");
-    }
-
-    fn take<M: serde::de::DeserializeOwned + 'static>(
-        sub: &Subscription<M>,
-        timeout: Duration,
-        what: &str,
-    ) -> M {
-        let deadline = Instant::now() + timeout;
-        while Instant::now() < deadline {
-            match sub.take() {
-                Ok(Some((m, _))) => return m,
-                Ok(None) => std::thread::sleep(Duration::from_millis(2)),
-                Err(e) => panic!("reading {what}: {e:?}"),
-            }
-        }
-        panic!("no {what} within {timeout:?}");
-    }
-
-    fn next_plan(&self, timeout: Duration) -> CutPlan {
-        Self::take(&self.plans, timeout, "CutPlan")
-    }
-
-    fn next_plan_text(&self) -> CutPlan {
-        let text = Self::take(&self.plan_texts, QUICK, "plan text");
-        serde_yaml_ng::from_str(&text.data).expect("plan text is a CutPlan as YAML")
-    }
-
-    fn assert_running(&self) {
-        let h = self.planner.as_ref().expect("planner handle");
-        assert!(!h.is_finished(), "the planner node stopped");
-    }
-
-    /// Stops the planner; it must end cleanly.
-    fn finish(mut self) {
-        self.stop.stop();
-        let h = self.planner.take().expect("planner handle");
-        h.join()
-            .expect("planner thread")
-            .expect("planner ends cleanly");
-    }
-}
-
-/// Checks status, request id and that `message` contains every needle.
-fn expect(plan: &CutPlan, id: &str, status: u8, needles: &[&str]) {
-    let name = |s| CutPlan::status_name(s).unwrap_or("?");
-    assert_eq!(
-        (plan.request_id.as_str(), name(plan.status)),
-        (id, name(status)),
-        "{}",
-        plan.message
-    );
-    for n in needles {
-        assert!(
-            plan.message.contains(n),
-            "{id}: {:?} lacks {n:?}",
-            plan.message
-        );
-    }
-    if status != CutPlan::SUCCESS {
-        assert!(
-            plan.trajectory.points.is_empty(),
-            "{id}: a failure carries no trajectory"
-        );
-    }
-}
-
 #[test]
 fn bad_requests_get_their_status_and_the_node_keeps_serving() {
     let env = support::loopback(61, ServiceMapping::Enhanced);
-    let planner = PlannerClient::start(&env, &[]);
+    let planner = PlannerClient::start(&mjto(), &env, &[]);
     type Case = (
         &'static str,
         fn(&mut msg::CutRequest),
@@ -377,13 +224,7 @@ fn bad_requests_get_their_status_and_the_node_keeps_serving() {
     }
     // One topic, one worker: answers come back in the order the requests were sent.
     for (id, _, needles) in &cases {
-        let plan = planner.next_plan(QUICK);
-        expect(&plan, id, CutPlan::INVALID_REQUEST, needles);
-        assert_eq!(
-            planner.next_plan_text(),
-            plan,
-            "{id}: text form of the same answer"
-        );
+        planner.expect_in_both_forms(QUICK, id, CutPlan::INVALID_REQUEST, needles);
     }
 
     // The text topic: line format, YAML, and an empty text; ids are kept when the text has one.
@@ -442,11 +283,10 @@ fn bad_requests_get_their_status_and_the_node_keeps_serving() {
     }
     // No failure published a trajectory (a success publishes exactly one).
     std::thread::sleep(Duration::from_millis(300));
-    let mut trajectories = 0;
-    while let Ok(Some(_)) = planner.trajectories.take() {
-        trajectories += 1;
-    }
-    assert_eq!(trajectories, usize::from(after.status == CutPlan::SUCCESS));
+    assert_eq!(
+        planner.trajectories_received(),
+        usize::from(after.status == CutPlan::SUCCESS)
+    );
     planner.assert_running();
     planner.finish();
 }
@@ -455,7 +295,7 @@ fn bad_requests_get_their_status_and_the_node_keeps_serving() {
 fn planner_failures_get_their_status() {
     let (_, case1) = case("case1.yaml");
     let env = support::loopback(62, ServiceMapping::Enhanced);
-    let planner = PlannerClient::start(&env, &[]);
+    let planner = PlannerClient::start(&mjto(), &env, &[]);
 
     let mut missing_mesh = case1.clone();
     missing_mesh.request_id = "missing-mesh".into();
@@ -540,47 +380,11 @@ fn case1_runs_from_planner_through_executor() {
     // The executor starts where the cut starts: the plan's first point is due at once and must
     // equal the commanded position.
     let (exec_stop, executor) = spawn_laser_executor(&env, &first);
-    let planner = PlannerClient::start(
-        &env,
-        &[
-            "-r",
-            "~/joint_trajectory:=/trajectory_executor/joint_trajectory",
-        ],
-    );
-    let mut watch = support::client_node("cut_watch", &env);
-    let states: Subscription<JointState> = watch
-        .subscription("/joint_states", JointState::ROS_TYPE, qos::state())
-        .unwrap();
-    let statuses: Subscription<TrajectoryStatus> = watch
-        .subscription(
-            "/trajectory_executor/trajectory_status",
-            TrajectoryStatus::ROS_TYPE,
-            qos::latched(),
-        )
-        .unwrap();
+    let planner = PlannerClient::start_feeding_executor(&mjto(), &env);
     // The executor is up when it publishes joint states, and they start at the cut's start.
-    let start = PlannerClient::take(&states, QUICK, "first joint state");
-    for (got, want) in start.position.iter().zip(first) {
-        assert!(
-            (got - want).abs() < 1e-12,
-            "{:?} vs {first:?}",
-            start.position
-        );
-    }
     // The planner's (remapped) trajectory publisher is the only writer on the executor's
     // input; it must be discovered before planning.
-    let deadline = Instant::now() + QUICK;
-    while !watch
-        .discovered_topics()
-        .iter()
-        .any(|(t, _)| t == "/trajectory_executor/joint_trajectory")
-    {
-        assert!(
-            Instant::now() < deadline,
-            "the planner's remapped trajectory writer was not discovered"
-        );
-        std::thread::sleep(Duration::from_millis(20));
-    }
+    let (watch, states, statuses) = support::watch_cell(&env, "cut_watch", &first);
     std::thread::sleep(Duration::from_millis(500));
 
     planner.send_text(&text);
@@ -616,41 +420,15 @@ fn case1_runs_from_planner_through_executor() {
     let deadline = Instant::now() + PLANNING;
     let mut seen = Vec::new();
     let mut moved = 0.0_f64;
-    let largest_step = offline
-        .positions
-        .windows(2)
-        .flat_map(|w| (0..6).map(move |j| (w[1][j] - w[0][j]).abs()))
-        .fold(0.0, f64::max);
+    let largest_step = support::largest_step(&offline.positions);
     let mut succeeded = false;
     while Instant::now() < deadline && !succeeded {
-        while let Ok(Some((s, _))) = statuses.take() {
-            assert_ne!(
-                s.status,
-                TrajectoryStatus::REJECTED,
-                "executor rejected: {}",
-                s.message
-            );
-            assert_ne!(
-                s.status,
-                TrajectoryStatus::ABORTED,
-                "executor aborted: {}",
-                s.message
-            );
-            succeeded |= s.status == TrajectoryStatus::SUCCEEDED;
-        }
+        succeeded |=
+            support::drain_statuses(&statuses, "case 1").contains(&TrajectoryStatus::SUCCEEDED);
         while let Ok(Some((s, _))) = states.take() {
             // Every measured state lies on the planned path: within one sample step of a
             // plan sample.
-            let off = offline
-                .positions
-                .iter()
-                .map(|q| {
-                    q.iter()
-                        .zip(&s.position)
-                        .map(|(a, b)| (a - b).abs())
-                        .fold(0.0, f64::max)
-                })
-                .fold(f64::INFINITY, f64::min);
+            let off = support::off_plan(&offline.positions, &s.position);
             assert!(
                 off <= largest_step + 1e-6,
                 "state {:?} is {off} off the plan",
@@ -666,25 +444,8 @@ fn case1_runs_from_planner_through_executor() {
         moved > 0.5 * (last[0] - first[0]).abs(),
         "q1 moved only {moved} m"
     );
-    // After the end: at rest on the last point (the newest state, read after a short hold;
-    // states queued before SUCCEEDED was seen may still be decelerating).
-    std::thread::sleep(Duration::from_millis(200));
-    let mut end = PlannerClient::take(&states, QUICK, "joint state after the cut");
-    while let Ok(Some((s, _))) = states.take() {
-        end = s;
-    }
-    for (j, (got, want)) in end.position.iter().zip(last).enumerate() {
-        assert!(
-            (got - want).abs() < 1e-4,
-            "joint q{} ends at {got}, plan {want}",
-            j + 1
-        );
-    }
-    assert!(
-        end.velocity.iter().all(|v| v.abs() < 1e-6),
-        "{:?}",
-        end.velocity
-    );
+    // After the end: at rest on the last point.
+    support::assert_rests_at(&states, &last, 1e-4, "case 1");
     assert!(
         seen.len() > 100,
         "{} joint states during the cut",
@@ -700,24 +461,9 @@ fn case1_runs_from_planner_through_executor() {
 /// Starts a laser-cutter executor at `initial` on `env`.
 fn spawn_laser_executor(
     env: &RosEnv,
-    initial: &[f64; 6],
+    initial: &[f64],
 ) -> (StopToken, JoinHandle<Result<(), String>>) {
-    let urdf = format!("{ROOT}/urdf");
-    let initial: Vec<String> = initial.iter().map(|v| format!("{v:?}")).collect();
-    support::spawn_node(
-        env,
-        vec![
-            "--ros-args".into(),
-            "--disable-rosout-logs".into(),
-            "-p".into(),
-            format!("urdf_file:={urdf}/laser_cutter.urdf"),
-            "-p".into(),
-            format!("joint_limits_file:={urdf}/laser_cutter_limits.yaml"),
-            "-p".into(),
-            format!("initial_positions:=[{}]", initial.join(", ")),
-        ],
-        |a, e, s| kerf_trajectory_executor::run(a, e, s).map_err(|e| e.to_string()),
-    )
+    support::spawn_robot_executor(env, "laser_cutter", &[support::initial_positions(initial)])
 }
 
 /// The node's trajectory format runs on the executor as it is, independent of the planner:
@@ -769,28 +515,9 @@ fn planned_trajectory_format_runs_on_the_executor() {
     let env = support::loopback(65, ServiceMapping::Enhanced);
     let (exec_stop, executor) = spawn_laser_executor(&env, &start);
     let mut cell = support::client_node("cut_cell", &env);
-    let publisher: Publisher<JointTrajectory> = cell
-        .publisher(
-            "/trajectory_executor/joint_trajectory",
-            JointTrajectory::ROS_TYPE,
-            qos::commands(),
-        )
-        .unwrap();
-    let states: Subscription<JointState> = cell
-        .subscription("/joint_states", JointState::ROS_TYPE, qos::state())
-        .unwrap();
-    let statuses: Subscription<TrajectoryStatus> = cell
-        .subscription(
-            "/trajectory_executor/trajectory_status",
-            TrajectoryStatus::ROS_TYPE,
-            qos::latched(),
-        )
-        .unwrap();
-    assert!(
-        cell.wait_for_subscriber(&publisher, QUICK),
-        "executor input not matched"
-    );
-    PlannerClient::take(&states, QUICK, "first joint state");
+    let (states, statuses) = support::watch_executor(&mut cell);
+    let publisher = support::executor_input(&mut cell);
+    take(&states, QUICK, "first joint state");
     publisher.publish(trajectory).unwrap();
     let deadline = Instant::now() + QUICK;
     let mut outcome = Vec::new();
@@ -811,10 +538,7 @@ fn planned_trajectory_format_runs_on_the_executor() {
         [TrajectoryStatus::ACCEPTED, TrajectoryStatus::SUCCEEDED]
     );
     std::thread::sleep(Duration::from_millis(200));
-    let mut end = PlannerClient::take(&states, QUICK, "joint state after the motion");
-    while let Ok(Some((s, _))) = states.take() {
-        end = s;
-    }
+    let end = support::take_newest(&states, QUICK, "joint state after the motion");
     for j in 0..6 {
         let want = start[j] + delta[j];
         assert!(
@@ -833,39 +557,18 @@ fn planned_trajectory_format_runs_on_the_executor() {
 fn full_queue_is_answered_not_dropped() {
     let (_, case1) = case("case1.yaml");
     let env = support::loopback(64, ServiceMapping::Enhanced);
-    let planner = PlannerClient::start(&env, &["-p", "queue_depth:=1"]);
+    let planner = PlannerClient::start(&mjto(), &env, &["-p", "queue_depth:=1"]);
     // A burst of eight case-1 requests against a queue of one: the first is planned, and the
     // ones arriving while a plan is running are refused at once. Case 1 plans in tens of
     // milliseconds, so how many arrive during a plan depends on timing; a burst of eight
     // always overlaps one plan.
-    let ids: Vec<String> = (0..8).map(|i| format!("burst-{i}")).collect();
-    for id in &ids {
-        let mut r = case1.clone();
-        r.request_id = id.clone();
-        planner.send(msg_of(&r));
-    }
-    let mut answers: Vec<CutPlan> = (0..ids.len())
-        .map(|_| planner.next_plan(PLANNING))
-        .collect();
-    answers.sort_by(|a, b| a.request_id.cmp(&b.request_id));
     // Every request is answered exactly once: nothing is dropped.
-    let answered: Vec<&str> = answers.iter().map(|a| a.request_id.as_str()).collect();
-    assert_eq!(answered, ids.iter().map(String::as_str).collect::<Vec<_>>());
-    expect(&answers[0], "burst-0", CutPlan::SUCCESS, &[]);
-    let mut busy = 0;
-    for a in &answers[1..] {
-        if a.status == CutPlan::SUCCESS {
-            continue;
-        }
-        expect(
-            a,
-            &a.request_id,
-            CutPlan::INTERNAL_ERROR,
-            &["planner busy", "queue_depth 1"],
-        );
-        busy += 1;
-    }
-    assert!(busy >= 1, "no request of the burst found the queue full");
+    let burst = |id: &str| {
+        let mut r = case1.clone();
+        r.request_id = id.into();
+        msg_of(&r)
+    };
+    planner.burst_against_a_queue_of_one(8, burst, CutPlan::INTERNAL_ERROR, PLANNING);
     planner.assert_running();
     planner.finish();
 }
@@ -878,15 +581,9 @@ fn kerf_plan_cut(args: &[&str]) -> std::process::Output {
         .expect("run kerf plan cut")
 }
 
-fn scratch(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("kerf_mjto_e2e_{}_{name}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
-}
-
 #[test]
 fn kerf_plan_cut_fails_with_code_2_and_the_reason() {
-    let dir = scratch("bad");
+    let dir = support::scratch("mjto_e2e", "bad");
     let bad = dir.join("one_point.yaml");
     std::fs::write(
         &bad,
@@ -917,7 +614,7 @@ fn kerf_plan_cut_fails_with_code_2_and_the_reason() {
 
 #[test]
 fn kerf_plan_cut_writes_plan_and_plots() {
-    let dir = scratch("case1");
+    let dir = support::scratch("mjto_e2e", "case1");
     let request = Path::new(ROOT).join("crates/mjto/cases/case1.yaml");
     let (_, case1) = case("case1.yaml");
     let out_file = dir.join("plan.json");
