@@ -9,11 +9,10 @@
 
 use std::path::{Path, PathBuf};
 
-use kerf_chatter::indicator::{DelayModel, IndicatorSettings};
-use kerf_chatter::{MillingProcess, Modal2, Mode};
+use kerf_chatter::indicator::IndicatorSettings;
+use kerf_chatter::{MillingProcess, Modal2};
 use kerf_robot::RobotModel;
-use nalgebra::{Isometry3, Matrix3, Rotation3, Translation3, UnitQuaternion, Vector3};
-use serde::Deserialize;
+use nalgebra::Isometry3;
 
 use crate::dynamics::{ComplianceModel, ToolTipDynamics};
 use crate::error::{check_finite, check_positive, MillError};
@@ -21,128 +20,17 @@ use crate::ik::Kinematics;
 use crate::jacobian::condition_number;
 use crate::path::{MillingPath, PathSpec};
 
+mod file;
+mod limits;
+mod sections;
+
+pub use limits::StateLimits;
+
+use file::CellFile;
+use sections::{indicator_from, process_from, tcp_from_axes};
+
 /// The shipped cell file, relative to the kerf data root.
 const DEFAULT_CELL: &str = "urdf/irb6660_milling.yaml";
-
-#[derive(Debug, Deserialize)]
-#[serde(deny_unknown_fields)]
-struct CellFile {
-    robot: RobotSection,
-    #[serde(default)]
-    tcp: Option<TcpSection>,
-    path: PathSection,
-    condition: ConditionSection,
-    dynamics: DynamicsSection,
-    process: ProcessSection,
-    #[serde(default)]
-    chatter: Option<ChatterSection>,
-}
-
-/// The `chatter` section: how the chatter indicator is evaluated for this
-/// cell (absent: the paper's model, state-dependent delays, linear force
-/// law, m = 40).
-#[derive(Debug, Deserialize)]
-#[serde(deny_unknown_fields)]
-struct ChatterSection {
-    model: String,
-    steps: usize,
-    force_exponent: f64,
-    reference_chip: f64,
-    wall_term: bool,
-}
-
-#[derive(Debug, Deserialize)]
-#[serde(deny_unknown_fields)]
-struct RobotSection {
-    urdf: String,
-    #[serde(default)]
-    limits: Option<String>,
-    reference_joints: [f64; 6],
-    joint_weights: [f64; 6],
-    branch_jump_threshold: f64,
-}
-
-#[derive(Debug, Deserialize)]
-#[serde(deny_unknown_fields)]
-struct TcpSection {
-    position: [f64; 3],
-    z_axis: [f64; 3],
-    x_axis: [f64; 3],
-}
-
-#[derive(Debug, Deserialize)]
-#[serde(deny_unknown_fields)]
-struct PathSection {
-    points: Vec<[f64; 3]>,
-    segments: usize,
-    approach_from_above: bool,
-    up: [f64; 3],
-}
-
-#[derive(Debug, Deserialize)]
-#[serde(deny_unknown_fields)]
-struct ConditionSection {
-    characteristic_length: f64,
-}
-
-#[derive(Debug, Deserialize)]
-#[serde(deny_unknown_fields)]
-struct DynamicsSection {
-    model: String,
-    joint_stiffness: [f64; 6],
-    modal_mass: [f64; 2],
-    damping_ratio: f64,
-    #[serde(default)]
-    measured: Option<MeasuredSection>,
-}
-
-#[derive(Debug, Deserialize)]
-#[serde(deny_unknown_fields)]
-struct MeasuredSection {
-    x: Mode,
-    y: Mode,
-}
-
-#[derive(Debug, Deserialize)]
-#[serde(deny_unknown_fields)]
-struct StepSection {
-    feed: f64,
-    spindle_rpm: f64,
-    redundancy_angle: f64,
-}
-
-#[derive(Debug, Deserialize)]
-#[serde(deny_unknown_fields)]
-struct ProcessSection {
-    teeth: usize,
-    tool_radius: f64,
-    axial_depth: f64,
-    kt: f64,
-    kn: f64,
-    engagement_over_pi: [f64; 2],
-    spindle_rpm: [f64; 2],
-    feed: [f64; 2],
-    redundancy_angle: [f64; 2],
-    step_bounds: StepSection,
-}
-
-/// Ranges and per-step bounds of the planning state (seed 004 Table 1,
-/// "State range" and the action bounds of eq. 9-11).
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct StateLimits {
-    /// Spindle speed range \[rpm\] (rpm at the API boundary, as named).
-    pub spindle_rpm: [f64; 2],
-    /// Feed range [m/s].
-    pub feed: [f64; 2],
-    /// Redundancy angle range \[rad\].
-    pub redundancy_angle: [f64; 2],
-    /// Largest feed change per step |Δf| [m/s].
-    pub max_feed_step: f64,
-    /// Largest spindle-speed change per step |ΔΩ| \[rpm\].
-    pub max_spindle_step_rpm: f64,
-    /// Largest redundancy-angle change per step |Δg| \[rad\].
-    pub max_redundancy_step: f64,
-}
 
 /// What the cell gives for one (segment, g).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -388,201 +276,6 @@ impl MillCell {
             condition_indicator: 1.0 / k,
             modal,
         })
-    }
-}
-
-/// The TCP isometry from a position and the tool's z and x axes in `tool0`.
-fn tcp_from_axes(t: &TcpSection) -> Result<Isometry3<f64>, MillError> {
-    for (name, v) in [
-        ("tcp.position", t.position),
-        ("tcp.z_axis", t.z_axis),
-        ("tcp.x_axis", t.x_axis),
-    ] {
-        for (i, c) in v.iter().enumerate() {
-            check_finite(&format!("{name}[{i}]"), *c)?;
-        }
-    }
-    let z = Vector3::from(t.z_axis);
-    let x = Vector3::from(t.x_axis);
-    for (name, v) in [("tcp.z_axis", &z), ("tcp.x_axis", &x)] {
-        if (v.norm() - 1.0).abs() > 1e-9 {
-            return Err(MillError::InvalidParameter {
-                name: format!("{name} (norm)"),
-                value: v.norm(),
-                reason: "must be a unit vector".to_string(),
-            });
-        }
-    }
-    if x.dot(&z).abs() > 1e-9 {
-        return Err(MillError::InvalidParameter {
-            name: "tcp.x_axis . tcp.z_axis".to_string(),
-            value: x.dot(&z),
-            reason: "the axes must be perpendicular".to_string(),
-        });
-    }
-    let r = Matrix3::from_columns(&[x, z.cross(&x), z]);
-    Ok(Isometry3::from_parts(
-        Translation3::from(Vector3::from(t.position)),
-        UnitQuaternion::from_rotation_matrix(&Rotation3::from_matrix_unchecked(r)),
-    ))
-}
-
-/// The indicator settings of the `chatter` section (module documentation
-/// of `kerf_chatter::indicator`); the paper's model when it is absent.
-fn indicator_from(c: Option<&ChatterSection>) -> Result<IndicatorSettings, MillError> {
-    let Some(c) = c else {
-        return Ok(IndicatorSettings::default());
-    };
-    let model = match c.model.as_str() {
-        "state_dependent" => DelayModel::StateDependent,
-        "constant" => DelayModel::Constant,
-        other => {
-            return Err(MillError::InvalidConfig {
-                name: "chatter.model".to_string(),
-                reason: format!("`{other}`: must be `state_dependent` or `constant`"),
-            })
-        }
-    };
-    if !(c.force_exponent.is_finite() && c.force_exponent > 0.0 && c.force_exponent <= 1.0) {
-        return Err(MillError::InvalidParameter {
-            name: "chatter.force_exponent [-]".to_string(),
-            value: c.force_exponent,
-            reason: "must be in (0, 1]".to_string(),
-        });
-    }
-    check_positive("chatter.reference_chip [m]", c.reference_chip)?;
-    let settings = IndicatorSettings::default()
-        .model(model)
-        .steps(c.steps)
-        .force_law(c.force_exponent, c.reference_chip)
-        .wall_term(c.wall_term);
-    settings.validate()?;
-    Ok(settings)
-}
-
-fn process_from(p: &ProcessSection) -> Result<(MillingProcess, StateLimits), MillError> {
-    use std::f64::consts::PI;
-    for (i, v) in p.engagement_over_pi.iter().enumerate() {
-        if !(v.is_finite() && (0.0..=1.0).contains(v)) {
-            return Err(MillError::InvalidParameter {
-                name: format!("process.engagement_over_pi[{i}]"),
-                value: *v,
-                reason: "must be in [0, 1] (fraction of pi)".to_string(),
-            });
-        }
-    }
-    let process = MillingProcess {
-        teeth: p.teeth,
-        radius: p.tool_radius,
-        axial_depth: p.axial_depth,
-        kt: p.kt,
-        kn: p.kn,
-        entry_angle: p.engagement_over_pi[0] * PI,
-        exit_angle: p.engagement_over_pi[1] * PI,
-    };
-    process.validate()?;
-    let range = |name: &str, r: [f64; 2], min: f64| -> Result<[f64; 2], MillError> {
-        for (i, v) in r.iter().enumerate() {
-            check_finite(&format!("{name}[{i}]"), *v)?;
-        }
-        if r[0] < min || r[1] <= r[0] {
-            return Err(MillError::InvalidParameter {
-                name: format!("{name}[1]"),
-                value: r[1],
-                reason: format!(
-                    "the range must satisfy {min} <= [0] < [1] (got [0] = {})",
-                    r[0]
-                ),
-            });
-        }
-        Ok(r)
-    };
-    let spindle_rpm = range("process.spindle_rpm", p.spindle_rpm, 0.0)?;
-    check_positive("process.spindle_rpm[0] [rpm]", spindle_rpm[0])?;
-    let feed = range("process.feed", p.feed, 0.0)?;
-    let redundancy_angle = range("process.redundancy_angle", p.redundancy_angle, -PI - 1e-12)?;
-    if redundancy_angle[1] > PI + 1e-12 {
-        return Err(MillError::InvalidParameter {
-            name: "process.redundancy_angle[1]".to_string(),
-            value: redundancy_angle[1],
-            reason: "must be <= pi".to_string(),
-        });
-    }
-    let limits = StateLimits {
-        spindle_rpm,
-        feed,
-        redundancy_angle,
-        max_feed_step: check_positive("process.step_bounds.feed [m/s]", p.step_bounds.feed)?,
-        max_spindle_step_rpm: check_positive(
-            "process.step_bounds.spindle_rpm [rpm]",
-            p.step_bounds.spindle_rpm,
-        )?,
-        max_redundancy_step: check_positive(
-            "process.step_bounds.redundancy_angle [rad]",
-            p.step_bounds.redundancy_angle,
-        )?,
-    };
-    Ok((process, limits))
-}
-
-impl StateLimits {
-    /// Checks the limits with the rules of the cell YAML's `process`
-    /// section ([`MillCell::from_yaml_str`]): every value finite; each
-    /// range `[min, max]` with min < max; the spindle range above 0 rpm;
-    /// the feed range from ≥ 0 m/s; the redundancy-angle range inside
-    /// [−π, π] (1e-12 slack); every step bound > 0.
-    ///
-    /// # Errors
-    /// [`MillError::InvalidParameter`] naming the field as
-    /// `state_limits.<field>[index]` with its unit.
-    pub fn validate(&self) -> Result<(), MillError> {
-        use std::f64::consts::PI;
-        let range = |name: &str, r: [f64; 2], min: f64, max: f64| -> Result<(), MillError> {
-            for (i, v) in r.iter().enumerate() {
-                check_finite(&format!("state_limits.{name}[{i}]"), *v)?;
-            }
-            if r[1] <= r[0] {
-                return Err(MillError::InvalidParameter {
-                    name: format!("state_limits.{name}[1]"),
-                    value: r[1],
-                    reason: format!("must be > state_limits.{name}[0] = {}", r[0]),
-                });
-            }
-            if r[0] < min {
-                return Err(MillError::InvalidParameter {
-                    name: format!("state_limits.{name}[0]"),
-                    value: r[0],
-                    reason: format!("must be >= {min}"),
-                });
-            }
-            if r[1] > max {
-                return Err(MillError::InvalidParameter {
-                    name: format!("state_limits.{name}[1]"),
-                    value: r[1],
-                    reason: format!("must be <= {max}"),
-                });
-            }
-            Ok(())
-        };
-        range("spindle_rpm [rpm]", self.spindle_rpm, 0.0, f64::INFINITY)?;
-        check_positive("state_limits.spindle_rpm[0] [rpm]", self.spindle_rpm[0])?;
-        range("feed [m/s]", self.feed, 0.0, f64::INFINITY)?;
-        range(
-            "redundancy_angle [rad]",
-            self.redundancy_angle,
-            -PI - 1e-12,
-            PI + 1e-12,
-        )?;
-        check_positive("state_limits.max_feed_step [m/s]", self.max_feed_step)?;
-        check_positive(
-            "state_limits.max_spindle_step_rpm [rpm]",
-            self.max_spindle_step_rpm,
-        )?;
-        check_positive(
-            "state_limits.max_redundancy_step [rad]",
-            self.max_redundancy_step,
-        )?;
-        Ok(())
     }
 }
 
