@@ -69,127 +69,22 @@
 //! truncated data, a checksum mismatch, or a fingerprint that differs from
 //! the cell's (a stale cache: the cell file was edited) is an error.
 
-use std::path::Path;
 use std::sync::Mutex;
 
 use kerf_chatter::indicator::chatter_indicator;
-use kerf_mill::{MillCell, MillError};
+use kerf_mill::MillCell;
 use serde::{Deserialize, Serialize};
 
 use crate::error::MillPlanError;
+use crate::fingerprint::fnv1a;
+
+pub use crate::direct::{direct_indicator, is_infeasible};
+pub use crate::fingerprint::cell_fingerprint;
+pub use crate::grid_spec::GridSpec;
+pub use crate::rng::SplitMix64;
 
 /// First line of a cache file.
 pub const CACHE_MAGIC: &str = "kerf-indicator-cache 1";
-
-/// Node lists of the cache grid (each strictly increasing, ≥ 2 nodes, except
-/// that a single segment node is allowed for a one-segment cache).
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct GridSpec {
-    /// Path segment indices (0-based).
-    pub segments: Vec<usize>,
-    /// Spindle speeds \[rpm\].
-    pub rpm: Vec<f64>,
-    /// Feeds [m/s] (> 0: the indicator of a zero feed is not a cutting
-    /// state of a plan, [`crate::env`]).
-    pub feed: Vec<f64>,
-    /// Redundancy angles \[rad\].
-    pub g: Vec<f64>,
-}
-
-/// `count` equally spaced values from `min` to `max` (both included).
-fn linspace(min: f64, max: f64, count: usize) -> Vec<f64> {
-    if count <= 1 {
-        return vec![min];
-    }
-    (0..count)
-        .map(|i| min + (max - min) * i as f64 / (count - 1) as f64)
-        .collect()
-}
-
-impl GridSpec {
-    /// A grid with every `stride`-th segment of `0..segment_count` plus the
-    /// last, and equally spaced Ω, f and g nodes.
-    ///
-    /// # Arguments
-    /// * `segment_count`, `stride` — segments 0, k, 2k, …, and N − 1;
-    /// * `rpm`, `feed`, `g` — (min, max, count) per axis.
-    ///
-    /// # Errors
-    /// As [`GridSpec::validate`]; `stride` or `segment_count` 0.
-    pub fn uniform(
-        segment_count: usize,
-        stride: usize,
-        rpm: (f64, f64, usize),
-        feed: (f64, f64, usize),
-        g: (f64, f64, usize),
-    ) -> Result<Self, MillPlanError> {
-        if stride == 0 || segment_count == 0 {
-            return Err(MillPlanError::InvalidConfig {
-                name: "cache grid segments".to_string(),
-                reason: format!("segment count {segment_count} and stride {stride} must be >= 1"),
-            });
-        }
-        let mut segments: Vec<usize> = (0..segment_count).step_by(stride).collect();
-        if segments.last() != Some(&(segment_count - 1)) {
-            segments.push(segment_count - 1);
-        }
-        let spec = Self {
-            segments,
-            rpm: linspace(rpm.0, rpm.1, rpm.2),
-            feed: linspace(feed.0, feed.1, feed.2),
-            g: linspace(g.0, g.1, g.2),
-        };
-        spec.validate()?;
-        Ok(spec)
-    }
-
-    /// Checks the node lists.
-    ///
-    /// # Errors
-    /// [`MillPlanError::InvalidConfig`] for an axis that is empty, not
-    /// strictly increasing, non-finite, or has fewer than 2 nodes (Ω, f, g);
-    /// feeds ≤ 0 or spindle speeds ≤ 0.
-    pub fn validate(&self) -> Result<(), MillPlanError> {
-        let bad = |name: &str, reason: &str| MillPlanError::InvalidConfig {
-            name: format!("cache grid {name}"),
-            reason: reason.to_string(),
-        };
-        if self.segments.is_empty() {
-            return Err(bad("segments", "no nodes"));
-        }
-        if self.segments.windows(2).any(|w| w[1] <= w[0]) {
-            return Err(bad("segments", "must be strictly increasing"));
-        }
-        for (name, axis, positive) in [
-            ("rpm", &self.rpm, true),
-            ("feed", &self.feed, true),
-            ("g", &self.g, false),
-        ] {
-            if axis.len() < 2 {
-                return Err(bad(name, "needs at least 2 nodes"));
-            }
-            if axis.iter().any(|v| !v.is_finite()) {
-                return Err(bad(name, "non-finite node"));
-            }
-            if axis.windows(2).any(|w| w[1] <= w[0]) {
-                return Err(bad(name, "must be strictly increasing"));
-            }
-            if positive && axis.first().is_some_and(|v| *v <= 0.0) {
-                return Err(bad(name, "nodes must be > 0"));
-            }
-        }
-        Ok(())
-    }
-
-    /// Number of nodes (segments × Ω × f × g).
-    pub fn node_count(&self) -> usize {
-        self.segments.len() * self.rpm.len() * self.feed.len() * self.g.len()
-    }
-
-    fn index(&self, s: usize, r: usize, f: usize, g: usize) -> usize {
-        ((s * self.rpm.len() + r) * self.feed.len() + f) * self.g.len() + g
-    }
-}
 
 /// Error of the cache against direct evaluation at random points.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -245,122 +140,8 @@ pub struct CacheHeader {
 /// The cached indicator (module documentation).
 #[derive(Debug, Clone, PartialEq)]
 pub struct IndicatorCache {
-    header: CacheHeader,
-    values: Vec<f64>,
-}
-
-/// FNV-1a 64-bit hash.
-fn fnv1a(bytes: &[u8]) -> u64 {
-    let mut h: u64 = 0xcbf2_9ce4_8422_2325;
-    for b in bytes {
-        h ^= u64::from(*b);
-        h = h.wrapping_mul(0x0000_0100_0000_01b3);
-    }
-    h
-}
-
-/// Rewrites every decimal number of a `Debug` text with 9 significant
-/// digits, so that last-ulp differences of computed values (a different
-/// libm on another machine) do not change a fingerprint.
-fn canonical_numbers(text: &str) -> String {
-    let mut out = String::with_capacity(text.len());
-    let mut token = String::new();
-    let flush = |token: &mut String, out: &mut String| {
-        if token.contains('.') {
-            match token.parse::<f64>() {
-                Ok(v) => out.push_str(&format!("{v:.8e}")),
-                Err(_) => out.push_str(token),
-            }
-        } else {
-            out.push_str(token);
-        }
-        token.clear();
-    };
-    for c in text.chars() {
-        let continues = c.is_ascii_digit()
-            || c == '.'
-            || ((c == 'e' || c == 'E') && !token.is_empty())
-            || ((c == '-' || c == '+') && (token.is_empty() || token.ends_with(['e', 'E'])));
-        if continues {
-            token.push(c);
-        } else {
-            flush(&mut token, &mut out);
-            out.push(c);
-        }
-    }
-    flush(&mut token, &mut out);
-    out
-}
-
-/// A fingerprint of everything in the cell that the indicator depends on:
-/// the milling process, the indicator settings, the state limits, the
-/// dynamics model, the characteristic length, the reference joints, every
-/// segment's geometry, and the cell state (joints, K, modal matrices) at
-/// g = 0 of the first, middle and last segments (which catches a changed
-/// URDF or TCP). FNV-1a over the `Debug` texts with every number rounded
-/// to 9 significant digits (so a last-ulp difference of a computed value
-/// on another machine does not make a cache stale), as 16 hex digits.
-pub fn cell_fingerprint(cell: &MillCell) -> String {
-    let mut text = String::new();
-    text.push_str(&format!("{:?}", cell.milling_process()));
-    text.push_str(&format!("{:?}", cell.indicator_settings()));
-    text.push_str(&format!("{:?}", cell.state_limits()));
-    text.push_str(&format!("{:?}", cell.dynamics()));
-    text.push_str(&format!("{:?}", cell.characteristic_length()));
-    text.push_str(&format!("{:?}", cell.reference_joints()));
-    for s in cell.path().segments() {
-        text.push_str(&format!("{:?}{:?}{:?}", s.length, s.mid, s.cutting_frame));
-    }
-    let n = cell.path().segments().len();
-    for seg in [0, n / 2, n.saturating_sub(1)] {
-        match cell.evaluate(seg, 0.0, None) {
-            Ok(state) => text.push_str(&format!("{state:?}")),
-            Err(e) => text.push_str(&e.to_string()),
-        }
-    }
-    format!("{:016x}", fnv1a(canonical_numbers(&text).as_bytes()))
-}
-
-/// Whether a cell-model error means "this (segment, g) is not a feasible
-/// state" (unreachable, joint limit, singular) rather than a failure.
-pub fn is_infeasible(e: &MillError) -> bool {
-    matches!(
-        e,
-        MillError::Unreachable { .. } | MillError::JointLimit { .. } | MillError::Singular { .. }
-    )
-}
-
-/// |μ|max evaluated directly (no cache): the cell state at (segment, g)
-/// with IK nearest `reference` (the cell's reference joints for `None`),
-/// then `chatter_indicator` with the cell's process and settings.
-///
-/// # Returns
-/// `Ok(None)` when the cell state is infeasible ([`is_infeasible`]).
-///
-/// # Errors
-/// Other cell-model errors, and every chatter-model error (NaN, non
-/// convergence) as [`MillPlanError::Chatter`].
-pub fn direct_indicator(
-    cell: &MillCell,
-    segment: usize,
-    rpm: f64,
-    feed: f64,
-    g: f64,
-    reference: Option<&[f64; 6]>,
-) -> Result<Option<f64>, MillPlanError> {
-    let state = match cell.evaluate(segment, g, reference) {
-        Ok(s) => s,
-        Err(e) if is_infeasible(&e) => return Ok(None),
-        Err(e) => return Err(e.into()),
-    };
-    let ind = chatter_indicator(
-        &state.modal,
-        &cell.milling_process(),
-        rpm,
-        feed,
-        cell.indicator_settings(),
-    )?;
-    Ok(Some(ind.spectral_radius))
+    pub(crate) header: CacheHeader,
+    pub(crate) values: Vec<f64>,
 }
 
 /// Bracketing interval of `x` in `nodes`: (lower index, weight of the
@@ -380,44 +161,6 @@ fn bracket(nodes: &[f64], x: f64) -> Option<(usize, f64)> {
     let (a, b) = (nodes[lo], nodes[lo + 1]);
     let w = ((x - a) / (b - a)).clamp(0.0, 1.0);
     Some((lo, w))
-}
-
-/// A small deterministic generator (SplitMix64) for the random test points.
-#[derive(Debug, Clone)]
-pub struct SplitMix64(u64);
-
-impl SplitMix64 {
-    /// Seeded generator.
-    pub fn new(seed: u64) -> Self {
-        Self(seed)
-    }
-
-    /// Next 64 random bits.
-    pub fn next_u64(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(0x9e37_79b9_7f4a_7c15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
-        z ^ (z >> 31)
-    }
-
-    /// Uniform in [0, 1).
-    pub fn next_f64(&mut self) -> f64 {
-        (self.next_u64() >> 11) as f64 / (1u64 << 53) as f64
-    }
-
-    /// Uniform in [lo, hi).
-    pub fn uniform(&mut self, lo: f64, hi: f64) -> f64 {
-        lo + (hi - lo) * self.next_f64()
-    }
-
-    /// Uniform integer in lo..=hi.
-    pub fn integer(&mut self, lo: usize, hi: usize) -> usize {
-        if hi <= lo {
-            return lo;
-        }
-        lo + (self.next_u64() % (hi - lo + 1) as u64) as usize
-    }
 }
 
 /// The outcome of one column: its values, `None` when infeasible.
@@ -827,113 +570,6 @@ impl IndicatorCache {
         })
     }
 
-    /// Writes the cache file (module documentation).
-    ///
-    /// # Errors
-    /// [`MillPlanError::Io`].
-    pub fn save(&self, path: &Path) -> Result<(), MillPlanError> {
-        let bytes: Vec<u8> = self.values.iter().flat_map(|v| v.to_le_bytes()).collect();
-        let mut header = self.header.clone();
-        header.data_checksum = format!("{:016x}", fnv1a(&bytes));
-        let json = serde_json::to_string(&header).map_err(|e| MillPlanError::Io {
-            path: path.display().to_string(),
-            message: e.to_string(),
-        })?;
-        let mut out = Vec::with_capacity(bytes.len() + json.len() + 64);
-        out.extend_from_slice(CACHE_MAGIC.as_bytes());
-        out.push(b'\n');
-        out.extend_from_slice(json.as_bytes());
-        out.push(b'\n');
-        out.extend_from_slice(&bytes);
-        std::fs::write(path, out).map_err(|e| MillPlanError::Io {
-            path: path.display().to_string(),
-            message: e.to_string(),
-        })
-    }
-
-    /// Reads a cache file and checks it against `cell`.
-    ///
-    /// # Errors
-    /// [`MillPlanError::Io`] (unreadable file); [`MillPlanError::InvalidConfig`]
-    /// for a wrong magic line, bad header, truncated/extra data, a checksum
-    /// mismatch (corrupt file), or a fingerprint that differs from
-    /// [`cell_fingerprint`]`(cell)` (stale cache: rebuild it with
-    /// `cargo run --release -p kerf_millplan --example build_cache`).
-    pub fn load(path: &Path, cell: &MillCell) -> Result<Self, MillPlanError> {
-        let bytes = std::fs::read(path).map_err(|e| MillPlanError::Io {
-            path: path.display().to_string(),
-            message: e.to_string(),
-        })?;
-        let cache = Self::from_bytes(&bytes, &path.display().to_string())?;
-        let expected = cell_fingerprint(cell);
-        if cache.header.cell_fingerprint != expected {
-            return Err(MillPlanError::InvalidConfig {
-                name: format!("indicator cache {}", path.display()),
-                reason: format!(
-                    "stale: built for cell fingerprint {} but the cell's is {expected} (the cell \
-                     file changed); rebuild with `cargo run --release -p kerf_millplan --example \
-                     build_cache`",
-                    cache.header.cell_fingerprint
-                ),
-            });
-        }
-        Ok(cache)
-    }
-
-    /// Parses the bytes of a cache file (no fingerprint check).
-    ///
-    /// # Errors
-    /// As [`IndicatorCache::load`], except the fingerprint.
-    pub fn from_bytes(bytes: &[u8], name: &str) -> Result<Self, MillPlanError> {
-        let corrupt = |reason: String| MillPlanError::InvalidConfig {
-            name: format!("indicator cache {name}"),
-            reason,
-        };
-        let magic_end = bytes
-            .iter()
-            .position(|b| *b == b'\n')
-            .ok_or_else(|| corrupt("no header line".to_string()))?;
-        if bytes.get(..magic_end) != Some(CACHE_MAGIC.as_bytes()) {
-            return Err(corrupt(format!(
-                "not a cache file (first line must be `{CACHE_MAGIC}`)"
-            )));
-        }
-        let rest = bytes.get(magic_end + 1..).unwrap_or(&[]);
-        let json_end = rest
-            .iter()
-            .position(|b| *b == b'\n')
-            .ok_or_else(|| corrupt("no JSON header line".to_string()))?;
-        let json = std::str::from_utf8(rest.get(..json_end).unwrap_or(&[]))
-            .map_err(|e| corrupt(format!("header is not UTF-8: {e}")))?;
-        let header: CacheHeader =
-            serde_json::from_str(json).map_err(|e| corrupt(format!("bad header: {e}")))?;
-        header.grid.validate()?;
-        let data = rest.get(json_end + 1..).unwrap_or(&[]);
-        let expected = header.grid.node_count() * 8;
-        if data.len() != expected {
-            return Err(corrupt(format!(
-                "{} data bytes, expected {expected} for the grid (truncated or extra data)",
-                data.len()
-            )));
-        }
-        let checksum = format!("{:016x}", fnv1a(data));
-        if checksum != header.data_checksum {
-            return Err(corrupt(format!(
-                "data checksum {checksum} differs from the header's {} (corrupt file)",
-                header.data_checksum
-            )));
-        }
-        let values = data
-            .chunks_exact(8)
-            .map(|c| {
-                let mut b = [0u8; 8];
-                b.copy_from_slice(c);
-                f64::from_le_bytes(b)
-            })
-            .collect();
-        Ok(Self { header, values })
-    }
-
     /// The default cache file of the default cell,
     /// `crates/millplan/data/indicator_cache.bin` below the kerf data root
     /// ([`kerf_robot::data`]: `KERF_DATA_DIR`, the share directory beside the binary, the
@@ -944,27 +580,5 @@ impl IndicatorCache {
     /// ([`kerf_robot::data::default_path`]).
     pub fn default_path() -> std::path::PathBuf {
         kerf_robot::data::default_path("crates/millplan/data/indicator_cache.bin")
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn canonical_numbers_round_to_nine_digits() {
-        let a =
-            canonical_numbers("Mode { f: 1.2345678901234567, m: -3.0e-5, n: 7, x: [0.1, 2e3] }");
-        assert_eq!(
-            a,
-            "Mode { f: 1.23456789e0, m: -3.00000000e-5, n: 7, x: [1.00000000e-1, 2e3] }"
-        );
-        // A last-ulp difference vanishes.
-        let x = 0.1f64 + 0.2;
-        assert_ne!(format!("{x:?}"), format!("{:?}", 0.3));
-        assert_eq!(
-            canonical_numbers(&format!("{x:?}")),
-            canonical_numbers(&format!("{:?}", 0.3))
-        );
     }
 }

@@ -11,12 +11,21 @@ pub mod rl;
 
 // The environment of seed 004 section 3 and the baselines.
 pub mod cache;
+pub mod cache_file;
+pub mod direct;
 pub mod dp;
 pub mod env;
+pub mod env_config;
+pub mod evaluation;
+pub mod fingerprint;
+pub mod grid_dp;
+pub mod grid_spec;
 pub mod joint_speed;
 pub mod naive;
 pub mod plan;
+pub mod provenance;
 pub mod reward;
+pub mod rollout;
 pub mod timing;
 
 // The joint trajectory (the executor's type), as planned and as executed.

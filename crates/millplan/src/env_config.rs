@@ -1,0 +1,86 @@
+//! The settings of the milling environment ([`EnvConfig`] of
+//! [`crate::env::MillEnv`]; the module documentation of [`crate::env`]
+//! says what each does).
+
+use crate::reward::{ChatterMargin, RewardWeights};
+
+/// Settings of [`MillEnv`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct EnvConfig {
+    /// Reward weights (seed 004 eq. 12).
+    pub weights: RewardWeights,
+    /// Inertia coefficient α ∈ (0, 1] of the filter (seed 004 eq. 11).
+    pub alpha: f64,
+    /// Ω0 \[rpm\] of the initial value problem.
+    pub initial_rpm: f64,
+    /// f0 [m/s].
+    pub initial_feed: f64,
+    /// g0 \[rad\].
+    pub initial_g: f64,
+    /// Reward of a terminal constraint violation (< 0).
+    pub violation_penalty: f64,
+    /// The paper's ablation: g fixed at g0, action (ΔΩ, Δf).
+    pub fixed_g: bool,
+    /// kerf's chatter margin subtracted from the step reward
+    /// ([`ChatterMargin`]; `None` = seed 004 eq. 12 alone).
+    pub chatter_margin: Option<ChatterMargin>,
+    /// Whether a step whose joints would move faster than the URDF's
+    /// velocity limits between the two segments' midpoints is a terminal
+    /// violation ([`crate::joint_speed`]; kerf's constraint, default on).
+    pub joint_speed_limits: bool,
+    /// kerf's projection of the g move (default on): when the filtered move
+    /// leads to an infeasible state (IK, joint limit, joint speed), the
+    /// largest fraction of its g part that keeps the state feasible is
+    /// applied instead (bisection, [`PROJECTION_BISECTIONS`] steps), and
+    /// the filter state takes the applied move. Only when g unchanged is
+    /// infeasible too is the step a terminal violation.
+    pub project_g: bool,
+    /// Lowest feed of the clip of eq. 11 [m/s] (default 0.01, kerf's): the
+    /// transitions clip f to [max(f_min, min_feed), f_max]. Why: f = 0 is
+    /// no machining state (the segment never ends; it is undefined under the
+    /// cell's sublinear force law) and the indicator cache starts at
+    /// 0.01 m/s; with the paper's f_min = 0 a policy that drives the feed
+    /// down ends its episode with the violation penalty, a cliff that
+    /// measurably destabilized training. 0 restores the paper's clip (a zero
+    /// feed is then a terminal violation). The initial feed must be at least
+    /// this.
+    pub min_feed: f64,
+    /// kerf's joint-acceleration shaping (default `None`: off): with
+    /// `Some(w)`, w · Σ_j (|a_j| / a_max,j − 1)₊ is subtracted from the
+    /// step reward, a_j the acceleration of joint j at the current segment's
+    /// midpoint estimated from the joints at three consecutive midpoints
+    /// (second divided difference over the midpoint intervals, Fornberg
+    /// 1988 three-point formula), a_max,j the limits YAML's (joints
+    /// without one are not counted). Why: the plans are timed by the feed
+    /// and the executor interpolates the joints; a g that changes
+    /// direction from one segment to the next asks the wrist for several
+    /// times its acceleration limit and the trajectory must be slowed
+    /// ([`crate::timing`]). A soft term, not a constraint: a terminal
+    /// acceleration violation made training collapse (issue-5 note).
+    pub acceleration_penalty: Option<f64>,
+}
+
+/// Bisection steps of [`EnvConfig::project_g`] (resolution 2⁻⁸ of the move).
+pub const PROJECTION_BISECTIONS: usize = 8;
+
+impl Default for EnvConfig {
+    /// Seed 004's IVP (2000 rpm, 0.04 m/s, 0 rad), α = 0.5, penalty −100,
+    /// default weights, g free, the default [`ChatterMargin`] (module
+    /// documentation).
+    fn default() -> Self {
+        Self {
+            weights: RewardWeights::default(),
+            alpha: 0.5,
+            initial_rpm: 2000.0,
+            initial_feed: 0.04,
+            initial_g: 0.0,
+            violation_penalty: -100.0,
+            fixed_g: false,
+            chatter_margin: Some(ChatterMargin::default()),
+            joint_speed_limits: true,
+            project_g: true,
+            min_feed: 0.01,
+            acceleration_penalty: None,
+        }
+    }
+}

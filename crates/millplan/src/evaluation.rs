@@ -1,0 +1,413 @@
+//! The evaluation of a plan's states ([`crate::plan::Plan::evaluate`] and
+//! its variants): the state checks, the direct |μ|max of every segment on
+//! up to [`default_eval_threads`] threads (the plan bit for bit the
+//! sequential one), and, with an indicator cache, its values where they
+//! apply.
+
+use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
+
+use kerf_chatter::indicator::chatter_indicator;
+use kerf_chatter::Modal2;
+use kerf_mill::{CellState, MillCell};
+
+use crate::cache::{is_infeasible, IndicatorCache};
+use crate::env::PhysicalState;
+use crate::error::MillPlanError;
+use crate::plan::{Plan, SegmentPlan};
+use crate::provenance::{IndicatorProvenance, IndicatorSource};
+use crate::reward::{step_reward, RewardWeights};
+
+/// The evaluation of [`Plan::evaluate_with_threads`] and, with a cache,
+/// [`Plan::evaluate_cached`].
+pub(crate) fn evaluate_impl(
+    cell: &MillCell,
+    weights: &RewardWeights,
+    states: &[PhysicalState],
+    planner: &str,
+    threads: usize,
+    cache: Option<&IndicatorCache>,
+) -> Result<(Plan, IndicatorProvenance), MillPlanError> {
+    if threads == 0 {
+        return Err(MillPlanError::InvalidParameter {
+            name: "evaluation threads".to_string(),
+            value: 0.0,
+            reason: "must be >= 1".to_string(),
+        });
+    }
+    weights.validate()?;
+    let n = cell.path().segments().len();
+    if states.len() != n {
+        return Err(MillPlanError::InvalidConfig {
+            name: format!("plan `{planner}`"),
+            reason: format!("{} states for {n} segments", states.len()),
+        });
+    }
+    let lim = cell.state_limits();
+    // Step 1: checks and cell states, in order, up to the first error.
+    let mut cell_states: Vec<CellState> = Vec::with_capacity(n);
+    let mut first_error: Option<MillPlanError> = None;
+    let mut reference: Option<[f64; 6]> = None;
+    for (i, s) in states.iter().enumerate() {
+        match check_state(cell, i, s, planner)
+            .and_then(|()| Ok(cell.evaluate(i, s.g, reference.as_ref())?))
+        {
+            Ok(cs) => {
+                reference = Some(cs.joints);
+                cell_states.push(cs);
+            }
+            Err(e) => {
+                first_error = Some(e);
+                break;
+            }
+        }
+    }
+    // Step 2: cached values where the cache applies, the rest directly.
+    let k = cell_states.len();
+    let cached = match cache {
+        Some(c) => cached_values(cell, states, &cell_states, c)?,
+        None => vec![None; k],
+    };
+    let direct: Vec<usize> = (0..k).filter(|i| cached[*i].is_none()).collect();
+    let mut direct_mus = spectral_radii(cell, states, &cell_states, &direct, threads).into_iter();
+    let mut mus: Vec<Result<f64, MillPlanError>> = Vec::with_capacity(k);
+    for value in &cached {
+        match value {
+            Some((v, _)) => mus.push(Ok(*v)),
+            None => match direct_mus.next() {
+                Some(r) => mus.push(r),
+                // The direct evaluations stopped at an earlier error.
+                None => break,
+            },
+        }
+    }
+    // Step 3: in order; a |μ| error at segment j precedes a step-1 error at
+    // a later segment (sequential order).
+    let mut segments = Vec::with_capacity(n);
+    for (i, (cs, mu)) in cell_states.iter().zip(mus).enumerate() {
+        let s = &states[i];
+        let mu = mu?;
+        let reward = step_reward(weights, cs.condition_number, s.feed, lim.feed[1], mu)?;
+        let length = cell.path().segment(i)?.length;
+        segments.push(SegmentPlan {
+            segment: i,
+            rpm: s.rpm,
+            feed: s.feed,
+            g: s.g,
+            spectral_radius: mu,
+            condition_number: cs.condition_number,
+            condition_indicator: cs.condition_indicator,
+            joints: cs.joints,
+            time: length / s.feed,
+            reward,
+        });
+    }
+    if let Some(e) = first_error {
+        return Err(e);
+    }
+    if segments.len() != n {
+        // Unreachable: every segment is evaluated when none failed.
+        return Err(MillPlanError::InvalidConfig {
+            name: format!("plan `{planner}`"),
+            reason: format!("{} of {n} segments evaluated", segments.len()),
+        });
+    }
+    let cached_segments: Vec<usize> = (0..n).filter(|i| cached[*i].is_some()).collect();
+    let margin = |i: usize| cached[i].map_or(0.0, |(_, b)| b);
+    let bound = cached.iter().flatten().map(|(_, b)| *b).reduce(f64::max);
+    let plan = Plan::from_segments(planner, segments, margin);
+    let provenance = match (cache, bound) {
+        (None, _) => IndicatorProvenance::direct(IndicatorSource::Direct, n, ""),
+        (Some(c), None) => IndicatorProvenance::direct(
+            IndicatorSource::Cache,
+            n,
+            if c.header().error_bound.is_none() {
+                "the indicator cache states no error bound"
+            } else {
+                "no state is inside the indicator cache's feasible grid with the cache's tool-tip dynamics"
+            },
+        ),
+        (Some(_), Some(b)) => IndicatorProvenance {
+            requested: IndicatorSource::Cache,
+            note: format!(
+                "|mu|max of {} of {n} segments INTERPOLATED from the indicator cache (stated \
+                 error bound +/-{b:.3}; chatter-free is claimed only where |mu|max + bound < 1), \
+                 {} evaluated directly",
+                cached_segments.len(),
+                n - cached_segments.len()
+            ),
+            cached_segments,
+            segments: n,
+            error_bound: Some(b),
+        },
+    };
+    Ok((plan, provenance))
+}
+
+/// Per cell state, the cache's |μ|max and the stated bound that applies
+/// to it (the bound for g on a g node when the state's g is a node and
+/// the cache states one, else the general bound), when the cache answers
+/// on the same IK branch ([`Plan::evaluate_cached`]); all `None` without
+/// a stated general bound.
+///
+/// # Errors
+/// A NaN state (refused earlier by [`check_state`]); a cell-model error
+/// other than an infeasible state.
+pub(crate) fn cached_values(
+    cell: &MillCell,
+    states: &[PhysicalState],
+    cell_states: &[CellState],
+    cache: &IndicatorCache,
+) -> Result<Vec<Option<(f64, f64)>>, MillPlanError> {
+    let k = cell_states.len();
+    let valid = |b: &f64| b.is_finite() && *b >= 0.0;
+    let header = cache.header();
+    let Some(general) = header.error_bound.filter(valid) else {
+        return Ok(vec![None; k]);
+    };
+    let on_nodes = header.error_bound_g_nodes.filter(valid);
+    let mut out = Vec::with_capacity(k);
+    for (s, cs) in states.iter().zip(cell_states) {
+        let Some(v) = cache.try_query(s.segment, s.rpm, s.feed, s.g)? else {
+            out.push(None);
+            continue;
+        };
+        // The cache's nodes use the IK nearest the reference joints; the
+        // cached |μ| applies when that state has the same tool-tip dynamics
+        // (|μ| depends on the cell state only through them; e.g. a wrist
+        // flip of the chain keeps them).
+        let same_dynamics = match cell.evaluate(s.segment, s.g, None) {
+            Ok(r) => same_modal(&r.modal, &cs.modal),
+            Err(e) if is_infeasible(&e) => false,
+            Err(e) => return Err(e.into()),
+        };
+        let bound = match on_nodes {
+            Some(b) if cache.grid().g.contains(&s.g) => b.min(general),
+            _ => general,
+        };
+        out.push((same_dynamics && v.is_finite()).then_some((v, bound)));
+    }
+    Ok(out)
+}
+
+/// Relative tolerance of [`same_modal`].
+const SAME_MODAL_TOLERANCE: f64 = 1e-9;
+
+/// Whether two tool-tip models are equal within [`SAME_MODAL_TOLERANCE`]
+/// relative to each matrix's largest entry (a NaN or infinite entry: not
+/// equal).
+fn same_modal(a: &Modal2, b: &Modal2) -> bool {
+    [
+        (&a.mass, &b.mass),
+        (&a.damping, &b.damping),
+        (&a.stiffness, &b.stiffness),
+    ]
+    .iter()
+    .all(|(x, y)| {
+        if !(x.iter().chain(y.iter()).all(|v| v.is_finite())) {
+            return false;
+        }
+        let scale = x.amax().max(y.amax());
+        let diff = (*x - *y).amax();
+        diff <= SAME_MODAL_TOLERANCE * scale
+    })
+}
+
+/// Largest number of threads [`Plan::evaluate`] uses, whatever the
+/// machine reports (a cap for a node serving several requests at once).
+pub const MAX_EVAL_THREADS: usize = 8;
+
+/// The thread count of [`Plan::evaluate`]:
+/// [`std::thread::available_parallelism`] (1 when unknown), at most
+/// [`MAX_EVAL_THREADS`].
+///
+/// # Returns
+/// A number in 1..=[`MAX_EVAL_THREADS`].
+pub fn default_eval_threads() -> usize {
+    std::thread::available_parallelism()
+        .map(|n| n.get())
+        .unwrap_or(1)
+        .clamp(1, MAX_EVAL_THREADS)
+}
+
+/// The checks of one state of [`Plan::evaluate`]: segment order, Ω, f, g
+/// in the cell's ranges (NaN refused), f > 0.
+fn check_state(
+    cell: &MillCell,
+    i: usize,
+    s: &PhysicalState,
+    planner: &str,
+) -> Result<(), MillPlanError> {
+    if s.segment != i {
+        return Err(MillPlanError::InvalidConfig {
+            name: format!("plan `{planner}`"),
+            reason: format!("state {i} is for segment {}", s.segment),
+        });
+    }
+    let lim = cell.state_limits();
+    for (name, v, lo, hi) in [
+        (
+            "spindle speed [rpm]",
+            s.rpm,
+            lim.spindle_rpm[0],
+            lim.spindle_rpm[1],
+        ),
+        ("feed [m/s]", s.feed, lim.feed[0], lim.feed[1]),
+        (
+            "redundancy angle [rad]",
+            s.g,
+            lim.redundancy_angle[0],
+            lim.redundancy_angle[1],
+        ),
+    ] {
+        if !(v >= lo && v <= hi) {
+            return Err(MillPlanError::InvalidParameter {
+                name: format!("{name} at segment {i}"),
+                value: v,
+                reason: format!("must be in [{lo}, {hi}]"),
+            });
+        }
+    }
+    if s.feed <= 0.0 {
+        return Err(MillPlanError::InvalidParameter {
+            name: format!("feed [m/s] at segment {i}"),
+            value: s.feed,
+            reason: "must be > 0 (the segment time l/f would be infinite)".to_string(),
+        });
+    }
+    Ok(())
+}
+
+/// |μ|max of segment `i`: the direct chatter indicator at the segment's
+/// cell state, Ω and f.
+fn spectral_radius(
+    cell: &MillCell,
+    state: &PhysicalState,
+    cell_state: &CellState,
+) -> Result<f64, MillPlanError> {
+    Ok(chatter_indicator(
+        &cell_state.modal,
+        &cell.milling_process(),
+        state.rpm,
+        state.feed,
+        cell.indicator_settings(),
+    )?
+    .spectral_radius)
+}
+
+/// Step 2 of [`Plan::evaluate_with_threads`]: the direct |μ|max of the
+/// segments `indices` (ascending), one result per index in that order.
+/// Indices are handed out in increasing order from a shared counter; after
+/// the first error no new one starts, so every result before the lowest
+/// failing index is computed; the list stops after that error (step 3
+/// stops there first).
+pub(crate) fn spectral_radii(
+    cell: &MillCell,
+    states: &[PhysicalState],
+    cell_states: &[CellState],
+    indices: &[usize],
+    threads: usize,
+) -> Vec<Result<f64, MillPlanError>> {
+    let n = indices.len();
+    let eval = |j: usize| spectral_radius(cell, &states[indices[j]], &cell_states[indices[j]]);
+    let workers = threads.min(n).clamp(1, MAX_EVAL_THREADS);
+    if workers == 1 {
+        let mut out = Vec::with_capacity(n);
+        for j in 0..n {
+            let r = eval(j);
+            let failed = r.is_err();
+            out.push(r);
+            if failed {
+                break;
+            }
+        }
+        return out;
+    }
+    let next = AtomicUsize::new(0);
+    let failed = AtomicBool::new(false);
+    let work = || {
+        let mut done = Vec::new();
+        while !failed.load(Ordering::Acquire) {
+            let j = next.fetch_add(1, Ordering::AcqRel);
+            if j >= n {
+                break;
+            }
+            let r = eval(j);
+            if r.is_err() {
+                failed.store(true, Ordering::Release);
+            }
+            done.push((j, r));
+        }
+        done
+    };
+    let mut slots: Vec<Option<Result<f64, MillPlanError>>> = (0..n).map(|_| None).collect();
+    std::thread::scope(|scope| {
+        let helpers: Vec<_> = (1..workers)
+            .filter_map(|k| {
+                std::thread::Builder::new()
+                    .name(format!("plan-eval-{k}"))
+                    .spawn_scoped(scope, work)
+                    .ok()
+            })
+            .collect();
+        let mut all = work();
+        for h in helpers {
+            match h.join() {
+                Ok(done) => all.extend(done),
+                Err(panic) => std::panic::resume_unwind(panic),
+            }
+        }
+        for (j, r) in all {
+            slots[j] = Some(r);
+        }
+    });
+    let mut out = Vec::with_capacity(n);
+    for (j, slot) in slots.into_iter().enumerate() {
+        match slot {
+            Some(r) => {
+                let failed = r.is_err();
+                out.push(r);
+                if failed {
+                    break;
+                }
+            }
+            None => {
+                // Only after a failing index (see above); reported as an
+                // error rather than dropped, should that ever not hold.
+                out.push(Err(MillPlanError::InvalidConfig {
+                    name: format!("plan evaluation of segment {}", indices[j]),
+                    reason: "not evaluated (an earlier segment failed)".to_string(),
+                }));
+                break;
+            }
+        }
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use kerf_chatter::Mode;
+
+    #[test]
+    fn same_modal_is_a_relative_tolerance_and_refuses_nan() {
+        let mode = Mode {
+            natural_frequency_hz: 25.0,
+            damping_ratio: 0.05,
+            modal_mass: 50.0,
+        };
+        let a = Modal2::from_modes(mode, mode).expect("modal");
+        assert!(same_modal(&a, &a));
+        let mut b = a;
+        b.stiffness[(0, 1)] += 1e-12 * a.stiffness.amax();
+        assert!(same_modal(&a, &b));
+        b.stiffness[(0, 1)] += 1e-6 * a.stiffness.amax();
+        assert!(!same_modal(&a, &b));
+        for bad in [f64::NAN, f64::INFINITY] {
+            let mut c = a;
+            c.mass[(1, 1)] = bad;
+            assert!(!same_modal(&a, &c));
+            assert!(!same_modal(&c, &c));
+        }
+    }
+}

@@ -1,0 +1,158 @@
+//! The generic dynamic program of [`crate::dp`] on a 3-D grid: stages,
+//! moves of −1/0/+1 grid steps per axis (27 moves), a stage reward per
+//! node ([`solve_grid`]) and optionally a filter on moves
+//! ([`solve_grid_with_moves`]).
+
+use crate::error::MillPlanError;
+
+/// Result of the generic DP.
+#[derive(Debug, Clone, PartialEq)]
+pub struct GridPath {
+    /// The value (Σ stage rewards, f64 re-summed along the path).
+    pub value: f64,
+    /// Node indices (i, j, k) per stage.
+    pub nodes: Vec<[usize; 3]>,
+}
+
+/// The generic DP on a 3-D grid (module documentation): `stages` stages,
+/// grid `dims`, start node `start`, moves of −1/0/+1 per axis, stage
+/// reward `stage(t, [i, j, k])` (`None` = forbidden state).
+///
+/// # Returns
+/// `Ok(None)` when no feasible sequence exists (the start is forbidden or
+/// every continuation dies).
+///
+/// # Errors
+/// [`MillPlanError::InvalidConfig`] for zero stages, empty dimensions, a
+/// start outside the grid, or a grid too large (> 2^31 nodes × stages).
+pub fn solve_grid<F>(
+    stages: usize,
+    dims: [usize; 3],
+    start: [usize; 3],
+    stage: F,
+) -> Result<Option<GridPath>, MillPlanError>
+where
+    F: FnMut(usize, [usize; 3]) -> Option<f64>,
+{
+    solve_grid_with_moves(stages, dims, start, stage, |_, _, _| true)
+}
+
+/// As [`solve_grid`], with a filter on moves: `allowed(t, x, y)` says
+/// whether the move from node x at stage t to node y at stage t + 1 is
+/// allowed (e.g. joint speeds, [`crate::joint_speed`]).
+///
+/// # Errors
+/// As [`solve_grid`].
+pub fn solve_grid_with_moves<F, M>(
+    stages: usize,
+    dims: [usize; 3],
+    start: [usize; 3],
+    mut stage: F,
+    allowed: M,
+) -> Result<Option<GridPath>, MillPlanError>
+where
+    F: FnMut(usize, [usize; 3]) -> Option<f64>,
+    M: Fn(usize, [usize; 3], [usize; 3]) -> bool,
+{
+    let nodes = dims[0] * dims[1] * dims[2];
+    if stages == 0 || nodes == 0 || (0..3).any(|a| start[a] >= dims[a]) {
+        return Err(MillPlanError::InvalidConfig {
+            name: "DP grid".to_string(),
+            reason: format!("stages {stages}, dims {dims:?}, start {start:?}"),
+        });
+    }
+    if nodes.checked_mul(stages).is_none_or(|v| v > (1usize << 31)) {
+        return Err(MillPlanError::InvalidConfig {
+            name: "DP grid".to_string(),
+            reason: "too many states".to_string(),
+        });
+    }
+    let index = |i: usize, j: usize, k: usize| (i * dims[1] + j) * dims[2] + k;
+    let stage_table = |t: usize, stage: &mut F| -> Vec<f32> {
+        let mut out = vec![f32::NEG_INFINITY; nodes];
+        for i in 0..dims[0] {
+            for j in 0..dims[1] {
+                for k in 0..dims[2] {
+                    if let Some(r) = stage(t, [i, j, k]) {
+                        if r.is_finite() {
+                            out[index(i, j, k)] = r as f32;
+                        }
+                    }
+                }
+            }
+        }
+        out
+    };
+    // Backward pass.
+    let mut next = stage_table(stages - 1, &mut stage);
+    let mut back: Vec<u8> = vec![u8::MAX; nodes * (stages - 1)];
+    for t in (0..stages - 1).rev() {
+        let r = stage_table(t, &mut stage);
+        let mut value = vec![f32::NEG_INFINITY; nodes];
+        let bt = &mut back[t * nodes..(t + 1) * nodes];
+        for i in 0..dims[0] {
+            for j in 0..dims[1] {
+                for k in 0..dims[2] {
+                    let here = index(i, j, k);
+                    let rv = r[here];
+                    if rv == f32::NEG_INFINITY {
+                        continue;
+                    }
+                    let mut best = f32::NEG_INFINITY;
+                    let mut best_m = u8::MAX;
+                    for di in 0..3usize {
+                        let Some(ni) = (i + di).checked_sub(1).filter(|v| *v < dims[0]) else {
+                            continue;
+                        };
+                        for dj in 0..3usize {
+                            let Some(nj) = (j + dj).checked_sub(1).filter(|v| *v < dims[1]) else {
+                                continue;
+                            };
+                            for dk in 0..3usize {
+                                let Some(nk) = (k + dk).checked_sub(1).filter(|v| *v < dims[2])
+                                else {
+                                    continue;
+                                };
+                                let v = next[index(ni, nj, nk)];
+                                if v > best && allowed(t, [i, j, k], [ni, nj, nk]) {
+                                    best = v;
+                                    best_m = (di * 9 + dj * 3 + dk) as u8;
+                                }
+                            }
+                        }
+                    }
+                    if best > f32::NEG_INFINITY {
+                        value[here] = rv + best;
+                        bt[here] = best_m;
+                    }
+                }
+            }
+        }
+        next = value;
+    }
+    let s0 = index(start[0], start[1], start[2]);
+    if next.get(s0).is_none_or(|v| *v == f32::NEG_INFINITY) {
+        return Ok(None);
+    }
+    // Forward pass, re-summing the stage rewards in f64.
+    let mut path = Vec::with_capacity(stages);
+    let mut x = start;
+    let mut total = 0.0;
+    for t in 0..stages {
+        path.push(x);
+        total += stage(t, x).unwrap_or(f64::NEG_INFINITY);
+        if t + 1 == stages {
+            break;
+        }
+        let m = back[t * nodes + index(x[0], x[1], x[2])];
+        if m == u8::MAX {
+            return Ok(None);
+        }
+        let m = m as usize;
+        x = [x[0] + m / 9 - 1, x[1] + (m / 3) % 3 - 1, x[2] + m % 3 - 1];
+    }
+    Ok(Some(GridPath {
+        value: total,
+        nodes: path,
+    }))
+}
