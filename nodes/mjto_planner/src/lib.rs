@@ -132,11 +132,11 @@ impl PlanningService for CutService {
         }
     }
 
-    fn from_msg(&self, m: &msg::CutRequest) -> Result<CutRequest, Box<CutPlan>> {
+    fn request_from_msg(&self, m: &msg::CutRequest) -> Result<CutRequest, Box<CutPlan>> {
         convert::request_from_msg(m).map_err(|e| Box::new(convert::error_to_msg(&m.request_id, &e)))
     }
 
-    fn from_text(&self, text: &str) -> Result<CutRequest, Box<CutPlan>> {
+    fn request_from_text(&self, text: &str) -> Result<CutRequest, Box<CutPlan>> {
         text::parse_request(text)
             .map_err(|e| Box::new(convert::error_to_msg(&e.request_id, &e.error)))
     }

@@ -228,7 +228,7 @@ impl<S: PlanningService> PlannerNode<S> {
         while let Some(received) = self.requests.try_recv() {
             any = true;
             let job = match received {
-                Ok(m) => match self.service.from_msg(&m) {
+                Ok(m) => match self.service.request_from_msg(&m) {
                     Ok(r) => Job::Plan(Box::new(r)),
                     Err(answer) => Job::Answer(answer),
                 },
@@ -245,7 +245,7 @@ impl<S: PlanningService> PlannerNode<S> {
         while let Some(received) = self.text_requests.try_recv() {
             any = true;
             let job = match received {
-                Ok(m) => match self.service.from_text(&m.data) {
+                Ok(m) => match self.service.request_from_text(&m.data) {
                     Ok(r) => Job::Plan(Box::new(r)),
                     Err(answer) => Job::Answer(answer),
                 },

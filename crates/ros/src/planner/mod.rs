@@ -1,7 +1,7 @@
 //! The planner-node harness: every kerf planner node is a [`PlanningService`] run by [`run`].
 //!
 //! ```text
-//! request (message or text) → service.from_msg / from_text (convert, validate)
+//! request (message or text) → service.request_from_msg / request_from_text (convert, validate)
 //!   → queue (arrival order, `queue_depth`) → worker: service.plan
 //!   → executability check (the executor's own validation, check_trajectory_msg)
 //!   → publish: answer (latched), answer as YAML text (latched), trajectory on success

@@ -88,10 +88,10 @@ pub trait PlanningService: Send + Sync + 'static {
 
     /// Converts a request message; a request that cannot be converted is answered with the
     /// returned answer (its status and message).
-    fn from_msg(&self, msg: &Self::RequestMsg) -> Result<Self::Request, Box<Self::Answer>>;
+    fn request_from_msg(&self, msg: &Self::RequestMsg) -> Result<Self::Request, Box<Self::Answer>>;
 
-    /// Parses a text request (the `data` of a `std_msgs/String`); as [`Self::from_msg`].
-    fn from_text(&self, text: &str) -> Result<Self::Request, Box<Self::Answer>>;
+    /// Parses a text request (the `data` of a `std_msgs/String`); as [`Self::request_from_msg`].
+    fn request_from_text(&self, text: &str) -> Result<Self::Request, Box<Self::Answer>>;
 
     /// The key of a request (for the answers the harness gives it).
     fn key(&self, request: &Self::Request) -> AnswerKey;
