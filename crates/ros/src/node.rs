@@ -152,9 +152,12 @@ impl KerfNode {
         })
     }
 
-    fn node_mut(&mut self) -> &mut Node {
-        // `node` is only None during drop.
-        self.node.as_mut().expect("node present until drop")
+    /// The ros2-client node (`None` only while the node is being dropped).
+    fn node_mut(&mut self) -> Result<&mut Node, RosError> {
+        self.node.as_mut().ok_or_else(|| RosError::Dds {
+            what: "an endpoint".into(),
+            reason: "the node is shutting down".into(),
+        })
     }
 
     /// Node base name.
@@ -241,7 +244,7 @@ impl KerfNode {
     ) -> Result<Publisher<M>, RosError> {
         let (pkg, ty) = split_type(ros_type, "msg")?;
         let name = self.ros_name(topic)?;
-        let node = self.node_mut();
+        let node = self.node_mut()?;
         let t = node
             .create_topic(&name, MessageTypeName::new(pkg, ty), &qos)
             .map_err(dds_err(format!("topic {name}")))?;
@@ -276,7 +279,7 @@ impl KerfNode {
     ) -> Result<Subscription<M>, RosError> {
         let (pkg, ty) = split_type(ros_type, "msg")?;
         let name = self.ros_name(topic)?;
-        let node = self.node_mut();
+        let node = self.node_mut()?;
         let t = node
             .create_topic(&name, MessageTypeName::new(pkg, ty), &qos)
             .map_err(dds_err(format!("topic {name}")))?;
@@ -315,7 +318,7 @@ impl KerfNode {
         let (pkg, ty) = split_type(ros_type, "action")?;
         let name = self.ros_name(name)?;
         let mapping = self.service_mapping;
-        self.node_mut()
+        self.node_mut()?
             .create_action_server(
                 mapping,
                 &name,
@@ -338,7 +341,7 @@ impl KerfNode {
         let (pkg, ty) = split_type(ros_type, "srv")?;
         let name = self.ros_name(name)?;
         let mapping = self.service_mapping;
-        self.node_mut()
+        self.node_mut()?
             .create_server(
                 mapping,
                 &name,
@@ -374,7 +377,7 @@ impl KerfNode {
             status_subscription: s.status_publisher,
         };
         let mapping = self.service_mapping;
-        self.node_mut()
+        self.node_mut()?
             .create_action_client(mapping, &name, &ActionTypeName::new(pkg, ty), policies)
             .map_err(dds_err(format!("action client {name}")))
     }
@@ -392,7 +395,7 @@ impl KerfNode {
         let (pkg, ty) = split_type(ros_type, "srv")?;
         let name = self.ros_name(name)?;
         let mapping = self.service_mapping;
-        self.node_mut()
+        self.node_mut()?
             .create_client(
                 mapping,
                 &name,
