@@ -14,7 +14,7 @@ use kerf_msgs::{
     trajectory_msgs::JointTrajectory,
     RosType,
 };
-use kerf_ros::{qos, KerfNode, RosArgs, RosEnv, StopToken};
+use kerf_ros::{planner::PlanAnswer, qos, KerfNode, RosArgs, RosEnv, StopToken};
 use ros2_client::{Publisher, Subscription};
 use serde::{de::DeserializeOwned, Serialize};
 
@@ -68,41 +68,27 @@ pub fn mill() -> Planner<msg::MillRequest, MillPlan> {
     })
 }
 
-/// An answer message (`CutPlan`, `MillPlan`, …) as the tests read it.
-pub trait Answer: RosType + DeserializeOwned + Debug + PartialEq + 'static {
+/// An answer message (`CutPlan`, `MillPlan`, …) as the tests read it: what the harness reads
+/// of it ([`PlanAnswer`]: request id, status, message, trajectory) and more.
+pub trait Answer: PlanAnswer + DeserializeOwned + Debug + PartialEq {
     /// The SUCCESS status.
     const SUCCESS: u8;
     /// What a failure must not carry, for the failure message ("trajectory", "plan").
     const PLANNED: &'static str;
-    /// The request id it answers.
-    fn request_id(&self) -> &str;
-    /// Its status.
-    fn status(&self) -> u8;
-    /// Its human-readable message.
-    fn message(&self) -> &str;
     /// The name of a status value, `None` for an unknown one.
-    fn status_name(status: u8) -> Option<&'static str>;
+    fn name_of(status: u8) -> Option<&'static str>;
     /// Whether it carries nothing planned (as every failure must).
     fn is_bare(&self) -> bool;
 }
 
-/// Implements [`Answer`] for a plan message with `request_id`, `status`, `message`, its
-/// constants and `status_name`; `|p| bare` says whether `p` carries nothing planned.
+/// Implements [`Answer`] for a plan message with the `SUCCESS` constant and `status_name`;
+/// `|p| bare` says whether `p` carries nothing planned.
 macro_rules! answer {
     ($plan:ty, $planned:literal, |$p:ident| $bare:expr) => {
         impl Answer for $plan {
             const SUCCESS: u8 = <$plan>::SUCCESS;
             const PLANNED: &'static str = $planned;
-            fn request_id(&self) -> &str {
-                &self.request_id
-            }
-            fn status(&self) -> u8 {
-                self.status
-            }
-            fn message(&self) -> &str {
-                &self.message
-            }
-            fn status_name(status: u8) -> Option<&'static str> {
+            fn name_of(status: u8) -> Option<&'static str> {
                 <$plan>::status_name(status)
             }
             fn is_bare(&self) -> bool {
@@ -113,14 +99,14 @@ macro_rules! answer {
     };
 }
 
-answer!(CutPlan, "trajectory", |p| p.trajectory.points.is_empty());
-answer!(MillPlan, "plan", |p| p.trajectory.points.is_empty()
+answer!(CutPlan, "trajectory", |p| p.trajectory().points.is_empty());
+answer!(MillPlan, "plan", |p| p.trajectory().points.is_empty()
     && p.segments.is_empty());
 
 /// Checks an answer: its request id is `id`, its status `status` (compared by name), its
 /// message contains every needle, and a failure carries nothing planned.
 pub fn expect<P: Answer>(plan: &P, id: &str, status: u8, needles: &[&str]) {
-    let name = |s| P::status_name(s).unwrap_or("?");
+    let name = |s| P::name_of(s).unwrap_or("?");
     assert_eq!(
         (plan.request_id(), name(plan.status())),
         (id, name(status)),
