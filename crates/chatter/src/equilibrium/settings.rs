@@ -68,7 +68,7 @@ impl ForceLaw {
     }
 }
 
-/// Numerical settings of [`Equilibrium::compute`].
+/// Numerical settings of [`Equilibrium::compute`](super::Equilibrium::compute).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct EquilibriumSettings {
     /// Grid nodes per tooth period (≥ 200; default 200).

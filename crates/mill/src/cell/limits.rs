@@ -22,7 +22,7 @@ pub struct StateLimits {
 
 impl StateLimits {
     /// Checks the limits with the rules of the cell YAML's `process`
-    /// section ([`MillCell::from_yaml_str`]): every value finite; each
+    /// section ([`MillCell::from_yaml_str`](super::MillCell::from_yaml_str)): every value finite; each
     /// range `[min, max]` with min < max; the spindle range above 0 rpm;
     /// the feed range from ≥ 0 m/s; the redundancy-angle range inside
     /// [−π, π] (1e-12 slack); every step bound > 0.

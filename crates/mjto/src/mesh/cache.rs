@@ -32,7 +32,7 @@ impl MeshCache {
     /// changed.
     ///
     /// # Errors
-    /// As [`load`]; a file whose metadata cannot be read is a
+    /// As [`load`](super::load); a file whose metadata cannot be read is a
     /// [`PlanError::Mesh`] ("cannot read").
     ///
     /// # Performance
