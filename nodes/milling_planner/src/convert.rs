@@ -18,15 +18,9 @@
 use kerf_millplan::{
     planner::status,
     request::{RequestInitial, RequestLimits, RequestProcess, RequestStepBounds},
-    timing::hermite_extremes,
     MillPlanError, MillPlanOutput, MillRequest, PlannerKind,
 };
-use kerf_msgs::{
-    builtin_interfaces::Duration,
-    msg,
-    std_msgs::Header,
-    trajectory_msgs::{JointTrajectory, JointTrajectoryPoint},
-};
+use kerf_msgs::{msg, trajectory_msgs::JointTrajectory};
 
 /// Status of a request refused because the queue is full (`MillPlan::QUEUE_FULL`; the
 /// planner library has no such status, it belongs to the node).
@@ -189,7 +183,7 @@ pub fn check_trajectory(t: &kerf_millplan::JointTrajectory) -> Result<(), String
 /// executed trajectory ([`kerf_millplan::Executed`]: `out.executed.scaling.trajectory`, from
 /// rest to rest and time-scaled to the joints' velocity and acceleration limits) as it is —
 /// its executor form ([`kerf_millplan::JointTrajectory::request`], a
-/// `kerf_executor::TrajectoryRequest`) field by field: the planner's joint names (`joint_1` …
+/// `kerf_executor::TrajectoryRequest`) converted by [`kerf_ros::planner::trajectory_msg`]: the planner's joint names (`joint_1` …
 /// `joint_6`), one point per trajectory point with its positions, velocities and time (the
 /// planner gives no accelerations: the executor interpolates cubic Hermite segments).
 /// `header.stamp` is zero (the planner's `start_time` is `None`: the executor starts it on
@@ -199,109 +193,7 @@ pub fn check_trajectory(t: &kerf_millplan::JointTrajectory) -> Result<(), String
 /// As [`check_trajectory`], or a time that does not fit a `Duration`.
 pub fn trajectory_msg(t: &kerf_millplan::JointTrajectory) -> Result<JointTrajectory, String> {
     check_trajectory(t)?;
-    let t = &t.request;
-    let points = t
-        .points
-        .iter()
-        .map(|p| {
-            let time = p.time_from_start;
-            Ok(JointTrajectoryPoint {
-                positions: p.positions.clone(),
-                velocities: p.velocities.clone(),
-                accelerations: p.accelerations.clone(),
-                effort: p.effort.clone(),
-                time_from_start: Duration::from_secs_f64(time)
-                    .map_err(|e| format!("time {time} s: {e}"))?,
-            })
-        })
-        .collect::<Result<Vec<_>, String>>()?;
-    Ok(JointTrajectory {
-        header: Header::default(),
-        joint_names: t.joint_names.clone(),
-        points,
-    })
-}
-
-/// Velocity and acceleration limits of one joint (the cell's robot: its URDF and limits
-/// YAML).
-#[derive(Debug, Clone, PartialEq)]
-pub struct JointLimit {
-    /// Joint name.
-    pub name: String,
-    /// Largest speed \[rad/s\].
-    pub max_velocity: f64,
-    /// Largest acceleration \[rad/s²\], if known.
-    pub max_acceleration: Option<f64>,
-}
-
-/// Relative slack of [`first_limit_excess`] (the executor's `LIMIT_SLACK`).
-const LIMIT_SLACK: f64 = 1e-9;
-
-/// The first place where the cubic Hermite interpolation of `t` between its points (what the
-/// executor runs: positions and velocities at every point) exceeds a joint's velocity or
-/// acceleration limit, as a sentence; `None` when it stays within every limit. Joints of `t`
-/// without an entry in `limits` are not checked.
-///
-/// Per interval and joint, the accelerations at both ends (it is linear in between) and the
-/// largest speed of the cubic are those of [`kerf_millplan::timing::hermite_extremes`], the
-/// formulas the planner time-scales its trajectory with. The node's guard: a planner answer
-/// (time-scaled to the same limits) never exceeds them, so an excess means a library bug or
-/// other limits.
-pub fn first_limit_excess(t: &JointTrajectory, limits: &[JointLimit]) -> Option<String> {
-    let joints: Vec<(usize, &JointLimit)> = t
-        .joint_names
-        .iter()
-        .enumerate()
-        .filter_map(|(j, n)| limits.iter().find(|l| &l.name == n).map(|l| (j, l)))
-        .collect();
-    for (k, w) in t.points.windows(2).enumerate() {
-        let (t0, t1) = (
-            w[0].time_from_start.as_secs_f64(),
-            w[1].time_from_start.as_secs_f64(),
-        );
-        let h = t1 - t0;
-        if h.is_nan() || h <= 0.0 {
-            continue;
-        }
-        for &(j, l) in &joints {
-            let value = |v: &Vec<f64>| v.get(j).copied().unwrap_or(0.0);
-            let e = hermite_extremes(
-                h,
-                value(&w[0].positions),
-                value(&w[1].positions),
-                value(&w[0].velocities),
-                value(&w[1].velocities),
-            );
-            let where_ = |tau: f64| {
-                format!(
-                    "at t = {:.3} s (between point {k} and point {})",
-                    t0 + tau,
-                    k + 1
-                )
-            };
-            if let Some(max) = l.max_acceleration {
-                for (tau, a) in e.accelerations {
-                    if a.abs() > max * (1.0 + LIMIT_SLACK) {
-                        return Some(format!(
-                            "joint '{}': acceleration {a:.4} rad/s^2 {} exceeds its limit {max}",
-                            l.name,
-                            where_(tau)
-                        ));
-                    }
-                }
-            }
-            let (tau, v) = e.peak_velocity;
-            if v.abs() > l.max_velocity * (1.0 + LIMIT_SLACK) {
-                return Some(format!(
-                    "joint '{}': velocity {v:.4} rad/s {} exceeds its limit {}",
-                    l.name,
-                    where_(tau),
-                    l.max_velocity
-                ));
-            }
-        }
-    }
-    None
+    kerf_ros::planner::trajectory_msg(&t.request)
 }
 
 /// The `MillSegment` messages of a plan AS EXECUTED (`out.executed.plan`: the feed the robot

@@ -212,12 +212,12 @@ impl PlanningService for MillService {
         }
     }
 
-    fn from_msg(&self, m: &msg::MillRequest) -> Result<MillRequest, Box<MillPlan>> {
+    fn request_from_msg(&self, m: &msg::MillRequest) -> Result<MillRequest, Box<MillPlan>> {
         convert::request_from_msg(m)
             .map_err(|e| Box::new(convert::error_to_msg(&m.request_id, &m.planner, &e)))
     }
 
-    fn from_text(&self, text: &str) -> Result<MillRequest, Box<MillPlan>> {
+    fn request_from_text(&self, text: &str) -> Result<MillRequest, Box<MillPlan>> {
         text::parse_request(text)
             .map_err(|e| Box::new(convert::error_to_msg(&e.request_id, &e.planner, &e.error)))
     }

@@ -6,12 +6,14 @@
 
 use std::sync::OnceLock;
 
+use kerf_executor::JointLimits;
 use kerf_milling_planner::{convert, text};
 use kerf_millplan::{
     request::{RequestInitial, RequestLimits, RequestProcess, RequestStepBounds},
     MillPlanError, MillPlanOutput, MillPlanner, MillRequest,
 };
 use kerf_msgs::{geometry_msgs::Point, msg};
+use kerf_ros::planner::{check_trajectory_msg, executor_limits};
 
 fn point(x: f64, y: f64, z: f64) -> Point {
     Point { x, y, z }
@@ -328,9 +330,8 @@ fn assert_published_as_executed(m: &msg::MillPlan, out: &MillPlanOutput) {
         );
     }
     // Within the robot's limits, as the executor interpolates it.
-    let planner = MillPlanner::with_default_cell().expect("planner");
-    let limits = kerf_milling_planner::robot_limits(&planner);
-    assert_eq!(convert::first_limit_excess(t, &limits), None);
+    let limits = robot_limits();
+    assert_eq!(check_trajectory_msg(&limits, t), Ok(()));
     // Segments and totals: the executed plan's.
     let x = &out.executed.plan;
     assert_eq!(m.segments.len(), n);
@@ -579,6 +580,12 @@ fn a_defective_trajectory_is_an_internal_error_not_a_plan() {
     }
 }
 
+/// The robot's limits as the executor (and the node's executability check) takes them.
+fn robot_limits() -> Vec<JointLimits> {
+    let planner = MillPlanner::with_default_cell().expect("planner");
+    executor_limits(planner.cell().robot()).expect("acceleration limits")
+}
+
 #[test]
 fn limit_excess_of_the_interpolated_trajectory() {
     use kerf_msgs::{
@@ -598,30 +605,28 @@ fn limit_excess_of_the_interpolated_trajectory() {
         points: vec![point(0.0, 0), point(1.0, 2)],
         ..JointTrajectory::default()
     };
-    let limit = |v: f64, a: Option<f64>| {
-        vec![convert::JointLimit {
-            name: "a".into(),
-            max_velocity: v,
-            max_acceleration: a,
-        }]
+    let limit = |v: f64, a: f64| {
+        ["a", "b"]
+            .map(|name| JointLimits {
+                name: name.into(),
+                min_position: -10.0,
+                max_position: 10.0,
+                max_velocity: v,
+                max_acceleration: a,
+            })
+            .to_vec()
     };
-    assert_eq!(
-        convert::first_limit_excess(&t, &limit(0.76, Some(1.51))),
-        None
-    );
-    assert_eq!(convert::first_limit_excess(&t, &limit(0.76, None)), None);
-    let e = convert::first_limit_excess(&t, &limit(0.76, Some(1.49))).unwrap();
+    assert_eq!(check_trajectory_msg(&limit(0.76, 1.51), &t), Ok(()));
+    let e = check_trajectory_msg(&limit(0.76, 1.49), &t).unwrap_err();
     assert!(
-        e.contains("joint 'a'") && e.contains("acceleration 1.5000") && e.contains("t = 0.000 s"),
+        e.contains("joint 'a'") && e.contains("acceleration 1.5") && e.contains("t = 0 s"),
         "{e}"
     );
-    let e = convert::first_limit_excess(&t, &limit(0.74, Some(1.51))).unwrap();
+    let e = check_trajectory_msg(&limit(0.74, 1.51), &t).unwrap_err();
     assert!(
-        e.contains("velocity 0.7500") && e.contains("t = 1.000 s") && e.contains("limit 0.74"),
+        e.contains("velocity 0.75") && e.contains("t = 1 s") && e.contains("limit 0.74"),
         "{e}"
     );
-    // A joint without limits is not checked.
-    assert_eq!(convert::first_limit_excess(&t, &[]), None);
 }
 
 /// Every published plan of the default request (naive, ddpg, dp) stays within the robot's
@@ -629,32 +634,37 @@ fn limit_excess_of_the_interpolated_trajectory() {
 /// time-scaled it) does not, so the guard does fire on a trajectory that asks too much.
 #[test]
 fn plans_of_the_default_request_are_within_the_robot_limits() {
-    let planner = MillPlanner::with_default_cell().expect("planner");
-    let limits = kerf_milling_planner::robot_limits(&planner);
+    let limits = robot_limits();
     let names: Vec<&str> = limits.iter().map(|l| l.name.as_str()).collect();
     assert_eq!(
         names,
         ["joint_1", "joint_2", "joint_3", "joint_4", "joint_5", "joint_6"]
     );
     // urdf/irb6660_limits.yaml: joint_5 4 rad/s², URDF 120 deg/s.
-    assert_eq!(limits[4].max_acceleration, Some(4.0));
+    assert_eq!(limits[4].max_acceleration, 4.0);
     assert!((limits[4].max_velocity - 120f64.to_radians()).abs() < 1e-3);
     for out in [naive_output(), ddpg_output(), dp_output()] {
         let name = out.planner.name();
         let m = convert::output_to_msg(out);
         assert_eq!(m.status, msg::MillPlan::SUCCESS, "{name}: {}", m.message);
         assert_eq!(
-            convert::first_limit_excess(&m.trajectory, &limits),
-            None,
+            check_trajectory_msg(&limits, &m.trajectory),
+            Ok(()),
             "{name}"
         );
         if name != "naive" {
-            let excess = convert::first_limit_excess(&planned_msg(out), &limits);
+            // The planned timing does not end at rest (the executor's first refusal); brought
+            // to rest at its last point, the interpolated curve exceeds a joint limit.
+            let mut planned = planned_msg(out);
+            if let Some(last) = planned.points.last_mut() {
+                last.velocities.iter_mut().for_each(|v| *v = 0.0);
+            }
+            let excess = check_trajectory_msg(&limits, &planned);
             println!("{name} as planned: {excess:?}");
             assert!(
                 excess
-                    .as_deref()
-                    .is_some_and(|e| e.contains("exceeds its limit")),
+                    .as_ref()
+                    .is_err_and(|e| e.contains("exceeds the limit")),
                 "{name}: the planned timing was expected to exceed a joint limit"
             );
         }
