@@ -37,6 +37,7 @@ pub mod selection;
 pub mod series;
 pub mod standoff;
 pub mod timelaw;
+pub mod trajectory;
 
 pub use error::PlanError;
 pub use machine::{AxisLimits, LaserMachine};
