@@ -8,6 +8,7 @@
 //! parsing and message conversion of a 241-point request and a ~200-point plan).
 //!
 //! Run: `cargo bench --bench cut_latency`. Timings are reported, never asserted.
+#![allow(clippy::unwrap_used, clippy::expect_used)] // tests report failures by panicking
 
 use std::time::{Duration, Instant};
 

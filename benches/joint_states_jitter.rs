@@ -15,6 +15,7 @@
 //! (parameter `realtime_priority`; needs CAP_SYS_NICE).
 //!
 //! Run: `cargo bench --bench joint_states_jitter`. Timings are reported, never asserted.
+#![allow(clippy::unwrap_used, clippy::expect_used)] // tests report failures by panicking
 
 use std::time::{Duration, Instant};
 

@@ -3,6 +3,7 @@
 //! late it wakes. `KERF_JITTER_RT=N` runs it with `SCHED_FIFO` priority N.
 //!
 //! Run: `cargo bench --bench sleep_baseline`. Reported, never asserted.
+#![allow(clippy::unwrap_used, clippy::expect_used)] // tests report failures by panicking
 
 use std::time::{Duration, Instant};
 

@@ -3,6 +3,7 @@
 //! preemption, cancel, and the `~/validate_trajectory` dry-run service.
 //!
 //! Each test runs its own executor (in this process, own Context) on its own ROS domain.
+#![allow(clippy::unwrap_used, clippy::expect_used)] // tests report failures by panicking
 
 use std::{
     thread::JoinHandle,

@@ -1,5 +1,6 @@
 //! The `kerf` tool as a user runs it: `kerf launch` serves, `kerf echo` prints a topic as YAML,
 //! Ctrl-C (SIGINT) stops the launch cleanly, and bad ROS arguments are refused. Loopback DDS.
+#![allow(clippy::unwrap_used, clippy::expect_used)] // tests report failures by panicking
 
 use std::{
     io::{BufRead, BufReader},

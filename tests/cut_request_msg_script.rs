@@ -1,6 +1,7 @@
 //! `launch_scripts/cut_request_msg.py` (the README's `ros2 topic pub` helper) turns each
 //! committed case file into a `kerf_msgs/msg/CutRequest` that the planner node reads back as
 //! exactly the request of the file.
+#![allow(clippy::unwrap_used, clippy::expect_used)] // tests report failures by panicking
 
 use std::{path::Path, process::Command};
 

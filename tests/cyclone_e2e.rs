@@ -15,6 +15,7 @@
 //! Both sides stay on 127.0.0.1: the executor with `ROS_AUTOMATIC_DISCOVERY_RANGE=LOCALHOST`,
 //! Cyclone with `tests/cyclone/cyclonedds.xml` (loopback interface, no multicast, unicast
 //! discovery of the peer 127.0.0.1).
+#![allow(clippy::unwrap_used, clippy::expect_used)] // tests report failures by panicking
 
 use std::{
     fs::File,

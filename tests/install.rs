@@ -7,6 +7,7 @@
 //! used, not the source tree the binary was built from, is shown by breaking a file in the
 //! share directory only: the same commands then fail naming that file. A `KERF_DATA_DIR`
 //! that is not a kerf data directory is an error naming the variable.
+#![allow(clippy::unwrap_used, clippy::expect_used)] // tests report failures by panicking
 
 use std::{
     path::{Path, PathBuf},

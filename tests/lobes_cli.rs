@@ -3,6 +3,7 @@
 //! parses, and one row agrees with direct calls of the libraries (`kerf_mill` for the state,
 //! `kerf_chatter` for the constant-delay lobe, the state-dependent critical depth and |μ| at the
 //! cell's depth). Bad inputs exit with code 2 and a message naming the problem.
+#![allow(clippy::unwrap_used, clippy::expect_used)] // tests report failures by panicking
 
 use std::{
     path::PathBuf,

@@ -13,6 +13,7 @@
 //! * Bad inputs exit with code 2 and a message naming the problem.
 //!
 //! Needs the committed indicator cache to fit the cell (naive refuses to plan otherwise).
+#![allow(clippy::unwrap_used, clippy::expect_used)] // tests report failures by panicking
 
 use std::{
     path::{Path, PathBuf},

@@ -25,6 +25,7 @@
 //! `naive` needs the shipped indicator cache of the shipped cell
 //! (`crates/millplan/data/indicator_cache.bin`): while it is being rebuilt these tests fail
 //! with "needs the default cell's indicator cache"; rerun them when it is back.
+#![allow(clippy::unwrap_used, clippy::expect_used)] // tests report failures by panicking
 
 use std::{
     path::Path,

@@ -1,6 +1,7 @@
 //! `launch_scripts/mill_request_msg.py` (the `ros2 topic pub` helper of the milling planner)
 //! turns request files into `kerf_msgs/msg/MillRequest` messages that the node reads back as
 //! the request of the file, and refuses what the message cannot carry (a partial `limits`).
+#![allow(clippy::unwrap_used, clippy::expect_used)] // tests report failures by panicking
 
 use std::{path::Path, process::Command};
 

@@ -11,6 +11,7 @@
 //! * A full queue is answered, not dropped.
 //!
 //! Each DDS test runs its own nodes (in this process, own Contexts) on its own domain (61-64).
+#![allow(clippy::unwrap_used, clippy::expect_used)] // tests report failures by panicking
 
 use std::{
     path::Path,

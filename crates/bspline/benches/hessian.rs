@@ -1,6 +1,7 @@
 //! Cost of the QP building blocks of seed 001 section 2.2: the jerk Hessian
 //! (eq. 17-18) and the collocation matrix (eq. 35) for n + 1 = 64 and 628
 //! coefficients (the paper reports 9.5 s in Python for 628).
+#![allow(clippy::unwrap_used, clippy::expect_used)] // tests report failures by panicking
 
 use criterion::{criterion_group, criterion_main, Criterion};
 use kerf_bspline::{collocation, derivative_operator, jerk_hessian, KnotVector};

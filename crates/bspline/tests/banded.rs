@@ -1,5 +1,6 @@
 //! Band matrices: BandRows products and BandedSym Cholesky solves against
 //! dense nalgebra.
+#![allow(clippy::unwrap_used, clippy::expect_used)] // tests report failures by panicking
 
 mod common;
 

@@ -1,5 +1,6 @@
 //! Knot vectors, spans and basis functions (seed 001 eq. 5, 8-10; NURBS
 //! Book A2.1, A2.3).
+#![allow(clippy::unwrap_used, clippy::expect_used)] // tests report failures by panicking
 
 mod common;
 

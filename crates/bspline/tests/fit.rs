@@ -1,5 +1,6 @@
 //! Collocation matrices and least-squares / interpolating fits (seed 001
 //! eq. 35, 49-52).
+#![allow(clippy::unwrap_used, clippy::expect_used)] // tests report failures by panicking
 
 mod common;
 

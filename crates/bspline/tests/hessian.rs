@@ -1,4 +1,5 @@
 //! The jerk Hessian of seed 001 eq. 17-19 against brute-force quadrature.
+#![allow(clippy::unwrap_used, clippy::expect_used)] // tests report failures by panicking
 
 mod common;
 

@@ -1,6 +1,7 @@
 //! `KnotVector::for_parameters`: knots placed by the fit parameters, de
 //! Boor's averaging for interpolation (*The NURBS Book* eq. 9.8) and
 //! Piegl-Tiller eq. 9.68-9.69 for least squares.
+#![allow(clippy::unwrap_used, clippy::expect_used)] // tests report failures by panicking
 
 mod common;
 

@@ -1,5 +1,6 @@
 //! Input validation: every bad input is an error, never a panic or a
 //! silent NaN.
+#![allow(clippy::unwrap_used, clippy::expect_used)] // tests report failures by panicking
 
 use kerf_bspline::{
     basis_row, collocation, derivative_operator, BSpline, BandedSym, BsplineError, KnotVector,

@@ -13,6 +13,7 @@
 //!   linearization, discretization, spectral radius; nothing precomputed) on
 //!   the same modes at 3000 rpm, 0.04 m/s, with the default cell's force law
 //!   (x_F = 0.75 at h_ref = 0.224 mm) and wall term.
+#![allow(clippy::unwrap_used, clippy::expect_used)] // tests report failures by panicking
 
 use std::f64::consts::PI;
 use std::hint::black_box;

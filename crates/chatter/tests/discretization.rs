@@ -3,6 +3,7 @@
 //! references: closed-form free vibration, integral identities, brute-force
 //! quadrature, the characteristic equation of an autonomous DDE, and
 //! self-consistency under re-expressions of the same equation.
+#![allow(clippy::unwrap_used, clippy::expect_used)] // tests report failures by panicking
 
 mod common;
 

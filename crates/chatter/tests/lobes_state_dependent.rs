@@ -4,6 +4,7 @@
 //! on a scan below it — and, with the constant-delay model, it equals the
 //! critical depth of the independent per-unit-depth search of
 //! `stability_lobes` (scaled equation on one discretization).
+#![allow(clippy::unwrap_used, clippy::expect_used)] // tests report failures by panicking
 
 mod common;
 

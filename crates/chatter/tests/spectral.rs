@@ -4,6 +4,7 @@
 //! dominant multipliers; milling monodromy matrices on both sides of the
 //! stability boundary, with single and multiple (fractional) delays; and
 //! the iteration caps.
+#![allow(clippy::unwrap_used, clippy::expect_used)] // tests report failures by panicking
 
 mod common;
 

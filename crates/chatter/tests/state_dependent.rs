@@ -3,6 +3,7 @@
 //! references (analytic chip expansion, Newton on eq. 3, a finer RK4
 //! integration, finite differences of the exact tooth-path geometry of
 //! `trochoid.rs`).
+#![allow(clippy::unwrap_used, clippy::expect_used)] // tests report failures by panicking
 
 mod common;
 

@@ -26,6 +26,7 @@
 //!    (frequency domain, no time discretization).
 //!    The same script also gives the slot-milling boundary, peaks included.
 //! 3. **Convergence** of our own method: m = 40 against m = 200.
+#![allow(clippy::unwrap_used, clippy::expect_used)] // tests report failures by panicking
 
 mod common;
 

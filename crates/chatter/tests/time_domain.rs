@@ -4,6 +4,7 @@
 //! and mean force of a rigid tool, and (issue 4 section 5) the stability
 //! boundary of the semi/full-discretization and of the state-dependent
 //! indicator.
+#![allow(clippy::unwrap_used, clippy::expect_used)] // tests report failures by panicking
 
 mod common;
 

@@ -2,6 +2,7 @@
 //!
 //! Run: `cargo bench -p kerf_executor --bench interpolation`. For the worst case per call see
 //! `examples/cycle_cost.rs`.
+#![allow(clippy::unwrap_used, clippy::expect_used)] // tests report failures by panicking
 
 mod common;
 

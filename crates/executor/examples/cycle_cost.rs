@@ -4,6 +4,7 @@
 //! Run: `cargo run --release -p kerf_executor --example cycle_cost`. Prints mean, p50, p99,
 //! p99.9 and max in µs. Timings include `Instant::now()` overhead (tens of ns) and any
 //! preemption by the OS; no real-time scheduling is set up.
+#![allow(clippy::unwrap_used, clippy::expect_used)] // tests report failures by panicking
 
 #[path = "../benches/common/mod.rs"]
 mod common;

@@ -1,5 +1,6 @@
 //! `check_executable`: the executor's validation from rest at the first point, the check
 //! every planner runs on its output.
+#![allow(clippy::unwrap_used, clippy::expect_used)] // tests report failures by panicking
 
 mod common;
 

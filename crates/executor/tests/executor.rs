@@ -1,5 +1,6 @@
 //! The executor state machine with mock hardware.
 #![allow(clippy::needless_range_loop)] // joints index several parallel arrays
+#![allow(clippy::unwrap_used, clippy::expect_used)] // tests report failures by panicking
 
 mod common;
 

@@ -1,5 +1,6 @@
 //! Interpolation against closed-form curves, and limits on a dense time grid.
 #![allow(clippy::needless_range_loop)] // joints index several parallel arrays
+#![allow(clippy::unwrap_used, clippy::expect_used)] // tests report failures by panicking
 
 mod common;
 

@@ -1,4 +1,5 @@
 //! The real-root finder and extremum search on intervals.
+#![allow(clippy::unwrap_used, clippy::expect_used)] // tests report failures by panicking
 
 mod common;
 

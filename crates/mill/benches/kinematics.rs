@@ -15,6 +15,7 @@
 //! * lobe diagrams of 100 speeds (2000-4000 rpm) × scan + bisection on depth
 //!   (0-20 mm, 20 intervals, 1 µm): constant delay, and state-dependent at
 //!   0.04 m/s (`kerf_chatter::lobes::state_dependent_critical_depth`).
+#![allow(clippy::unwrap_used, clippy::expect_used)] // tests report failures by panicking
 
 use std::hint::black_box;
 

@@ -1,6 +1,7 @@
 //! The cell YAML: the default file loads with the seed 004 Table 1 values,
 //! evaluate() is consistent with the path and the kinematics, and bad
 //! fields are reported by name.
+#![allow(clippy::unwrap_used, clippy::expect_used)] // tests report failures by panicking
 
 mod common;
 

@@ -2,6 +2,7 @@
 //! `with_state_limits`) and the tool pose / joints at an arc length
 //! (`tool_pose_at`, `joints_at`): what a planner request changes, checked
 //! against the default cell and analytic references.
+#![allow(clippy::unwrap_used, clippy::expect_used)] // tests report failures by panicking
 
 use kerf_mill::{MillCell, MillError, PathSpec, StateLimits};
 use nalgebra::Vector3;

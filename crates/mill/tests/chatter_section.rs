@@ -2,6 +2,7 @@
 //! the paper's model when the section is absent, bad values by name, and
 //! the feed lower bound of seed 004 Fig. 4/7 on the default cell's real
 //! pose-dependent tool-tip dynamics.
+#![allow(clippy::unwrap_used, clippy::expect_used)] // tests report failures by panicking
 
 mod common;
 

@@ -1,6 +1,7 @@
 //! The geometric Jacobian against finite differences of FK, the condition
 //! number of seed 004 eq. 14 against a second formula, singular poses, and
 //! the characteristic length stored in the cell YAML.
+#![allow(clippy::unwrap_used, clippy::expect_used)] // tests report failures by panicking
 
 mod common;
 

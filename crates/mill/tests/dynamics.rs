@@ -3,6 +3,7 @@
 //! state-space eigenvalues, the measured override, and the variation of the
 //! stiffness along the path and with g (the mechanism by which g changes
 //! stability in seed 004).
+#![allow(clippy::unwrap_used, clippy::expect_used)] // tests report failures by panicking
 
 mod common;
 

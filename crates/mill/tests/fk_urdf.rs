@@ -1,5 +1,6 @@
 //! The MDH forward kinematics equals the URDF chain's `tool0` (issue 4:
 //! "FK must equal tool0 from the URDF chain, to 1e-9, at random joint values").
+#![allow(clippy::unwrap_used, clippy::expect_used)] // tests report failures by panicking
 
 mod common;
 

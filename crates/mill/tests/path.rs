@@ -1,6 +1,7 @@
 //! The planar milling path: interpolation, equal arc lengths (checked by an
 //! independent adaptive Simpson quadrature and a fine polyline), tool axis,
 //! cutting frames and input validation.
+#![allow(clippy::unwrap_used, clippy::expect_used)] // tests report failures by panicking
 
 use kerf_mill::{MillError, MillingPath, PathSpec};
 use nalgebra::Vector3;

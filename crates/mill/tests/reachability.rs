@@ -1,7 +1,7 @@
 //! Which redundancy angles are reachable within the joint limits along the
 //! default path (tool pointing down at z = 1.7 m, 100 segments): the map the
 //! milling planner works in. Printed with `--nocapture`.
-
+#![allow(clippy::unwrap_used, clippy::expect_used)] // tests report failures by panicking
 #![allow(clippy::needless_range_loop)] // (g, segment) grids read best with indices
 
 use kerf_mill::{MillCell, MillError};

@@ -20,6 +20,7 @@
 //! jobs).
 //!
 //! Run: `cargo bench -p kerf_millplan --bench ddpg_update -- --quick`.
+#![allow(clippy::unwrap_used, clippy::expect_used)] // tests report failures by panicking
 
 use std::hint::black_box;
 use std::time::Instant;

@@ -29,6 +29,7 @@
 //!
 //! Run (small sample counts, the machine is shared):
 //! `cargo bench -p kerf_millplan --bench plan_latency -- --warm-up-time 1 --measurement-time 5`
+#![allow(clippy::unwrap_used, clippy::expect_used)] // tests report failures by panicking
 
 use std::path::PathBuf;
 use std::time::Instant;

@@ -14,6 +14,7 @@
 //! ```sh
 //! cargo run --release -p kerf_millplan --example compare
 //! ```
+#![allow(clippy::unwrap_used, clippy::expect_used)] // tests report failures by panicking
 
 use kerf_mill::MillCell;
 use kerf_millplan::cache::IndicatorCache;

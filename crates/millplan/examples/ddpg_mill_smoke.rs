@@ -13,6 +13,7 @@
 //! (a zero-action episode); per-episode reward, losses and σ; the mean wall
 //! time per training step (environment + action + update); the greedy
 //! return of the trained actor and the time of its 99-step rollout.
+#![allow(clippy::unwrap_used, clippy::expect_used)] // tests report failures by panicking
 
 use std::path::Path;
 use std::sync::Arc;

@@ -13,6 +13,7 @@
 //! Writes FILE, its JSON sidecar and `FILE` with `.history.json` (one
 //! [`kerf_millplan::ddpg::EpisodeReport`] per episode, for seed 004 Fig. 5),
 //! and prints the greedy plan evaluated directly.
+#![allow(clippy::unwrap_used, clippy::expect_used)] // tests report failures by panicking
 
 use std::path::PathBuf;
 use std::sync::Arc;

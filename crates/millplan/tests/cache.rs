@@ -1,6 +1,7 @@
 //! The indicator cache against direct evaluation of the chatter indicator:
 //! a small grid built here, the file format, and the committed default
 //! cache's stated error bound.
+#![allow(clippy::unwrap_used, clippy::expect_used)] // tests report failures by panicking
 
 use std::path::Path;
 

@@ -1,6 +1,7 @@
 //! DDPG (kerf_millplan::ddpg) on a toy environment with a known optimum:
 //! it learns, it is deterministic for a seed, it refuses bad settings, and
 //! it propagates environment errors.
+#![allow(clippy::unwrap_used, clippy::expect_used)] // tests report failures by panicking
 
 use kerf_millplan::ddpg::{train, DdpgSettings, EpisodeReport};
 use kerf_millplan::policy::Policy;

@@ -1,6 +1,7 @@
 //! The DP optimum: the generic grid DP against brute-force enumeration and
 //! a closed-form optimum; the cell DP against feasible plans it must beat,
 //! and its chatter constraint.
+#![allow(clippy::unwrap_used, clippy::expect_used)] // tests report failures by panicking
 
 use kerf_mill::MillCell;
 use kerf_millplan::cache::{IndicatorCache, SplitMix64};

@@ -1,6 +1,7 @@
 //! MillEnv (seed 004 section 3, eq. 11-17) and plan evaluation on the
 //! default cell, without the cache (direct evaluation), against hand
 //! computations and the model itself.
+#![allow(clippy::unwrap_used, clippy::expect_used)] // tests report failures by panicking
 
 use std::sync::Arc;
 

@@ -4,6 +4,7 @@
 //! [`kerf_millplan::execute`]) pass `kerf_executor::validate` from rest at
 //! their first point, with the cell robot's limits, as the trajectory
 //! executor node would receive them.
+#![allow(clippy::unwrap_used, clippy::expect_used)] // tests report failures by panicking
 
 use std::sync::OnceLock;
 

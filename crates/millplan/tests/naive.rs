@@ -1,4 +1,5 @@
 //! The naive constant-(Ω, f) planner against direct evaluation.
+#![allow(clippy::unwrap_used, clippy::expect_used)] // tests report failures by panicking
 
 use kerf_mill::MillCell;
 use kerf_millplan::cache::{direct_indicator, GridSpec, IndicatorCache};

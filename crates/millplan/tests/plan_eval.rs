@@ -3,6 +3,7 @@
 //! segment's |μ|max is the direct evaluation, errors are those of a
 //! sequential evaluation (the first bad segment), and the planner's
 //! evaluation-thread option and phase timings.
+#![allow(clippy::unwrap_used, clippy::expect_used)] // tests report failures by panicking
 
 use std::sync::{Arc, OnceLock};
 

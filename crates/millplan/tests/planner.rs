@@ -3,6 +3,7 @@
 //! trajectory is timed by the planned feeds and follows the path, whose
 //! |μ|max is the direct evaluation, and whose DDPG states are the policy's
 //! greedy rollout.
+#![allow(clippy::unwrap_used, clippy::expect_used)] // tests report failures by panicking
 
 use std::path::PathBuf;
 use std::sync::{Arc, OnceLock};

@@ -1,5 +1,6 @@
 //! Policy files (kerf_millplan::policy): save/load round trip, the plain
 //! forward pass against candle's, and every way a file can be bad.
+#![allow(clippy::unwrap_used, clippy::expect_used)] // tests report failures by panicking
 
 use std::path::{Path, PathBuf};
 

@@ -1,7 +1,7 @@
 //! Milling requests (kerf_millplan::request) and the planner's bad-input
 //! answers (issue 5 section 5): every bad input gets the right error, a
 //! clear message naming the field, and its status category.
-
+#![allow(clippy::unwrap_used, clippy::expect_used)] // tests report failures by panicking
 #![allow(clippy::field_reassign_with_default)]
 
 use std::path::PathBuf;

@@ -3,6 +3,7 @@
 //! the cubic Hermite extremes against dense sampling, the three-point
 //! derivative on parabolas, a zig-zag that must be slowed down, a slow one
 //! that must not, and every refused input.
+#![allow(clippy::unwrap_used, clippy::expect_used)] // tests report failures by panicking
 
 use kerf_millplan::timing::{hermite_extremes, three_point_velocity, time_scale, JointLimit};
 use kerf_millplan::{JointTrajectory, MillPlanError, TrajectoryPoint, TrajectoryRequest};

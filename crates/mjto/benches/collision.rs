@@ -10,6 +10,7 @@
 //! (every link tested, the most expensive case).
 //!
 //! Run: `cargo bench -p kerf_mjto --bench collision`.
+#![allow(clippy::unwrap_used, clippy::expect_used)] // tests report failures by panicking
 
 use std::hint::black_box;
 

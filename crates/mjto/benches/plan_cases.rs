@@ -9,6 +9,7 @@
 //! Prints markdown tables (the ones in BENCHMARKS.md). Timings are medians
 //! over `KERF_PLAN_RUNS` runs (default 20) after one warm-up run, which also
 //! loads the mesh into the planner's cache (a node plans with a warm cache).
+#![allow(clippy::unwrap_used, clippy::expect_used)] // tests report failures by panicking
 
 use std::path::Path;
 use std::time::Instant;

@@ -1,4 +1,5 @@
 //! The quaternion-interpolation baseline (seed 001 ref. [3], section 3).
+#![allow(clippy::unwrap_used, clippy::expect_used)] // tests report failures by panicking
 
 use std::f64::consts::PI;
 

@@ -1,5 +1,6 @@
 //! Collision checking of the laser head of `urdf/laser_cutter.urdf` against
 //! real meshes (parry3d, no mocks).
+#![allow(clippy::unwrap_used, clippy::expect_used)] // tests report failures by panicking
 
 use std::f64::consts::FRAC_PI_2;
 
@@ -164,7 +165,8 @@ fn wall_beside_the_path_depends_on_q4() {
     mesh.append(&MeshData::cuboid(
         [C[0] + 0.07, C[1] - 0.3, C[2]],
         [C[0] + 0.12, C[1] + 0.3, C[2] + 0.15],
-    ));
+    ))
+    .unwrap();
     let w = world(&mesh, 0.0);
     // q4 = 0: fork arms at y = +-0.10 span x in [-0.05, 0.05]; the housing
     // spans x in [-0.045, 0.045]; the nozzle body radius 0.025: free.

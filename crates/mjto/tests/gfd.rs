@@ -4,6 +4,7 @@
 //! `q4_half_span(0.35, q̂5)` (the full circle, ± π, when |q̂5| is below
 //! asin(0.35 / π) ≈ 0.1116 rad), 9 q5 samples over reference ± 0.3 rad
 //! (0.075 apart) and 5 q6 samples over `q6_span(q̂6, stroke)`.
+#![allow(clippy::unwrap_used, clippy::expect_used)] // tests report failures by panicking
 
 use std::f64::consts::{FRAC_PI_2, PI};
 

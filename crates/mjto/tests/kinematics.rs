@@ -1,5 +1,6 @@
 //! Forward and inverse kinematics of the laser cutting machine (seed 001
 //! eq. 2 and 3) against the URDF chain and along paths.
+#![allow(clippy::unwrap_used, clippy::expect_used)] // tests report failures by panicking
 
 use std::f64::consts::{FRAC_PI_2, PI, TAU};
 

@@ -1,4 +1,5 @@
 //! Mesh loading, writing, validation, resolution and caching.
+#![allow(clippy::unwrap_used, clippy::expect_used)] // tests report failures by panicking
 
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
@@ -25,7 +26,8 @@ fn sample_mesh() -> MeshData {
             [0.13, 0.58, 0.44],
         ],
         triangles: vec![[0, 1, 2], [0, 2, 3]],
-    });
+    })
+    .unwrap();
     m
 }
 
@@ -271,7 +273,7 @@ fn cache_loads_once_and_reloads_on_change() {
     assert_eq!((cache.loads(), cache.len()), (1, 1));
     // A changed file (different length) is reloaded.
     let mut m2 = m.clone();
-    m2.append(&MeshData::cuboid([0.0; 3], [0.1; 3]));
+    m2.append(&MeshData::cuboid([0.0; 3], [0.1; 3])).unwrap();
     mesh::write_obj(&path, &m2).unwrap();
     let c = cache.get(path.to_str().unwrap()).unwrap();
     assert_eq!(*c, m2);

@@ -1,5 +1,6 @@
 //! Finite-difference derivatives, peaks, RMS jerk and limit violations of
 //! sampled joint trajectories.
+#![allow(clippy::unwrap_used, clippy::expect_used)] // tests report failures by panicking
 
 use approx::assert_abs_diff_eq;
 use kerf_mjto::metrics::{finite_differences, kinematic_metrics, limit_violations, LIMIT_REL_TOL};

@@ -1,4 +1,5 @@
 //! Path frames and lead/tilt angles (seed 001 section 2.4, Figure 4).
+#![allow(clippy::unwrap_used, clippy::expect_used)] // tests report failures by panicking
 
 use std::f64::consts::{FRAC_1_SQRT_2, FRAC_PI_2, FRAC_PI_4, PI};
 

@@ -3,6 +3,7 @@
 //! returned sample re-checked independently (Table 2 limits, collisions
 //! with a fresh `CollisionWorld`, lead/tilt, CL error, timing), MJTO
 //! against the QI baseline, and bad requests through `Planner::plan`.
+#![allow(clippy::unwrap_used, clippy::expect_used)] // tests report failures by panicking
 
 use std::path::{Path, PathBuf};
 
@@ -467,7 +468,8 @@ fn bad_requests_give_the_right_error_and_the_planner_recovers() {
     let bpillar = load(&base.mesh).unwrap();
     let with_plate = |x0: f64, x1: f64| {
         let mut mesh = bpillar.clone();
-        mesh.append(&MeshData::cuboid([x0, -0.5, 0.7], [x1, 0.15, 0.75]));
+        mesh.append(&MeshData::cuboid([x0, -0.5, 0.7], [x1, 0.15, 0.75]))
+            .unwrap();
         mesh
     };
     // Over the middle of the path only, with RTOs at the two ends: the

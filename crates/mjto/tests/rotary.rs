@@ -4,6 +4,7 @@
 //! solve of the equality-constrained problem, the closed-form minimum-jerk
 //! quintic, and dense evaluation of the resulting splines against the
 //! limits scaled by eq. 13.
+#![allow(clippy::unwrap_used, clippy::expect_used)] // tests report failures by panicking
 
 use kerf_bspline::{jerk_hessian, BSpline, KnotVector};
 use kerf_mjto::error::ConstraintFamily;

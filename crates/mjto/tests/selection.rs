@@ -1,5 +1,6 @@
 //! Initial RTO selection (seed 001 eq. 56): lazy vs eager, optimality by
 //! brute force, and the error of a layer without a free candidate.
+#![allow(clippy::unwrap_used, clippy::expect_used)] // tests report failures by panicking
 
 use kerf_mjto::collision::{CollisionWorld, HeadModel};
 use kerf_mjto::gfd::Gfd;
@@ -28,7 +29,8 @@ fn world() -> CollisionWorld {
     mesh.append(&MeshData::cuboid(
         [0.895, Y - 0.3, Z],
         [0.899, Y + 0.3, Z + 0.1],
-    ));
+    ))
+    .unwrap();
     CollisionWorld::new(head, &mesh, &Isometry3::identity(), 0.0).unwrap()
 }
 

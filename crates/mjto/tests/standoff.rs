@@ -3,6 +3,7 @@
 //! computations: control points from `kerf_bspline::fit` of
 //! `C_a − O_a · w` (eq. 49-52), the jerk of the M path from the explicit
 //! Hessian of eq. 18, and a dense KKT solve of the QP of eq. 62.
+#![allow(clippy::unwrap_used, clippy::expect_used)] // tests report failures by panicking
 
 use kerf_bspline::{fit, jerk_hessian, BSpline, KnotVector};
 use kerf_mjto::error::ConstraintFamily;

@@ -1,4 +1,5 @@
 //! The jerk-limited feed profile and the chain rule of seed 001 eq. 6/7.
+#![allow(clippy::unwrap_used, clippy::expect_used)] // tests report failures by panicking
 
 use approx::assert_abs_diff_eq;
 use kerf_mjto::timelaw::{chain_rule, TimeLaw};

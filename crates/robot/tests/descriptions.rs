@@ -1,4 +1,5 @@
 //! The robot descriptions in `urdf/` load with the specified joints and limits.
+#![allow(clippy::unwrap_used, clippy::expect_used)] // tests report failures by panicking
 
 mod common;
 

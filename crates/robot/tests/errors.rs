@@ -1,5 +1,6 @@
 //! Invalid joint vectors and invalid robot descriptions are rejected with
 //! errors that name what is wrong.
+#![allow(clippy::unwrap_used, clippy::expect_used)] // tests report failures by panicking
 
 mod common;
 

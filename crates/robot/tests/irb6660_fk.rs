@@ -18,6 +18,7 @@
 //! MDH frame 6 and URDF `tool0` is the identity: frame 6 at q = 0 has
 //! x = -Z, y = +Y, z = +X of the base, which is exactly link_6 rotated by
 //! rpy (0, pi/2, 0).
+#![allow(clippy::unwrap_used, clippy::expect_used)] // tests report failures by panicking
 
 mod common;
 

@@ -1,4 +1,5 @@
 //! The laser cutter URDF reproduces seed 001 eq. (2) exactly.
+#![allow(clippy::unwrap_used, clippy::expect_used)] // tests report failures by panicking
 
 mod common;
 

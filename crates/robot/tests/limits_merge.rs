@@ -1,4 +1,5 @@
 //! Merging a MoveIt `joint_limits.yaml` into the URDF limits.
+#![allow(clippy::unwrap_used, clippy::expect_used)] // tests report failures by panicking
 
 mod common;
 

@@ -10,6 +10,7 @@
 //! point counts, path lengths, the tool-axis change between adjacent RTOs,
 //! the mesh's bounding box and the machine-frame range of the nominal M
 //! points. The output is deterministic.
+#![allow(clippy::unwrap_used, clippy::expect_used)] // tests report failures by panicking
 
 use std::path::PathBuf;
 use std::process::ExitCode;

@@ -1,6 +1,7 @@
 //! The B-pillar test workpiece and the two cut requests of seed 001
 //! section 3 (`kerf_testparts::bpillar`, `crates/mjto/cases/case{1,2}.yaml`,
 //! `urdf/meshes/bpillar.obj`).
+#![allow(clippy::unwrap_used, clippy::expect_used)] // tests report failures by panicking
 
 use std::collections::HashMap;
 use std::path::PathBuf;

@@ -5,6 +5,7 @@
 //! primitives aligned to their size from the start of the payload, `string`
 //! as uint32 length including the terminating NUL then the bytes and NUL,
 //! sequences as uint32 element count then the elements.
+#![allow(clippy::unwrap_used, clippy::expect_used)] // tests report failures by panicking
 
 use byteorder::LittleEndian;
 use kerf_msgs::builtin_interfaces::{Duration, Time};

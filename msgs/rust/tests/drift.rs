@@ -7,6 +7,7 @@
 //! The interface files are read with `kerf_msgs::idl`; when Debian's
 //! `python3-rosidl` is installed, `rosidl_dump.py` parses them again with the
 //! real ROS 2 parser and both views must agree.
+#![allow(clippy::unwrap_used, clippy::expect_used)] // tests report failures by panicking
 
 use std::collections::{BTreeMap, BTreeSet, HashMap};
 use std::path::{Path, PathBuf};

@@ -1,4 +1,5 @@
 //! YAML round trips (the format `kerf echo` prints) and `Default` values.
+#![allow(clippy::unwrap_used, clippy::expect_used)] // tests report failures by panicking
 
 use kerf_msgs::builtin_interfaces::{Duration, Time};
 use kerf_msgs::control_msgs::{

@@ -1,5 +1,6 @@
 //! The node's parameters: the shipped cell (and its cache, when fresh) load by default, the
 //! default policies can be replaced, and bad parameters are refused with the parameter's name.
+#![allow(clippy::unwrap_used, clippy::expect_used)] // tests report failures by panicking
 
 use std::path::Path;
 

@@ -3,6 +3,7 @@
 //! shipped policy, dp) converted to a `MillPlan` whose trajectory, segments and totals are the
 //! planner's AS EXECUTED: the trajectory time-scaled to the joint limits, from rest to rest,
 //! and the plan at the feeds it runs.
+#![allow(clippy::unwrap_used, clippy::expect_used)] // tests report failures by panicking
 
 use std::sync::OnceLock;
 

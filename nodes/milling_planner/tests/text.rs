@@ -1,5 +1,6 @@
 //! The text form of requests: YAML and JSON of the `kerf_millplan::MillRequest` schema; errors
 //! keep the request id and planner so the answer can carry them.
+#![allow(clippy::unwrap_used, clippy::expect_used)] // tests report failures by panicking
 
 use kerf_milling_planner::{convert, text};
 use kerf_msgs::msg;

@@ -1,6 +1,7 @@
 //! The harness's job function with the milling service: already-answered jobs pass through, jobs queued when the node
 //! stops are answered without planning, and `ddpg` / `fixed_g` requests without a policy file
 //! get the node's default policy (a missing one is that request's POLICY_ERROR, naming it).
+#![allow(clippy::unwrap_used, clippy::expect_used)] // tests report failures by panicking
 
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::OnceLock;

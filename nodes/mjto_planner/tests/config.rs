@@ -1,5 +1,6 @@
 //! The node's parameters: the shipped machine loads by default or from files, and bad
 //! parameters are refused with the parameter's name.
+#![allow(clippy::unwrap_used, clippy::expect_used)] // tests report failures by panicking
 
 use kerf_mjto_planner::{config::DEFAULT_QUEUE_DEPTH, NodeConfig, NodeError, KNOWN_PARAMS};
 use kerf_ros::RosArgs;

@@ -1,5 +1,6 @@
 //! The shipped parameter files load against the shipped robots, and bad parameters are refused
 //! with the parameter's name.
+#![allow(clippy::unwrap_used, clippy::expect_used)] // tests report failures by panicking
 
 use kerf_ros::RosArgs;
 use kerf_trajectory_executor::{NodeConfig, NodeError};

@@ -60,11 +60,24 @@ impl MeshData {
 
     /// Appends the vertices and triangles of `other` (indices shifted).
     ///
-    /// # Panics
-    /// If the merged vertex count exceeds `u32::MAX` (a mesh of more than
-    /// four billion vertices).
-    pub fn append(&mut self, other: &MeshData) {
-        let offset = u32::try_from(self.vertices.len()).expect("mesh larger than u32 indices");
+    /// # Errors
+    /// [`PlanError::InvalidRequest`] (field `mesh`) when the merged vertex count would not fit the `u32`
+    /// triangle indices (a mesh of more than four billion vertices); nothing is appended.
+    pub fn append(&mut self, other: &MeshData) -> Result<(), PlanError> {
+        let too_large = || {
+            PlanError::invalid(
+                "mesh",
+                format!(
+                    "{} + {} vertices do not fit u32 triangle indices",
+                    self.vertices.len(),
+                    other.vertices.len()
+                ),
+            )
+        };
+        let offset = u32::try_from(self.vertices.len()).map_err(|_| too_large())?;
+        if u32::try_from(self.vertices.len() + other.vertices.len()).is_err() {
+            return Err(too_large());
+        }
         self.vertices.extend_from_slice(&other.vertices);
         self.triangles.extend(
             other
@@ -72,6 +85,7 @@ impl MeshData {
                 .iter()
                 .map(|t| [t[0] + offset, t[1] + offset, t[2] + offset]),
         );
+        Ok(())
     }
 
     /// Axis-aligned bounding box `(min, max)` of the vertices, or `None`
