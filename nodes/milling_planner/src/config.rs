@@ -43,18 +43,11 @@ pub struct NodeConfig {
     pub queue_depth: usize,
 }
 
-fn param_err(name: &str, reason: impl Into<String>) -> NodeError {
-    NodeError::Config {
-        name: name.to_string(),
-        reason: reason.into(),
-    }
-}
-
 /// A path parameter: `None` when unset, an error when set to the empty string.
 fn path_param(params: &Params, name: &str) -> Result<Option<PathBuf>, NodeError> {
     match params.string(name)? {
         None => Ok(None),
-        Some(s) if s.trim().is_empty() => Err(param_err(
+        Some(s) if s.trim().is_empty() => Err(NodeError::config(
             name,
             "is empty; leave it unset for the default, or give a file path",
         )),
@@ -65,7 +58,7 @@ fn path_param(params: &Params, name: &str) -> Result<Option<PathBuf>, NodeError>
 /// The shipped policy of `kind` (a planner with a policy).
 fn shipped_policy(kind: PlannerKind) -> Result<PathBuf, NodeError> {
     default_policy_path(kind).ok_or_else(|| {
-        param_err(
+        NodeError::config(
             &format!("{}_policy_file", kind.name()),
             "kerf_millplan names no shipped policy for this planner",
         )
@@ -106,7 +99,7 @@ impl NodeConfig {
     ///
     /// # Errors
     /// [`NodeError::Config`] naming the parameter, [`NodeError::Ros`] for a wrong type,
-    /// [`NodeError::Planner`] when the cell or a given cache does not load.
+    /// [`NodeError::Setup`] when the cell or a given cache does not load.
     pub fn from_params(params: &Params) -> Result<Self, NodeError> {
         let cell_file = path_param(params, "cell_file")?;
         let cache_file = path_param(params, "indicator_cache_file")?;
@@ -122,28 +115,27 @@ impl NodeConfig {
             None | Some("direct") => IndicatorSource::Direct,
             Some("cache") => IndicatorSource::Cache,
             Some(other) => {
-                return Err(param_err(
+                return Err(NodeError::config(
                     "indicator_source",
                     format!("must be direct or cache, got {other:?}"),
                 ))
             }
         };
-        let eval_threads =
-            match params.get("eval_threads") {
-                None => None,
-                Some(_) => {
-                    let n = params.i64_or("eval_threads", 1)?;
-                    Some(usize::try_from(n).ok().filter(|n| *n >= 1).ok_or_else(|| {
-                        param_err("eval_threads", format!("must be >= 1, got {n}"))
-                    })?)
-                }
-            };
+        let eval_threads = match params.get("eval_threads") {
+            None => None,
+            Some(_) => {
+                let n = params.i64_or("eval_threads", 1)?;
+                Some(usize::try_from(n).ok().filter(|n| *n >= 1).ok_or_else(|| {
+                    NodeError::config("eval_threads", format!("must be >= 1, got {n}"))
+                })?)
+            }
+        };
         let queue_depth = kerf_ros::planner::queue_depth(params)?;
 
         let (planner, cell_source, cache_note) = match (cell_file, cache_file) {
             (None, None) => {
                 // The library's default: the shipped cell, its cache when fresh.
-                let planner = MillPlanner::with_default_cell()?;
+                let planner = MillPlanner::with_default_cell().map_err(NodeError::setup)?;
                 let path = IndicatorCache::default_path();
                 let note = if planner.cache().is_some() {
                     format!("indicator cache {}", path.display())
@@ -159,10 +151,10 @@ impl NodeConfig {
             }
             (cell_file, cache_file) => {
                 let cell_path = cell_file.unwrap_or_else(MillCell::default_path);
-                let cell = Arc::new(MillCell::load(&cell_path)?);
+                let cell = Arc::new(MillCell::load(&cell_path).map_err(NodeError::setup)?);
                 let (cache, note) = match cache_file {
                     Some(path) => {
-                        let cache = IndicatorCache::load(&path, &cell)?;
+                        let cache = IndicatorCache::load(&path, &cell).map_err(NodeError::setup)?;
                         (Some(Arc::new(cache)), cache_source(&path))
                     }
                     None => {
@@ -179,13 +171,13 @@ impl NodeConfig {
                         }
                     }
                 };
-                let planner = MillPlanner::new(cell, cache)?;
+                let planner = MillPlanner::new(cell, cache).map_err(NodeError::setup)?;
                 (planner, cell_path.display().to_string(), note)
             }
         };
         let mut planner = planner.with_indicator_source(indicator_source);
         if let Some(n) = eval_threads {
-            planner = planner.with_eval_threads(n)?;
+            planner = planner.with_eval_threads(n).map_err(NodeError::setup)?;
         }
         Ok(Self {
             planner,

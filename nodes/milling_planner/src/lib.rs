@@ -76,7 +76,7 @@ use kerf_millplan::{planner::status, MillPlanError, MillPlanner, MillRequest, Pl
 use kerf_msgs::msg::{self, MillPlan};
 use kerf_ros::{
     planner::{self, AnswerKey, Failure, PlanningService, Topics},
-    NodeSpec, RosArgs, RosEnv, RosError, StopToken,
+    NodeSpec, RosArgs, RosEnv, StopToken,
 };
 
 pub use config::{NodeConfig, KNOWN_PARAMS};
@@ -84,27 +84,19 @@ pub use config::{NodeConfig, KNOWN_PARAMS};
 /// Default node name.
 pub const DEFAULT_NAME: &str = "milling_planner";
 
-/// Why the node could not start.
+/// What the milling service's set-up can fail on.
 #[derive(Debug, thiserror::Error)]
-pub enum NodeError {
-    /// Environment, arguments, names or DDS.
-    #[error(transparent)]
-    Ros(#[from] RosError),
+pub enum SetupError {
     /// The milling cell or the indicator cache could not be loaded.
     #[error("milling planner: {0}")]
     Planner(#[from] MillPlanError),
     /// The milling cell file could not be loaded.
     #[error("milling cell: {0}")]
     Cell(#[from] kerf_mill::MillError),
-    /// A parameter has a wrong value.
-    #[error("parameter '{name}': {reason}")]
-    Config {
-        /// Parameter.
-        name: String,
-        /// What is wrong.
-        reason: String,
-    },
 }
+
+/// Why the node could not start: plumbing, a parameter, or [`SetupError`].
+pub type NodeError = planner::NodeError<SetupError>;
 
 /// The policies used by `ddpg` / `fixed_g` requests that name none.
 #[derive(Debug, Clone, PartialEq)]

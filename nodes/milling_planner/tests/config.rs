@@ -4,7 +4,9 @@
 
 use std::path::Path;
 
-use kerf_milling_planner::{config::DEFAULT_QUEUE_DEPTH, NodeConfig, NodeError, KNOWN_PARAMS};
+use kerf_milling_planner::{
+    config::DEFAULT_QUEUE_DEPTH, NodeConfig, NodeError, SetupError, KNOWN_PARAMS,
+};
 use kerf_millplan::{plan::IndicatorSource, PlannerKind};
 use kerf_ros::RosArgs;
 
@@ -137,7 +139,7 @@ fn bad_parameters_are_refused_by_name() {
         );
     }
     let e = config(&["cell_file:=/nonexistent/cell.yaml"]).unwrap_err();
-    assert!(matches!(e, NodeError::Cell(_)), "{e}");
+    assert!(matches!(e, NodeError::Setup(SetupError::Cell(_))), "{e}");
     assert!(e.to_string().contains("/nonexistent/cell.yaml"), "{e}");
 
     // A given cache must load: garbage is refused, naming the file.
@@ -145,7 +147,7 @@ fn bad_parameters_are_refused_by_name() {
     let garbage = dir.join("garbage.bin");
     std::fs::write(&garbage, "not a cache\n").unwrap();
     let e = config(&[&format!("indicator_cache_file:={}", garbage.display())]).unwrap_err();
-    assert!(matches!(e, NodeError::Planner(_)), "{e}");
+    assert!(matches!(e, NodeError::Setup(SetupError::Planner(_))), "{e}");
     let e = e.to_string();
     assert!(
         e.contains("garbage.bin") && e.contains("not a cache file"),

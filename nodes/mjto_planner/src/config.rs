@@ -23,13 +23,6 @@ pub struct NodeConfig {
     pub queue_depth: usize,
 }
 
-fn param_err(name: &str, reason: impl Into<String>) -> NodeError {
-    NodeError::Config {
-        name: name.to_string(),
-        reason: reason.into(),
-    }
-}
-
 impl NodeConfig {
     /// Reads and checks every parameter, and loads the machine.
     ///
@@ -44,7 +37,7 @@ impl NodeConfig {
     ///
     /// # Errors
     /// [`NodeError::Config`] naming the parameter, [`NodeError::Ros`] for a wrong type,
-    /// [`NodeError::Machine`] when the machine does not load.
+    /// [`NodeError::Setup`] ([`crate::SetupError::Machine`]) when the machine does not load.
     pub fn from_params(params: &Params) -> Result<Self, NodeError> {
         let urdf = params.string("urdf_file")?;
         let limits = params.string("joint_limits_file")?;
@@ -52,19 +45,20 @@ impl NodeConfig {
             match (urdf, limits) {
                 (Some(urdf), limits) => {
                     let limits = limits.map(PathBuf::from);
-                    let m = LaserMachine::from_files(&PathBuf::from(&urdf), limits.as_deref())?;
+                    let m = LaserMachine::from_files(&PathBuf::from(&urdf), limits.as_deref())
+                        .map_err(NodeError::setup)?;
                     let source = match &limits {
                         Some(l) => format!("{urdf} with {}", l.display()),
                         None => urdf,
                     };
                     (m, source)
                 }
-                (None, Some(_)) => return Err(param_err(
+                (None, Some(_)) => return Err(NodeError::config(
                     "joint_limits_file",
                     "given without urdf_file; set both, or neither for the shipped laser cutter",
                 )),
                 (None, None) => (
-                    LaserMachine::default_machine()?,
+                    LaserMachine::default_machine().map_err(NodeError::setup)?,
                     "the shipped laser_cutter.urdf".to_string(),
                 ),
             };

@@ -41,7 +41,7 @@ use kerf_mjto::{error::status, planner::Planner, CutRequest, LaserMachine, PlanE
 use kerf_msgs::msg::{self, CutPlan};
 use kerf_ros::{
     planner::{self, AnswerKey, Failure, PlanningService, Topics},
-    NodeSpec, RosArgs, RosEnv, RosError, StopToken,
+    NodeSpec, RosArgs, RosEnv, StopToken,
 };
 
 pub use config::{NodeConfig, KNOWN_PARAMS};
@@ -49,24 +49,16 @@ pub use config::{NodeConfig, KNOWN_PARAMS};
 /// Default node name.
 pub const DEFAULT_NAME: &str = "mjto_planner";
 
-/// Why the node could not start.
+/// What the MJTO service's set-up can fail on.
 #[derive(Debug, thiserror::Error)]
-pub enum NodeError {
-    /// Environment, arguments, names or DDS.
-    #[error(transparent)]
-    Ros(#[from] RosError),
+pub enum SetupError {
     /// The machine (URDF + limits) could not be loaded.
     #[error("machine: {0}")]
     Machine(#[from] PlanError),
-    /// A parameter has a wrong value.
-    #[error("parameter '{name}': {reason}")]
-    Config {
-        /// Parameter.
-        name: String,
-        /// What is wrong.
-        reason: String,
-    },
 }
+
+/// Why the node could not start: plumbing, a parameter, or [`SetupError`].
+pub type NodeError = planner::NodeError<SetupError>;
 
 /// Runs the node until its stop token (or Ctrl-C) stops it.
 ///
@@ -82,7 +74,8 @@ pub fn run(args: &RosArgs, env: &RosEnv, stop: StopToken) -> Result<(), NodeErro
     planner::run(spec, args, env, stop, |node| {
         let cfg = NodeConfig::from_params(node.params())?;
         let depth = cfg.queue_depth;
-        Ok((CutService::new(cfg.machine, cfg.machine_source)?, depth))
+        let service = CutService::new(cfg.machine, cfg.machine_source).map_err(NodeError::setup)?;
+        Ok((service, depth))
     })
 }
 

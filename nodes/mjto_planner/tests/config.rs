@@ -2,7 +2,9 @@
 //! parameters are refused with the parameter's name.
 #![allow(clippy::unwrap_used, clippy::expect_used)] // tests report failures by panicking
 
-use kerf_mjto_planner::{config::DEFAULT_QUEUE_DEPTH, NodeConfig, NodeError, KNOWN_PARAMS};
+use kerf_mjto_planner::{
+    config::DEFAULT_QUEUE_DEPTH, NodeConfig, NodeError, SetupError, KNOWN_PARAMS,
+};
 use kerf_ros::RosArgs;
 
 const ROOT: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../..");
@@ -56,8 +58,8 @@ fn bad_parameters_are_refused_by_name() {
     let urdf = format!("urdf_file:={ROOT}/urdf/irb6660.urdf");
     let limits = format!("joint_limits_file:={ROOT}/urdf/irb6660_limits.yaml");
     let e = config(&[&urdf, &limits]).unwrap_err();
-    assert!(matches!(e, NodeError::Machine(_)), "{e}");
+    assert!(matches!(e, NodeError::Setup(SetupError::Machine(_))), "{e}");
     assert!(e.to_string().contains("q1"), "{e}");
     let e = config(&["urdf_file:=/nonexistent/machine.urdf"]).unwrap_err();
-    assert!(matches!(e, NodeError::Machine(_)), "{e}");
+    assert!(matches!(e, NodeError::Setup(SetupError::Machine(_))), "{e}");
 }

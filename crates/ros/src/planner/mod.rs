@@ -23,12 +23,14 @@
 //!   planning.
 
 mod answers;
+mod error;
 mod executable;
 mod harness;
 mod main;
 mod service;
 mod text;
 
+pub use error::NodeError;
 pub use executable::{check_trajectory_msg, executor_limits, trajectory_msg, trajectory_request};
 pub use harness::{answer_text, run, work, Job};
 pub use main::node_main;

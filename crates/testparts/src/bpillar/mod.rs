@@ -84,12 +84,6 @@ pub const CASE2_FILE: &str = "crates/mjto/cases/case2.yaml";
 /// repository root).
 pub const REGENERATE_COMMAND: &str = "cargo run -p kerf_testparts --example gen_bpillar -- --out .";
 
-/// The regeneration command as the headers of the committed case files
-/// name it (from when the generator lived in `kerf_mjto`). The headers keep
-/// it so that the generated files stay byte-identical across the move;
-/// switching them to [`REGENERATE_COMMAND`] is a deliberate regeneration.
-const FILE_HEADER_COMMAND: &str = "cargo run -p kerf_mjto --example gen_bpillar -- --out .";
-
 /// Shortest accepted straight piece of a section (flange, wall, top) and
 /// shortest spine segment (m): shorter ones would give degenerate triangles.
 const MIN_PIECE: f64 = 1e-3;
