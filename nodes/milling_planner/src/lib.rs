@@ -76,7 +76,7 @@ use kerf_millplan::{planner::status, MillPlanError, MillPlanner, MillRequest, Pl
 use kerf_msgs::msg::{self, MillPlan};
 use kerf_ros::{
     planner::{self, AnswerKey, Failure, PlanningService, Topics},
-    NodeSpec, RosArgs, RosEnv, StopToken,
+    RosArgs, RosEnv, StopToken,
 };
 
 pub use config::{NodeConfig, KNOWN_PARAMS};
@@ -113,12 +113,7 @@ pub struct DefaultPolicies {
 /// `Ok` after a clean shutdown; an error if the node could not start (bad parameter,
 /// unreadable cell, DDS failure). Request errors never end the node.
 pub fn run(args: &RosArgs, env: &RosEnv, stop: StopToken) -> Result<(), NodeError> {
-    let spec = NodeSpec {
-        default_name: DEFAULT_NAME,
-        default_namespace: "/",
-        known_params: KNOWN_PARAMS,
-    };
-    planner::run(spec, args, env, stop, |node| {
+    planner::run(DEFAULT_NAME, KNOWN_PARAMS, args, env, stop, |node| {
         let cfg = NodeConfig::from_params(node.params())?;
         let policies = DefaultPolicies {
             ddpg: cfg.ddpg_policy_file.clone(),
@@ -195,13 +190,7 @@ impl PlanningService for MillService {
     type Answer = MillPlan;
 
     fn topics(&self) -> Topics {
-        Topics {
-            noun: "mill",
-            request: "~/mill_request",
-            request_text: "~/mill_request_text",
-            plan: "~/mill_plan",
-            plan_text: "~/mill_plan_text",
-        }
+        Topics::new("mill")
     }
 
     fn request_from_msg(&self, m: &msg::MillRequest) -> Result<MillRequest, Box<MillPlan>> {

@@ -41,7 +41,7 @@ use kerf_mjto::{error::status, planner::Planner, CutRequest, LaserMachine, PlanE
 use kerf_msgs::msg::{self, CutPlan};
 use kerf_ros::{
     planner::{self, AnswerKey, Failure, PlanningService, Topics},
-    NodeSpec, RosArgs, RosEnv, StopToken,
+    RosArgs, RosEnv, StopToken,
 };
 
 pub use config::{NodeConfig, KNOWN_PARAMS};
@@ -66,12 +66,7 @@ pub type NodeError = planner::NodeError<SetupError>;
 /// `Ok` after a clean shutdown; an error if the node could not start (bad parameter,
 /// unreadable machine description, DDS failure). Request errors never end the node.
 pub fn run(args: &RosArgs, env: &RosEnv, stop: StopToken) -> Result<(), NodeError> {
-    let spec = NodeSpec {
-        default_name: DEFAULT_NAME,
-        default_namespace: "/",
-        known_params: KNOWN_PARAMS,
-    };
-    planner::run(spec, args, env, stop, |node| {
+    planner::run(DEFAULT_NAME, KNOWN_PARAMS, args, env, stop, |node| {
         let cfg = NodeConfig::from_params(node.params())?;
         let depth = cfg.queue_depth;
         let service = CutService::new(cfg.machine, cfg.machine_source).map_err(NodeError::setup)?;
@@ -116,13 +111,7 @@ impl PlanningService for CutService {
     type Answer = CutPlan;
 
     fn topics(&self) -> Topics {
-        Topics {
-            noun: "cut",
-            request: "~/cut_request",
-            request_text: "~/cut_request_text",
-            plan: "~/cut_plan",
-            plan_text: "~/cut_plan_text",
-        }
+        Topics::new("cut")
     }
 
     fn request_from_msg(&self, m: &msg::CutRequest) -> Result<CutRequest, Box<CutPlan>> {

@@ -35,7 +35,8 @@ pub enum Job<R, A> {
 /// Starts a planner node and serves until its stop token (or Ctrl-C) stops it.
 ///
 /// # Arguments
-/// * `spec` — the node's default name, namespace and known parameters.
+/// * `default_name`, `known_params` — the node's default name (in namespace `/`) and the
+///   parameters it reads (others are refused at start-up).
 /// * `args`, `env`, `stop` — command line, environment, stop token.
 /// * `setup` — reads the node's parameters and builds the service; returns it with the
 ///   `queue_depth` (requests waiting or being planned before new ones are answered
@@ -45,7 +46,8 @@ pub enum Job<R, A> {
 /// `Ok` after a clean shutdown; an error if the node could not start (bad parameter, model
 /// that does not load, DDS failure). Request errors never end the node.
 pub fn run<S, E>(
-    spec: NodeSpec,
+    default_name: &str,
+    known_params: &[&str],
     args: &RosArgs,
     env: &RosEnv,
     stop: StopToken,
@@ -55,6 +57,11 @@ where
     S: PlanningService,
     E: From<RosError> + Display,
 {
+    let spec = NodeSpec {
+        default_name,
+        default_namespace: "/",
+        known_params,
+    };
     let node = KerfNode::new(spec, args, env, stop)?;
     let (service, queue_depth) = match setup(&node) {
         Ok(s) => s,
@@ -143,12 +150,12 @@ struct PlannerNode<S: PlanningService> {
 impl<S: PlanningService> PlannerNode<S> {
     fn new(mut node: KerfNode, service: S, queue_depth: usize) -> Result<Self, RosError> {
         let topics = service.topics();
-        let requests = node.inbox(topics.request, S::RequestMsg::ROS_TYPE, qos::commands())?;
+        let requests = node.inbox(&topics.request, S::RequestMsg::ROS_TYPE, qos::commands())?;
         let text_requests =
-            node.inbox(topics.request_text, StringMsg::ROS_TYPE, qos::commands())?;
+            node.inbox(&topics.request_text, StringMsg::ROS_TYPE, qos::commands())?;
         // Latched, so `kerf echo --transient-local` shows the last answers.
-        let plans = node.publisher(topics.plan, S::Answer::ROS_TYPE, qos::latched())?;
-        let plan_texts = node.publisher(topics.plan_text, StringMsg::ROS_TYPE, qos::latched())?;
+        let plans = node.publisher(&topics.plan, S::Answer::ROS_TYPE, qos::latched())?;
+        let plan_texts = node.publisher(&topics.plan_text, StringMsg::ROS_TYPE, qos::latched())?;
         // Volatile: a late (restarted) executor must never receive an old plan.
         let trajectories =
             node.publisher(TRAJECTORY_TOPIC, JointTrajectory::ROS_TYPE, qos::commands())?;
@@ -156,9 +163,9 @@ impl<S: PlanningService> PlannerNode<S> {
         log.info(&format!(
             "serving {} requests on {} and {}; plans on {}, trajectories on {}; {}; queue_depth {}",
             topics.noun,
-            node.resolve(topics.request)?,
-            node.resolve(topics.request_text)?,
-            node.resolve(topics.plan)?,
+            node.resolve(&topics.request)?,
+            node.resolve(&topics.request_text)?,
+            node.resolve(&topics.plan)?,
             node.resolve(TRAJECTORY_TOPIC)?,
             service.startup_note(),
             queue_depth,

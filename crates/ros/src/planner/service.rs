@@ -4,22 +4,37 @@ use kerf_executor::JointLimits;
 use kerf_msgs::{trajectory_msgs::JointTrajectory, RosType};
 use serde::{de::DeserializeOwned, Serialize};
 
-/// The topics of one planner node, relative to the node (`~/…`).
+/// The topics of one planner node, relative to the node (`~/…`), named after what it plans
+/// ([`Topics::new`]).
 ///
 /// Every planner node also publishes the planned trajectory on `~/joint_trajectory` (reliable,
 /// volatile: a restarted executor must never receive an old plan).
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, PartialEq, Eq)]
 pub struct Topics {
     /// What the node plans, for log lines ("cut", "mill").
     pub noun: &'static str,
-    /// The request message topic, e.g. `~/cut_request` (reliable, keep-last 10).
-    pub request: &'static str,
-    /// The text request topic (`std_msgs/String`), e.g. `~/cut_request_text`.
-    pub request_text: &'static str,
-    /// The answer topic, e.g. `~/cut_plan` (reliable, transient-local, keep-last 10).
-    pub plan: &'static str,
-    /// The answer as YAML text (`std_msgs/String`), e.g. `~/cut_plan_text` (latched too).
-    pub plan_text: &'static str,
+    /// The request message topic, `~/<noun>_request` (reliable, keep-last 10).
+    pub request: String,
+    /// The text request topic (`std_msgs/String`), `~/<noun>_request_text`.
+    pub request_text: String,
+    /// The answer topic, `~/<noun>_plan` (reliable, transient-local, keep-last 10).
+    pub plan: String,
+    /// The answer as YAML text (`std_msgs/String`), `~/<noun>_plan_text` (latched too).
+    pub plan_text: String,
+}
+
+impl Topics {
+    /// The topics of a node planning `noun`s: `~/<noun>_request`, `~/<noun>_request_text`,
+    /// `~/<noun>_plan`, `~/<noun>_plan_text`.
+    pub fn new(noun: &'static str) -> Self {
+        Self {
+            noun,
+            request: format!("~/{noun}_request"),
+            request_text: format!("~/{noun}_request_text"),
+            plan: format!("~/{noun}_plan"),
+            plan_text: format!("~/{noun}_plan_text"),
+        }
+    }
 }
 
 /// The topic every planner node publishes its successful trajectories on.
