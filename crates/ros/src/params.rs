@@ -125,6 +125,33 @@ pub struct Params {
 }
 
 impl Params {
+    /// The parameters node `name` (namespace `/`) reads from `--ros-args -p a:=1 -p b:=x …`,
+    /// as parsed from a command line, with unknown names refused: what a node's `run` would
+    /// see, for checking a node's configuration without starting it.
+    ///
+    /// # Arguments
+    /// * `name` — the node's name.
+    /// * `known` — the parameter names the node reads.
+    /// * `assignments` — `name:=value` strings.
+    ///
+    /// # Errors
+    /// As [`crate::RosArgs::parse`] and [`Params::reject_unknown`].
+    pub fn from_assignments(
+        name: &str,
+        known: &[&str],
+        assignments: &[&str],
+    ) -> Result<Self, RosError> {
+        let mut words = vec!["--ros-args".to_string()];
+        for a in assignments {
+            words.push("-p".into());
+            words.push(a.to_string());
+        }
+        let args = crate::RosArgs::parse(words)?;
+        let params = args.params_for(&format!("/{name}"), name)?;
+        params.reject_unknown(known)?;
+        Ok(params)
+    }
+
     /// Sets (or overrides) one parameter.
     pub fn set(&mut self, name: &str, value: ParamValue) {
         self.values.insert(name.to_string(), value);

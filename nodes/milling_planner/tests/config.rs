@@ -8,20 +8,16 @@ use kerf_milling_planner::{
     config::DEFAULT_QUEUE_DEPTH, NodeConfig, NodeError, SetupError, KNOWN_PARAMS,
 };
 use kerf_millplan::{plan::IndicatorSource, PlannerKind};
-use kerf_ros::RosArgs;
+use kerf_ros::Params;
 
 const ROOT: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../..");
 
 fn config(params: &[&str]) -> Result<NodeConfig, NodeError> {
-    let mut args = vec!["--ros-args".to_string()];
-    for p in params {
-        args.push("-p".into());
-        args.push(p.to_string());
-    }
-    let args = RosArgs::parse(args)?;
-    let params = args.params_for("/milling_planner", "milling_planner")?;
-    params.reject_unknown(KNOWN_PARAMS)?;
-    NodeConfig::from_params(&params)
+    NodeConfig::from_params(&Params::from_assignments(
+        "milling_planner",
+        KNOWN_PARAMS,
+        params,
+    )?)
 }
 
 fn scratch(name: &str) -> std::path::PathBuf {

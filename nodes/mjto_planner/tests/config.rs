@@ -5,20 +5,16 @@
 use kerf_mjto_planner::{
     config::DEFAULT_QUEUE_DEPTH, NodeConfig, NodeError, SetupError, KNOWN_PARAMS,
 };
-use kerf_ros::RosArgs;
+use kerf_ros::Params;
 
 const ROOT: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../..");
 
 fn config(params: &[&str]) -> Result<NodeConfig, NodeError> {
-    let mut args = vec!["--ros-args".to_string()];
-    for p in params {
-        args.push("-p".into());
-        args.push(p.to_string());
-    }
-    let args = RosArgs::parse(args)?;
-    let params = args.params_for("/mjto_planner", "mjto_planner")?;
-    params.reject_unknown(KNOWN_PARAMS)?;
-    NodeConfig::from_params(&params)
+    NodeConfig::from_params(&Params::from_assignments(
+        "mjto_planner",
+        KNOWN_PARAMS,
+        params,
+    )?)
 }
 
 #[test]
