@@ -50,4 +50,12 @@ pub enum MillPlanError {
     /// The learning backend (candle) failed.
     #[error("learning backend: {0}")]
     Backend(String),
+    /// The executed trajectory fails the trajectory executor's own validation
+    /// (`kerf_executor::check_executable`): a planner bug, or a cell whose robot the executor
+    /// cannot model (a joint without an acceleration limit).
+    #[error("the executed trajectory would be refused by the trajectory executor: {reason}")]
+    NotExecutable {
+        /// The executor's reason.
+        reason: String,
+    },
 }

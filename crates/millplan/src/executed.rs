@@ -3,6 +3,7 @@
 //! joints' velocity and acceleration limits ([`crate::timing::time_scale`])
 //! and the plan at the feeds that result ([`Plan::as_executed`]).
 
+use kerf_executor::{check_executable, ExecutorConfig};
 use kerf_mill::MillCell;
 
 use crate::cache::IndicatorCache;
@@ -56,7 +57,9 @@ pub fn execute(
 ///
 /// # Errors
 /// A joint of `trajectory` the robot does not have; [`time_scale`] and
-/// [`Plan::as_executed_with`] errors.
+/// [`Plan::as_executed_with`] errors; [`MillPlanError::NotExecutable`] when
+/// the scaled trajectory fails `kerf_executor::check_executable` (the
+/// executor's own validation: the one executability check of kerf).
 pub(crate) fn executed(
     cell: &MillCell,
     plan: &Plan,
@@ -87,6 +90,18 @@ pub(crate) fn executed(
     let times: Vec<f64> = plan.segments.iter().map(|s| s.time).collect();
     let feeds: Vec<f64> = plan.segments.iter().map(|s| s.feed).collect();
     let scaling = time_scale(trajectory, &times, &feeds, &limits)?;
+    // Judged by what the executor runs: its own validation, from rest at the first point.
+    let not_executable = |reason: String| MillPlanError::NotExecutable { reason };
+    let model = cell
+        .robot()
+        .executor_limits()
+        .map_err(|e| not_executable(e.to_string()))?;
+    check_executable(
+        &model,
+        &ExecutorConfig::default(),
+        &scaling.trajectory.request,
+    )
+    .map_err(|e| not_executable(e.to_string()))?;
     let (plan, cached_segments) = plan.as_executed_with(
         cell,
         weights,

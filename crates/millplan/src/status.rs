@@ -69,6 +69,8 @@ pub fn status_of(error: &MillPlanError) -> u8 {
         },
         MillPlanError::Chatter(_) => CHATTER_MODEL_ERROR,
         MillPlanError::Policy { .. } => POLICY_ERROR,
-        MillPlanError::Io { .. } | MillPlanError::Backend(_) => INTERNAL_ERROR,
+        MillPlanError::Io { .. }
+        | MillPlanError::Backend(_)
+        | MillPlanError::NotExecutable { .. } => INTERNAL_ERROR,
     }
 }

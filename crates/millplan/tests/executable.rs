@@ -23,18 +23,8 @@ fn planner() -> &'static MillPlanner {
 /// The cell robot's joints as the executor's robot model (model order).
 fn executor_limits(cell: &MillCell) -> Vec<JointLimits> {
     cell.robot()
-        .joints()
-        .iter()
-        .map(|j| JointLimits {
-            name: j.name.clone(),
-            min_position: j.min_position,
-            max_position: j.max_position,
-            max_velocity: j.max_velocity,
-            max_acceleration: j
-                .max_acceleration
-                .expect("the cell's robot has acceleration limits"),
-        })
-        .collect()
+        .executor_limits()
+        .expect("the cell's robot has acceleration limits")
 }
 
 /// `kerf_executor::validate` of `t` from rest at its first point, start

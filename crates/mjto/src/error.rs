@@ -145,6 +145,14 @@ pub enum PlanError {
         /// Every violation found (at most one per joint and quantity).
         violations: Vec<LimitViolation>,
     },
+    /// The plan fails the trajectory executor's own validation
+    /// (`kerf_executor::check_executable` of [`crate::CutPlan::joint_trajectory`]): a planner
+    /// bug, never published as a success.
+    #[error("the planned trajectory would be refused by the trajectory executor: {reason}")]
+    NotExecutable {
+        /// The executor's reason.
+        reason: String,
+    },
 }
 
 /// Status codes of `kerf_msgs/msg/CutPlan` (kept equal to the constants in
@@ -180,7 +188,7 @@ impl PlanError {
                 status::COLLISION
             }
             PlanError::LimitViolation { .. } => status::LIMIT_VIOLATION,
-            PlanError::Solver { .. } => status::INTERNAL_ERROR,
+            PlanError::Solver { .. } | PlanError::NotExecutable { .. } => status::INTERNAL_ERROR,
         }
     }
 

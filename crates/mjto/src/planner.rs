@@ -22,6 +22,7 @@
 //!   current trajectory at that CL point (the GFD is centred there), so the
 //!   smooth solution is perturbed as little as possible.
 
+use kerf_executor::{check_executable, ExecutorConfig};
 use std::time::Instant;
 
 use kerf_bspline::{BSpline, KnotVector};
@@ -111,7 +112,10 @@ impl Planner {
     /// beside the QI baseline, and stage timings.
     ///
     /// # Errors
-    /// Every [`PlanError`] variant; see their documentation.
+    /// Every [`PlanError`] variant; see their documentation. The last check is the trajectory
+    /// executor's own validation of [`CutPlan::joint_trajectory`]
+    /// (`kerf_executor::check_executable`, the one executability check of kerf):
+    /// [`PlanError::NotExecutable`].
     ///
     /// # Performance
     /// Dominated by the dense collision checks (one query per sample per
@@ -149,7 +153,17 @@ impl Planner {
         let factor = JerkFactor::new(&knots)?;
         times.hessian = t.elapsed().as_secs_f64();
 
-        ctx.run(&world, &knots, &factor, times, start)
+        let plan = ctx.run(&world, &knots, &factor, times, start)?;
+        // Judged by what the executor runs: its own validation, from rest at the first point.
+        let not_executable = |reason: String| PlanError::NotExecutable { reason };
+        let model = self
+            .machine
+            .robot()
+            .executor_limits()
+            .map_err(|e| not_executable(e.to_string()))?;
+        check_executable(&model, &ExecutorConfig::default(), &plan.joint_trajectory())
+            .map_err(|e| not_executable(e.to_string()))?;
+        Ok(plan)
     }
 }
 

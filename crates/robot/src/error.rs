@@ -32,6 +32,16 @@ pub enum RobotError {
         source: serde_yaml_ng::Error,
     },
 
+    /// A joint has no acceleration limit, which the executor's model needs.
+    #[error(
+        "joint '{joint}' has no acceleration limit (max_acceleration in the joint limits \
+         YAML); the trajectory executor needs one to check trajectories"
+    )]
+    NoAccelerationLimit {
+        /// The joint.
+        joint: String,
+    },
+
     /// Two links share a name.
     #[error("URDF defines link `{name}` more than once")]
     DuplicateLink {

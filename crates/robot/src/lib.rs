@@ -54,6 +54,7 @@
 mod chain;
 pub mod data;
 mod error;
+mod executor_limits;
 mod joint;
 mod limits;
 mod model;

@@ -161,15 +161,11 @@ impl MillService {
         policies: DefaultPolicies,
         note: String,
     ) -> Result<Self, NodeError> {
-        let limits = planner::executor_limits(planner.cell().robot()).map_err(|joint| {
-            NodeError::Config {
-                name: "cell_file".into(),
-                reason: format!(
-                    "the cell's robot gives no max_acceleration for joint '{joint}'; the \
-                     executability check needs it"
-                ),
-            }
-        })?;
+        let limits = planner
+            .cell()
+            .robot()
+            .executor_limits()
+            .map_err(|e| NodeError::config("cell_file", e.to_string()))?;
         Ok(Self {
             planner,
             policies,

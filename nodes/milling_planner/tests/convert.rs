@@ -14,7 +14,7 @@ use kerf_millplan::{
     MillPlanError, MillPlanOutput, MillPlanner, MillRequest,
 };
 use kerf_msgs::{geometry_msgs::Point, msg};
-use kerf_ros::planner::{check_trajectory_msg, executor_limits};
+use kerf_ros::planner::check_trajectory_msg;
 
 fn point(x: f64, y: f64, z: f64) -> Point {
     Point { x, y, z }
@@ -584,7 +584,11 @@ fn a_defective_trajectory_is_an_internal_error_not_a_plan() {
 /// The robot's limits as the executor (and the node's executability check) takes them.
 fn robot_limits() -> Vec<JointLimits> {
     let planner = MillPlanner::with_default_cell().expect("planner");
-    executor_limits(planner.cell().robot()).expect("acceleration limits")
+    planner
+        .cell()
+        .robot()
+        .executor_limits()
+        .expect("acceleration limits")
 }
 
 #[test]

@@ -90,12 +90,10 @@ impl CutService {
     /// # Errors
     /// [`PlanError`] when the planner cannot be built for the machine.
     pub fn new(machine: LaserMachine, source: String) -> Result<Self, PlanError> {
-        let limits = planner::executor_limits(machine.robot()).map_err(|joint| {
-            PlanError::invalid(
-                "machine",
-                format!("joint '{joint}' has no acceleration limit"),
-            )
-        })?;
+        let limits = machine
+            .robot()
+            .executor_limits()
+            .map_err(|e| PlanError::invalid("machine", e.to_string()))?;
         Ok(Self {
             planner: Mutex::new(Planner::new(machine.clone())?),
             machine,

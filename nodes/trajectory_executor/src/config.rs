@@ -3,7 +3,7 @@
 use std::path::PathBuf;
 
 use kerf_executor::{ExecutorConfig, JointLimits, JointTolerance};
-use kerf_robot::RobotModel;
+use kerf_robot::{RobotError, RobotModel};
 use kerf_ros::Params;
 
 use crate::NodeError;
@@ -85,15 +85,16 @@ impl NodeConfig {
         let limits_file = PathBuf::from(params.required_string("joint_limits_file")?);
         let robot = RobotModel::from_files(&urdf, Some(&limits_file))?;
 
-        let limits = kerf_ros::planner::executor_limits(&robot).map_err(|joint| {
-            param_err(
+        let limits = robot.executor_limits().map_err(|e| match e {
+            RobotError::NoAccelerationLimit { joint } => param_err(
                 "joint_limits_file",
                 format!(
                     "{} gives no max_acceleration for joint '{joint}'; the executor needs it to \
                      check trajectories",
                     limits_file.display(),
                 ),
-            )
+            ),
+            other => NodeError::from(other),
         })?;
 
         let control_rate = positive(params, "control_rate", 250.0)?;

@@ -10,7 +10,6 @@ use kerf_msgs::{
     std_msgs::Header,
     trajectory_msgs::{JointTrajectory, JointTrajectoryPoint},
 };
-use kerf_robot::RobotModel;
 
 fn duration_secs(d: &Duration, what: impl FnOnce() -> String) -> Result<f64, String> {
     if d.nanosec >= 1_000_000_000 {
@@ -100,28 +99,6 @@ pub fn trajectory_msg(trajectory: &TrajectoryRequest) -> Result<JointTrajectory,
         joint_names: trajectory.joint_names.clone(),
         points,
     })
-}
-
-/// The executor's robot model of a loaded robot: every joint's position, velocity and
-/// acceleration limits, in the robot's joint order.
-///
-/// # Returns
-/// The limits, or the name of the first joint without an acceleration limit (the executor
-/// needs one to check trajectories).
-pub fn executor_limits(robot: &RobotModel) -> Result<Vec<JointLimits>, String> {
-    robot
-        .joints()
-        .iter()
-        .map(|j| {
-            Ok(JointLimits {
-                name: j.name.clone(),
-                min_position: j.min_position,
-                max_position: j.max_position,
-                max_velocity: j.max_velocity,
-                max_acceleration: j.max_acceleration.ok_or_else(|| j.name.clone())?,
-            })
-        })
-        .collect()
 }
 
 /// Would the trajectory executor (default configuration, robot standing still at the first

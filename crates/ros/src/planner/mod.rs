@@ -31,7 +31,7 @@ mod service;
 mod text;
 
 pub use error::NodeError;
-pub use executable::{check_trajectory_msg, executor_limits, trajectory_msg, trajectory_request};
+pub use executable::{check_trajectory_msg, trajectory_msg, trajectory_request};
 pub use harness::{answer_text, run, work, Job};
 pub use main::node_main;
 pub use service::{AnswerKey, Failure, PlanAnswer, PlanningService, Topics, TRAJECTORY_TOPIC};
