@@ -306,16 +306,24 @@ fn check_step(name: &str, v: Option<f64>) -> Result<(), MillPlanError> {
 }
 
 impl MillRequest {
-    /// Parses YAML (or JSON, a subset of YAML) text.
+    /// Parses YAML (or JSON) text.
+    ///
+    /// JSON is nearly a subset of YAML; where YAML refuses a JSON document
+    /// (a `\u` escape of a UTF-16 surrogate pair, e.g. `"\ud83d\ude00"`),
+    /// the text is read as JSON.
     ///
     /// # Errors
-    /// [`MillPlanError::InvalidConfig`] naming `request` with the parser's
-    /// message (unknown or missing field, wrong type, with line and column).
+    /// [`MillPlanError::InvalidConfig`] naming `request` with the YAML
+    /// parser's message (unknown or missing field, wrong type, with line and
+    /// column).
     pub fn from_yaml_str(text: &str) -> Result<Self, MillPlanError> {
-        serde_yaml_ng::from_str(text).map_err(|e| MillPlanError::InvalidConfig {
-            name: "request".to_string(),
-            reason: e.to_string(),
-        })
+        serde_yaml_ng::from_str(text)
+            .map_err(|yaml| yaml.to_string())
+            .or_else(|yaml| json_fallback(text, yaml))
+            .map_err(|e| MillPlanError::InvalidConfig {
+                name: "request".to_string(),
+                reason: e.to_string(),
+            })
     }
 
     /// Parses JSON text.
@@ -564,5 +572,15 @@ impl MillRequest {
             }
         }
         Ok(())
+    }
+}
+
+/// A document YAML refused, read as JSON: JSON's answer (its value, or its error with line and
+/// column) when the text is a JSON document, else the YAML parser's error `yaml`.
+fn json_fallback<T: serde::de::DeserializeOwned>(text: &str, yaml: String) -> Result<T, String> {
+    if serde_json::from_str::<serde_json::Value>(text).is_ok() {
+        serde_json::from_str(text).map_err(|e| e.to_string())
+    } else {
+        Err(yaml)
     }
 }

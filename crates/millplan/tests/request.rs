@@ -461,3 +461,22 @@ fn status_values_and_names() {
         status::INTERNAL_ERROR
     );
 }
+
+/// JSON that YAML cannot read (a surrogate-pair `\u` escape) parses as JSON; a JSON document's
+/// own error (an unknown field) is the one reported.
+#[test]
+fn json_with_unicode_escapes_parses() {
+    let json = r#"{"request_id": "job \ud83d\ude00 \u00e9", "planner": "naive",
+        "points": [[1.4, -0.3, 1.7], [2.1, 0.3, 1.7]]}"#;
+    for r in [
+        MillRequest::from_yaml_str(json).expect("as YAML text"),
+        MillRequest::from_json_str(json).expect("as JSON text"),
+    ] {
+        assert_eq!(r.request_id, "job \u{1F600} \u{e9}");
+        assert_eq!(r.points.len(), 2);
+    }
+    let e = MillRequest::from_yaml_str(&json.replace("\"planner\"", "\"planer\""))
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("planer"), "{e}");
+}

@@ -254,9 +254,19 @@ fn positive(field: &str, v: f64) -> Result<f64, PlanError> {
 }
 
 impl CutRequest {
-    /// Parses a YAML (or JSON, a YAML subset) request document.
+    /// Parses a YAML (or JSON) request document.
+    ///
+    /// JSON is nearly a subset of YAML; where YAML refuses a JSON document (a `\u` escape of a
+    /// UTF-16 surrogate pair, e.g. `"\ud83d\ude00"`), the text is read as JSON.
+    ///
+    /// # Errors
+    /// [`PlanError::InvalidRequest`] (field `request`) with the YAML parser's message (unknown
+    /// or missing field, wrong type, with line and column).
     pub fn from_yaml(text: &str) -> Result<Self, PlanError> {
-        serde_yaml_ng::from_str(text).map_err(|e| PlanError::invalid("request", e.to_string()))
+        serde_yaml_ng::from_str(text)
+            .map_err(|yaml| yaml.to_string())
+            .or_else(|yaml| json_fallback(text, yaml))
+            .map_err(|e| PlanError::invalid("request", e.to_string()))
     }
 
     /// Checks every field and transforms the path into the machine frame.
@@ -447,5 +457,15 @@ impl CutRequest {
             return Err(PlanError::invalid("options.clearance", "must be ≥ 0"));
         }
         Ok(())
+    }
+}
+
+/// A document YAML refused, read as JSON: JSON's answer (its value, or its error with line and
+/// column) when the text is a JSON document, else the YAML parser's error `yaml`.
+fn json_fallback<T: serde::de::DeserializeOwned>(text: &str, yaml: String) -> Result<T, String> {
+    if serde_json::from_str::<serde_json::Value>(text).is_ok() {
+        serde_json::from_str(text).map_err(|e| e.to_string())
+    } else {
+        Err(yaml)
     }
 }

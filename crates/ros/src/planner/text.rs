@@ -23,10 +23,30 @@ impl<E: std::fmt::Display> std::fmt::Display for TextRequestError<E> {
 impl<E: std::fmt::Debug + std::fmt::Display> std::error::Error for TextRequestError<E> {}
 
 /// The string value of the top-level `key` of a YAML (or JSON) document that may not parse
-/// as a request (empty if the text is no YAML mapping or the key is no string).
+/// as a request (empty if the text is no YAML or JSON mapping or the key is no string).
 pub fn yaml_field(text: &str, key: &str) -> String {
-    serde_yaml_ng::from_str::<serde_yaml_ng::Value>(text)
+    let yaml = serde_yaml_ng::from_str::<serde_yaml_ng::Value>(text)
         .ok()
-        .and_then(|v| v.get(key).and_then(|r| r.as_str()).map(String::from))
-        .unwrap_or_default()
+        .and_then(|v| v.get(key).and_then(|r| r.as_str()).map(String::from));
+    // JSON that YAML cannot read (surrogate-pair `\u` escapes) is read as JSON.
+    yaml.or_else(|| {
+        serde_json::from_str::<serde_json::Value>(text)
+            .ok()
+            .and_then(|v| v.get(key).and_then(|r| r.as_str()).map(String::from))
+    })
+    .unwrap_or_default()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::yaml_field;
+
+    #[test]
+    fn fields_of_yaml_and_of_json_yaml_cannot_read() {
+        assert_eq!(yaml_field("{request_id: a-1, x: [", "request_id"), "");
+        assert_eq!(yaml_field("request_id: a-1\nx: 1\n", "request_id"), "a-1");
+        let json = r#"{"request_id": "b \ud83d\ude00", "points": 3}"#;
+        assert_eq!(yaml_field(json, "request_id"), "b \u{1F600}");
+        assert_eq!(yaml_field(json, "points"), "");
+    }
 }

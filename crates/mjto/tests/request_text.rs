@@ -1,0 +1,42 @@
+//! Request documents: JSON is read as JSON where YAML cannot read it (`\u` escapes of
+//! characters outside the Basic Multilingual Plane are UTF-16 surrogate pairs in JSON, which
+//! YAML refuses), and YAML flow style keeps working.
+#![allow(clippy::unwrap_used, clippy::expect_used)] // tests report failures by panicking
+
+use kerf_mjto::CutRequest;
+
+const JSON: &str = r#"{
+  "request_id": "slot \ud83d\ude00 \u00e9\u4e2d",
+  "points": [[0.6, 0.2, 0.1], [0.7, 0.2, 0.1]],
+  "axes": [[0, 0, 1], [0, 0, 1]],
+  "feedrate": 0.3,
+  "sample_period": 0.004,
+  "max_lead_angle": 0.1,
+  "max_tilt_angle": 0.1,
+  "mesh": "m.stl"
+}"#;
+
+#[test]
+fn json_with_unicode_escapes_parses() {
+    let r = CutRequest::from_yaml(JSON).expect("JSON request");
+    assert_eq!(r.request_id, "slot \u{1F600} \u{e9}\u{4e2d}");
+    assert_eq!(r.points.len(), 2);
+}
+
+#[test]
+fn yaml_flow_style_and_errors_still_come_from_yaml() {
+    let flow = "{request_id: flow-1, points: [[0.6, 0.2, 0.1], [0.7, 0.2, 0.1]], \
+                axes: [[0, 0, 1], [0, 0, 1]], feedrate: 0.3, sample_period: 0.004, \
+                max_lead_angle: 0.1, max_tilt_angle: 0.1, mesh: m.stl}";
+    assert_eq!(CutRequest::from_yaml(flow).unwrap().request_id, "flow-1");
+    // Neither YAML nor JSON: the YAML parser's message (with its position).
+    let e = CutRequest::from_yaml("{request_id: [")
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("request"), "{e}");
+    // JSON with an unknown field: refused, naming it.
+    let e = CutRequest::from_yaml(&JSON.replace("\"feedrate\"", "\"feed_rate\""))
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("feed_rate"), "{e}");
+}
