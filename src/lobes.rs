@@ -49,9 +49,6 @@ pub use table::table;
 
 use crate::plots;
 
-/// Exit code of every `kerf lobes` failure (as `kerf plan cut`).
-pub const EXIT_FAILURE: u8 = 2;
-
 /// Default number of spindle speeds.
 const DEFAULT_SPEEDS: usize = 100;
 
@@ -230,7 +227,7 @@ pub fn compute(a: &LobesArgs) -> Result<LobesReport, String> {
 /// Runs `kerf lobes`: computes, writes the two plots, prints the table.
 ///
 /// # Errors
-/// The message to print; the caller exits with [`EXIT_FAILURE`].
+/// The message to print; the caller exits with [`crate::EXIT_FAILURE`].
 pub fn run(a: LobesArgs) -> Result<(), String> {
     if a.format == Format::Png {
         return Err("--format png: png not built in; use svg".to_string());

@@ -2,6 +2,9 @@
 //!
 //! * `kerf launch` starts every kerf node that exists, each with its own Context, in one
 //!   process (today: the trajectory executor).
+//!
+//! Every failure exits with code 2 and a message on stderr; a closed output pipe ends a
+//! command quietly (SIGPIPE).
 //! * `kerf echo TOPIC` prints a kerf or standard topic as YAML, with no ROS install.
 //! * `kerf plan cut --request FILE` plans a laser cut offline (exit code 2 on failure).
 //! * `kerf plan mill --request FILE` plans a milling path offline (issue 5; exit code 2 on
@@ -50,23 +53,37 @@ enum Command {
     Train(Box<train_mill::TrainArgs>),
 }
 
+/// Exit code of every `kerf` failure, with a message on stderr (clap's usage errors exit with
+/// 2 too).
+pub const EXIT_FAILURE: u8 = 2;
+
 fn main() -> ExitCode {
+    restore_default_sigpipe();
     let cli = Cli::parse();
-    let (result, failure) = match cli.command {
-        Command::Launch(a) => (launch::run(a), ExitCode::FAILURE),
-        Command::Echo(a) => (echo::run(a), ExitCode::FAILURE),
-        Command::Plan(a) => (plan_cut::run(a), ExitCode::from(plan_cut::EXIT_FAILURE)),
-        Command::Lobes(a) => (lobes::run(a), ExitCode::from(lobes::EXIT_FAILURE)),
-        Command::Train(a) => (
-            train_mill::run(*a),
-            ExitCode::from(train_mill::EXIT_FAILURE),
-        ),
+    let result = match cli.command {
+        Command::Launch(a) => launch::run(a),
+        Command::Echo(a) => echo::run(a),
+        Command::Plan(a) => plan_cut::run(a),
+        Command::Lobes(a) => lobes::run(a),
+        Command::Train(a) => train_mill::run(*a),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
             eprintln!("kerf: {e}");
-            failure
+            ExitCode::from(EXIT_FAILURE)
         }
+    }
+}
+
+/// A closed pipe ends kerf quietly, as it ends `cat` or `grep` (`kerf echo … | head`): the
+/// Rust runtime ignores SIGPIPE, so a write to a closed pipe would fail and `print!` panic;
+/// with the default disposition the process ends by SIGPIPE at that write instead. DDS uses
+/// UDP, which never raises SIGPIPE.
+fn restore_default_sigpipe() {
+    // SAFETY: signal(2) with SIG_DFL for SIGPIPE, at start-up before any thread exists; it
+    // changes no memory of this process.
+    unsafe {
+        libc::signal(libc::SIGPIPE, libc::SIG_DFL);
     }
 }

@@ -58,13 +58,10 @@ pub struct CutArgs {
     limits: Option<PathBuf>,
 }
 
-/// Exit code of every `kerf plan` failure.
-pub const EXIT_FAILURE: u8 = 2;
-
 /// Runs `kerf plan`.
 ///
 /// # Errors
-/// The message to print; the caller exits with [`EXIT_FAILURE`].
+/// The message to print; the caller exits with [`crate::EXIT_FAILURE`].
 pub fn run(a: PlanArgs) -> Result<(), String> {
     match a.command {
         PlanCommand::Cut(c) => cut(c),

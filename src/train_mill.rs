@@ -60,9 +60,6 @@ use progress::{format_duration, Progress};
 mod curve;
 mod progress;
 
-/// Exit code of every `kerf train` failure (as `kerf plan`).
-pub const EXIT_FAILURE: u8 = 2;
-
 /// Arguments of `kerf train`.
 #[derive(Args, Debug)]
 pub struct TrainArgs {
@@ -177,7 +174,7 @@ pub struct MillTrainArgs {
 /// Runs `kerf train`.
 ///
 /// # Errors
-/// The message to print; the caller exits with [`EXIT_FAILURE`].
+/// The message to print; the caller exits with [`crate::EXIT_FAILURE`].
 pub fn run(a: TrainArgs) -> Result<(), String> {
     match a.command {
         TrainCommand::Mill(m) => mill(*m),

@@ -122,6 +122,8 @@ fn bad_arguments_and_environment_are_refused() {
         .output()
         .unwrap();
     assert!(!out.status.success());
+    // Every kerf failure exits with code 2 (issue 11, item 8).
+    assert_eq!(out.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&out.stderr).contains("no_such_param"));
 
     let out = kerf()
@@ -137,5 +139,50 @@ fn bad_arguments_and_environment_are_refused() {
         .output()
         .unwrap();
     assert!(!out.status.success());
+    assert_eq!(out.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&out.stderr).contains("no publisher of /nothing_here"));
+}
+
+/// A closed output pipe (`kerf … | head`) ends a command quietly: by SIGPIPE at the first write
+/// after the close, or successfully if everything was written before it; never a panic.
+#[test]
+fn a_closed_pipe_ends_kerf_quietly() {
+    use std::os::unix::process::ExitStatusExt;
+    let dir = std::env::temp_dir().join(format!("kerf_cli_pipe_{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let runs: [&[&str]; 2] = [
+        &[
+            "lobes",
+            "--segment",
+            "50",
+            "--g",
+            "0",
+            "--rpm",
+            "2000:4000:2",
+            "--feed",
+            "0.02:0.06:2",
+            "--out",
+            dir.to_str().unwrap(),
+        ],
+        &["plan", "--help"],
+    ];
+    for args in runs {
+        let mut child = kerf()
+            .args(args)
+            .stdout(Stdio::piped())
+            .stderr(Stdio::piped())
+            .spawn()
+            .unwrap();
+        // The reader goes away before kerf writes (or while it writes).
+        drop(child.stdout.take());
+        let out = child.wait_with_output().unwrap();
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert!(!stderr.contains("panicked"), "{args:?}: {stderr}");
+        assert!(
+            out.status.success() || out.status.signal() == Some(libc::SIGPIPE),
+            "{args:?}: {} {stderr}",
+            out.status
+        );
+    }
+    let _ = std::fs::remove_dir_all(&dir);
 }
