@@ -6,6 +6,8 @@
 //! Every failure exits with code 2 and a message on stderr; a closed output pipe ends a
 //! command quietly (SIGPIPE).
 //! * `kerf echo TOPIC` prints a kerf or standard topic as YAML, with no ROS install.
+//! * `kerf pub TOPIC FILE|-` publishes one message written as YAML or JSON, with no ROS
+//!   install.
 //! * `kerf plan cut --request FILE` plans a laser cut offline (exit code 2 on failure).
 //! * `kerf plan mill --request FILE` plans a milling path offline (issue 5; exit code 2 on
 //!   failure).
@@ -21,6 +23,8 @@ mod output_paths;
 mod plan_cut;
 mod plan_mill;
 mod plots;
+mod publish;
+mod topic_types;
 mod train_mill;
 
 use std::process::ExitCode;
@@ -44,6 +48,8 @@ enum Command {
     Launch(launch::LaunchArgs),
     /// Print the messages of a topic as YAML.
     Echo(echo::EchoArgs),
+    /// Publish one message written as YAML or JSON (`kerf pub TOPIC FILE`, `-` for stdin).
+    Pub(publish::PubArgs),
     /// Plan offline, without ROS (`kerf plan cut --request cut.yaml`,
     /// `kerf plan mill --request mill.yaml`).
     Plan(plan_cut::PlanArgs),
@@ -63,6 +69,7 @@ fn main() -> ExitCode {
     let result = match cli.command {
         Command::Launch(a) => launch::run(a),
         Command::Echo(a) => echo::run(a),
+        Command::Pub(a) => publish::run(a),
         Command::Plan(a) => plan_cut::run(a),
         Command::Lobes(a) => lobes::run(a),
         Command::Train(a) => train_mill::run(*a),

@@ -1,4 +1,5 @@
 //! The `kerf` tool as a user runs it: `kerf launch` serves, `kerf echo` prints a topic as YAML,
+//! `kerf pub` publishes a message written as YAML,
 //! Ctrl-C (SIGINT) stops the launch cleanly, and bad ROS arguments are refused. Loopback DDS.
 #![allow(clippy::unwrap_used, clippy::expect_used)] // tests report failures by panicking
 
@@ -92,6 +93,80 @@ fn launch_echo_and_ctrl_c() {
         log.contains("trajectory_executor") && log.contains("ready"),
         "{log}"
     );
+
+    // kerf pub: a move of q1 written as YAML on stdin, its type discovered from the
+    // executor's subscription; the executor accepts and runs it.
+    let mut publish = kerf()
+        .args(["pub", "/trajectory_executor/joint_trajectory", "-"])
+        .stdin(Stdio::piped())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("run kerf pub");
+    {
+        use std::io::Write;
+        let mut stdin = publish.stdin.take().expect("stdin");
+        stdin
+            .write_all(
+                b"header: {stamp: {sec: 0, nanosec: 0}, frame_id: ''}\n\
+                  joint_names: [q1, q2, q3, q4, q5, q6]\n\
+                  points:\n\
+                  - {positions: [0, 0, 0, 0, 0, 0], velocities: [0, 0, 0, 0, 0, 0], \
+                     accelerations: [], effort: [], time_from_start: {sec: 0, nanosec: 0}}\n\
+                  - {positions: [0.01, 0, 0, 0, 0, 0], velocities: [0, 0, 0, 0, 0, 0], \
+                     accelerations: [], effort: [], time_from_start: {sec: 1, nanosec: 0}}\n",
+            )
+            .unwrap();
+    }
+    let out = publish.wait_with_output().unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(
+        String::from_utf8_lossy(&out.stdout)
+            .contains("published 1 trajectory_msgs/msg/JointTrajectory"),
+        "{}",
+        String::from_utf8_lossy(&out.stdout)
+    );
+    let out = kerf()
+        .args([
+            "echo",
+            "/trajectory_executor/trajectory_status",
+            "--transient-local",
+            "-n",
+            "1",
+            "--timeout",
+            "20",
+        ])
+        .output()
+        .expect("run kerf echo trajectory_status");
+    let status = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        status.contains("source: topic") && status.contains("status: 1"),
+        "{status}\n{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    // A document that is no JointTrajectory: exit code 2, naming the field.
+    let dir = std::env::temp_dir().join(format!("kerf_cli_pub_{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let bad = dir.join("bad.yaml");
+    std::fs::write(
+        &bad,
+        "header: {stamp: {sec: 0, nanosec: 0}, frame_id: ''}\njoint_names: []\npoints: []\n\
+         joint_nmes: [q1]\n",
+    )
+    .unwrap();
+    let out = kerf()
+        .args(["pub", "/trajectory_executor/joint_trajectory"])
+        .arg(&bad)
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(2));
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(stderr.contains("joint_nmes"), "{stderr}");
+    let _ = std::fs::remove_dir_all(&dir);
 
     // Ctrl-C: a clean shutdown and exit status 0.
     let pid = launch.0.id().to_string();

@@ -202,21 +202,32 @@ impl KerfNode {
         let Some(c) = self.context.as_ref() else {
             return Vec::new();
         };
-        let mut out: Vec<(String, String)> = c
-            .domain_participant()
-            .discovered_writers()
-            .into_iter()
-            .filter_map(|w| {
-                let t = w.publication_topic_data;
-                t.topic_name
-                    .strip_prefix("rt")
-                    .filter(|n| n.starts_with('/'))
-                    .map(|n| (n.to_string(), t.type_name.clone()))
-            })
-            .collect();
-        out.sort();
-        out.dedup();
-        out
+        ros_topics(
+            c.domain_participant()
+                .discovered_writers()
+                .into_iter()
+                .map(|w| {
+                    let t = w.publication_topic_data;
+                    (t.topic_name, t.type_name)
+                }),
+        )
+    }
+
+    /// Topics with a discovered subscription (DDS reader) on the domain, as
+    /// [`KerfNode::discovered_topics`] lists publishers: what `kerf pub` can publish to.
+    pub fn discovered_subscriptions(&self) -> Vec<(String, String)> {
+        let Some(c) = self.context.as_ref() else {
+            return Vec::new();
+        };
+        ros_topics(
+            c.domain_participant()
+                .discovered_readers()
+                .into_iter()
+                .map(|r| {
+                    let t = r.subscription_topic_data;
+                    (t.topic_name().clone(), t.type_name().clone())
+                }),
+        )
     }
 
     /// Expands and remaps a topic or service name as this node sees it.
@@ -462,6 +473,21 @@ impl KerfNode {
         };
         block_on_timeout(client.wait_for_service(node), timeout).is_some()
     }
+}
+
+/// The ROS topics (`rt/…` DDS topics, the prefix removed) among (DDS topic, DDS type) pairs,
+/// sorted, without repeats.
+fn ros_topics(topics: impl Iterator<Item = (String, String)>) -> Vec<(String, String)> {
+    let mut out: Vec<(String, String)> = topics
+        .filter_map(|(name, ty)| {
+            name.strip_prefix("rt")
+                .filter(|n| n.starts_with('/'))
+                .map(|n| (n.to_string(), ty))
+        })
+        .collect();
+    out.sort();
+    out.dedup();
+    out
 }
 
 /// Runs a future to completion on this thread, giving up after `timeout`.
