@@ -7,10 +7,12 @@ use std::path::PathBuf;
 use clap::{Args, ValueEnum};
 use kerf_ros::{shutdown, ParamSource, ParamValue, RosArgs, RosEnv, StopToken};
 
-/// The robots whose descriptions ship in `urdf/`.
+/// The robots whose descriptions ship in `urdf/`, named as their files and as the launch
+/// file's `robot:=` argument (`laser_cutter`, `irb6660`).
 #[derive(Debug, Clone, Copy, ValueEnum)]
 pub enum Robot {
-    /// The 6-axis laser cutting machine of seed 001.
+    /// The 6-axis laser cutting machine of seed 001 (`laser-cutter` is accepted too).
+    #[value(name = "laser_cutter", alias = "laser-cutter")]
     LaserCutter,
     /// ABB IRB 6660-130/3.1.
     Irb6660,
@@ -30,7 +32,7 @@ impl Robot {
 pub struct LaunchArgs {
     /// Robot for the trajectory executor (sets `urdf_file` and `joint_limits_file` from the
     /// shipped descriptions; `-p` arguments after `--ros-args` override them).
-    #[arg(long, value_enum, default_value = "laser-cutter")]
+    #[arg(long, value_enum, default_value = "laser_cutter")]
     robot: Robot,
     /// Also start the robot's planner: the MJTO laser-cutting planner (`mjto_planner`) for
     /// the laser cutter, the milling planner (`milling_planner`) for the IRB 6660. Its
@@ -178,6 +180,18 @@ pub fn run(a: LaunchArgs) -> Result<(), String> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn robots_are_named_as_in_the_launch_file() {
+        for (name, stem) in [
+            ("laser_cutter", "laser_cutter"),
+            ("laser-cutter", "laser_cutter"),
+            ("irb6660", "irb6660"),
+        ] {
+            assert_eq!(Robot::from_str(name, false).unwrap().stem(), stem);
+        }
+        assert!(Robot::from_str("laser", false).is_err());
+    }
 
     #[test]
     fn parameters_go_to_the_nodes_that_know_them() {

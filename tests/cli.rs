@@ -31,7 +31,7 @@ impl Drop for Killed {
 #[test]
 fn launch_echo_and_ctrl_c() {
     let child = kerf()
-        .args(["launch", "--robot", "laser-cutter"])
+        .args(["launch", "--robot", "laser_cutter"])
         .stderr(Stdio::piped())
         .spawn()
         .expect("start kerf launch");
