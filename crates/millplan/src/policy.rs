@@ -100,6 +100,14 @@ pub struct GreedyRollout {
     pub total_reward: f64,
 }
 
+/// Largest policy weights file read (64 MiB; the committed policies are about 100 KB). A larger
+/// file, a FIFO, a device or a directory is refused before it is read
+/// ([`kerf_robot::file::read_regular`]).
+pub const MAX_POLICY_BYTES: u64 = 64 << 20;
+
+/// Largest settings sidecar read (1 MiB; the committed ones are a few KB).
+pub const MAX_SIDECAR_BYTES: u64 = 1 << 20;
+
 /// The sidecar path of a policy file: the same path with the extension
 /// `json`.
 pub fn metadata_path(path: &Path) -> PathBuf {
@@ -248,29 +256,27 @@ impl Policy {
                 "give the .safetensors weights file, not the .json sidecar",
             ));
         }
-        let bytes = std::fs::read(path).map_err(|e| {
-            policy_error(
+        let bytes = if path.exists() {
+            kerf_robot::file::read_regular(path, MAX_POLICY_BYTES)
+                .map_err(|reason| policy_error(path, format!("the weights file: {reason}")))?
+        } else {
+            return Err(policy_error(path, "weights file not found"));
+        };
+        let json = if sidecar.exists() {
+            let raw = kerf_robot::file::read_regular(&sidecar, MAX_SIDECAR_BYTES)
+                .map_err(|reason| policy_error(path, format!("the settings sidecar: {reason}")))?;
+            String::from_utf8(raw).map_err(|_| {
+                policy_error(
+                    path,
+                    format!("settings sidecar {} is not UTF-8 text", sidecar.display()),
+                )
+            })?
+        } else {
+            return Err(policy_error(
                 path,
-                if e.kind() == std::io::ErrorKind::NotFound {
-                    "weights file not found".to_string()
-                } else {
-                    format!("cannot read the weights file: {e}")
-                },
-            )
-        })?;
-        let json = std::fs::read_to_string(&sidecar).map_err(|e| {
-            policy_error(
-                path,
-                if e.kind() == std::io::ErrorKind::NotFound {
-                    format!("settings sidecar {} not found", sidecar.display())
-                } else {
-                    format!(
-                        "cannot read the settings sidecar {}: {e}",
-                        sidecar.display()
-                    )
-                },
-            )
-        })?;
+                format!("settings sidecar {} not found", sidecar.display()),
+            ));
+        };
         let metadata: PolicyMetadata = serde_json::from_str(&json).map_err(|e| {
             policy_error(
                 path,

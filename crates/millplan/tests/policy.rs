@@ -400,3 +400,42 @@ fn trained_agent_round_trip() {
     assert_eq!(r1.actions.len(), 10);
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// Issue 11, row 6: a FIFO named as a policy (or as its sidecar) is refused at once, never
+/// opened; the planner does not hang.
+#[test]
+fn a_fifo_is_no_policy() {
+    let dir = temp_dir("fifo");
+    let weights = dir.join("pipe.safetensors");
+    let make_fifo = |p: &Path| {
+        let c = std::ffi::CString::new(p.to_str().unwrap()).unwrap();
+        // SAFETY: mkfifo(3) on a NUL-terminated path we own.
+        assert_eq!(unsafe { libc::mkfifo(c.as_ptr(), 0o600) }, 0);
+    };
+    make_fifo(&weights);
+    let (tx, rx) = std::sync::mpsc::channel();
+    let w = weights.clone();
+    std::thread::spawn(move || {
+        let _ = tx.send(Policy::load(&w).map(|_| ()));
+    });
+    let e = rx
+        .recv_timeout(std::time::Duration::from_secs(10))
+        .expect("loading a FIFO as a policy hung")
+        .unwrap_err();
+    assert!(matches!(e, MillPlanError::Policy { .. }), "{e}");
+    assert!(e.to_string().contains("FIFO"), "{e}");
+    // A real weights file whose sidecar is a FIFO.
+    let real = dir.join("real.safetensors");
+    std::fs::write(&real, b"not read").unwrap();
+    make_fifo(&metadata_path(&real));
+    let (tx, rx) = std::sync::mpsc::channel();
+    std::thread::spawn(move || {
+        let _ = tx.send(Policy::load(&real).map(|_| ()));
+    });
+    let e = rx
+        .recv_timeout(std::time::Duration::from_secs(10))
+        .expect("loading a FIFO sidecar hung")
+        .unwrap_err();
+    assert!(e.to_string().contains("FIFO"), "{e}");
+    let _ = std::fs::remove_dir_all(&dir);
+}

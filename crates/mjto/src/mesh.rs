@@ -135,6 +135,11 @@ fn percent_decode(s: &str) -> Result<String, String> {
     String::from_utf8(out).map_err(|_| "the URI path is not UTF-8 after decoding".to_owned())
 }
 
+/// Largest mesh file read (64 MiB: a binary STL of about 1.4 million triangles). A larger
+/// file, a FIFO, a device or a directory named as a mesh is refused before it is read
+/// ([`kerf_robot::file::read_regular`]).
+pub const MAX_MESH_BYTES: u64 = 64 << 20;
+
 /// Loads and validates a workpiece mesh.
 ///
 /// # Arguments
@@ -176,8 +181,7 @@ fn load_path(path: &Path, source_name: &str) -> Result<MeshData, PlanError> {
             path.display()
         )));
     }
-    let bytes =
-        std::fs::read(path).map_err(|e| err(format!("cannot read {}: {e}", path.display())))?;
+    let bytes = kerf_robot::file::read_regular(path, MAX_MESH_BYTES).map_err(&err)?;
     let mesh = if ext == "stl" {
         parse_stl(&bytes)
     } else {

@@ -174,7 +174,11 @@ fn errors_name_the_problem() {
     )
     .unwrap();
     let r = mesh_reason(mesh::load(ascii.to_str().unwrap()));
-    assert!(r.contains("line 5") && r.contains("'zero'"), "{r}");
+    // Issue 11, row 9: the line and the coordinate, never the file's own text.
+    assert!(
+        r.contains("line 5") && r.contains("coordinate 3 is not a number") && !r.contains("zero"),
+        "{r}"
+    );
     // Truncated binary STL.
     let trunc = dir.join("trunc.stl");
     mesh::write_stl(&trunc, &m).unwrap();
@@ -281,4 +285,66 @@ fn cache_loads_once_and_reloads_on_change() {
     assert!(cache
         .get(dir.join("missing.obj").to_str().unwrap())
         .is_err());
+}
+
+/// Runs `f` on a thread and fails the test if it does not end within 10 s (a request file
+/// must never hang the planner).
+fn within_10_s<T: Send + 'static>(f: impl FnOnce() -> T + Send + 'static) -> T {
+    let (tx, rx) = std::sync::mpsc::channel();
+    std::thread::spawn(move || {
+        let _ = tx.send(f());
+    });
+    rx.recv_timeout(std::time::Duration::from_secs(10))
+        .expect("the call hung (a FIFO opened for reading blocks)")
+}
+
+/// Issue 11, rows 6 and 9: a FIFO named as a mesh is refused at once (directly or through a
+/// symbolic link), an oversized file by its size, and parse errors quote no file contents.
+#[test]
+fn fifos_oversized_files_and_secrets_are_not_read() {
+    let dir = scratch("unsafe");
+    let fifo = dir.join("pipe.stl");
+    let c = std::ffi::CString::new(fifo.to_str().unwrap()).unwrap();
+    // SAFETY: mkfifo(3) on a NUL-terminated path we own.
+    assert_eq!(unsafe { libc::mkfifo(c.as_ptr(), 0o600) }, 0);
+    let link = dir.join("link.obj");
+    std::os::unix::fs::symlink(&fifo, &link).unwrap();
+    for p in [fifo.clone(), link] {
+        let shown = p.display().to_string();
+        let e = within_10_s(move || mesh::load(&shown)).unwrap_err();
+        assert!(matches!(e, PlanError::Mesh { .. }), "{e}");
+        assert!(e.to_string().contains("FIFO"), "{e}");
+        let shown = p.display().to_string();
+        let e = within_10_s(move || MeshCache::new().get(&shown).map(|_| ())).unwrap_err();
+        assert!(e.to_string().contains("FIFO"), "{e}");
+    }
+    let big = dir.join("big.stl");
+    std::fs::File::create(&big)
+        .unwrap()
+        .set_len(mesh::MAX_MESH_BYTES + 1)
+        .unwrap();
+    let e = mesh::load(big.to_str().unwrap()).unwrap_err().to_string();
+    assert!(e.contains("over the limit"), "{e}");
+    let secret = dir.join("secret.obj");
+    for (text, needle) in [
+        ("v 0 0 0\nv 1 TOPSECRET 0\n", "coordinate 2 is not a number"),
+        (
+            "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 TOPSECRET\n",
+            "not an integer",
+        ),
+    ] {
+        std::fs::write(&secret, text).unwrap();
+        let e = mesh::load(secret.to_str().unwrap())
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains(needle) && !e.contains("TOPSECRET"), "{e}");
+    }
+    let stl = dir.join("secret.stl");
+    std::fs::write(&stl, "solid x\nTOPSECRET 1 2 3\nendsolid\n").unwrap();
+    let e = mesh::load(stl.to_str().unwrap()).unwrap_err().to_string();
+    assert!(
+        e.contains("unexpected keyword") && !e.contains("TOPSECRET"),
+        "{e}"
+    );
+    let _ = std::fs::remove_dir_all(&dir);
 }

@@ -55,6 +55,7 @@ mod chain;
 pub mod data;
 mod error;
 mod executor_limits;
+pub mod file;
 mod joint;
 mod limits;
 mod model;

@@ -137,7 +137,7 @@ fn parse_stl_ascii(text: &str) -> Result<MeshData, String> {
                     }
                 }
             }
-            other => return Err(format!("line {ln}: unexpected keyword '{other}'")),
+            _ => return Err(format!("line {ln}: unexpected keyword (expected facet, outer loop, vertex, endloop, endfacet or endsolid)")),
         }
     }
     if let Some((start, _)) = facet {
@@ -153,9 +153,11 @@ fn parse_xyz<'a>(tok: &mut impl Iterator<Item = &'a str>) -> Result<[f64; 3], St
         let s = tok
             .next()
             .ok_or_else(|| format!("expected 3 coordinates, got {k}"))?;
-        let x: f64 = s.parse().map_err(|_| format!("'{s}' is not a number"))?;
+        let x: f64 = s
+            .parse()
+            .map_err(|_| format!("coordinate {} is not a number", k + 1))?;
         if !x.is_finite() {
-            return Err(format!("coordinate '{s}' is not finite"));
+            return Err(format!("coordinate {} is not finite", k + 1));
         }
         *slot = x;
     }
@@ -202,7 +204,7 @@ fn obj_index(token: &str, n: usize) -> Result<u32, String> {
     let s = token.split('/').next().unwrap_or("");
     let i: i64 = s
         .parse()
-        .map_err(|_| format!("face index '{token}' is not an integer"))?;
+        .map_err(|_| "a face index is not an integer".to_string())?;
     let zero_based = match i {
         0 => return Err("face index 0 (OBJ indices start at 1)".into()),
         i if i > 0 => i - 1,
