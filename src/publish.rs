@@ -119,6 +119,7 @@ impl ForType for Publish<'_> {
 /// A message from YAML, or from JSON YAML cannot read (surrogate-pair `\u` escapes); a key
 /// the type does not have is refused, not ignored.
 fn parse<M: DeserializeOwned + Serialize>(text: &str) -> Result<M, String> {
+    kerf_robot::document::check_depth(text)?;
     let (msg, given): (M, serde_yaml_ng::Value) = match serde_yaml_ng::from_str(text) {
         Ok(m) => (m, serde_yaml_ng::from_str(text).map_err(|e| e.to_string())?),
         Err(yaml) => {

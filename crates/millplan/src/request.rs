@@ -315,8 +315,11 @@ impl MillRequest {
     /// # Errors
     /// [`MillPlanError::InvalidConfig`] naming `request` with the YAML
     /// parser's message (unknown or missing field, wrong type, with line and
-    /// column).
+    /// column), or for a document nested deeper than
+    /// `kerf_robot::document::MAX_DEPTH` (checked before parsing: YAML parsing
+    /// is quadratic in the depth).
     pub fn from_yaml_str(text: &str) -> Result<Self, MillPlanError> {
+        check_depth(text)?;
         serde_yaml_ng::from_str(text)
             .map_err(|yaml| yaml.to_string())
             .or_else(|yaml| json_fallback(text, yaml))
@@ -331,6 +334,7 @@ impl MillRequest {
     /// # Errors
     /// As [`MillRequest::from_yaml_str`].
     pub fn from_json_str(text: &str) -> Result<Self, MillPlanError> {
+        check_depth(text)?;
         serde_json::from_str(text).map_err(|e| MillPlanError::InvalidConfig {
             name: "request".to_string(),
             reason: e.to_string(),
@@ -573,6 +577,14 @@ impl MillRequest {
         }
         Ok(())
     }
+}
+
+/// The nesting check of request documents, before any parsing.
+fn check_depth(text: &str) -> Result<(), MillPlanError> {
+    kerf_robot::document::check_depth(text).map_err(|reason| MillPlanError::InvalidConfig {
+        name: "request".to_string(),
+        reason,
+    })
 }
 
 /// A document YAML refused, read as JSON: JSON's answer (its value, or its error with line and

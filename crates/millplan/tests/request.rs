@@ -480,3 +480,19 @@ fn json_with_unicode_escapes_parses() {
         .to_string();
     assert!(e.contains("planer"), "{e}");
 }
+
+/// Issue 11, row 8: deep nesting is refused before parsing, in both forms.
+#[test]
+fn deep_nesting_is_refused_before_parsing() {
+    let deep = format!("{{\"points\": {}}}", "[".repeat(100_000));
+    for r in [
+        MillRequest::from_yaml_str(&deep),
+        MillRequest::from_json_str(&deep),
+    ] {
+        let e = r.unwrap_err().to_string();
+        assert!(
+            e.contains("levels deep") && e.contains("limit of 32"),
+            "{e}"
+        );
+    }
+}

@@ -261,8 +261,11 @@ impl CutRequest {
     ///
     /// # Errors
     /// [`PlanError::InvalidRequest`] (field `request`) with the YAML parser's message (unknown
-    /// or missing field, wrong type, with line and column).
+    /// or missing field, wrong type, with line and column), or for a document nested deeper
+    /// than `kerf_robot::document::MAX_DEPTH` (checked before parsing).
     pub fn from_yaml(text: &str) -> Result<Self, PlanError> {
+        // Nesting is checked before parsing: YAML parsing is quadratic in it.
+        kerf_robot::document::check_depth(text).map_err(|e| PlanError::invalid("request", e))?;
         serde_yaml_ng::from_str(text)
             .map_err(|yaml| yaml.to_string())
             .or_else(|yaml| json_fallback(text, yaml))

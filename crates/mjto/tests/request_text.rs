@@ -40,3 +40,15 @@ fn yaml_flow_style_and_errors_still_come_from_yaml() {
         .to_string();
     assert!(e.contains("feed_rate"), "{e}");
 }
+
+/// Issue 11, row 8: a document nested 10^5 levels deep (200 KB) is refused before it is parsed
+/// (YAML parsing took 31 s, quadratic in the depth), naming the depth and the limit.
+#[test]
+fn deep_nesting_is_refused_before_parsing() {
+    let deep = format!("request_id: deep\npoints: {}\n", "[".repeat(100_000));
+    let e = CutRequest::from_yaml(&deep).unwrap_err().to_string();
+    assert!(
+        e.contains("levels deep") && e.contains("limit of 32"),
+        "{e}"
+    );
+}

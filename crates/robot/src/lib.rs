@@ -53,6 +53,7 @@
 
 mod chain;
 pub mod data;
+pub mod document;
 mod error;
 mod executor_limits;
 pub mod file;

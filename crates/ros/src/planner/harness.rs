@@ -15,7 +15,8 @@ use kerf_msgs::{std_msgs::StringMsg, trajectory_msgs::JointTrajectory, RosType};
 use ros2_client::Publisher;
 
 use super::{
-    check_trajectory_msg, AnswerKey, Failure, PlanAnswer, PlanningService, TRAJECTORY_TOPIC,
+    check_text_size, check_trajectory_msg, AnswerKey, Failure, PlanAnswer, PlanningService,
+    TRAJECTORY_TOPIC,
 };
 use crate::{qos, Inbox, KerfNode, Logger, NodeSpec, RosArgs, RosEnv, RosError, StopToken};
 use crate::{Worker, WorkerError};
@@ -252,9 +253,16 @@ impl<S: PlanningService> PlannerNode<S> {
         while let Some(received) = self.text_requests.try_recv() {
             any = true;
             let job = match received {
-                Ok(m) => match self.service.request_from_text(&m.data) {
-                    Ok(r) => Job::Plan(Box::new(r)),
-                    Err(answer) => Job::Answer(answer),
+                Ok(m) => match check_text_size(&m.data) {
+                    Err(reason) => Job::Answer(Box::new(self.service.failure(
+                        &AnswerKey::default(),
+                        Failure::Unreadable,
+                        reason,
+                    ))),
+                    Ok(()) => match self.service.request_from_text(&m.data) {
+                        Ok(r) => Job::Plan(Box::new(r)),
+                        Err(answer) => Job::Answer(answer),
+                    },
                 },
                 Err(e) => self.unreadable("text request", e),
             };

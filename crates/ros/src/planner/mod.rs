@@ -35,7 +35,7 @@ pub use executable::{check_trajectory_msg, trajectory_msg, trajectory_request};
 pub use harness::{answer_text, run, work, Job};
 pub use main::node_main;
 pub use service::{AnswerKey, Failure, PlanAnswer, PlanningService, Topics, TRAJECTORY_TOPIC};
-pub use text::{yaml_field, TextRequestError};
+pub use text::{check_text_size, yaml_field, TextRequestError, MAX_TEXT_REQUEST_BYTES};
 
 use crate::{Params, RosError};
 

@@ -1,6 +1,24 @@
 //! What the text request topics of every planner node share: the error of a text request
 //! that cannot be read, and the fields it can still name.
 
+/// Largest text request read (16 MiB, about 250 000 CL points in the line format); a larger
+/// one is answered INVALID_REQUEST before any parsing.
+pub const MAX_TEXT_REQUEST_BYTES: usize = 16 << 20;
+
+/// Checks the size of a text request before it is parsed.
+///
+/// # Returns
+/// The reason it is refused, naming the size and the limit, or `Ok`.
+pub fn check_text_size(text: &str) -> Result<(), String> {
+    if text.len() > MAX_TEXT_REQUEST_BYTES {
+        return Err(format!(
+            "the text request is {} bytes, over the limit of {MAX_TEXT_REQUEST_BYTES} bytes",
+            text.len()
+        ));
+    }
+    Ok(())
+}
+
 /// A text request that could not be turned into a request.
 #[derive(Debug)]
 pub struct TextRequestError<E> {
@@ -25,6 +43,10 @@ impl<E: std::fmt::Debug + std::fmt::Display> std::error::Error for TextRequestEr
 /// The string value of the top-level `key` of a YAML (or JSON) document that may not parse
 /// as a request (empty if the text is no YAML or JSON mapping or the key is no string).
 pub fn yaml_field(text: &str, key: &str) -> String {
+    if text.len() > MAX_TEXT_REQUEST_BYTES || kerf_robot::document::check_depth(text).is_err() {
+        // Not parsed at all: the request is refused for its size or nesting anyway.
+        return String::new();
+    }
     let yaml = serde_yaml_ng::from_str::<serde_yaml_ng::Value>(text)
         .ok()
         .and_then(|v| v.get(key).and_then(|r| r.as_str()).map(String::from));
@@ -48,5 +70,16 @@ mod tests {
         let json = r#"{"request_id": "b \ud83d\ude00", "points": 3}"#;
         assert_eq!(yaml_field(json, "request_id"), "b \u{1F600}");
         assert_eq!(yaml_field(json, "points"), "");
+        // Too deep to be parsed at all (YAML parsing is quadratic in the depth).
+        let deep = format!("request_id: x\nd: {}\n", "[".repeat(100_000));
+        assert_eq!(yaml_field(&deep, "request_id"), "");
+    }
+
+    #[test]
+    fn text_requests_have_a_size_limit() {
+        assert!(super::check_text_size("request_id: a\n").is_ok());
+        let big = "#".repeat(super::MAX_TEXT_REQUEST_BYTES + 1);
+        let e = super::check_text_size(&big).unwrap_err();
+        assert!(e.contains("over the limit of 16777216 bytes"), "{e}");
     }
 }
