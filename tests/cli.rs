@@ -5,7 +5,7 @@
 
 use std::{
     io::{BufRead, BufReader},
-    process::{Child, Command, Stdio},
+    process::{Command, Stdio},
     sync::mpsc,
     time::{Duration, Instant},
 };
@@ -20,13 +20,9 @@ fn kerf() -> Command {
     c
 }
 
-struct Killed(Child);
-impl Drop for Killed {
-    fn drop(&mut self) {
-        let _ = self.0.kill();
-        let _ = self.0.wait();
-    }
-}
+mod support;
+
+use support::{assert_clean_exit, interrupt, Killed};
 
 #[test]
 fn launch_echo_and_ctrl_c() {
@@ -169,25 +165,9 @@ fn launch_echo_and_ctrl_c() {
     let _ = std::fs::remove_dir_all(&dir);
 
     // Ctrl-C: a clean shutdown and exit status 0.
-    let pid = launch.0.id().to_string();
-    assert!(Command::new("kill")
-        .args(["-INT", &pid])
-        .status()
-        .unwrap()
-        .success());
+    interrupt(&launch.0);
     wait_line("shutting down");
-    let deadline = Instant::now() + Duration::from_secs(10);
-    loop {
-        if let Some(status) = launch.0.try_wait().unwrap() {
-            assert!(status.success(), "exit status {status}");
-            break;
-        }
-        assert!(
-            Instant::now() < deadline,
-            "kerf launch did not exit after SIGINT"
-        );
-        std::thread::sleep(Duration::from_millis(20));
-    }
+    assert_clean_exit(&mut launch.0, Duration::from_secs(10));
 }
 
 #[test]

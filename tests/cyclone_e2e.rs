@@ -636,8 +636,10 @@ fn million_point_trajectories_never_stall_the_control_loop() {
             return Err("trajectory topic not matched".into());
         }
         log.wait("first joint state", TIMEOUT, |_| true)?;
-        // Moving: a long swing of joint 1 (16 × 12.6 s).
-        topic.publish(swing(16)).map_err(|e| format!("{e:?}"))?;
+        // Moving: a long swing of joint 1 (64 × 12.6 s = 13 min), so that it is still moving
+        // when the valid trajectory arrives even on a loaded machine (sending the three
+        // 128 MB trajectories took 183 s on 2 busy cores, longer than a 16-period swing).
+        topic.publish(swing(64)).map_err(|e| format!("{e:?}"))?;
         let mut wait = |status: u8, timeout: Duration| -> Result<TrajectoryStatus, String> {
             wait_status(&statuses, status, timeout, &mut || session.failure())
         };

@@ -667,15 +667,6 @@ fn full_queue_is_answered_not_dropped() {
 }
 
 /// Kills the child on drop (a failed test leaves no process behind).
-struct Killed(std::process::Child);
-
-impl Drop for Killed {
-    fn drop(&mut self) {
-        let _ = self.0.kill();
-        let _ = self.0.wait();
-    }
-}
-
 /// `kerf launch --robot irb6660 --with-planner` (the user's command, as a child process)
 /// runs the executor and the milling planner: a text request is planned, its trajectory
 /// (remapped on the command line) reaches the executor, which starts it from the
@@ -713,7 +704,7 @@ fn kerf_launch_irb6660_with_planner_serves_mill_requests() {
         .stderr(Stdio::piped())
         .spawn()
         .expect("start kerf launch");
-    let mut launch = Killed(child);
+    let mut launch = support::Killed(child);
     let stderr = launch.0.stderr.take().expect("stderr");
     let (tx, rx) = std::sync::mpsc::channel();
     std::thread::spawn(move || {
@@ -787,22 +778,6 @@ fn kerf_launch_irb6660_with_planner_serves_mill_requests() {
     drop((texts, plans, statuses, client));
 
     // Ctrl-C: a clean shutdown of both nodes and exit status 0.
-    let pid = launch.0.id().to_string();
-    assert!(Command::new("kill")
-        .args(["-INT", &pid])
-        .status()
-        .unwrap()
-        .success());
-    let deadline = Instant::now() + QUICK;
-    loop {
-        if let Some(status) = launch.0.try_wait().unwrap() {
-            assert!(status.success(), "exit status {status}");
-            break;
-        }
-        assert!(
-            Instant::now() < deadline,
-            "kerf launch did not exit after SIGINT"
-        );
-        std::thread::sleep(Duration::from_millis(20));
-    }
+    support::interrupt(&launch.0);
+    support::assert_clean_exit(&mut launch.0, QUICK);
 }

@@ -7,15 +7,20 @@
 //! * [`motion`]: joint states and trajectory statuses against a plan.
 //! * [`planner`]: a planner node and its client ([`PlannerClient`]), answers ([`expect`]).
 //! * [`take`], [`scratch`]: reading a subscription with a deadline, scratch directories.
+//! * [`Killed`], [`interrupt`], [`assert_clean_exit`]: `kerf` child processes.
 
 use std::time::Duration;
 
+#[allow(dead_code)] // not every crate including this module needs it
 mod executor;
 #[allow(dead_code)] // the moving-robot checks; not every crate including this module needs them
 mod motion;
+#[allow(dead_code)] // not every crate including this module needs it
 mod nodes;
 #[allow(dead_code)] // the planner tests' client; not every crate including this module needs it
 pub mod planner;
+#[allow(dead_code)] // not every crate including this module needs it
+mod process;
 #[allow(dead_code)] // not every crate including this module needs it
 mod scratch;
 #[allow(dead_code)] // not every crate including this module needs it
@@ -30,6 +35,7 @@ pub use {
     },
     nodes::{client_node, loopback, spawn_node, wait_for_writer},
     planner::{expect, PlannerClient},
+    process::{assert_clean_exit, interrupt, Killed},
     scratch::scratch,
     take::{take, take_newest},
 };
