@@ -66,6 +66,11 @@ impl PoseSpec {
     }
 }
 
+/// Largest GFD grid (candidates q4_steps × q5_steps × q6_steps) a request may ask for: 17 times
+/// the default 13 × 9 × 5 = 585. Each candidate costs a kinematics and a collision query per
+/// inserted RTO.
+pub const MAX_GFD_CANDIDATES: usize = 10_000;
+
 /// The sampling grid of one 3D GFD (section 2.4), centred on the
 /// reference configuration of the RTO.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -410,6 +415,19 @@ impl CutRequest {
             return Err(PlanError::invalid(
                 "options.gfd.q6_steps",
                 format!("{} must be in [1, 101]", g.q6_steps),
+            ));
+        }
+        // Every candidate of a GFD costs a kinematics and a collision query; a grid of
+        // 101 × 101 × 101 was still planning after 10 min (issue 11, row 7).
+        let candidates = g.q4_steps * g.q5_steps * g.q6_steps;
+        if candidates > MAX_GFD_CANDIDATES {
+            return Err(PlanError::invalid(
+                "options.gfd",
+                format!(
+                    "q4_steps × q5_steps × q6_steps = {} × {} × {} = {candidates} candidates per \
+                     GFD, over the limit of {MAX_GFD_CANDIDATES}",
+                    g.q4_steps, g.q5_steps, g.q6_steps
+                ),
             ));
         }
         for (name, v) in [

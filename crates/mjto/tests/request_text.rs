@@ -52,3 +52,23 @@ fn deep_nesting_is_refused_before_parsing() {
         "{e}"
     );
 }
+
+/// Issue 11, row 7: a GFD grid of 101 × 101 × 101 (each dimension allowed alone) is refused
+/// before planning, naming the fields, the product and the limit.
+#[test]
+fn gfd_grids_are_bounded_as_a_product() {
+    let mut r = CutRequest::from_yaml(JSON).unwrap();
+    r.options.gfd.q4_steps = 101;
+    r.options.gfd.q5_steps = 101;
+    r.options.gfd.q6_steps = 101;
+    let e = r.validate().unwrap_err().to_string();
+    assert!(
+        e.contains("options.gfd") && e.contains("1030301 candidates") && e.contains("10000"),
+        "{e}"
+    );
+    // The default grid and one at the limit's scale are accepted.
+    r.options.gfd.q4_steps = 21;
+    r.options.gfd.q5_steps = 21;
+    r.options.gfd.q6_steps = 21;
+    assert!(r.validate().is_ok());
+}
