@@ -104,7 +104,7 @@ pub use lobe_map::{LobeGrid, LobeMap};
 pub use lobes::{critical_depth, stability_lobes, LobeOptions, LobePoint};
 pub use model::{
     chip_direction, force_direction, DdeSample, DelayTerm, MillingProcess, Modal2, Mode,
-    PeriodicDde,
+    PeriodicDde, MAX_TEETH,
 };
 pub use modes::{natural_frequencies, symmetric_eigenvalues};
 pub use spectral::{

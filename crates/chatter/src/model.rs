@@ -27,6 +27,11 @@ use serde::{Deserialize, Serialize};
 
 use crate::error::{check_non_negative, check_positive, ChatterError};
 
+/// Most teeth a cutter may have: the model sums the cutting forces over every tooth at every
+/// time step, so the count bounds the work (issue 11, item 2). Milling cutters have at most a
+/// few dozen.
+pub const MAX_TEETH: usize = 100;
+
 /// One vibration mode along one direction of the cutting plane.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct Mode {
@@ -202,17 +207,17 @@ impl MillingProcess {
         }
     }
 
-    /// Checks every field (finite, positive where it must be, engagement
-    /// inside [0, π] and non-empty).
+    /// Checks every field (finite, positive where it must be, at most
+    /// [`MAX_TEETH`] teeth, engagement inside [0, π] and non-empty).
     ///
     /// # Errors
     /// [`ChatterError::InvalidParameter`] naming the field.
     pub fn validate(&self) -> Result<(), ChatterError> {
-        if self.teeth == 0 {
+        if self.teeth == 0 || self.teeth > MAX_TEETH {
             return Err(ChatterError::InvalidParameter {
                 name: "number of teeth".to_string(),
-                value: 0.0,
-                reason: "must be >= 1".to_string(),
+                value: self.teeth as f64,
+                reason: format!("must be in 1..={MAX_TEETH}"),
             });
         }
         check_positive("tool radius [m]", self.radius)?;

@@ -496,3 +496,15 @@ fn deep_nesting_is_refused_before_parsing() {
         );
     }
 }
+
+/// Issue 11, item 2: the number of teeth (the chatter model's work per time step) is bounded;
+/// 10^9 teeth is refused at validation, naming the field and the limit.
+#[test]
+fn teeth_are_bounded() {
+    let mut r = full_request();
+    if let Some(p) = r.process.as_mut() {
+        p.teeth = 1_000_000_000;
+    }
+    let e = r.validate().unwrap_err().to_string();
+    assert!(e.contains("teeth") && e.contains("1..=100"), "{e}");
+}
