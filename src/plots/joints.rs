@@ -156,47 +156,12 @@ pub fn write_plots(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use kerf_mjto::{plan::RtoRecord, CutPlan, CutRequest, LaserMachine};
-
-    /// A straight cut along +x with the head vertical: with both RTOs at q4 = q5 = 0,
-    /// q6 = -0.05, the QI baseline is exactly M = C − q6·O (seed 001 eq. 2) with O = (0, 0, 1).
-    fn straight() -> (CutRequest, CutPlan) {
-        let yaml =
-            "request_id: line\npoints: [[0.5, 0.7, 1.0], [0.55, 0.7, 1.0], [0.6, 0.7, 1.0]]\n\
-                    axes: [[0, 0, 1], [0, 0, 1], [0, 0, 1]]\nfeedrate: 0.2\nsample_period: 0.01\n\
-                    max_lead_angle: 0.1\nmax_tilt_angle: 0.1\nmesh: unused.stl\n\
-                    workpiece_pose: {position: [0.0, 0.0, 0.2], orientation: [0, 0, 0, 1]}\n";
-        let request = CutRequest::from_yaml(yaml).unwrap();
-        let rto = |u, cl_index| RtoRecord {
-            u,
-            cl_index,
-            q4: 0.0,
-            q5: 0.0,
-            q6: -0.05,
-            inserted_at_iteration: 0,
-        };
-        let plan = CutPlan {
-            request_id: "line".into(),
-            joint_names: JOINT_NAMES.iter().map(|s| s.to_string()).collect(),
-            times: vec![0.0, 0.5, 1.0],
-            positions: vec![[0.5, 0.7, 1.25, 0.0, 0.0, -0.05]; 3],
-            velocities: vec![[0.0; 6]; 3],
-            accelerations: vec![[0.0; 6]; 3],
-            rtos: vec![rto(0.0, 0), rto(1.0, 2)],
-            metrics: Default::default(),
-            qi_metrics: Default::default(),
-            iterations: 1,
-            collision_queries: 0,
-            control_points: 3,
-            path_length: 0.1,
-            times_per_stage: Default::default(),
-        };
-        (request, plan)
-    }
+    use kerf_mjto::LaserMachine;
+    use kerf_testparts::straight::straight_cut;
 
     #[test]
     fn plots_are_written_per_axis() {
-        let (request, plan) = straight();
+        let (request, plan) = straight_cut().unwrap();
         let machine = LaserMachine::default_machine().unwrap();
         let qi = JointSeries::qi_baseline(&request, &plan, machine.limits()).unwrap();
         let mjto = JointSeries {

@@ -6,8 +6,12 @@
 //! tests, benchmarks and end-to-end tests run on. Regenerate the committed
 //! files with `cargo run -p kerf_testparts --example gen_bpillar -- --out .`
 //! from the repository root.
+//!
+//! [`straight::straight_cut`] is a three-point cut with a hand-made plan whose QI baseline is
+//! known exactly.
 
 pub mod bpillar;
 pub mod error;
+pub mod straight;
 
 pub use error::TestPartError;
