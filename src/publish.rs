@@ -10,6 +10,8 @@ use clap::Args;
 use kerf_ros::{qos, KerfNode};
 use serde::{de::DeserializeOwned, Serialize};
 
+use kerf_robot::document::from_yaml_or_json;
+
 use crate::topic_types::{cli_node, discover, dispatch, ForType, Side};
 
 /// Arguments of `kerf pub`.
@@ -119,20 +121,8 @@ impl ForType for Publish<'_> {
 /// A message from YAML, or from JSON YAML cannot read (surrogate-pair `\u` escapes); a key
 /// the type does not have is refused, not ignored.
 fn parse<M: DeserializeOwned + Serialize>(text: &str) -> Result<M, String> {
-    kerf_robot::document::check_depth(text)?;
-    let (msg, given): (M, serde_yaml_ng::Value) = match serde_yaml_ng::from_str(text) {
-        Ok(m) => (m, serde_yaml_ng::from_str(text).map_err(|e| e.to_string())?),
-        Err(yaml) => {
-            let Ok(value) = serde_json::from_str::<serde_json::Value>(text) else {
-                return Err(yaml.to_string());
-            };
-            let m = serde_json::from_str(text).map_err(|e| e.to_string())?;
-            (
-                m,
-                serde_yaml_ng::to_value(value).map_err(|e| e.to_string())?,
-            )
-        }
-    };
+    let msg: M = from_yaml_or_json(text)?;
+    let given: serde_yaml_ng::Value = from_yaml_or_json(text)?;
     let read = serde_yaml_ng::to_value(&msg).map_err(|e| e.to_string())?;
     match unknown_key(&given, &read, "") {
         Some(path) => Err(format!("unknown field `{path}`")),

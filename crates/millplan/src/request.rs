@@ -319,14 +319,12 @@ impl MillRequest {
     /// `kerf_robot::document::MAX_DEPTH` (checked before parsing: YAML parsing
     /// is quadratic in the depth).
     pub fn from_yaml_str(text: &str) -> Result<Self, MillPlanError> {
-        check_depth(text)?;
-        serde_yaml_ng::from_str(text)
-            .map_err(|yaml| yaml.to_string())
-            .or_else(|yaml| json_fallback(text, yaml))
-            .map_err(|e| MillPlanError::InvalidConfig {
+        kerf_robot::document::from_yaml_or_json(text).map_err(|reason| {
+            MillPlanError::InvalidConfig {
                 name: "request".to_string(),
-                reason: e.to_string(),
-            })
+                reason,
+            }
+        })
     }
 
     /// Parses JSON text.
@@ -585,14 +583,4 @@ fn check_depth(text: &str) -> Result<(), MillPlanError> {
         name: "request".to_string(),
         reason,
     })
-}
-
-/// A document YAML refused, read as JSON: JSON's answer (its value, or its error with line and
-/// column) when the text is a JSON document, else the YAML parser's error `yaml`.
-fn json_fallback<T: serde::de::DeserializeOwned>(text: &str, yaml: String) -> Result<T, String> {
-    if serde_json::from_str::<serde_json::Value>(text).is_ok() {
-        serde_json::from_str(text).map_err(|e| e.to_string())
-    } else {
-        Err(yaml)
-    }
 }

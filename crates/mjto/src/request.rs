@@ -270,11 +270,7 @@ impl CutRequest {
     /// than `kerf_robot::document::MAX_DEPTH` (checked before parsing).
     pub fn from_yaml(text: &str) -> Result<Self, PlanError> {
         // Nesting is checked before parsing: YAML parsing is quadratic in it.
-        kerf_robot::document::check_depth(text).map_err(|e| PlanError::invalid("request", e))?;
-        serde_yaml_ng::from_str(text)
-            .map_err(|yaml| yaml.to_string())
-            .or_else(|yaml| json_fallback(text, yaml))
-            .map_err(|e| PlanError::invalid("request", e.to_string()))
+        kerf_robot::document::from_yaml_or_json(text).map_err(|e| PlanError::invalid("request", e))
     }
 
     /// Checks every field and transforms the path into the machine frame.
@@ -478,15 +474,5 @@ impl CutRequest {
             return Err(PlanError::invalid("options.clearance", "must be ≥ 0"));
         }
         Ok(())
-    }
-}
-
-/// A document YAML refused, read as JSON: JSON's answer (its value, or its error with line and
-/// column) when the text is a JSON document, else the YAML parser's error `yaml`.
-fn json_fallback<T: serde::de::DeserializeOwned>(text: &str, yaml: String) -> Result<T, String> {
-    if serde_json::from_str::<serde_json::Value>(text).is_ok() {
-        serde_json::from_str(text).map_err(|e| e.to_string())
-    } else {
-        Err(yaml)
     }
 }

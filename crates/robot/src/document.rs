@@ -82,6 +82,24 @@ pub fn check_depth(text: &str) -> Result<(), String> {
     Ok(())
 }
 
+/// Reads a request document: YAML, or JSON where YAML refuses it (JSON is nearly a subset of
+/// YAML, but YAML rejects a `\u` escape of a UTF-16 surrogate pair such as `"\ud83d\ude00"`),
+/// after [`check_depth`].
+///
+/// # Returns
+/// The value, or the reason: the nesting check's, JSON's own error (with line and column) when
+/// the text is a JSON document, else the YAML parser's.
+pub fn from_yaml_or_json<T: serde::de::DeserializeOwned>(text: &str) -> Result<T, String> {
+    check_depth(text)?;
+    serde_yaml_ng::from_str(text).or_else(|yaml| {
+        if serde_json::from_str::<serde_json::Value>(text).is_ok() {
+            serde_json::from_str(text).map_err(|e| e.to_string())
+        } else {
+            Err(yaml.to_string())
+        }
+    })
+}
+
 #[cfg(test)]
 mod tests {
     use super::{check_depth, nesting_depth};

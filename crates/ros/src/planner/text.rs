@@ -43,20 +43,15 @@ impl<E: std::fmt::Debug + std::fmt::Display> std::error::Error for TextRequestEr
 /// The string value of the top-level `key` of a YAML (or JSON) document that may not parse
 /// as a request (empty if the text is no YAML or JSON mapping or the key is no string).
 pub fn yaml_field(text: &str, key: &str) -> String {
-    if text.len() > MAX_TEXT_REQUEST_BYTES || kerf_robot::document::check_depth(text).is_err() {
-        // Not parsed at all: the request is refused for its size or nesting anyway.
+    if text.len() > MAX_TEXT_REQUEST_BYTES {
+        // Not parsed at all: the request is refused for its size anyway.
         return String::new();
     }
-    let yaml = serde_yaml_ng::from_str::<serde_yaml_ng::Value>(text)
+    // Too deep a document is not parsed either (kerf_robot::document::check_depth).
+    kerf_robot::document::from_yaml_or_json::<serde_yaml_ng::Value>(text)
         .ok()
-        .and_then(|v| v.get(key).and_then(|r| r.as_str()).map(String::from));
-    // JSON that YAML cannot read (surrogate-pair `\u` escapes) is read as JSON.
-    yaml.or_else(|| {
-        serde_json::from_str::<serde_json::Value>(text)
-            .ok()
-            .and_then(|v| v.get(key).and_then(|r| r.as_str()).map(String::from))
-    })
-    .unwrap_or_default()
+        .and_then(|v| v.get(key).and_then(|r| r.as_str()).map(String::from))
+        .unwrap_or_default()
 }
 
 #[cfg(test)]
