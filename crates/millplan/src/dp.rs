@@ -68,6 +68,7 @@
 //!   (segments 86–99 above 0.95): the paper's "chatter in the second half"
 //!   of the fixed-g ablation, here at the margin of stability.
 
+use kerf_budget::Budget;
 use std::time::Instant;
 
 use kerf_mill::MillCell;
@@ -188,6 +189,24 @@ pub fn solve(
     cache: &IndicatorCache,
     spec: &DpSpec,
 ) -> Result<DpResult, MillPlanError> {
+    solve_within(cell, cache, spec, &Budget::unlimited())
+}
+
+/// Number of grid nodes rewarded between two checks of the time budget.
+const BUDGET_STRIDE: usize = 4096;
+
+/// [`solve`] under a time budget: checked per segment while the tables are
+/// built and every [`BUDGET_STRIDE`] grid nodes while the DP runs (after
+/// an interrupt every further node is skipped, so the DP ends at once).
+///
+/// # Errors
+/// As [`solve`], and [`MillPlanError::Interrupted`].
+pub fn solve_within(
+    cell: &MillCell,
+    cache: &IndicatorCache,
+    spec: &DpSpec,
+    budget: &Budget,
+) -> Result<DpResult, MillPlanError> {
     let start_time = Instant::now();
     spec.weights.validate()?;
     if let Some(m) = &spec.chatter_margin {
@@ -218,6 +237,7 @@ pub fn solve(
     let mut ro: Vec<Option<f64>> = Vec::with_capacity(n * g.len());
     let mut joints: Vec<[f64; 6]> = Vec::with_capacity(n * g.len());
     for t in 0..n {
+        budget.check("the DP's cell states")?;
         for gv in &g {
             match cell.evaluate(t, *gv, None) {
                 Ok(cs) => {
@@ -242,6 +262,7 @@ pub fn solve(
     let mut need = vec![f64::INFINITY; n * ng * 3];
     if spec.joint_speed_limits {
         for t in 0..n.saturating_sub(1) {
+            budget.check("the DP's joint-speed table")?;
             for k in 0..ng {
                 for dk in 0..3usize {
                     let Some(nk) = (k + dk).checked_sub(1).filter(|v| *v < ng) else {
@@ -288,11 +309,22 @@ pub fn solve(
     let w = spec.weights;
     let mut forbidden = 0usize;
     let mut error: Option<MillPlanError> = None;
+    let mut rewarded = 0usize;
     let path = solve_grid_with_moves(
         n,
         [rpm.len(), feed.len(), g.len()],
         [i0, j0, k0],
         |t, [i, j, k]| {
+            if error.is_some() {
+                return None;
+            }
+            rewarded += 1;
+            if rewarded % BUDGET_STRIDE == 0 {
+                if let Err(e) = budget.check("the DP") {
+                    error = Some(e.into());
+                    return None;
+                }
+            }
             let ro = ro.get(t * g.len() + k).copied().flatten();
             let (Some(ro), Some(re)) = (ro, re.get(j)) else {
                 forbidden += 1;

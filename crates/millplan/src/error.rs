@@ -58,4 +58,8 @@ pub enum MillPlanError {
         /// The executor's reason.
         reason: String,
     },
+    /// Planning stopped before its end: the request's time budget ran out (status TIMEOUT) or
+    /// the planner was cancelled (the node is stopping; INTERNAL_ERROR).
+    #[error("{0}")]
+    Interrupted(#[from] kerf_budget::Interrupt),
 }

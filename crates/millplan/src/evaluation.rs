@@ -4,6 +4,7 @@
 //! sequential one), and, with an indicator cache, its values where they
 //! apply.
 
+use kerf_budget::Budget;
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 
 use kerf_chatter::indicator::chatter_indicator;
@@ -26,6 +27,7 @@ pub(crate) fn evaluate_impl(
     planner: &str,
     threads: usize,
     cache: Option<&IndicatorCache>,
+    budget: &Budget,
 ) -> Result<(Plan, IndicatorProvenance), MillPlanError> {
     if threads == 0 {
         return Err(MillPlanError::InvalidParameter {
@@ -48,6 +50,7 @@ pub(crate) fn evaluate_impl(
     let mut first_error: Option<MillPlanError> = None;
     let mut reference: Option<[f64; 6]> = None;
     for (i, s) in states.iter().enumerate() {
+        budget.check("the plan's cell states")?;
         match check_state(cell, i, s, planner)
             .and_then(|()| Ok(cell.evaluate(i, s.g, reference.as_ref())?))
         {
@@ -68,7 +71,8 @@ pub(crate) fn evaluate_impl(
         None => vec![None; k],
     };
     let direct: Vec<usize> = (0..k).filter(|i| cached[*i].is_none()).collect();
-    let mut direct_mus = spectral_radii(cell, states, &cell_states, &direct, threads).into_iter();
+    let mut direct_mus =
+        spectral_radii(cell, states, &cell_states, &direct, threads, budget).into_iter();
     let mut mus: Vec<Result<f64, MillPlanError>> = Vec::with_capacity(k);
     for value in &cached {
         match value {
@@ -299,16 +303,21 @@ fn spectral_radius(
 /// Indices are handed out in increasing order from a shared counter; after
 /// the first error no new one starts, so every result before the lowest
 /// failing index is computed; the list stops after that error (step 3
-/// stops there first).
+/// stops there first). `budget` is checked before each evaluation: an
+/// interrupt is that segment's error.
 pub(crate) fn spectral_radii(
     cell: &MillCell,
     states: &[PhysicalState],
     cell_states: &[CellState],
     indices: &[usize],
     threads: usize,
+    budget: &Budget,
 ) -> Vec<Result<f64, MillPlanError>> {
     let n = indices.len();
-    let eval = |j: usize| spectral_radius(cell, &states[indices[j]], &cell_states[indices[j]]);
+    let eval = |j: usize| {
+        budget.check("the chatter indicator")?;
+        spectral_radius(cell, &states[indices[j]], &cell_states[indices[j]])
+    };
     let workers = threads.min(n).clamp(1, MAX_EVAL_THREADS);
     if workers == 1 {
         let mut out = Vec::with_capacity(n);

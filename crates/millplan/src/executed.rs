@@ -3,6 +3,7 @@
 //! joints' velocity and acceleration limits ([`crate::timing::time_scale`])
 //! and the plan at the feeds that result ([`Plan::as_executed`]).
 
+use kerf_budget::Budget;
 use kerf_executor::{check_executable, ExecutorConfig};
 use kerf_mill::MillCell;
 
@@ -44,7 +45,16 @@ pub fn execute(
 ) -> Result<Executed, MillPlanError> {
     let (trajectory, _) = planned_trajectory(cell, plan)?;
     let direct = IndicatorProvenance::direct(IndicatorSource::Direct, plan.segments.len(), "");
-    executed(cell, plan, &trajectory, weights, threads, &direct, None)
+    executed(
+        cell,
+        plan,
+        &trajectory,
+        weights,
+        threads,
+        &direct,
+        None,
+        &Budget::unlimited(),
+    )
 }
 
 /// Step 7: the executable trajectory and the plan it runs.
@@ -68,6 +78,7 @@ pub(crate) fn executed(
     threads: usize,
     indicator: &IndicatorProvenance,
     cache: Option<&IndicatorCache>,
+    budget: &Budget,
 ) -> Result<Executed, MillPlanError> {
     let joints = cell.robot().joints();
     let limits = trajectory
@@ -89,7 +100,9 @@ pub(crate) fn executed(
         .collect::<Result<Vec<_>, _>>()?;
     let times: Vec<f64> = plan.segments.iter().map(|s| s.time).collect();
     let feeds: Vec<f64> = plan.segments.iter().map(|s| s.feed).collect();
+    budget.check("the time scaling")?;
     let scaling = time_scale(trajectory, &times, &feeds, &limits)?;
+    budget.check("the executability check")?;
     // Judged by what the executor runs: its own validation, from rest at the first point.
     let not_executable = |reason: String| MillPlanError::NotExecutable { reason };
     let model = cell
@@ -110,6 +123,7 @@ pub(crate) fn executed(
         threads,
         indicator,
         cache,
+        budget,
     )?;
     Ok(Executed {
         scaling,

@@ -22,6 +22,7 @@
 //! segment (it is the baseline a process engineer would program, not a
 //! policy of the environment).
 
+use kerf_budget::Budget;
 use kerf_mill::MillCell;
 
 use crate::cache::{direct_indicator, IndicatorCache};
@@ -61,10 +62,12 @@ fn direct_max(
     feed: f64,
     g: f64,
     early_stop: bool,
+    budget: &Budget,
 ) -> Result<Option<f64>, MillPlanError> {
     let mut reference: Option<[f64; 6]> = None;
     let mut max: f64 = 0.0;
     for seg in 0..cell.path().segments().len() {
+        budget.check("the naive plan's verification")?;
         let cs = match cell.evaluate(seg, g, reference.as_ref()) {
             Ok(cs) => cs,
             Err(e) if crate::cache::is_infeasible(&e) => return Ok(None),
@@ -99,6 +102,20 @@ pub fn solve(
     cache: &IndicatorCache,
     g: f64,
 ) -> Result<NaiveResult, MillPlanError> {
+    solve_within(cell, cache, g, &Budget::unlimited())
+}
+
+/// [`solve`] under a time budget, checked per (Ω, f) pair of the cached
+/// search and per segment of each direct verification.
+///
+/// # Errors
+/// As [`solve`], and [`MillPlanError::Interrupted`].
+pub fn solve_within(
+    cell: &MillCell,
+    cache: &IndicatorCache,
+    g: f64,
+    budget: &Budget,
+) -> Result<NaiveResult, MillPlanError> {
     if g.is_nan() {
         return Err(MillPlanError::InvalidParameter {
             name: "naive redundancy angle g [rad]".to_string(),
@@ -115,6 +132,7 @@ pub fn solve(
     for i in 0..=n_rpm {
         let rpm = lim.spindle_rpm[0] + i as f64 * lim.max_spindle_step_rpm;
         for j in 1..=n_feed {
+            budget.check("the naive plan's search")?;
             let feed = j as f64 * lim.max_feed_step;
             if feed < lim.feed[0] {
                 continue;
@@ -149,7 +167,7 @@ pub fn solve(
     let mut verified = 0;
     for (feed, _, rpm) in candidates.iter().take(MAX_VERIFICATIONS) {
         verified += 1;
-        if let Some(max) = direct_max(cell, *rpm, *feed, g, true)? {
+        if let Some(max) = direct_max(cell, *rpm, *feed, g, true, budget)? {
             if max < 1.0 {
                 return Ok(NaiveResult {
                     rpm: *rpm,
@@ -168,13 +186,14 @@ pub fn solve(
         2000.0_f64.clamp(lim.spindle_rpm[0], lim.spindle_rpm[1]),
         0.04,
     );
-    let max =
-        direct_max(cell, rpm, feed, g, false)?.ok_or_else(|| MillPlanError::InvalidParameter {
+    let max = direct_max(cell, rpm, feed, g, false, budget)?.ok_or_else(|| {
+        MillPlanError::InvalidParameter {
             name: "naive redundancy angle g [rad]".to_string(),
             value: g,
             reason: "infeasible (IK or joint limit) at some segment: no constant plan exists"
                 .to_string(),
-        })?;
+        }
+    })?;
     Ok(NaiveResult {
         rpm,
         feed,

@@ -20,6 +20,7 @@
 //!   [`default_eval_threads`] threads ([`Plan::evaluate_with_threads`]);
 //!   the plan is bit for bit the sequential one (`tests/plan_eval.rs`).
 
+use kerf_budget::Budget;
 use kerf_mill::MillCell;
 
 use crate::cache::IndicatorCache;
@@ -162,7 +163,16 @@ impl Plan {
         planner: &str,
         threads: usize,
     ) -> Result<Self, MillPlanError> {
-        evaluate_impl(cell, weights, states, planner, threads, None).map(|(plan, _)| plan)
+        evaluate_impl(
+            cell,
+            weights,
+            states,
+            planner,
+            threads,
+            None,
+            &Budget::unlimited(),
+        )
+        .map(|(plan, _)| plan)
     }
 
     /// [`Plan::evaluate_with_threads`] with |μ|max from `cache` where it
@@ -192,8 +202,9 @@ impl Plan {
         planner: &str,
         threads: usize,
         cache: &IndicatorCache,
+        budget: &Budget,
     ) -> Result<(Self, IndicatorProvenance), MillPlanError> {
-        evaluate_impl(cell, weights, states, planner, threads, Some(cache))
+        evaluate_impl(cell, weights, states, planner, threads, Some(cache), budget)
     }
 
     /// The plan with its totals from `segments` (in order): machining time
@@ -263,8 +274,17 @@ impl Plan {
         threads: usize,
         cached: &IndicatorProvenance,
     ) -> Result<Self, MillPlanError> {
-        self.as_executed_with(cell, weights, feeds, times, threads, cached, None)
-            .map(|(plan, _)| plan)
+        self.as_executed_with(
+            cell,
+            weights,
+            feeds,
+            times,
+            threads,
+            cached,
+            None,
+            &Budget::unlimited(),
+        )
+        .map(|(plan, _)| plan)
     }
 
     /// [`Plan::as_executed`], with `cache` `Some` when the plan was
@@ -287,6 +307,7 @@ impl Plan {
         threads: usize,
         cached: &IndicatorProvenance,
         cache: Option<&IndicatorCache>,
+        budget: &Budget,
     ) -> Result<(Self, Vec<usize>), MillPlanError> {
         let n = self.segments.len();
         if feeds.len() != n || times.len() != n {
@@ -323,6 +344,7 @@ impl Plan {
         let mut states = Vec::with_capacity(changed.len());
         let mut cell_states = Vec::with_capacity(changed.len());
         for &i in &changed {
+            budget.check("the executed plan's cell states")?;
             let s = &self.segments[i];
             let reference = i.checked_sub(1).map(|p| self.segments[p].joints);
             cell_states.push(cell.evaluate(i, s.g, reference.as_ref())?);
@@ -341,7 +363,7 @@ impl Plan {
             .filter(|j| cached_now[*j].is_none())
             .collect();
         let mut direct_mus =
-            spectral_radii(cell, &states, &cell_states, &direct, threads).into_iter();
+            spectral_radii(cell, &states, &cell_states, &direct, threads, budget).into_iter();
         let max_feed = cell.state_limits().feed[1];
         let mut segments = self.segments.clone();
         let mut margins = vec![0.0; n];

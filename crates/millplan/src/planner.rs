@@ -63,12 +63,14 @@ use std::path::{Path, PathBuf};
 use std::sync::{Arc, Mutex};
 use std::time::{Instant, SystemTime};
 
+use kerf_budget::Budget;
 use kerf_mill::{MillCell, MillError, PathSpec, StateLimits};
 
 use crate::cache::{cell_fingerprint, is_infeasible, IndicatorCache};
 use crate::dp::{self, DpSpec};
 use crate::env::{EnvConfig, MillEnv, PhysicalState};
 use crate::error::MillPlanError;
+use crate::evaluation::evaluate_impl;
 use crate::executed::executed;
 use crate::naive;
 use crate::plan::{default_eval_threads, IndicatorProvenance, IndicatorSource, Plan};
@@ -387,14 +389,35 @@ impl MillPlanner {
     /// answer). The first plan of a new path pays 15–30 ms more for the
     /// path's spline fit (then kept, step 2).
     pub fn plan(&self, request: &MillRequest) -> Result<MillPlanOutput, MillPlanError> {
+        self.plan_within(request, &Budget::unlimited())
+    }
+
+    /// [`Self::plan`] under a time budget and a cancellation token (issue 11, item 3).
+    ///
+    /// # Arguments
+    /// * `request` — the request; its own `time_budget` (if any) tightens `budget`.
+    /// * `budget` — checked between units of work: each segment of the reachability check,
+    ///   each step of the policy rollout, each indicator evaluation, each segment of the
+    ///   naive planner's verifications, every 4096 nodes of the DP, each stage after.
+    ///
+    /// # Errors
+    /// As [`Self::plan`], and [`MillPlanError::Interrupted`] when the budget runs out
+    /// (status TIMEOUT) or is cancelled.
+    pub fn plan_within(
+        &self,
+        request: &MillRequest,
+        budget: &Budget,
+    ) -> Result<MillPlanOutput, MillPlanError> {
         let start = Instant::now();
         let base = *self.cell.state_limits();
         request.validate_with(&base)?;
+        let budget = &budget.tightened(request.time_limit()?);
         let kind = request.planner_kind()?;
         let limits = request.effective_limits(&base);
+        budget.check("validation")?;
         let (cell, cache_applies) = self.request_cell(request, limits)?;
         let [rpm0, feed0, g0] = request.initial_state();
-        check_reachable(&cell, g0)?;
+        check_reachable(&cell, g0, budget)?;
         let mut phases = PlanningPhases {
             setup: start.elapsed().as_secs_f64(),
             ..PlanningPhases::default()
@@ -427,7 +450,10 @@ impl MillPlanner {
                 let mut env = MillEnv::new(cell.clone(), cache.clone(), config)?;
                 let policy = self.policy(&path)?;
                 policy.check_sizes(env.observation_dim(), env.action_dim())?;
-                let rollout = env.rollout(|obs, _| policy.act(obs))?;
+                let rollout = env.rollout(|obs, _| {
+                    budget.check("the policy rollout")?;
+                    policy.act(obs)
+                })?;
                 if !rollout.completed {
                     let why = rollout.stop_reason();
                     return Err(MillPlanError::Policy {
@@ -462,9 +488,9 @@ impl MillPlanner {
                         initial: [rpm0, feed0, g0],
                         ..DpSpec::full(&cell, self.env_config.weights, false)
                     };
-                    dp::solve(&cell, &cache, &spec)?.states
+                    dp::solve_within(&cell, &cache, &spec, budget)?.states
                 } else {
-                    naive::solve(&cell, &cache, g0)?.states
+                    naive::solve_within(&cell, &cache, g0, budget)?.states
                 }
             }
         };
@@ -473,16 +499,24 @@ impl MillPlanner {
         let weights = &self.env_config.weights;
         let segments = states.len();
         let (plan, indicator) = match (self.indicator_source, &cache) {
-            (IndicatorSource::Cache, Some(c)) => {
-                Plan::evaluate_cached(&cell, weights, &states, kind.name(), self.eval_threads, c)?
-            }
+            (IndicatorSource::Cache, Some(c)) => Plan::evaluate_cached(
+                &cell,
+                weights,
+                &states,
+                kind.name(),
+                self.eval_threads,
+                c,
+                budget,
+            )?,
             (source, _) => {
-                let plan = Plan::evaluate_with_threads(
+                let (plan, _) = evaluate_impl(
                     &cell,
                     weights,
                     &states,
                     kind.name(),
                     self.eval_threads,
+                    None,
+                    budget,
                 )?;
                 let reason = if source == IndicatorSource::Cache {
                     if self.cache.is_none() {
@@ -498,6 +532,7 @@ impl MillPlanner {
         };
         phases.evaluation = step.elapsed().as_secs_f64();
         let step = Instant::now();
+        budget.check("the planned trajectory")?;
         let (trajectory, branch_jumps) = planned_trajectory(&cell, &plan)?;
         let executed = executed(
             &cell,
@@ -510,6 +545,7 @@ impl MillPlanner {
                 IndicatorSource::Cache => cache.as_deref(),
                 IndicatorSource::Direct => None,
             },
+            budget,
         )?;
         phases.trajectory = step.elapsed().as_secs_f64();
         Ok(MillPlanOutput {
@@ -539,7 +575,7 @@ const REACH_SAMPLES: usize = 64;
 /// The cell's error of the least-violating g of the first segment without
 /// a feasible g (a joint-limit error beats an unreachable one; among
 /// those, the smallest excess or distance).
-fn check_reachable(cell: &MillCell, g0: f64) -> Result<(), MillPlanError> {
+fn check_reachable(cell: &MillCell, g0: f64, budget: &Budget) -> Result<(), MillPlanError> {
     let [lo, hi] = cell.state_limits().redundancy_angle;
     let mut sweep = vec![g0];
     sweep.extend((0..=REACH_SAMPLES).map(|k| lo + (hi - lo) * k as f64 / REACH_SAMPLES as f64));
@@ -552,6 +588,7 @@ fn check_reachable(cell: &MillCell, g0: f64) -> Result<(), MillPlanError> {
         _ => 2e6,
     };
     for segment in 0..cell.path().segments().len() {
+        budget.check("the reachability check")?;
         let mut least: Option<MillError> = None;
         let mut ok = false;
         for &g in &sweep {

@@ -224,6 +224,12 @@ pub struct MillRequest {
     /// directory); the planner's default policy when absent.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub policy_file: Option<String>,
+    /// Time budget of the plan (s), in (0, [`kerf_budget::MAX_BUDGET_SECONDS`]]; absent or 0 =
+    /// none of the request's own (a planner node then applies its `plan_timeout`, and a
+    /// request may only ask for less). A plan that runs out of it ends with
+    /// [`MillPlanError::Interrupted`] (status TIMEOUT).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub time_budget: Option<f64>,
 }
 
 fn default_planner() -> String {
@@ -243,6 +249,7 @@ impl Default for MillRequest {
             initial: None,
             planner: default_planner(),
             policy_file: None,
+            time_budget: None,
         }
     }
 }
@@ -415,6 +422,7 @@ impl MillRequest {
     /// Builds the spline once with one segment (well under a millisecond
     /// for a few points).
     pub fn validate(&self) -> Result<(), MillPlanError> {
+        self.time_limit()?;
         if self.points.len() < 2 {
             return Err(MillPlanError::InvalidParameter {
                 name: "points (count)".to_string(),
@@ -548,6 +556,20 @@ impl MillRequest {
         let limits = self.effective_limits(cell_limits);
         limits.validate()?;
         self.check_initial(&limits)
+    }
+
+    /// The request's own time budget (`None`: absent or 0).
+    ///
+    /// # Errors
+    /// [`MillPlanError::InvalidParameter`] (`time_budget [s]`) for a negative, non-finite or
+    /// too large value.
+    pub fn time_limit(&self) -> Result<Option<std::time::Duration>, MillPlanError> {
+        let seconds = self.time_budget.unwrap_or(0.0);
+        kerf_budget::limit_from_seconds(seconds).map_err(|reason| MillPlanError::InvalidParameter {
+            name: "time_budget [s]".to_string(),
+            value: seconds,
+            reason,
+        })
     }
 
     /// The request's limits over `cell_limits`.

@@ -19,8 +19,11 @@ pub const UNREACHABLE: u8 = 2;
 pub const POLICY_ERROR: u8 = 3;
 /// The chatter model failed (non-convergence, NaN).
 pub const CHATTER_MODEL_ERROR: u8 = 4;
-/// Anything else (I/O, learning backend, a numerical failure).
+/// Anything else (I/O, learning backend, a numerical failure; planning
+/// cancelled because the node is stopping).
 pub const INTERNAL_ERROR: u8 = 6;
+/// The request's time budget ran out before the plan was finished.
+pub const TIMEOUT: u8 = 7;
 
 /// The name of a status value, `None` for an unknown one.
 pub fn status_name(value: u8) -> Option<&'static str> {
@@ -31,6 +34,7 @@ pub fn status_name(value: u8) -> Option<&'static str> {
         POLICY_ERROR => Some("POLICY_ERROR"),
         CHATTER_MODEL_ERROR => Some("CHATTER_MODEL_ERROR"),
         INTERNAL_ERROR => Some("INTERNAL_ERROR"),
+        TIMEOUT => Some("TIMEOUT"),
         _ => None,
     }
 }
@@ -43,7 +47,8 @@ pub fn status_name(value: u8) -> Option<&'static str> {
 /// | `Mill` of `Unreachable`, `JointLimit`, `Singular` | UNREACHABLE 2 |
 /// | `Policy` | POLICY_ERROR 3 |
 /// | `Chatter`, `Mill(Chatter)` | CHATTER_MODEL_ERROR 4 |
-/// | `Io`, `Backend`, `Mill` of a non-finite value, non-convergence, a file or robot-model failure | INTERNAL_ERROR 6 |
+/// | `Io`, `Backend`, `Mill` of a non-finite value, non-convergence, a file or robot-model failure; `Interrupted` by a cancellation | INTERNAL_ERROR 6 |
+/// | `Interrupted` by the time budget | TIMEOUT 7 |
 ///
 /// Value 5 (`QUEUE_FULL` of `kerf_msgs/msg/MillPlan`) belongs to the node
 /// (its request queue) and is not produced here.
@@ -72,5 +77,7 @@ pub fn status_of(error: &MillPlanError) -> u8 {
         MillPlanError::Io { .. }
         | MillPlanError::Backend(_)
         | MillPlanError::NotExecutable { .. } => INTERNAL_ERROR,
+        MillPlanError::Interrupted(i) if i.is_timeout() => TIMEOUT,
+        MillPlanError::Interrupted(_) => INTERNAL_ERROR,
     }
 }

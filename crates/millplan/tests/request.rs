@@ -87,6 +87,7 @@ fn full_request() -> MillRequest {
         }),
         planner: "fixed_g".to_string(),
         policy_file: Some("policies/x.safetensors".to_string()),
+        time_budget: Some(12.5),
     }
 }
 

@@ -12,6 +12,7 @@
 //! Run: `cargo bench -p kerf_mjto --bench collision`.
 #![allow(clippy::unwrap_used, clippy::expect_used)] // tests report failures by panicking
 
+use kerf_budget::Budget;
 use std::hint::black_box;
 
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
@@ -192,7 +193,7 @@ fn bench_gfd(c: &mut Criterion, m: &MeshData) {
     g.bench_function("build + nearest_free(reference)", |b| {
         b.iter(|| {
             let mut gfd = build();
-            gfd.nearest_free(gfd.reference, &Weights::default(), &w)
+            gfd.nearest_free(gfd.reference, &Weights::default(), &w, &Budget::unlimited())
         })
     });
     g.finish();
@@ -230,7 +231,8 @@ fn bench_selection(c: &mut Criterion, m: &MeshData) {
     let weights = Weights::default();
     let before = w.queries();
     let mut once = gfds.clone();
-    let choice = select_rtos(&mut once, &sigma, &weights, &w).expect("selection");
+    let choice =
+        select_rtos(&mut once, &sigma, &weights, &w, &Budget::unlimited()).expect("selection");
     eprintln!(
         "selection: {} layers of {} candidates, {} queries, choice {choice:?}",
         gfds.len(),
@@ -241,7 +243,7 @@ fn bench_selection(c: &mut Criterion, m: &MeshData) {
     g.bench_function("lazy (6 RTOs, default grid)", |b| {
         b.iter(|| {
             let mut l = gfds.clone();
-            select_rtos(&mut l, &sigma, &weights, &w).expect("selection")
+            select_rtos(&mut l, &sigma, &weights, &w, &Budget::unlimited()).expect("selection")
         })
     });
     g.bench_function("eager (6 RTOs, default grid)", |b| {

@@ -16,6 +16,7 @@
 //!
 //! The result is sampled on the same time law and Δt as the plan.
 
+use kerf_budget::Budget;
 use nalgebra::Vector3;
 
 use crate::kinematics::{inverse, tool_axis};
@@ -154,6 +155,23 @@ pub fn quaternion_interpolation(
     dt: f64,
     limits: &[AxisLimits; 6],
 ) -> Result<(Vec<f64>, Vec<[f64; 6]>), PlanError> {
+    quaternion_interpolation_within(frames, rtos, law, sigma, dt, limits, &Budget::unlimited())
+}
+
+/// [`quaternion_interpolation`] under a time budget, checked every
+/// [`crate::planner::BUDGET_STRIDE`] samples.
+///
+/// # Errors
+/// As [`quaternion_interpolation`], and [`PlanError::Interrupted`].
+pub fn quaternion_interpolation_within(
+    frames: &PathFrames,
+    rtos: &[Rto],
+    law: &TimeLaw,
+    sigma: f64,
+    dt: f64,
+    limits: &[AxisLimits; 6],
+    budget: &Budget,
+) -> Result<(Vec<f64>, Vec<[f64; 6]>), PlanError> {
     check_rtos(rtos)?;
     if !(sigma.is_finite() && (sigma - law.sigma()).abs() <= 1e-9 * law.sigma().max(1.0)) {
         return Err(PlanError::invalid(
@@ -167,7 +185,10 @@ pub fn quaternion_interpolation(
     let times = law.checked_sample_times(dt, MAX_SAMPLES)?;
     let mut positions = Vec::with_capacity(times.len());
     let mut previous = rtos.first().map(|r| r.q4);
-    for &t in &times {
+    for (k, &t) in times.iter().enumerate() {
+        if k % crate::planner::BUDGET_STRIDE == 0 {
+            budget.check("the QI baseline")?;
+        }
         let u = (law.eval(t)[0] / sigma).clamp(0.0, 1.0);
         let q = pose_unchecked(frames, rtos, u, previous, limits)?;
         previous = Some(q[3]);

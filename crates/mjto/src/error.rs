@@ -153,6 +153,10 @@ pub enum PlanError {
         /// The executor's reason.
         reason: String,
     },
+    /// Planning stopped before its end: the request's time budget ran out (status TIMEOUT) or
+    /// the planner was cancelled (the node is stopping; INTERNAL_ERROR).
+    #[error("{0}")]
+    Interrupted(#[from] kerf_budget::Interrupt),
 }
 
 /// Status codes of `kerf_msgs/msg/CutPlan` (kept equal to the constants in
@@ -174,6 +178,8 @@ pub mod status {
     pub const LIMIT_VIOLATION: u8 = 6;
     /// Solver failure or another internal error.
     pub const INTERNAL_ERROR: u8 = 7;
+    /// The request's time budget ran out before the plan was finished.
+    pub const TIMEOUT: u8 = 8;
 }
 
 impl PlanError {
@@ -189,6 +195,8 @@ impl PlanError {
             }
             PlanError::LimitViolation { .. } => status::LIMIT_VIOLATION,
             PlanError::Solver { .. } | PlanError::NotExecutable { .. } => status::INTERNAL_ERROR,
+            PlanError::Interrupted(i) if i.is_timeout() => status::TIMEOUT,
+            PlanError::Interrupted(_) => status::INTERNAL_ERROR,
         }
     }
 

@@ -16,6 +16,7 @@
 //! memoised: the RTO selection (eq. 56, [`crate::selection`]) and the RTO
 //! insertion of Figure 6 usually need a handful of them.
 
+use kerf_budget::{Budget, Interrupt};
 use nalgebra::Vector3;
 
 use crate::collision::CollisionWorld;
@@ -305,6 +306,9 @@ impl Gfd {
     /// # Returns
     /// The candidate index, or `None` when every candidate collides.
     ///
+    /// # Errors
+    /// The budget's [`Interrupt`], checked before each collision query.
+    ///
     /// # Performance
     /// O(n log n) sort plus as many collision queries as colliding
     /// candidates nearer than the answer (memoised ones are free).
@@ -313,7 +317,8 @@ impl Gfd {
         target: [f64; 3],
         weights: &Weights,
         world: &CollisionWorld,
-    ) -> Option<usize> {
+        budget: &Budget,
+    ) -> Result<Option<usize>, Interrupt> {
         let mut order: Vec<(f64, usize)> = self
             .candidates
             .iter()
@@ -321,10 +326,13 @@ impl Gfd {
             .map(|(p, c)| (weighted_distance(&c.q, &target, weights), p))
             .collect();
         order.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
-        order
-            .into_iter()
-            .map(|(_, p)| p)
-            .find(|&p| self.is_free(p, world))
+        for (_, p) in order {
+            budget.check("the search for a free GFD candidate")?;
+            if self.is_free(p, world) {
+                return Ok(Some(p));
+            }
+        }
+        Ok(None)
     }
 
     /// Number of candidates whose collision status has been evaluated.

@@ -22,6 +22,7 @@
 //!   current trajectory at that CL point (the GFD is centred there), so the
 //!   smooth solution is perturbed as little as possible.
 
+use kerf_budget::Budget;
 use kerf_executor::{check_executable, ExecutorConfig};
 use std::time::Instant;
 
@@ -45,6 +46,9 @@ pub const DEGREE: usize = 5;
 
 /// Relative tolerance of the lead/tilt check on the dense samples.
 const ANGLE_TOLERANCE: f64 = 1e-9;
+
+/// Trajectory samples (sampled or collision-checked) between two checks of the time budget.
+pub const BUDGET_STRIDE: usize = 256;
 
 /// Relative tolerance of the analytic limit check of the final plan.
 const LIMIT_TOLERANCE: f64 = 1e-6;
@@ -121,9 +125,30 @@ impl Planner {
     /// Dominated by the dense collision checks (one query per sample per
     /// iteration) and the two QPs; see BENCHMARKS.md.
     pub fn plan(&mut self, request: &CutRequest) -> Result<CutPlan, PlanError> {
+        self.plan_within(request, &Budget::unlimited())
+    }
+
+    /// [`Self::plan`] under a time budget and a cancellation token (issue 11, item 3).
+    ///
+    /// # Arguments
+    /// * `request` — the cut request; its own `time_budget` (if any) tightens `budget`.
+    /// * `budget` — checked between units of work: each GFD candidate's collision query, each
+    ///   DP layer of the RTO selection, each QP (each bounded to 200 interior-point
+    ///   iterations), every [`BUDGET_STRIDE`] trajectory samples, each stage of the evaluation.
+    ///
+    /// # Errors
+    /// As [`Self::plan`], and [`PlanError::Interrupted`] when the budget runs out (status
+    /// TIMEOUT) or is cancelled.
+    pub fn plan_within(
+        &mut self,
+        request: &CutRequest,
+        budget: &Budget,
+    ) -> Result<CutPlan, PlanError> {
         let start = Instant::now();
         let mut times = StageTimes::default();
         let v = request.validate()?;
+        let budget = budget.tightened(v.time_budget);
+        budget.check("validation")?;
         if v.points.len() < DEGREE + 1 {
             return Err(PlanError::invalid(
                 "points",
@@ -135,13 +160,14 @@ impl Planner {
             ));
         }
         let mesh = self.meshes.get(&request.mesh)?;
+        budget.check("mesh loading")?;
         let world = CollisionWorld::new(
             self.head.clone(),
             &mesh,
             &v.workpiece_pose,
             request.options.clearance,
         )?;
-        let ctx = Context::new(&self.machine, request, &v)?;
+        let ctx = Context::new(&self.machine, request, &v, budget)?;
         times.setup = start.elapsed().as_secs_f64();
 
         let t = Instant::now();
@@ -150,10 +176,12 @@ impl Planner {
             c => c,
         };
         let knots = KnotVector::for_parameters(DEGREE, n_coeffs, &v.u).map_err(bspline_error)?;
+        ctx.budget.check("the jerk Hessian")?;
         let factor = JerkFactor::new(&knots)?;
         times.hessian = t.elapsed().as_secs_f64();
 
         let plan = ctx.run(&world, &knots, &factor, times, start)?;
+        ctx.budget.check("the executability check")?;
         // Judged by what the executor runs: its own validation, from rest at the first point.
         let not_executable = |reason: String| PlanError::NotExecutable { reason };
         let model = self
@@ -207,6 +235,8 @@ struct Context<'a> {
     sample_times: Vec<f64>,
     /// Nominal (q4, q5) per CL point by IKT (eq. 3) with q4 continuity.
     nominal: Vec<(f64, f64)>,
+    /// The plan's time budget and cancellation.
+    budget: Budget,
 }
 
 fn internal(detail: &str) -> PlanError {

@@ -219,6 +219,15 @@ pub struct CutRequest {
     /// Options.
     #[serde(default)]
     pub options: CutOptions,
+    /// Time budget of the plan (s), in (0, [`kerf_budget::MAX_BUDGET_SECONDS`]]; 0 = none of the request's own
+    /// (a planner node then applies its `plan_timeout`, and a request may only ask for less).
+    /// A plan that runs out of it ends with [`PlanError::Interrupted`] (status TIMEOUT).
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub time_budget: f64,
+}
+
+fn is_zero(v: &f64) -> bool {
+    *v == 0.0
 }
 
 /// A request after validation, in the machine frame.
@@ -236,6 +245,8 @@ pub struct ValidatedRequest {
     pub sigma: f64,
     /// Workpiece pose in the machine frame.
     pub workpiece_pose: Isometry3<f64>,
+    /// The request's own time budget (`time_budget`; `None` for 0).
+    pub time_budget: Option<std::time::Duration>,
 }
 
 fn finite(field: &str, v: f64) -> Result<f64, PlanError> {
@@ -303,6 +314,8 @@ impl CutRequest {
         positive("feed_acceleration", self.feed_acceleration)?;
         positive("feed_jerk", self.feed_jerk)?;
         positive("sample_period", self.sample_period)?;
+        let time_budget = kerf_budget::limit_from_seconds(self.time_budget)
+            .map_err(|e| PlanError::invalid("time_budget", e))?;
         for (name, v) in [
             ("max_lead_angle", self.max_lead_angle),
             ("max_tilt_angle", self.max_tilt_angle),
@@ -381,6 +394,7 @@ impl CutRequest {
             u,
             sigma,
             workpiece_pose: pose,
+            time_budget,
         })
     }
 

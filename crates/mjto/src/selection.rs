@@ -43,6 +43,8 @@
 //!   predecessors), and a lower index tying over F would have had a cost
 //!   ≤ over S and won there. So the eager DP backtracks the same P.
 
+use kerf_budget::{Budget, Interrupt};
+
 use crate::collision::CollisionWorld;
 use crate::gfd::Gfd;
 use crate::request::Weights;
@@ -209,19 +211,21 @@ impl Dp {
     /// Recomputes the forward costs of layers `from..` (earlier layers
     /// are unchanged): `fwd_i(b) = k1 Δd_b + min_a (fwd_{i−1}(a) + k2
     /// ‖q̃_b − q̃_a‖ / σ_i)`.
-    fn forward(&mut self, gfds: &[Gfd], from: usize) {
+    fn forward(&mut self, gfds: &[Gfd], from: usize, budget: &Budget) -> Result<(), Interrupt> {
         for (i, g) in gfds.iter().enumerate().skip(from) {
             let (done, rest) = self.fwd.split_at_mut(i);
             let (Some(cost), Some(pred), Some(layer)) =
                 (rest.first_mut(), self.pred.get_mut(i), self.layers.get(i))
             else {
-                return;
+                return Ok(());
             };
             let prev = done
                 .last()
                 .zip(i.checked_sub(1).and_then(|k| self.layers.get(k)));
             let c = self.c.get(i).copied().unwrap_or(0.0);
             for (b, (cs, ps)) in cost.iter_mut().zip(pred.iter_mut()).enumerate() {
+                // Each candidate relaxes a whole previous layer (up to 10⁴ edges).
+                budget.check("RTO selection")?;
                 let (Some(p), Some(&node)) = (layer.point(b), layer.node.get(b)) else {
                     continue;
                 };
@@ -235,19 +239,21 @@ impl Dp {
                 };
             }
         }
+        Ok(())
     }
 
     /// Recomputes every backward cost: `bwd_i(b) = k1 Δd_b + min_c
     /// (bwd_{i+1}(c) + k2 ‖q̃_c − q̃_b‖ / σ_{i+1})`.
-    fn backward(&mut self, gfds: &[Gfd]) {
+    fn backward(&mut self, gfds: &[Gfd], budget: &Budget) -> Result<(), Interrupt> {
         for (i, g) in gfds.iter().enumerate().rev() {
             let (head, after) = self.bwd.split_at_mut(i + 1);
             let (Some(cost), Some(layer)) = (head.last_mut(), self.layers.get(i)) else {
-                return;
+                return Ok(());
             };
             let next = after.first().zip(self.layers.get(i + 1));
             let c = self.c.get(i + 1).copied().unwrap_or(0.0);
             for (b, cs) in cost.iter_mut().enumerate() {
+                budget.check("RTO selection")?;
                 let (Some(p), Some(&node)) = (layer.point(b), layer.node.get(b)) else {
                     continue;
                 };
@@ -260,6 +266,7 @@ impl Dp {
                 };
             }
         }
+        Ok(())
     }
 
     /// Cost of the best full path through candidate `b` of layer `i`.
@@ -309,6 +316,7 @@ impl Dp {
 ///   `gfds.len() - 1` values, each > 0.
 /// * `weights` - k1, k2 of eq. 56 and k4, k5, k6 of eq. 55.
 /// * `world` - the collision world.
+/// * `budget` - checked at each DP layer and before each look-ahead collision query.
 ///
 /// # Returns
 /// The chosen candidate index in each GFD: the collision-free optimum of
@@ -321,6 +329,7 @@ impl Dp {
 /// * [`PlanError::InvalidRequest`] for no GFD, a wrong number of path
 ///   lengths, a non-positive or non-finite σ, or a negative or non-finite
 ///   weight.
+/// * [`PlanError::Interrupted`] when the budget runs out or is cancelled.
 ///
 /// # Performance
 /// Each round is one DP, O(Σ n_{i−1} n_i), and checks at most m + 1 new
@@ -331,6 +340,7 @@ pub fn select_rtos(
     path_lengths: &[f64],
     weights: &Weights,
     world: &CollisionWorld,
+    budget: &Budget,
 ) -> Result<Vec<usize>, PlanError> {
     validate(gfds, path_lengths, weights)?;
     let mut dp = Dp::new(gfds, path_lengths, weights);
@@ -344,7 +354,7 @@ pub fn select_rtos(
         {
             return Err(no_feasible(g));
         }
-        dp.forward(gfds, from);
+        dp.forward(gfds, from, budget)?;
         let path = dp.path().ok_or_else(|| PlanError::Solver {
             problem: "RTO selection".into(),
             detail: "no finite-cost path through the candidate layers".into(),
@@ -366,8 +376,8 @@ pub fn select_rtos(
         // candidates in order of the best full path through them until one
         // is free, so the next optimum is likely free. Extra knowledge
         // never changes the result (module docs), it saves DP rounds.
-        dp.forward(gfds, first);
-        dp.backward(gfds);
+        dp.forward(gfds, first, budget)?;
+        dp.backward(gfds, budget)?;
         for &i in &collided {
             let Some(g) = gfds.get_mut(i) else { continue };
             let mut order: Vec<(f64, usize)> = (0..g.candidates.len())
@@ -376,6 +386,7 @@ pub fn select_rtos(
                 .collect();
             order.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
             for (_, b) in order {
+                budget.check("RTO selection")?;
                 if g.is_free(b, world) {
                     break;
                 }
@@ -403,7 +414,7 @@ pub fn select_rtos_eager(
             g.is_free(p, world);
         }
     }
-    select_rtos(gfds, path_lengths, weights, world)
+    select_rtos(gfds, path_lengths, weights, world, &Budget::unlimited())
 }
 
 /// The objective of eq. 56 for a choice of one candidate per GFD,

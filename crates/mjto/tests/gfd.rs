@@ -6,6 +6,7 @@
 //! (0.075 apart) and 5 q6 samples over `q6_span(q̂6, stroke)`.
 #![allow(clippy::unwrap_used, clippy::expect_used)] // tests report failures by panicking
 
+use kerf_budget::Budget;
 use std::f64::consts::{FRAC_PI_2, PI};
 
 use kerf_mjto::collision::{CollisionWorld, HeadModel};
@@ -452,7 +453,9 @@ fn nearest_free_equals_brute_force() {
             let db = weighted_distance(&eager.candidates[b].q, &target, &w);
             da.total_cmp(&db).then(a.cmp(&b))
         });
-        let got = lazy.nearest_free(target, &w, &world);
+        let got = lazy
+            .nearest_free(target, &w, &world, &Budget::unlimited())
+            .unwrap();
         assert_eq!(got, brute, "target {target:?}");
         let p = got.unwrap();
         let [_, q5, q6] = lazy.candidates[p].q;

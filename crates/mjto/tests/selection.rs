@@ -2,6 +2,7 @@
 //! brute force, and the error of a layer without a free candidate.
 #![allow(clippy::unwrap_used, clippy::expect_used)] // tests report failures by panicking
 
+use kerf_budget::Budget;
 use kerf_mjto::collision::{CollisionWorld, HeadModel};
 use kerf_mjto::gfd::Gfd;
 use kerf_mjto::mesh::MeshData;
@@ -68,7 +69,7 @@ fn lazy_equals_eager_with_fewer_queries() {
     let w = Weights::default();
 
     let lazy_world = world();
-    let a = select_rtos(&mut lazy, &sigma, &w, &lazy_world).unwrap();
+    let a = select_rtos(&mut lazy, &sigma, &w, &lazy_world, &Budget::unlimited()).unwrap();
     let eager_world = world();
     let b = select_rtos_eager(&mut eager, &sigma, &w, &eager_world).unwrap();
 
@@ -110,7 +111,7 @@ fn selection_is_the_brute_force_optimum() {
     };
     let (mut gfds, sigma) = layers(&[0.7, 0.8, 0.85], &grid);
     let world = world();
-    let choice = select_rtos(&mut gfds, &sigma, &w, &world).unwrap();
+    let choice = select_rtos(&mut gfds, &sigma, &w, &world, &Budget::unlimited()).unwrap();
     let best = selection_cost(&gfds, &choice, &sigma, &w).unwrap();
 
     let free: Vec<Vec<usize>> = gfds
@@ -147,14 +148,17 @@ fn single_layer_is_the_nearest_free_candidate() {
     assert!(sigma.is_empty());
     let world = world();
     let w = Weights::default();
-    let choice = select_rtos(&mut gfds, &sigma, &w, &world).unwrap();
+    let choice = select_rtos(&mut gfds, &sigma, &w, &world, &Budget::unlimited()).unwrap();
     let mut g = gfds[0].clone();
     // The GFD's distances (eq. 55 to the reference) weight q4 by sin²q̂5.
     let reference_w = Weights {
         k4: w.k4 * g.reference[1].sin().powi(2),
         ..w
     };
-    let nearest = g.nearest_free(g.reference, &reference_w, &world).unwrap();
+    let nearest = g
+        .nearest_free(g.reference, &reference_w, &world, &Budget::unlimited())
+        .unwrap()
+        .unwrap();
     assert_eq!(choice, vec![nearest]);
 }
 
@@ -178,7 +182,14 @@ fn all_colliding_layer_is_no_feasible_orientation() {
     );
     let n = gfds[1].candidates.len();
     assert!(n > 0);
-    let err = select_rtos(&mut gfds, &sigma, &Weights::default(), &world()).unwrap_err();
+    let err = select_rtos(
+        &mut gfds,
+        &sigma,
+        &Weights::default(),
+        &world(),
+        &Budget::unlimited(),
+    )
+    .unwrap_err();
     match &err {
         PlanError::NoFeasibleOrientation { index, u, reason } => {
             assert_eq!((*index, *u), (10, 0.5));
@@ -206,20 +217,20 @@ fn empty_layer_and_bad_inputs() {
     let w = Weights::default();
     // Wrong number of path lengths, non-positive length, NaN weight.
     assert!(matches!(
-        select_rtos(&mut gfds, &[], &w, &world),
+        select_rtos(&mut gfds, &[], &w, &world, &Budget::unlimited()),
         Err(PlanError::InvalidRequest { .. })
     ));
     assert!(matches!(
-        select_rtos(&mut gfds, &[0.0], &w, &world),
+        select_rtos(&mut gfds, &[0.0], &w, &world, &Budget::unlimited()),
         Err(PlanError::InvalidRequest { .. })
     ));
     let nan_w = Weights { k2: f64::NAN, ..w };
     assert!(matches!(
-        select_rtos(&mut gfds, &sigma, &nan_w, &world),
+        select_rtos(&mut gfds, &sigma, &nan_w, &world, &Budget::unlimited()),
         Err(PlanError::InvalidRequest { .. })
     ));
     assert!(matches!(
-        select_rtos(&mut [], &[], &w, &world),
+        select_rtos(&mut [], &[], &w, &world, &Budget::unlimited()),
         Err(PlanError::InvalidRequest { .. })
     ));
     assert_eq!(world.queries(), 0);
@@ -237,7 +248,7 @@ fn empty_layer_and_bad_inputs() {
         &lead_tilt,
         machine.limits(),
     );
-    match select_rtos(&mut gfds, &sigma, &w, &world) {
+    match select_rtos(&mut gfds, &sigma, &w, &world, &Budget::unlimited()) {
         Err(PlanError::NoFeasibleOrientation {
             index: 0, reason, ..
         }) => {

@@ -125,6 +125,8 @@ pub struct CutRequest {
     pub reference_standoff: f64,
     /// Required head–workpiece clearance (m, ≥ 0).
     pub clearance: f64,
+    /// Time budget of the plan (s): 0 = the node's `plan_timeout`; else in (0, plan_timeout].
+    pub time_budget: f64,
 }
 impl_ros_type!(CutRequest, "kerf_msgs", msg, "CutRequest");
 
@@ -256,8 +258,10 @@ impl CutPlan {
     pub const COLLISION: u8 = 5;
     /// A joint limit is exceeded.
     pub const LIMIT_VIOLATION: u8 = 6;
-    /// Solver failure, overload or another internal error.
+    /// Solver failure, overload or another internal error (also: cancelled, node stopping).
     pub const INTERNAL_ERROR: u8 = 7;
+    /// The request's time budget ran out before the plan was finished.
+    pub const TIMEOUT: u8 = 8;
 
     /// Name of a status value (`"SUCCESS"` …), or `None` for an unknown value.
     pub fn status_name(status: u8) -> Option<&'static str> {
@@ -270,6 +274,7 @@ impl CutPlan {
             Self::COLLISION => Some("COLLISION"),
             Self::LIMIT_VIOLATION => Some("LIMIT_VIOLATION"),
             Self::INTERNAL_ERROR => Some("INTERNAL_ERROR"),
+            Self::TIMEOUT => Some("TIMEOUT"),
             _ => None,
         }
     }
@@ -342,6 +347,8 @@ pub struct MillRequest {
     /// Path of the actor (safetensors) of the ddpg / fixed_g planner; empty = the shipped
     /// policy of that planner.
     pub policy_file: String,
+    /// Time budget of the plan (s): 0 = the node's `plan_timeout`; else in (0, plan_timeout].
+    pub time_budget: f64,
 }
 impl_ros_type!(MillRequest, "kerf_msgs", msg, "MillRequest");
 
@@ -424,8 +431,10 @@ impl MillPlan {
     pub const CHATTER_MODEL_ERROR: u8 = 4;
     /// The request queue is full; the request was not planned.
     pub const QUEUE_FULL: u8 = 5;
-    /// Another internal error.
+    /// Another internal error (also: cancelled, node stopping).
     pub const INTERNAL_ERROR: u8 = 6;
+    /// The request's time budget ran out before the plan was finished.
+    pub const TIMEOUT: u8 = 7;
 
     /// Name of a status value (`"SUCCESS"` …), or `None` for an unknown value.
     pub fn status_name(status: u8) -> Option<&'static str> {
@@ -437,6 +446,7 @@ impl MillPlan {
             Self::CHATTER_MODEL_ERROR => Some("CHATTER_MODEL_ERROR"),
             Self::QUEUE_FULL => Some("QUEUE_FULL"),
             Self::INTERNAL_ERROR => Some("INTERNAL_ERROR"),
+            Self::TIMEOUT => Some("TIMEOUT"),
             _ => None,
         }
     }
@@ -462,7 +472,8 @@ mod tests {
         assert_eq!(CutPlan::status_name(CutPlan::SUCCESS), Some("SUCCESS"));
         assert_eq!(CutPlan::status_name(5), Some("COLLISION"));
         assert_eq!(CutPlan::status_name(7), Some("INTERNAL_ERROR"));
-        assert_eq!(CutPlan::status_name(8), None);
+        assert_eq!(CutPlan::status_name(8), Some("TIMEOUT"));
+        assert_eq!(CutPlan::status_name(9), None);
     }
 
     #[test]
@@ -473,13 +484,14 @@ mod tests {
         assert_eq!(MillPlan::status_name(4), Some("CHATTER_MODEL_ERROR"));
         assert_eq!(MillPlan::status_name(5), Some("QUEUE_FULL"));
         assert_eq!(MillPlan::status_name(6), Some("INTERNAL_ERROR"));
-        assert_eq!(MillPlan::status_name(7), None);
+        assert_eq!(MillPlan::status_name(7), Some("TIMEOUT"));
+        assert_eq!(MillPlan::status_name(8), None);
         // Every name is distinct and round-trips through its code.
         let names: Vec<&str> = (0..=u8::MAX).filter_map(MillPlan::status_name).collect();
-        assert_eq!(names.len(), 7);
+        assert_eq!(names.len(), 8);
         let mut sorted = names.clone();
         sorted.sort_unstable();
         sorted.dedup();
-        assert_eq!(sorted.len(), 7);
+        assert_eq!(sorted.len(), 8);
     }
 }

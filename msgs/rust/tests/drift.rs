@@ -459,6 +459,7 @@ fn rust_constants() -> ConstantTable {
                 c_u8("COLLISION", Cp::COLLISION),
                 c_u8("LIMIT_VIOLATION", Cp::LIMIT_VIOLATION),
                 c_u8("INTERNAL_ERROR", Cp::INTERNAL_ERROR),
+                c_u8("TIMEOUT", Cp::TIMEOUT),
             ],
         ),
         (
@@ -480,6 +481,7 @@ fn rust_constants() -> ConstantTable {
                 c_u8("CHATTER_MODEL_ERROR", Mp::CHATTER_MODEL_ERROR),
                 c_u8("QUEUE_FULL", Mp::QUEUE_FULL),
                 c_u8("INTERNAL_ERROR", Mp::INTERNAL_ERROR),
+                c_u8("TIMEOUT", Mp::TIMEOUT),
             ],
         ),
     ]

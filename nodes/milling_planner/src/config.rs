@@ -7,7 +7,7 @@ use kerf_mill::MillCell;
 use kerf_millplan::{
     default_policy_path, plan::IndicatorSource, IndicatorCache, MillPlanner, PlannerKind,
 };
-use kerf_ros::Params;
+use kerf_ros::{planner::HarnessSettings, Params};
 
 use crate::NodeError;
 
@@ -20,6 +20,7 @@ pub const KNOWN_PARAMS: &[&str] = &[
     "indicator_source",
     "eval_threads",
     "queue_depth",
+    "plan_timeout",
 ];
 
 pub use kerf_ros::planner::DEFAULT_QUEUE_DEPTH;
@@ -40,7 +41,7 @@ pub struct NodeConfig {
     /// Where the plans' |μ|max come from (`indicator_source`).
     pub indicator_source: IndicatorSource,
     /// Requests waiting or being planned before new ones are refused (≥ 1).
-    pub queue_depth: usize,
+    pub harness: HarnessSettings,
 }
 
 /// A path parameter: `None` when unset, an error when set to the empty string.
@@ -93,6 +94,8 @@ impl NodeConfig {
     ///   evaluation (the plan does not depend on it, only the latency).
     /// * `queue_depth` (integer ≥ 1, default 10): requests waiting or being planned; a request
     ///   arriving when the queue is full is answered at once with status QUEUE_FULL.
+    /// * `plan_timeout` (seconds, default 60): the time budget of every plan; a request may ask
+    ///   for less with its `time_budget`. A plan that runs out of it is answered TIMEOUT.
     ///
     /// Empty strings are refused (leave a parameter unset for its default). Relative paths
     /// are relative to the node's working directory.
@@ -130,7 +133,7 @@ impl NodeConfig {
                 })?)
             }
         };
-        let queue_depth = kerf_ros::planner::queue_depth(params)?;
+        let harness = HarnessSettings::from_params(params)?;
 
         let (planner, cell_source, cache_note) = match (cell_file, cache_file) {
             (None, None) => {
@@ -186,7 +189,7 @@ impl NodeConfig {
             cache_note,
             ddpg_policy_file,
             fixed_g_policy_file,
-            queue_depth,
+            harness,
         })
     }
 

@@ -106,6 +106,7 @@ pub fn request_from_msg(m: &msg::MillRequest) -> Result<MillRequest, MillPlanErr
         initial,
         planner,
         policy_file,
+        time_budget: (m.time_budget != 0.0).then_some(m.time_budget),
     })
 }
 

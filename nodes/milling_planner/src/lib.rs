@@ -71,6 +71,9 @@ pub mod text;
 
 use std::path::PathBuf;
 
+use std::time::Duration;
+
+use kerf_budget::Budget;
 use kerf_executor::JointLimits;
 use kerf_millplan::{planner::status, MillPlanError, MillPlanner, MillRequest, PlannerKind};
 use kerf_msgs::msg::{self, MillPlan};
@@ -136,8 +139,8 @@ pub fn run(args: &RosArgs, env: &RosEnv, stop: StopToken) -> Result<(), NodeErro
             policies.ddpg.display(),
             policies.fixed_g.display(),
         );
-        let depth = cfg.queue_depth;
-        Ok((MillService::new(cfg.planner, policies, note)?, depth))
+        let harness = cfg.harness;
+        Ok((MillService::new(cfg.planner, policies, note)?, harness))
     })
 }
 
@@ -214,8 +217,13 @@ impl PlanningService for MillService {
         )
     }
 
+    fn requested_budget(&self, request: &MillRequest) -> Option<Duration> {
+        // An invalid value is refused by the planner's validation (INVALID_REQUEST).
+        request.time_limit().ok().flatten()
+    }
+
     /// Plans one request with the node's default policy filled in when it names none.
-    fn plan(&self, mut request: MillRequest) -> MillPlan {
+    fn plan(&self, mut request: MillRequest, budget: &Budget) -> MillPlan {
         if request.policy_file.is_none() {
             let default = match PlannerKind::parse(&request.planner) {
                 Ok(PlannerKind::Ddpg) => Some(&self.policies.ddpg),
@@ -224,17 +232,18 @@ impl PlanningService for MillService {
             };
             request.policy_file = default.map(|p| p.display().to_string());
         }
-        match self.planner.plan(&request) {
+        match self.planner.plan_within(&request, budget) {
             Ok(out) => convert::output_to_msg(&out),
             Err(e) => convert::error_to_msg(&request.request_id, &request.planner, &e),
         }
     }
 
-    /// Busy is QUEUE_FULL; unreadable samples INVALID_REQUEST (no planner named); stopped,
-    /// panicked and not executable INTERNAL_ERROR.
+    /// Busy is QUEUE_FULL; unreadable samples and budgets over `plan_timeout`
+    /// INVALID_REQUEST (no planner named for an unreadable sample); stopped, panicked and not
+    /// executable INTERNAL_ERROR.
     fn failure(&self, key: &AnswerKey, failure: Failure, message: String) -> MillPlan {
         let code = match failure {
-            Failure::Unreadable => status::INVALID_REQUEST,
+            Failure::Unreadable | Failure::OverBudget => status::INVALID_REQUEST,
             Failure::Busy => convert::QUEUE_FULL,
             Failure::Stopped | Failure::Panicked | Failure::NotExecutable => status::INTERNAL_ERROR,
         };

@@ -32,7 +32,7 @@ fn scratch(name: &str) -> std::path::PathBuf {
 #[test]
 fn shipped_cell_and_policies_by_default_and_replaced_by_parameters() {
     let c = config(&[]).unwrap();
-    assert_eq!(c.queue_depth, DEFAULT_QUEUE_DEPTH);
+    assert_eq!(c.harness.queue_depth, DEFAULT_QUEUE_DEPTH);
     assert!(
         c.cell_source.ends_with("irb6660_milling.yaml"),
         "{}",
@@ -82,7 +82,7 @@ fn shipped_cell_and_policies_by_default_and_replaced_by_parameters() {
         "eval_threads:=2",
     ])
     .unwrap();
-    assert_eq!(c.queue_depth, 3);
+    assert_eq!(c.harness.queue_depth, 3);
     assert_eq!(c.indicator_source, IndicatorSource::Cache);
     assert_eq!(c.planner.indicator_source(), IndicatorSource::Cache);
     assert!(c.cell_source.ends_with("urdf/irb6660_milling.yaml"));

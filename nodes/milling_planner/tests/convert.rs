@@ -42,7 +42,14 @@ fn flags_off_means_the_cell_and_empty_means_the_default() {
             initial: None,
             planner: "ddpg".into(),
             policy_file: None,
+            time_budget: None,
         }
+    );
+    let mut m = message();
+    m.time_budget = 4.0;
+    assert_eq!(
+        convert::request_from_msg(&m).unwrap().time_budget,
+        Some(4.0)
     );
     // Values of a group whose flag is false are ignored, even NaN.
     let mut m = message();

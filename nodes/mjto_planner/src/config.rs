@@ -3,12 +3,17 @@
 use std::path::PathBuf;
 
 use kerf_mjto::LaserMachine;
-use kerf_ros::Params;
+use kerf_ros::{planner::HarnessSettings, Params};
 
 use crate::NodeError;
 
 /// Parameter names this node reads; others are refused at start-up.
-pub const KNOWN_PARAMS: &[&str] = &["urdf_file", "joint_limits_file", "queue_depth"];
+pub const KNOWN_PARAMS: &[&str] = &[
+    "urdf_file",
+    "joint_limits_file",
+    "queue_depth",
+    "plan_timeout",
+];
 
 pub use kerf_ros::planner::DEFAULT_QUEUE_DEPTH;
 
@@ -19,8 +24,8 @@ pub struct NodeConfig {
     pub machine: LaserMachine,
     /// Where the machine came from (for the start-up log).
     pub machine_source: String,
-    /// Requests waiting or being planned before new ones are refused (≥ 1).
-    pub queue_depth: usize,
+    /// The harness's `queue_depth` and `plan_timeout`.
+    pub harness: HarnessSettings,
 }
 
 impl NodeConfig {
@@ -34,6 +39,8 @@ impl NodeConfig {
     ///   without `urdf_file` is refused.
     /// * `queue_depth` (integer ≥ 1, default 10): requests waiting or being planned; a request
     ///   arriving when the queue is full is answered at once with status INTERNAL_ERROR.
+    /// * `plan_timeout` (seconds, default 60): the time budget of every plan; a request may ask
+    ///   for less with its `time_budget`. A plan that runs out of it is answered TIMEOUT.
     ///
     /// # Errors
     /// [`NodeError::Config`] naming the parameter, [`NodeError::Ros`] for a wrong type,
@@ -62,11 +69,11 @@ impl NodeConfig {
                     "the shipped laser_cutter.urdf".to_string(),
                 ),
             };
-        let queue_depth = kerf_ros::planner::queue_depth(params)?;
+        let harness = HarnessSettings::from_params(params)?;
         Ok(Self {
             machine,
             machine_source,
-            queue_depth,
+            harness,
         })
     }
 }

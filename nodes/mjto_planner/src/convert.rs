@@ -107,6 +107,7 @@ pub fn request_from_msg(m: &msg::CutRequest) -> Result<CutRequest, PlanError> {
             orientation: [q.x, q.y, q.z, q.w],
         },
         options,
+        time_budget: m.time_budget,
     })
 }
 

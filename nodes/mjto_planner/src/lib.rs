@@ -36,6 +36,9 @@ pub mod text;
 
 use std::sync::Mutex;
 
+use std::time::Duration;
+
+use kerf_budget::Budget;
 use kerf_executor::JointLimits;
 use kerf_mjto::{error::status, planner::Planner, CutRequest, LaserMachine, PlanError};
 use kerf_msgs::msg::{self, CutPlan};
@@ -68,9 +71,8 @@ pub type NodeError = planner::NodeError<SetupError>;
 pub fn run(args: &RosArgs, env: &RosEnv, stop: StopToken) -> Result<(), NodeError> {
     planner::run(DEFAULT_NAME, KNOWN_PARAMS, args, env, stop, |node| {
         let cfg = NodeConfig::from_params(node.params())?;
-        let depth = cfg.queue_depth;
         let service = CutService::new(cfg.machine, cfg.machine_source).map_err(NodeError::setup)?;
-        Ok((service, depth))
+        Ok((service, cfg.harness))
     })
 }
 
@@ -132,7 +134,14 @@ impl PlanningService for CutService {
         format!("{} CL points", request.points.len())
     }
 
-    fn plan(&self, request: CutRequest) -> CutPlan {
+    fn requested_budget(&self, request: &CutRequest) -> Option<Duration> {
+        // An invalid value is refused by the planner's validation (INVALID_REQUEST).
+        kerf_budget::limit_from_seconds(request.time_budget)
+            .ok()
+            .flatten()
+    }
+
+    fn plan(&self, request: CutRequest, budget: &Budget) -> CutPlan {
         let mut guard = match self.planner.lock() {
             Ok(g) => g,
             Err(poisoned) => {
@@ -151,7 +160,7 @@ impl PlanningService for CutService {
                 g
             }
         };
-        match guard.plan(&request) {
+        match guard.plan_within(&request, budget) {
             Ok(plan) => {
                 let mut m = convert::plan_to_msg(&plan);
                 m.request_id.clone_from(&request.request_id);
@@ -161,11 +170,11 @@ impl PlanningService for CutService {
         }
     }
 
-    /// Unreadable samples are INVALID_REQUEST; busy, stopped, panicked and not executable are
-    /// INTERNAL_ERROR.
+    /// Unreadable samples and budgets over `plan_timeout` are INVALID_REQUEST; busy, stopped,
+    /// panicked and not executable are INTERNAL_ERROR.
     fn failure(&self, key: &AnswerKey, failure: Failure, message: String) -> CutPlan {
         let code = match failure {
-            Failure::Unreadable => status::INVALID_REQUEST,
+            Failure::Unreadable | Failure::OverBudget => status::INVALID_REQUEST,
             Failure::Busy | Failure::Stopped | Failure::Panicked | Failure::NotExecutable => {
                 status::INTERNAL_ERROR
             }
@@ -184,7 +193,7 @@ impl PlanningService for CutService {
 
 #[cfg(test)]
 mod tests {
-    use std::sync::atomic::{AtomicBool, Ordering};
+    use kerf_budget::CancelToken;
 
     use kerf_ros::planner::{work, Job};
 
@@ -212,8 +221,13 @@ mod tests {
         })
         .join();
         assert!(service.planner.is_poisoned());
-        let stopping = AtomicBool::new(false);
-        let m = work(&*service, &stopping, Job::Plan(one_point_request()));
+        let stopping = CancelToken::new();
+        let m = work(
+            &*service,
+            &stopping,
+            Duration::from_secs(60),
+            Job::Plan(one_point_request()),
+        );
         // A fresh planner answered (validation: one point), and the mutex is usable again.
         assert_eq!(m.status, status::INVALID_REQUEST, "{}", m.message);
         assert_eq!(m.request_id, "w1");
@@ -222,11 +236,21 @@ mod tests {
 
         // Already-answered jobs pass through unchanged.
         let failed = convert::failure_msg("w2", status::MESH_ERROR, "gone");
-        let m = work(&*service, &stopping, Job::Answer(Box::new(failed.clone())));
+        let m = work(
+            &*service,
+            &stopping,
+            Duration::from_secs(60),
+            Job::Answer(Box::new(failed.clone())),
+        );
         assert_eq!(m, failed);
 
-        stopping.store(true, Ordering::Relaxed);
-        let m = work(&*service, &stopping, Job::Plan(one_point_request()));
+        stopping.cancel();
+        let m = work(
+            &*service,
+            &stopping,
+            Duration::from_secs(60),
+            Job::Plan(one_point_request()),
+        );
         assert_eq!(m.status, status::INTERNAL_ERROR);
         assert!(
             m.message.contains("stopped before planning"),

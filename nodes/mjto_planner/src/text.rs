@@ -15,7 +15,7 @@
 //!   `x y z qx qy qz qw`), `control_points`, `max_iterations`, `gfd_q4_steps`, `gfd_q5_steps`,
 //!   `gfd_q6_steps`, `gfd_q4_half_range`, `gfd_q5_half_range`, `rto_indices` (integers
 //!   separated by spaces or commas), `rto_spacing`, `rto_angle`, `reference_standoff` (giving
-//!   it sets `has_reference_standoff`) and `clearance`. `feedrate`, `sample_period`,
+//!   it sets `has_reference_standoff`), `clearance` and `time_budget`. `feedrate`, `sample_period`,
 //!   `max_lead_angle`, `max_tilt_angle` and `mesh` are required; every key may appear once.
 //!   Blank lines and lines starting with `#` are ignored (comments are whole lines: a value
 //!   is never cut at `#`); points keep their order even when key lines come between them.
@@ -171,6 +171,7 @@ pub fn parse_lines(text: &str) -> Result<msg::CutRequest, PlanError> {
             "rto_spacing" => m.rto_spacing = number(n, key, value)?,
             "rto_angle" => m.rto_angle = number(n, key, value)?,
             "clearance" => m.clearance = number(n, key, value)?,
+            "time_budget" => m.time_budget = number(n, key, value)?,
             "reference_standoff" => {
                 m.reference_standoff = number(n, key, value)?;
                 m.has_reference_standoff = true;

@@ -20,15 +20,19 @@ fn config(params: &[&str]) -> Result<NodeConfig, NodeError> {
 #[test]
 fn shipped_machine_by_default_and_from_files() {
     let c = config(&[]).unwrap();
-    assert_eq!(c.queue_depth, DEFAULT_QUEUE_DEPTH);
+    assert_eq!(c.harness.queue_depth, DEFAULT_QUEUE_DEPTH);
     // seed 001 Table 2: q4 jerk 200 rad/s³, q6 stroke [-0.1, 0.02] m.
     assert_eq!(c.machine.limits()[3].jerk, 200.0);
     assert_eq!(c.machine.limits()[5].min, -0.1);
 
     let urdf = format!("urdf_file:={ROOT}/urdf/laser_cutter.urdf");
     let limits = format!("joint_limits_file:={ROOT}/urdf/laser_cutter_limits.yaml");
-    let c = config(&[&urdf, &limits, "queue_depth:=3"]).unwrap();
-    assert_eq!(c.queue_depth, 3);
+    let c = config(&[&urdf, &limits, "queue_depth:=3", "plan_timeout:=2.5"]).unwrap();
+    assert_eq!(c.harness.queue_depth, 3);
+    assert_eq!(
+        c.harness.plan_timeout,
+        std::time::Duration::from_millis(2500)
+    );
     assert_eq!(c.machine.limits()[0].acc, 12.0);
     assert!(c.machine_source.contains("laser_cutter_limits.yaml"));
 }
@@ -42,6 +46,14 @@ fn bad_parameters_are_refused_by_name() {
         e.contains("'queue_depth'") && e.contains("expected integer"),
         "{e}"
     );
+    for bad in [
+        "plan_timeout:=0.0",
+        "plan_timeout:=-1.0",
+        "plan_timeout:=1e9",
+    ] {
+        let e = config(&[bad]).unwrap_err().to_string();
+        assert!(e.contains("'plan_timeout'"), "{bad}: {e}");
+    }
     let e = config(&["control_rate:=100.0"]).unwrap_err().to_string();
     assert!(e.contains("'control_rate'") && e.contains("unknown"), "{e}");
     let limits = format!("joint_limits_file:={ROOT}/urdf/laser_cutter_limits.yaml");

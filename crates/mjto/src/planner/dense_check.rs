@@ -2,7 +2,9 @@
 //! sample), RTO insertion against its violations, and the geometric
 //! metrics of a sampled trajectory.
 
-use super::{Context, Iterate, RtoState, Samples, ANGLE_TOLERANCE};
+use kerf_budget::Interrupt;
+
+use super::{Context, Iterate, RtoState, Samples, ANGLE_TOLERANCE, BUDGET_STRIDE};
 use crate::collision::CollisionWorld;
 use crate::error::CollisionReport;
 use crate::kinematics::{forward, tool_axis};
@@ -11,32 +13,47 @@ use crate::PlanError;
 
 impl Context<'_> {
     /// Collision and lead/tilt check of every sample, on two threads.
-    pub(super) fn check(&self, world: &CollisionWorld, s: &Samples) -> Vec<CollisionReport> {
+    ///
+    /// # Errors
+    /// [`PlanError::Interrupted`] when the budget runs out (checked every
+    /// [`super::BUDGET_STRIDE`] samples on each thread).
+    pub(super) fn check(
+        &self,
+        world: &CollisionWorld,
+        s: &Samples,
+    ) -> Result<Vec<CollisionReport>, PlanError> {
         let n = s.times.len();
         let half = n / 2;
-        let check_range = |range: std::ops::Range<usize>| -> Vec<CollisionReport> {
-            range
-                .filter_map(|k| self.check_sample(world, s.times[k], s.u[k], &s.q[k]))
-                .collect()
-        };
-        let (mut first, second) = std::thread::scope(|scope| {
+        let check_range =
+            |range: std::ops::Range<usize>| -> Result<Vec<CollisionReport>, Interrupt> {
+                let mut found = Vec::new();
+                for k in range {
+                    if k % BUDGET_STRIDE == 0 {
+                        self.budget.check("the dense collision check")?;
+                    }
+                    found.extend(self.check_sample(world, s.times[k], s.u[k], &s.q[k]));
+                }
+                Ok(found)
+            };
+        let (first, second) = std::thread::scope(|scope| {
             let handle = scope.spawn(|| check_range(half..n));
             let first = check_range(0..half);
             // A panic in the worker is a bug; report it as a violation of
             // every sample rather than unwinding through the planner.
             let second = handle.join().unwrap_or_else(|_| {
-                vec![CollisionReport {
+                Ok(vec![CollisionReport {
                     u: 0.0,
                     time: 0.0,
                     cl_index: 0,
                     links: Vec::new(),
                     reason: "internal error: the collision-check thread panicked".into(),
-                }]
+                }])
             });
             (first, second)
         });
-        first.extend(second);
-        first
+        let mut first = first?;
+        first.extend(second?);
+        Ok(first)
     }
 
     pub(super) fn check_sample(
@@ -111,6 +128,7 @@ impl Context<'_> {
         }
         let mut added = 0;
         for (a, b) in runs {
+            self.budget.check("RTO insertion")?;
             let mid = &violations[(a + b) / 2];
             let Some(i) = self.free_cl_index(
                 mid.cl_index,
@@ -133,7 +151,7 @@ impl Context<'_> {
             ];
             let mut gfd = self.build_gfd(i, centre);
             let weights = &self.request.options.weights;
-            let Some(p) = gfd.nearest_free(target, weights, world) else {
+            let Some(p) = gfd.nearest_free(target, weights, world, &self.budget)? else {
                 return Err(PlanError::NoFeasibleOrientation {
                     index: i,
                     u,
@@ -202,14 +220,21 @@ impl Context<'_> {
 
     /// CL error against the reference path, lead/tilt extremes and (when a
     /// world is given) the colliding samples of a sampled trajectory.
+    ///
+    /// # Errors
+    /// [`PlanError::Interrupted`] when the budget runs out (checked every
+    /// [`BUDGET_STRIDE`] samples, on each thread of the collision count).
     pub(super) fn fill_geometry(
         &self,
         m: &mut Metrics,
         u: &[f64],
         q: &[[f64; 6]],
         world: Option<&CollisionWorld>,
-    ) {
-        for (&u, q) in u.iter().zip(q) {
+    ) -> Result<(), PlanError> {
+        for (k, (&u, q)) in u.iter().zip(q).enumerate() {
+            if k % BUDGET_STRIDE == 0 {
+                self.budget.check("the geometric metrics")?;
+            }
             let (c, o) = forward(q);
             m.max_cl_error = m.max_cl_error.max((c - self.frames.cl_point(u)).norm());
             let (lead, tilt) = self.frames.lead_tilt(u, &o);
@@ -219,13 +244,22 @@ impl Context<'_> {
         if let Some(w) = world {
             // Two threads, as the dense check of the plan itself.
             let half = q.len() / 2;
-            let count = |part: &[[f64; 6]]| part.iter().filter(|q| !w.is_free(q)).count();
-            m.colliding_samples = std::thread::scope(|scope| {
+            let count = |part: &[[f64; 6]]| -> Result<usize, Interrupt> {
+                let mut n = 0;
+                for chunk in part.chunks(BUDGET_STRIDE) {
+                    self.budget.check("the QI baseline's collision count")?;
+                    n += chunk.iter().filter(|q| !w.is_free(q)).count();
+                }
+                Ok(n)
+            };
+            let (first, second) = std::thread::scope(|scope| {
                 let second = scope.spawn(|| count(&q[half..]));
                 let first = count(&q[..half]);
                 // A panicking check thread counts every sample of its half.
-                first + second.join().unwrap_or(q.len() - half)
+                (first, second.join().unwrap_or(Ok(q.len() - half)))
             });
+            m.colliding_samples = first? + second?;
         }
+        Ok(())
     }
 }

@@ -7,7 +7,7 @@ use kerf_bspline::{BSpline, KnotVector};
 use nalgebra::Vector3;
 
 use super::{bspline_error, internal, Context, Iterate, RtoState, Samples, LIMIT_TOLERANCE};
-use crate::baseline::{quaternion_interpolation, Rto};
+use crate::baseline::{quaternion_interpolation_within, Rto};
 use crate::collision::CollisionWorld;
 use crate::gfd::Gfd;
 use crate::kinematics::tool_axis;
@@ -33,17 +33,18 @@ impl Context<'_> {
         // 1. GFDs of the initial RTOs and their selection (eq. 55-56).
         let t = Instant::now();
         let indices = self.initial_rto_indices();
-        let mut gfds: Vec<Gfd> = indices
-            .iter()
-            .map(|&i| self.build_gfd(i, self.reference(i)))
-            .collect();
+        let mut gfds: Vec<Gfd> = Vec::with_capacity(indices.len());
+        for &i in &indices {
+            self.budget.check("GFD construction")?;
+            gfds.push(self.build_gfd(i, self.reference(i)));
+        }
         times.gfd += t.elapsed().as_secs_f64();
         let t = Instant::now();
         let lengths: Vec<f64> = indices
             .windows(2)
             .map(|w| self.v.arc_length[w[1]] - self.v.arc_length[w[0]])
             .collect();
-        let chosen = select_rtos(&mut gfds, &lengths, &o.weights, world)?;
+        let chosen = select_rtos(&mut gfds, &lengths, &o.weights, world, &self.budget)?;
         times.selection += t.elapsed().as_secs_f64();
         let mut rtos: Vec<RtoState> = gfds
             .iter()
@@ -61,9 +62,9 @@ impl Context<'_> {
         let (iterate, samples) = loop {
             iteration += 1;
             let iterate = self.solve(knots, factor, &rtos, &mut times)?;
-            let samples = self.sample(&iterate);
+            let samples = self.sample(&iterate)?;
             let t = Instant::now();
-            let violations = self.check(world, &samples);
+            let violations = self.check(world, &samples)?;
             times.collision += t.elapsed().as_secs_f64();
             if violations.is_empty() {
                 break (iterate, samples);
@@ -92,6 +93,7 @@ impl Context<'_> {
 
         // 3. Limits (analytic, eq. 7), metrics, QI baseline.
         let t = Instant::now();
+        self.budget.check("the limit check")?;
         let limits = self.limits();
         let violations = limit_violations(
             &samples.times,
@@ -105,6 +107,7 @@ impl Context<'_> {
         if !violations.is_empty() {
             return Err(PlanError::LimitViolation { violations });
         }
+        self.budget.check("the metrics")?;
         let mut metrics = kinematic_metrics(
             &samples.times,
             &samples.q,
@@ -113,7 +116,7 @@ impl Context<'_> {
             &samples.qddd,
             limits,
         );
-        self.fill_geometry(&mut metrics, &samples.u, &samples.q, None);
+        self.fill_geometry(&mut metrics, &samples.u, &samples.q, None)?;
         metrics.max_cl_error = metrics.max_cl_error.max(self.cl_error_at_points(&iterate));
 
         let qi_rtos: Vec<Rto> = rtos
@@ -126,12 +129,22 @@ impl Context<'_> {
             })
             .collect();
         let dt = self.request.sample_period;
-        let (qi_times, qi_q) =
-            quaternion_interpolation(&self.frames, &qi_rtos, &self.law, self.v.sigma, dt, limits)?;
+        self.budget.check("the QI baseline")?;
+        let (qi_times, qi_q) = quaternion_interpolation_within(
+            &self.frames,
+            &qi_rtos,
+            &self.law,
+            self.v.sigma,
+            dt,
+            limits,
+            &self.budget,
+        )?;
+        self.budget.check("the QI baseline")?;
         let (qi_v, qi_a, qi_j) = finite_differences(&qi_times, &qi_q);
         let mut qi_metrics = kinematic_metrics(&qi_times, &qi_q, &qi_v, &qi_a, &qi_j, limits);
         let qi_u: Vec<f64> = qi_times.iter().map(|&t| self.u_at(t)).collect();
-        self.fill_geometry(&mut qi_metrics, &qi_u, &qi_q, Some(world));
+        self.budget.check("the QI baseline's geometry")?;
+        self.fill_geometry(&mut qi_metrics, &qi_u, &qi_q, Some(world))?;
         times.evaluation += t.elapsed().as_secs_f64();
         times.total = start.elapsed().as_secs_f64();
 
@@ -176,6 +189,7 @@ impl Context<'_> {
         let t = Instant::now();
         let mut rotary = Vec::with_capacity(2);
         for (k, name) in [(3usize, "q4"), (4usize, "q5")] {
+            self.budget.check("the rotary-axis QPs")?;
             let via: Vec<(f64, f64)> = rtos.iter().map(|r| (r.u, r.q[k - 3])).collect();
             let problem = RotaryQp {
                 axis_name: name,
@@ -206,6 +220,7 @@ impl Context<'_> {
             .map(|&u| tool_axis(q4.eval(u)[0], q5.eval(u)[0]))
             .collect();
         let via: Vec<(usize, f64)> = rtos.iter().map(|r| (r.cl_index, r.q[2])).collect();
+        self.budget.check("the M-path QP")?;
         let problem = MPathProblem {
             knots,
             factor,
@@ -241,7 +256,11 @@ impl Context<'_> {
 
     /// Samples every Δt: q1..q3 from the M path (eq. 47: M = (q1, q2, q3)),
     /// q4, q5 from eq. 5, q6 from its spline; derivatives by eq. 7.
-    pub(super) fn sample(&self, it: &Iterate) -> Samples {
+    ///
+    /// # Errors
+    /// [`PlanError::Interrupted`] when the budget runs out (checked every
+    /// [`super::BUDGET_STRIDE`] samples).
+    pub(super) fn sample(&self, it: &Iterate) -> Result<Samples, PlanError> {
         let times = self.sample_times.clone();
         let n = times.len();
         let mut s = Samples {
@@ -253,7 +272,10 @@ impl Context<'_> {
             times,
         };
         let splines = [&it.m[0], &it.m[1], &it.m[2], &it.q4, &it.q5, &it.q6];
-        for &t in &s.times {
+        for (k, &t) in s.times.iter().enumerate() {
+            if k % super::BUDGET_STRIDE == 0 {
+                self.budget.check("trajectory sampling")?;
+            }
             let law = self.law.eval(t);
             let u = (law[0] / self.v.sigma).clamp(0.0, 1.0);
             let mut row = [[0.0; 6]; 4];
@@ -269,6 +291,6 @@ impl Context<'_> {
             s.qdd.push(row[2]);
             s.qddd.push(row[3]);
         }
-        s
+        Ok(s)
     }
 }

@@ -1,6 +1,7 @@
 //! Setting up one plan: the path frames, feed profile and sample times, the
 //! nominal orientation, the initial RTOs and their GFDs.
 
+use kerf_budget::Budget;
 use nalgebra::Vector3;
 
 use super::Context;
@@ -17,6 +18,7 @@ impl<'a> Context<'a> {
         machine: &'a LaserMachine,
         request: &'a CutRequest,
         v: &'a ValidatedRequest,
+        budget: Budget,
     ) -> Result<Self, PlanError> {
         let frames = PathFrames::new(&v.points, &v.axes, &v.u);
         let law = TimeLaw::new(
@@ -81,6 +83,7 @@ impl<'a> Context<'a> {
             law,
             sample_times,
             nominal,
+            budget,
         })
     }
 

@@ -1,22 +1,15 @@
 //! The planner-node loop: requests in (message and text), one worker in arrival order, one
 //! answer per request, latched answers, the trajectory on success, clean shutdown.
 
-use std::{
-    collections::BTreeMap,
-    fmt::Display,
-    sync::{
-        atomic::{AtomicBool, Ordering},
-        Arc,
-    },
-    time::Duration,
-};
+use std::{collections::BTreeMap, fmt::Display, sync::Arc, time::Duration};
 
+use kerf_budget::{Budget, CancelToken};
 use kerf_msgs::{std_msgs::StringMsg, trajectory_msgs::JointTrajectory, RosType};
 use ros2_client::Publisher;
 
 use super::{
-    check_text_size, check_trajectory_msg, AnswerKey, Failure, PlanAnswer, PlanningService,
-    TRAJECTORY_TOPIC,
+    check_text_size, check_trajectory_msg, AnswerKey, Failure, HarnessSettings, PlanAnswer,
+    PlanningService, TRAJECTORY_TOPIC,
 };
 use crate::{qos, Inbox, KerfNode, Logger, NodeSpec, RosArgs, RosEnv, RosError, StopToken};
 use crate::{Worker, WorkerError};
@@ -40,8 +33,9 @@ pub enum Job<R, A> {
 ///   parameters it reads (others are refused at start-up).
 /// * `args`, `env`, `stop` — command line, environment, stop token.
 /// * `setup` — reads the node's parameters and builds the service; returns it with the
-///   `queue_depth` (requests waiting or being planned before new ones are answered
-///   [`Failure::Busy`]). Its error is logged ("cannot start: …") and returned.
+///   harness's settings ([`HarnessSettings::from_params`]: `queue_depth`, requests waiting or
+///   being planned before new ones are answered [`Failure::Busy`]; `plan_timeout`, the time
+///   budget of every plan). Its error is logged ("cannot start: …") and returned.
 ///
 /// # Returns
 /// `Ok` after a clean shutdown; an error if the node could not start (bad parameter, model
@@ -52,7 +46,7 @@ pub fn run<S, E>(
     args: &RosArgs,
     env: &RosEnv,
     stop: StopToken,
-    setup: impl FnOnce(&KerfNode) -> Result<(S, usize), E>,
+    setup: impl FnOnce(&KerfNode) -> Result<(S, HarnessSettings), E>,
 ) -> Result<(), E>
 where
     S: PlanningService,
@@ -64,32 +58,35 @@ where
         known_params,
     };
     let node = KerfNode::new(spec, args, env, stop)?;
-    let (service, queue_depth) = match setup(&node) {
+    let (service, settings) = match setup(&node) {
         Ok(s) => s,
         Err(e) => {
             node.logger().error(&format!("cannot start: {e}"));
             return Err(e);
         }
     };
-    let mut n = PlannerNode::new(node, service, queue_depth)?;
+    let mut n = PlannerNode::new(node, service, settings)?;
     n.spin();
     Ok(())
 }
 
 /// Runs one job on the worker thread: an already-answered job passes through; a job queued
-/// after the node began to stop is answered [`Failure::Stopped`] without planning; a
-/// successful plan whose trajectory the executor would refuse ([`check_trajectory_msg`])
-/// becomes [`Failure::NotExecutable`] and is not published as a success.
+/// after the node began to stop is answered [`Failure::Stopped`] without planning; a plan
+/// runs under a budget of `plan_timeout` (tightened by the request's own, started now, and
+/// cancelled by `cancel`); a successful plan whose trajectory the executor would refuse
+/// ([`check_trajectory_msg`]) becomes [`Failure::NotExecutable`] and is not published as a
+/// success.
 pub fn work<S: PlanningService>(
     service: &S,
-    stopping: &AtomicBool,
+    cancel: &CancelToken,
+    plan_timeout: Duration,
     job: Job<S::Request, S::Answer>,
 ) -> S::Answer {
     let request = match job {
         Job::Answer(m) => return *m,
         Job::Plan(r) => r,
     };
-    if stopping.load(Ordering::Relaxed) {
+    if cancel.is_cancelled() {
         // Queued when the node stopped: skipped, so that shutdown waits for one plan at most.
         return service.failure(
             &service.key(&request),
@@ -98,7 +95,9 @@ pub fn work<S: PlanningService>(
         );
     }
     let key = service.key(&request);
-    let answer = service.plan(*request);
+    let budget = Budget::new(Some(plan_timeout), cancel.clone())
+        .tightened(service.requested_budget(&request));
+    let answer = service.plan(*request, &budget);
     if !answer.is_success() {
         return answer;
     }
@@ -139,17 +138,17 @@ struct PlannerNode<S: PlanningService> {
     trajectories: Publisher<JointTrajectory>,
     worker: Worker<Job<S::Request, S::Answer>, S::Answer>,
     service: Arc<S>,
-    /// Set when the node stops: queued plans are skipped.
-    stopping: Arc<AtomicBool>,
+    /// Cancelled when the node stops: the plan in progress ends, queued plans are skipped.
+    cancel: CancelToken,
     /// Ticket → key of every job submitted and not yet answered.
     pending: BTreeMap<u64, AnswerKey>,
-    queue_depth: usize,
+    settings: HarnessSettings,
     log: Logger,
     node: KerfNode,
 }
 
 impl<S: PlanningService> PlannerNode<S> {
-    fn new(mut node: KerfNode, service: S, queue_depth: usize) -> Result<Self, RosError> {
+    fn new(mut node: KerfNode, service: S, settings: HarnessSettings) -> Result<Self, RosError> {
         let topics = service.topics();
         let requests = node.inbox(&topics.request, S::RequestMsg::ROS_TYPE, qos::commands())?;
         let text_requests =
@@ -162,23 +161,28 @@ impl<S: PlanningService> PlannerNode<S> {
             node.publisher(TRAJECTORY_TOPIC, JointTrajectory::ROS_TYPE, qos::commands())?;
         let log = node.logger();
         log.info(&format!(
-            "serving {} requests on {} and {}; plans on {}, trajectories on {}; {}; queue_depth {}",
+            "serving {} requests on {} and {}; plans on {}, trajectories on {}; {}; queue_depth {}, \
+             plan_timeout {} s",
             topics.noun,
             node.resolve(&topics.request)?,
             node.resolve(&topics.request_text)?,
             node.resolve(&topics.plan)?,
             node.resolve(TRAJECTORY_TOPIC)?,
             service.startup_note(),
-            queue_depth,
+            settings.queue_depth,
+            settings.plan_timeout.as_secs_f64(),
         ));
         let service = Arc::new(service);
-        let stopping = Arc::new(AtomicBool::new(false));
-        let (service_w, stopping_w) = (Arc::clone(&service), Arc::clone(&stopping));
-        let worker = Worker::spawn("plan", 1, move |job| work(&*service_w, &stopping_w, job))
-            .map_err(|e| RosError::Dds {
-                what: "planner thread".into(),
-                reason: e.to_string(),
-            })?;
+        let cancel = CancelToken::new();
+        let (service_w, cancel_w) = (Arc::clone(&service), cancel.clone());
+        let timeout = settings.plan_timeout;
+        let worker = Worker::spawn("plan", 1, move |job| {
+            work(&*service_w, &cancel_w, timeout, job)
+        })
+        .map_err(|e| RosError::Dds {
+            what: "planner thread".into(),
+            reason: e.to_string(),
+        })?;
         Ok(Self {
             requests,
             text_requests,
@@ -187,9 +191,9 @@ impl<S: PlanningService> PlannerNode<S> {
             trajectories,
             worker,
             service,
-            stopping,
+            cancel,
             pending: BTreeMap::new(),
-            queue_depth,
+            settings,
             log,
             node,
         })
@@ -204,18 +208,22 @@ impl<S: PlanningService> PlannerNode<S> {
                 std::thread::sleep(POLL);
             }
         }
-        // Queued requests are answered "stopped" without planning; the plan in progress (if
-        // any) is awaited and published, so no request is left without an answer.
-        self.stopping.store(true, Ordering::Relaxed);
+        // The plan in progress (if any) is cancelled through its budget and answered; queued
+        // requests are answered "stopped" without planning: no request is left without an
+        // answer, and the node stops as soon as the planner reaches its next budget check.
+        self.cancel.cancel();
         if !self.pending.is_empty() {
             self.log.warn(&format!(
-                "shutting down: answering {} queued request(s); waiting for the plan in progress",
+                "shutting down: cancelling the plan in progress and answering {} request(s)",
                 self.pending.len()
             ));
         }
         while !self.pending.is_empty() {
-            if let Some(done) = self.worker.recv_timeout(Duration::from_secs(1)) {
-                self.answer(done);
+            match self.worker.recv_timeout(Duration::from_secs(1)) {
+                Some(done) => self.answer(done),
+                None => self
+                    .log
+                    .warn("shutting down: the plan in progress has not reached a budget check yet"),
             }
         }
         self.log.info("shutting down");
@@ -237,7 +245,7 @@ impl<S: PlanningService> PlannerNode<S> {
             any = true;
             let job = match received {
                 Ok(m) => match self.service.request_from_msg(&m) {
-                    Ok(r) => Job::Plan(Box::new(r)),
+                    Ok(r) => self.plan_job(r),
                     Err(answer) => Job::Answer(answer),
                 },
                 Err(e) => self.unreadable(S::RequestMsg::NAME, e),
@@ -260,7 +268,7 @@ impl<S: PlanningService> PlannerNode<S> {
                         reason,
                     ))),
                     Ok(()) => match self.service.request_from_text(&m.data) {
-                        Ok(r) => Job::Plan(Box::new(r)),
+                        Ok(r) => self.plan_job(r),
                         Err(answer) => Job::Answer(answer),
                     },
                 },
@@ -271,13 +279,32 @@ impl<S: PlanningService> PlannerNode<S> {
         any
     }
 
+    /// The job of a converted request: planned, unless it asks for a larger time budget than
+    /// the node's `plan_timeout` ([`Failure::OverBudget`]).
+    fn plan_job(&self, request: S::Request) -> Job<S::Request, S::Answer> {
+        let limit = self.settings.plan_timeout;
+        match self.service.requested_budget(&request) {
+            Some(asked) if asked > limit => Job::Answer(Box::new(self.service.failure(
+                &self.service.key(&request),
+                Failure::OverBudget,
+                format!(
+                    "time_budget = {} s is over the node's plan_timeout of {} s: a request may \
+                     ask for less, not more (send 0 for the node's budget)",
+                    asked.as_secs_f64(),
+                    limit.as_secs_f64()
+                ),
+            ))),
+            _ => Job::Plan(Box::new(request)),
+        }
+    }
+
     /// Queues a job, or answers at once when the queue is full.
     fn submit(&mut self, job: Job<S::Request, S::Answer>, source: &str) {
         let key = match &job {
             Job::Plan(r) => self.service.key(r),
             Job::Answer(m) => m.key(),
         };
-        if self.pending.len() >= self.queue_depth {
+        if self.pending.len() >= self.settings.queue_depth {
             let answer = match job {
                 // Already failed: its own status says more than "busy".
                 Job::Answer(m) => *m,
@@ -288,7 +315,7 @@ impl<S: PlanningService> PlannerNode<S> {
                         "planner busy: {} request(s) waiting or being planned (queue_depth {}); \
                          request refused, send it again later",
                         self.pending.len(),
-                        self.queue_depth
+                        self.settings.queue_depth
                     ),
                 ),
             };

@@ -18,9 +18,15 @@
 //!   own status;
 //! * the executability check: a successful plan whose trajectory the trajectory executor
 //!   would refuse is answered [`Failure::NotExecutable`] and its trajectory is not published;
-//! * start-up (`queue_depth` from [`queue_depth`]) and clean shutdown: the plan in progress
-//!   is finished and published, queued requests are answered [`Failure::Stopped`] without
-//!   planning.
+//! * deadlines and cancellation (issue 11, item 3): every plan runs under a
+//!   [`kerf_budget::Budget`] of the node's `plan_timeout` parameter, tightened by the request's
+//!   own time budget ([`PlanningService::requested_budget`]; a request asking for more than
+//!   `plan_timeout` is refused, [`Failure::OverBudget`]); the planner checks it cooperatively
+//!   and a plan that runs out of it is answered TIMEOUT, freeing the worker;
+//! * start-up ([`HarnessSettings`]) and clean shutdown: on Ctrl-C, SIGTERM or the stop token,
+//!   the plan in progress is cancelled through its budget and answered (the planner's
+//!   cancellation status), queued requests are answered [`Failure::Stopped`] without planning,
+//!   and the node returns within a second.
 
 mod answers;
 mod error;
@@ -41,6 +47,61 @@ use crate::{Params, RosError};
 
 /// Default of the `queue_depth` parameter: requests waiting or being planned.
 pub const DEFAULT_QUEUE_DEPTH: usize = 10;
+
+/// Default of the `plan_timeout` parameter (s): the time budget of every plan.
+pub const DEFAULT_PLAN_TIMEOUT: f64 = 60.0;
+
+/// The parameters the harness reads (every planner node lists them among its known ones).
+pub const HARNESS_PARAMS: &[&str] = &["queue_depth", "plan_timeout"];
+
+/// The harness's settings, from the node's parameters ([`HarnessSettings::from_params`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct HarnessSettings {
+    /// Requests waiting or being planned before new ones are answered [`Failure::Busy`] (≥ 1).
+    pub queue_depth: usize,
+    /// The time budget of every plan; a request may ask for less, not more.
+    pub plan_timeout: std::time::Duration,
+}
+
+impl Default for HarnessSettings {
+    fn default() -> Self {
+        Self {
+            queue_depth: DEFAULT_QUEUE_DEPTH,
+            plan_timeout: std::time::Duration::from_secs_f64(DEFAULT_PLAN_TIMEOUT),
+        }
+    }
+}
+
+impl HarnessSettings {
+    /// Reads `queue_depth` ([`queue_depth`]) and `plan_timeout` (seconds, a number in
+    /// (0, [`kerf_budget::MAX_BUDGET_SECONDS`]], default [`DEFAULT_PLAN_TIMEOUT`]).
+    ///
+    /// # Errors
+    /// [`RosError::Param`] naming the parameter for a wrong type or a value out of range.
+    pub fn from_params(params: &Params) -> Result<Self, RosError> {
+        let queue_depth = queue_depth(params)?;
+        let seconds = params.f64_or("plan_timeout", DEFAULT_PLAN_TIMEOUT)?;
+        let plan_timeout = match kerf_budget::limit_from_seconds(seconds) {
+            Ok(Some(limit)) => limit,
+            Ok(None) => {
+                return Err(RosError::Param {
+                    name: "plan_timeout".into(),
+                    reason: "must be > 0 s (every plan has a time budget)".into(),
+                })
+            }
+            Err(reason) => {
+                return Err(RosError::Param {
+                    name: "plan_timeout".into(),
+                    reason,
+                })
+            }
+        };
+        Ok(Self {
+            queue_depth,
+            plan_timeout,
+        })
+    }
+}
 
 /// Reads the `queue_depth` parameter (integer ≥ 1, default [`DEFAULT_QUEUE_DEPTH`]).
 ///

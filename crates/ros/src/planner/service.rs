@@ -1,5 +1,8 @@
 //! [`PlanningService`]: what a planner gives the planner-node harness ([`super::run`]).
 
+use std::time::Duration;
+
+use kerf_budget::Budget;
 use kerf_executor::JointLimits;
 use kerf_msgs::{trajectory_msgs::JointTrajectory, RosType};
 use serde::{de::DeserializeOwned, Serialize};
@@ -64,8 +67,11 @@ pub enum Failure {
     /// The planner panicked.
     Panicked,
     /// The planned trajectory fails the executor's own validation
-    /// ([`crate::planner::check_executable`]): never published as a success.
+    /// ([`crate::planner::check_trajectory_msg`]): never published as a success.
     NotExecutable,
+    /// The request asks for a larger time budget than the node's `plan_timeout` (a request
+    /// may ask for less, never more): refused without planning, like an invalid request.
+    OverBudget,
 }
 
 /// An answer message (`kerf_msgs/msg/CutPlan`, `MillPlan`, …): what the harness reads of it.
@@ -114,9 +120,16 @@ pub trait PlanningService: Send + Sync + 'static {
     /// A short description of a request for the log, e.g. `"12 CL points"`.
     fn describe(&self, request: &Self::Request) -> String;
 
-    /// Plans a request (on the worker thread). Panics are contained by the harness and
-    /// answered [`Failure::Panicked`].
-    fn plan(&self, request: Self::Request) -> Self::Answer;
+    /// The request's own time budget, if it asks for one (its `time_budget` field). The
+    /// harness refuses one over the node's `plan_timeout` ([`Failure::OverBudget`]); a value
+    /// the service's own validation refuses may be returned as `None`.
+    fn requested_budget(&self, request: &Self::Request) -> Option<Duration>;
+
+    /// Plans a request (on the worker thread) under `budget` (the node's `plan_timeout`,
+    /// tightened by the request's own; cancelled when the node stops). The planner checks it
+    /// cooperatively and answers TIMEOUT when it runs out. Panics are contained by the
+    /// harness and answered [`Failure::Panicked`].
+    fn plan(&self, request: Self::Request, budget: &Budget) -> Self::Answer;
 
     /// An answer carrying only a status and a message, for a failure of the harness.
     fn failure(&self, key: &AnswerKey, failure: Failure, message: String) -> Self::Answer;

@@ -100,6 +100,7 @@ pub(super) fn make_request(
             rto_indices,
             ..CutOptions::default()
         },
+        time_budget: 0.0,
     })
 }
 
