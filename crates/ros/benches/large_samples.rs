@@ -180,6 +180,10 @@ trait Sample: Serialize + DeserializeOwned + Send + 'static {
     const ROS_TYPE: &'static str;
     fn make(seq: u64, bytes: usize) -> Self;
     fn seq(&self) -> u64;
+    /// What one unit of the sample costs serialized, for the answer-size limit.
+    fn describe(&self) -> String {
+        String::new()
+    }
 }
 
 impl Sample for StringMsg {
@@ -228,6 +232,15 @@ impl Sample for JointTrajectory {
     }
     fn seq(&self) -> u64 {
         self.header.frame_id.parse().unwrap_or(0)
+    }
+    fn describe(&self) -> String {
+        let n = self.points.len() as f64;
+        let yaml = serde_yaml_ng::to_string(self).map_or(0, |t| t.len());
+        format!(
+            "# six-joint point (positions, velocities, accelerations): {:.1} CDR bytes; as YAML (serde_yaml_ng, as on *_plan_text) {:.1} bytes",
+            cdr_size(self) as f64 / n,
+            yaml as f64 / n
+        )
     }
 }
 
@@ -377,6 +390,10 @@ fn publisher<M: Sample>(o: &Opts) {
         o.depth,
         mib(ready[0])
     );
+    let d = M::make(0, 1 << 20).describe();
+    if !d.is_empty() {
+        println!("{d}");
+    }
     let mut seq = 1_u64;
     if !o.sizes.is_empty() {
         println!("| sample | CDR bytes | publish call | delivered (median) | worst | MB/s (median) | lost |");
@@ -484,9 +501,9 @@ fn wait_for(sub: &Sub, seq: u64, timeout: Duration) -> Option<Vec<u64>> {
 }
 
 fn human(b: usize) -> String {
-    if b >= 1 << 20 && b % (1 << 20) == 0 {
+    if b >= 1 << 20 && b.is_multiple_of(1 << 20) {
         format!("{} MiB", b >> 20)
-    } else if b % (1 << 10) == 0 {
+    } else if b.is_multiple_of(1 << 10) {
         format!("{} KiB", b >> 10)
     } else {
         format!("{:.1} MB", b as f64 / 1e6)
