@@ -3,11 +3,16 @@
 //! Taking a sample deserializes it; a large message (a 5000-point trajectory is about 1 MB)
 //! costs milliseconds, more than a control period. The inbox thread takes and deserializes
 //! samples and hands them over through a channel, so a control loop only moves them.
+//!
+//! The channel holds at most [`INBOX_CAPACITY`] samples. While it is full the thread stops
+//! taking, so unread samples wait in the subscription's keep-last history, which drops the
+//! oldest: a reader that falls behind holds at most capacity + depth samples, never an
+//! unbounded backlog of deserialized messages (issue 11, item 5).
 
 use std::{
     sync::{
         atomic::{AtomicBool, Ordering},
-        mpsc::{channel, Receiver},
+        mpsc::{sync_channel, Receiver, TrySendError},
         Arc,
     },
     thread::JoinHandle,
@@ -20,6 +25,9 @@ use serde::de::DeserializeOwned;
 /// How often the inbox thread looks for new samples when it found none.
 pub const INBOX_POLL: Duration = Duration::from_millis(1);
 
+/// Most deserialized samples waiting in an inbox for the caller to take them.
+pub const INBOX_CAPACITY: usize = 4;
+
 /// A subscription drained by a background thread.
 pub struct Inbox<M> {
     rx: Receiver<Result<M, String>>,
@@ -30,22 +38,37 @@ pub struct Inbox<M> {
 impl<M: DeserializeOwned + Send + 'static> Inbox<M> {
     /// Moves `sub` to a thread named `name`.
     pub fn new(sub: Subscription<M>, name: &str) -> std::io::Result<Self> {
-        let (tx, rx) = channel();
+        let (tx, rx) = sync_channel(INBOX_CAPACITY);
         let stop = Arc::new(AtomicBool::new(false));
         let stop_t = Arc::clone(&stop);
         let thread = std::thread::Builder::new()
             .name(format!("in-{name}"))
             .spawn(move || {
+                // Hands `item` over, waiting while the channel is full; false once the inbox
+                // is dropped or stopped.
+                let hand_over = |mut item: Result<M, String>| loop {
+                    match tx.try_send(item) {
+                        Ok(()) => return true,
+                        Err(TrySendError::Disconnected(_)) => return false,
+                        Err(TrySendError::Full(back)) => {
+                            if stop_t.load(Ordering::Relaxed) {
+                                return false;
+                            }
+                            item = back;
+                            std::thread::sleep(INBOX_POLL);
+                        }
+                    }
+                };
                 while !stop_t.load(Ordering::Relaxed) {
                     match sub.take() {
                         Ok(Some((m, _))) => {
-                            if tx.send(Ok(m)).is_err() {
+                            if !hand_over(Ok(m)) {
                                 return;
                             }
                         }
                         Ok(None) => std::thread::sleep(INBOX_POLL),
                         Err(e) => {
-                            if tx.send(Err(format!("{e:?}"))).is_err() {
+                            if !hand_over(Err(format!("{e:?}"))) {
                                 return;
                             }
                             std::thread::sleep(INBOX_POLL);

@@ -31,7 +31,7 @@ mod worker;
 pub use args::{LogLevel, ParamSource, RosArgs};
 pub use env::{DiscoveryRange, RosEnv, MAX_DOMAIN_ID};
 pub use error::RosError;
-pub use inbox::{Inbox, INBOX_POLL};
+pub use inbox::{Inbox, INBOX_CAPACITY, INBOX_POLL};
 pub use logger::Logger;
 pub use node::{block_on_timeout, KerfNode, NodeSpec};
 pub use params::{ParamValue, Params};

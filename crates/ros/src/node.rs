@@ -8,6 +8,8 @@ use std::thread::JoinHandle;
 
 use ros2_client::{
     action::{ActionClient, ActionClientQosPolicies, ActionServer},
+    dds::rustdds::{policy::ResourceLimits, QosPolicies, QosPolicyBuilder, Topic, TopicKind},
+    qos::History,
     ActionTypeName, Client, Context, Message, MessageTypeName, Name, Node, NodeName, NodeOptions,
     Publisher, QosProfile, Server, ServiceMapping, ServiceTypeName, Subscription,
 };
@@ -290,12 +292,61 @@ impl KerfNode {
     ) -> Result<Subscription<M>, RosError> {
         let (pkg, ty) = split_type(ros_type, "msg")?;
         let name = self.ros_name(topic)?;
-        let node = self.node_mut()?;
-        let t = node
-            .create_topic(&name, MessageTypeName::new(pkg, ty), &qos)
-            .map_err(dds_err(format!("topic {name}")))?;
-        node.create_subscription(&t, Some(qos))
+        let t = self.bounded_topic(&name, MessageTypeName::new(pkg, ty), &qos)?;
+        self.node_mut()?
+            .create_subscription(&t, Some(qos))
             .map_err(dds_err(format!("subscription on {name}")))
+    }
+
+    /// Creates the DDS topic of a subscription with a resource limit of `depth` samples.
+    ///
+    /// RustDDS keeps every received sample in the participant's topic cache, taken or not,
+    /// until newer ones push it out; the count it keeps is the largest of the topic's
+    /// `ResourceLimits::max_samples` and history depths ever given, and ros2-client sets no
+    /// resource limit, so RustDDS's default of 64 applies: 64 large samples per topic stay in
+    /// memory (issue 11, item 5). Created here with `max_samples` = the keep-last depth, the
+    /// cache keeps at most `depth` samples. The limit is only ever raised: another topic of
+    /// the same name created in this participant through ros2-client (a publisher on it)
+    /// would raise it to 64 again, so publishers leave topics that are subscribed alone.
+    fn bounded_topic(
+        &self,
+        name: &Name,
+        type_name: MessageTypeName,
+        qos: &QosProfile,
+    ) -> Result<Topic, RosError> {
+        let context = self.context.as_ref().ok_or_else(|| RosError::Dds {
+            what: format!("topic {name}"),
+            reason: "the node is shutting down".into(),
+        })?;
+        let node_name = NodeName::new(&self.namespace, &self.name).map_err(|e| RosError::Name {
+            name: self.fqn(),
+            reason: format!("{e:?}"),
+        })?;
+        let depth = match qos.history {
+            History::KeepLast { depth } => depth,
+            History::KeepAll => qos::DEFAULT_DEPTH,
+        };
+        let depth = i32::try_from(depth.max(1)).unwrap_or(i32::MAX);
+        let limits = QosPolicyBuilder::new()
+            .resource_limits(ResourceLimits {
+                max_samples: depth,
+                max_instances: 1,
+                max_samples_per_instance: depth,
+            })
+            .build();
+        let dds_qos = QosPolicies::from(qos).modify_by(&limits);
+        context
+            .domain_participant()
+            .create_topic(
+                name.to_dds_name("rt", &node_name, ""),
+                type_name.dds_msg_type(),
+                &dds_qos,
+                TopicKind::NoKey,
+            )
+            .map_err(|e| RosError::Dds {
+                what: format!("topic {name}"),
+                reason: e.to_string(),
+            })
     }
 
     /// Creates a subscription read on its own thread ([`Inbox`]): taking and deserializing
