@@ -302,6 +302,16 @@ impl<Req: RosType + Serialize + Debug, Plan: Answer> PlannerClient<Req, Plan> {
         assert!(!h.is_finished(), "the planner node {} stopped", self.node);
     }
 
+    /// Asks the planner node to stop (its stop token: what Ctrl-C does) without waiting.
+    pub fn request_stop(&self) {
+        self.stop.stop();
+    }
+
+    /// Whether the planner node's thread has ended.
+    pub fn has_stopped(&self) -> bool {
+        self.planner.as_ref().is_none_or(|h| h.is_finished())
+    }
+
     /// Stops the planner; it must end cleanly.
     pub fn finish(mut self) {
         self.stop.stop();

@@ -5,6 +5,7 @@
 //! form of the `~/cut_request_text` topic. SI units throughout: m, m/s,
 //! m/s², m/s³, s, rad.
 
+use crate::timelaw::TimeLaw;
 use nalgebra::{Isometry3, Quaternion, Translation3, UnitQuaternion, Vector3};
 use serde::{Deserialize, Serialize};
 
@@ -282,6 +283,30 @@ impl CutRequest {
     pub fn from_yaml(text: &str) -> Result<Self, PlanError> {
         // Nesting is checked before parsing: YAML parsing is quadratic in it.
         kerf_robot::document::from_yaml_or_json(text).map_err(|e| PlanError::invalid("request", e))
+    }
+
+    /// The number of trajectory samples the plan will have (one every `sample_period` over the
+    /// feed profile's duration, both ends included), from the path length and the feed
+    /// profile alone, before any planning.
+    ///
+    /// # Returns
+    /// `None` when a field it needs is invalid ([`Self::validate`] names it).
+    pub fn sample_count(&self) -> Option<usize> {
+        let sigma: f64 = self
+            .points
+            .windows(2)
+            .map(|w| {
+                let d: f64 = (0..3).map(|k| (w[1][k] - w[0][k]).powi(2)).sum();
+                d.sqrt()
+            })
+            .sum();
+        if !(sigma.is_finite() && self.sample_period.is_finite() && self.sample_period > 0.0) {
+            return None;
+        }
+        let law =
+            TimeLaw::new(sigma, self.feedrate, self.feed_acceleration, self.feed_jerk).ok()?;
+        let samples = (law.duration() / self.sample_period).ceil() + 1.0;
+        (samples.is_finite() && samples < usize::MAX as f64).then_some(samples as usize)
     }
 
     /// Checks every field and transforms the path into the machine frame.

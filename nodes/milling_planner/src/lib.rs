@@ -217,6 +217,14 @@ impl PlanningService for MillService {
         )
     }
 
+    /// One point per segment plus the two at rest at the ends.
+    fn answer_points(&self, request: &MillRequest) -> Option<(usize, usize)> {
+        let segments = request
+            .segments
+            .unwrap_or_else(|| self.planner.cell().path().segments().len());
+        Some((segments.checked_add(2)?, self.limits.len()))
+    }
+
     fn requested_budget(&self, request: &MillRequest) -> Option<Duration> {
         // An invalid value is refused by the planner's validation (INVALID_REQUEST).
         request.time_limit().ok().flatten()
@@ -243,7 +251,9 @@ impl PlanningService for MillService {
     /// executable INTERNAL_ERROR.
     fn failure(&self, key: &AnswerKey, failure: Failure, message: String) -> MillPlan {
         let code = match failure {
-            Failure::Unreadable | Failure::OverBudget => status::INVALID_REQUEST,
+            Failure::Unreadable | Failure::OverBudget | Failure::TooLarge => {
+                status::INVALID_REQUEST
+            }
             Failure::Busy => convert::QUEUE_FULL,
             Failure::Stopped | Failure::Panicked | Failure::NotExecutable => status::INTERNAL_ERROR,
         };

@@ -134,6 +134,10 @@ impl PlanningService for CutService {
         format!("{} CL points", request.points.len())
     }
 
+    fn answer_points(&self, request: &CutRequest) -> Option<(usize, usize)> {
+        Some((request.sample_count()?, self.limits.len()))
+    }
+
     fn requested_budget(&self, request: &CutRequest) -> Option<Duration> {
         // An invalid value is refused by the planner's validation (INVALID_REQUEST).
         kerf_budget::limit_from_seconds(request.time_budget)
@@ -174,7 +178,9 @@ impl PlanningService for CutService {
     /// panicked and not executable are INTERNAL_ERROR.
     fn failure(&self, key: &AnswerKey, failure: Failure, message: String) -> CutPlan {
         let code = match failure {
-            Failure::Unreadable | Failure::OverBudget => status::INVALID_REQUEST,
+            Failure::Unreadable | Failure::OverBudget | Failure::TooLarge => {
+                status::INVALID_REQUEST
+            }
             Failure::Busy | Failure::Stopped | Failure::Panicked | Failure::NotExecutable => {
                 status::INTERNAL_ERROR
             }

@@ -8,8 +8,8 @@ use kerf_msgs::{std_msgs::StringMsg, trajectory_msgs::JointTrajectory, RosType};
 use ros2_client::Publisher;
 
 use super::{
-    check_text_size, check_trajectory_msg, AnswerKey, Failure, HarnessSettings, PlanAnswer,
-    PlanningService, TRAJECTORY_TOPIC,
+    check_answer, check_points, check_text_size, check_trajectory_msg, AnswerKey, Failure,
+    HarnessSettings, PlanAnswer, PlanningService, TRAJECTORY_TOPIC,
 };
 use crate::{qos, Inbox, KerfNode, Logger, NodeSpec, RosArgs, RosEnv, RosError, StopToken};
 use crate::{Worker, WorkerError};
@@ -100,6 +100,11 @@ pub fn work<S: PlanningService>(
     let answer = service.plan(*request, &budget);
     if !answer.is_success() {
         return answer;
+    }
+    // Checked before anything renders the answer (its YAML text would be ~6× its size).
+    let trajectory = answer.trajectory();
+    if let Err(reason) = check_points(trajectory.points.len(), trajectory.joint_names.len()) {
+        return service.failure(&key, Failure::TooLarge, reason);
     }
     match check_trajectory_msg(service.joint_limits(), answer.trajectory()) {
         Ok(()) => answer,
@@ -280,8 +285,18 @@ impl<S: PlanningService> PlannerNode<S> {
     }
 
     /// The job of a converted request: planned, unless it asks for a larger time budget than
-    /// the node's `plan_timeout` ([`Failure::OverBudget`]).
+    /// the node's `plan_timeout` ([`Failure::OverBudget`]) or its answer would be too large
+    /// ([`Failure::TooLarge`]).
     fn plan_job(&self, request: S::Request) -> Job<S::Request, S::Answer> {
+        if let Some((points, joints)) = self.service.answer_points(&request) {
+            if let Err(reason) = check_points(points, joints) {
+                return Job::Answer(Box::new(self.service.failure(
+                    &self.service.key(&request),
+                    Failure::TooLarge,
+                    format!("request refused before planning: {reason}"),
+                )));
+            }
+        }
         let limit = self.settings.plan_timeout;
         match self.service.requested_budget(&request) {
             Some(asked) if asked > limit => Job::Answer(Box::new(self.service.failure(
@@ -358,8 +373,19 @@ impl<S: PlanningService> PlannerNode<S> {
         self.publish(answer);
     }
 
-    /// Publishes one answer on the plan topics and, on success, the trajectory; logs it.
+    /// Publishes one answer on the plan topics and, on success, the trajectory; logs it. An
+    /// answer with a sample over [`super::MAX_ANSWER_BYTES`] is replaced by
+    /// [`Failure::TooLarge`] (one large sample would block every later one of its topic).
     fn publish(&self, plan: S::Answer) {
+        let mut text = answer_text(&plan);
+        let plan = match check_answer(&plan, &text, plan.trajectory()) {
+            Ok(()) => plan,
+            Err(reason) => {
+                let failure = self.service.failure(&plan.key(), Failure::TooLarge, reason);
+                text = answer_text(&failure);
+                failure
+            }
+        };
         let id = plan.request_id().to_string();
         if plan.is_success() {
             self.log
@@ -375,9 +401,7 @@ impl<S: PlanningService> PlannerNode<S> {
                 plan.message()
             ));
         }
-        let text = StringMsg {
-            data: answer_text(&plan),
-        };
+        let text = StringMsg { data: text };
         if let Err(e) = self.plans.publish(plan) {
             self.log.error(&format!(
                 "request '{id}': {} not published: {e}",

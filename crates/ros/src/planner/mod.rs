@@ -34,6 +34,7 @@ mod executable;
 mod harness;
 mod main;
 mod service;
+mod size;
 mod text;
 
 pub use error::NodeError;
@@ -41,6 +42,10 @@ pub use executable::{check_trajectory_msg, trajectory_msg, trajectory_request};
 pub use harness::{answer_text, run, work, Job};
 pub use main::node_main;
 pub use service::{AnswerKey, Failure, PlanAnswer, PlanningService, Topics, TRAJECTORY_TOPIC};
+pub use size::{
+    cdr_bytes, check_answer, check_points, max_answer_points, MAX_ANSWER_BYTES,
+    TEXT_BYTES_PER_JOINT_POINT,
+};
 pub use text::{check_text_size, yaml_field, TextRequestError, MAX_TEXT_REQUEST_BYTES};
 
 use crate::{Params, RosError};

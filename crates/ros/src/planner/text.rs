@@ -1,9 +1,10 @@
 //! What the text request topics of every planner node share: the error of a text request
 //! that cannot be read, and the fields it can still name.
 
-/// Largest text request read (16 MiB, about 250 000 CL points in the line format); a larger
-/// one is answered INVALID_REQUEST before any parsing.
-pub const MAX_TEXT_REQUEST_BYTES: usize = 16 << 20;
+/// Largest text request read (4 MiB, about 60 000 CL points in the line format; what DDS
+/// delivers promptly, [`super::MAX_ANSWER_BYTES`]); a larger one is answered INVALID_REQUEST
+/// before any parsing.
+pub const MAX_TEXT_REQUEST_BYTES: usize = super::MAX_ANSWER_BYTES;
 
 /// Checks the size of a text request before it is parsed.
 ///
