@@ -61,6 +61,7 @@ mod joint;
 mod limits;
 mod model;
 mod pose;
+pub mod roots;
 
 pub use error::RobotError;
 pub use joint::{JointKind, JointSpec};

@@ -7,6 +7,7 @@ use kerf_mill::MillCell;
 use kerf_millplan::{
     default_policy_path, plan::IndicatorSource, IndicatorCache, MillPlanner, PlannerKind,
 };
+use kerf_robot::roots::AllowedRoots;
 use kerf_ros::{planner::HarnessSettings, Params};
 
 use crate::NodeError;
@@ -21,6 +22,7 @@ pub const KNOWN_PARAMS: &[&str] = &[
     "eval_threads",
     "queue_depth",
     "plan_timeout",
+    "allowed_file_roots",
 ];
 
 pub use kerf_ros::planner::DEFAULT_QUEUE_DEPTH;
@@ -42,6 +44,8 @@ pub struct NodeConfig {
     pub indicator_source: IndicatorSource,
     /// Requests waiting or being planned before new ones are refused (≥ 1).
     pub harness: HarnessSettings,
+    /// Where a request's policy file may be (`allowed_file_roots`).
+    pub allowed_roots: AllowedRoots,
 }
 
 /// A path parameter: `None` when unset, an error when set to the empty string.
@@ -96,6 +100,9 @@ impl NodeConfig {
     ///   arriving when the queue is full is answered at once with status QUEUE_FULL.
     /// * `plan_timeout` (seconds, default 60): the time budget of every plan; a request may ask
     ///   for less with its `time_budget`. A plan that runs out of it is answered TIMEOUT.
+    /// * `allowed_file_roots` (string array, default: any): directories a request's
+    ///   `policy_file` must resolve under (links resolved; the shipped data is always
+    ///   allowed); a policy outside is POLICY_ERROR.
     ///
     /// Empty strings are refused (leave a parameter unset for its default). Relative paths
     /// are relative to the node's working directory.
@@ -134,6 +141,7 @@ impl NodeConfig {
             }
         };
         let harness = HarnessSettings::from_params(params)?;
+        let allowed_roots = kerf_ros::planner::allowed_roots(params)?;
 
         let (planner, cell_source, cache_note) = match (cell_file, cache_file) {
             (None, None) => {
@@ -190,6 +198,7 @@ impl NodeConfig {
             ddpg_policy_file,
             fixed_g_policy_file,
             harness,
+            allowed_roots,
         })
     }
 

@@ -77,6 +77,7 @@ use kerf_budget::Budget;
 use kerf_executor::JointLimits;
 use kerf_millplan::{planner::status, MillPlanError, MillPlanner, MillRequest, PlannerKind};
 use kerf_msgs::msg::{self, MillPlan};
+use kerf_robot::roots::AllowedRoots;
 use kerf_ros::{
     planner::{self, AnswerKey, Failure, PlanningService, Topics},
     RosArgs, RosEnv, StopToken,
@@ -140,7 +141,9 @@ pub fn run(args: &RosArgs, env: &RosEnv, stop: StopToken) -> Result<(), NodeErro
             policies.fixed_g.display(),
         );
         let harness = cfg.harness;
-        Ok((MillService::new(cfg.planner, policies, note)?, harness))
+        let service =
+            MillService::new(cfg.planner, policies, note)?.with_allowed_roots(cfg.allowed_roots);
+        Ok((service, harness))
     })
 }
 
@@ -150,6 +153,7 @@ pub struct MillService {
     policies: DefaultPolicies,
     limits: Vec<JointLimits>,
     note: String,
+    allowed_roots: AllowedRoots,
 }
 
 impl MillService {
@@ -174,7 +178,28 @@ impl MillService {
             policies,
             limits,
             note,
+            allowed_roots: AllowedRoots::any(),
         })
+    }
+
+    /// Requests' policy files must resolve under `roots` (the `allowed_file_roots`
+    /// parameter).
+    pub fn with_allowed_roots(mut self, roots: AllowedRoots) -> Self {
+        self.allowed_roots = roots;
+        self
+    }
+
+    /// Checks the request's policy file against the allowed roots (POLICY_ERROR outside).
+    fn check_files(&self, request: MillRequest) -> Result<MillRequest, MillPlanError> {
+        if let Some(file) = &request.policy_file {
+            self.allowed_roots
+                .check(std::path::Path::new(file))
+                .map_err(|reason| MillPlanError::Policy {
+                    path: file.clone(),
+                    reason,
+                })?;
+        }
+        Ok(request)
     }
 
     /// The planner.
@@ -194,12 +219,16 @@ impl PlanningService for MillService {
 
     fn request_from_msg(&self, m: &msg::MillRequest) -> Result<MillRequest, Box<MillPlan>> {
         convert::request_from_msg(m)
+            .and_then(|r| self.check_files(r))
             .map_err(|e| Box::new(convert::error_to_msg(&m.request_id, &m.planner, &e)))
     }
 
     fn request_from_text(&self, text: &str) -> Result<MillRequest, Box<MillPlan>> {
-        text::parse_request(text)
-            .map_err(|e| Box::new(convert::error_to_msg(&e.request_id, &e.planner, &e.error)))
+        let r = text::parse_request(text)
+            .map_err(|e| Box::new(convert::error_to_msg(&e.request_id, &e.planner, &e.error)))?;
+        let (id, planner) = (r.request_id.clone(), r.planner.clone());
+        self.check_files(r)
+            .map_err(|e| Box::new(convert::error_to_msg(&id, &planner, &e)))
     }
 
     fn key(&self, request: &MillRequest) -> AnswerKey {

@@ -3,6 +3,7 @@
 use std::path::PathBuf;
 
 use kerf_mjto::LaserMachine;
+use kerf_robot::roots::AllowedRoots;
 use kerf_ros::{planner::HarnessSettings, Params};
 
 use crate::NodeError;
@@ -13,6 +14,7 @@ pub const KNOWN_PARAMS: &[&str] = &[
     "joint_limits_file",
     "queue_depth",
     "plan_timeout",
+    "allowed_file_roots",
 ];
 
 pub use kerf_ros::planner::DEFAULT_QUEUE_DEPTH;
@@ -26,6 +28,8 @@ pub struct NodeConfig {
     pub machine_source: String,
     /// The harness's `queue_depth` and `plan_timeout`.
     pub harness: HarnessSettings,
+    /// Where a request's mesh may be (`allowed_file_roots`).
+    pub allowed_roots: AllowedRoots,
 }
 
 impl NodeConfig {
@@ -41,6 +45,9 @@ impl NodeConfig {
     ///   arriving when the queue is full is answered at once with status INTERNAL_ERROR.
     /// * `plan_timeout` (seconds, default 60): the time budget of every plan; a request may ask
     ///   for less with its `time_budget`. A plan that runs out of it is answered TIMEOUT.
+    /// * `allowed_file_roots` (string array, default: any): directories a request's mesh must
+    ///   resolve under (links resolved; the shipped data is always allowed); a mesh outside is
+    ///   MESH_ERROR.
     ///
     /// # Errors
     /// [`NodeError::Config`] naming the parameter, [`NodeError::Ros`] for a wrong type,
@@ -70,10 +77,12 @@ impl NodeConfig {
                 ),
             };
         let harness = HarnessSettings::from_params(params)?;
+        let allowed_roots = kerf_ros::planner::allowed_roots(params)?;
         Ok(Self {
             machine,
             machine_source,
             harness,
+            allowed_roots,
         })
     }
 }

@@ -42,6 +42,7 @@ use kerf_budget::Budget;
 use kerf_executor::JointLimits;
 use kerf_mjto::{error::status, planner::Planner, CutRequest, LaserMachine, PlanError};
 use kerf_msgs::msg::{self, CutPlan};
+use kerf_robot::roots::AllowedRoots;
 use kerf_ros::{
     planner::{self, AnswerKey, Failure, PlanningService, Topics},
     RosArgs, RosEnv, StopToken,
@@ -71,7 +72,9 @@ pub type NodeError = planner::NodeError<SetupError>;
 pub fn run(args: &RosArgs, env: &RosEnv, stop: StopToken) -> Result<(), NodeError> {
     planner::run(DEFAULT_NAME, KNOWN_PARAMS, args, env, stop, |node| {
         let cfg = NodeConfig::from_params(node.params())?;
-        let service = CutService::new(cfg.machine, cfg.machine_source).map_err(NodeError::setup)?;
+        let service = CutService::new(cfg.machine, cfg.machine_source)
+            .map_err(NodeError::setup)?
+            .with_allowed_roots(cfg.allowed_roots);
         Ok((service, cfg.harness))
     })
 }
@@ -84,6 +87,7 @@ pub struct CutService {
     machine: LaserMachine,
     limits: Vec<JointLimits>,
     machine_source: String,
+    allowed_roots: AllowedRoots,
 }
 
 impl CutService {
@@ -101,7 +105,28 @@ impl CutService {
             machine,
             limits,
             machine_source: source,
+            allowed_roots: AllowedRoots::any(),
         })
+    }
+
+    /// Requests' meshes must resolve under `roots` (the `allowed_file_roots` parameter).
+    pub fn with_allowed_roots(mut self, roots: AllowedRoots) -> Self {
+        self.allowed_roots = roots;
+        self
+    }
+
+    /// Checks the request's mesh against the allowed roots (MESH_ERROR outside them).
+    fn check_files(&self, request: CutRequest) -> Result<CutRequest, PlanError> {
+        if self.allowed_roots.is_any() {
+            return Ok(request);
+        }
+        let mesh_error = |reason: String| PlanError::Mesh {
+            source_name: request.mesh.clone(),
+            reason,
+        };
+        let path = kerf_mjto::mesh::resolve(&request.mesh)?;
+        self.allowed_roots.check(&path).map_err(mesh_error)?;
+        Ok(request)
     }
 }
 
@@ -115,12 +140,17 @@ impl PlanningService for CutService {
     }
 
     fn request_from_msg(&self, m: &msg::CutRequest) -> Result<CutRequest, Box<CutPlan>> {
-        convert::request_from_msg(m).map_err(|e| Box::new(convert::error_to_msg(&m.request_id, &e)))
+        convert::request_from_msg(m)
+            .and_then(|r| self.check_files(r))
+            .map_err(|e| Box::new(convert::error_to_msg(&m.request_id, &e)))
     }
 
     fn request_from_text(&self, text: &str) -> Result<CutRequest, Box<CutPlan>> {
-        text::parse_request(text)
-            .map_err(|e| Box::new(convert::error_to_msg(&e.request_id, &e.error)))
+        let r = text::parse_request(text)
+            .map_err(|e| Box::new(convert::error_to_msg(&e.request_id, &e.error)))?;
+        let id = r.request_id.clone();
+        self.check_files(r)
+            .map_err(|e| Box::new(convert::error_to_msg(&id, &e)))
     }
 
     fn key(&self, request: &CutRequest) -> AnswerKey {

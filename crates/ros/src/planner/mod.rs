@@ -56,6 +56,27 @@ pub const DEFAULT_QUEUE_DEPTH: usize = 10;
 /// Default of the `plan_timeout` parameter (s): the time budget of every plan.
 pub const DEFAULT_PLAN_TIMEOUT: f64 = 60.0;
 
+/// Reads the `allowed_file_roots` parameter (string array of directories): files named by
+/// requests (meshes, policies, programs) must resolve under one of them or under the shipped
+/// data. Unset or empty: any path.
+///
+/// # Errors
+/// [`RosError::Param`] naming `allowed_file_roots` for a wrong type, or a root that does not
+/// exist or is not a directory.
+pub fn allowed_roots(params: &Params) -> Result<kerf_robot::roots::AllowedRoots, RosError> {
+    match params.string_array("allowed_file_roots")? {
+        None => Ok(kerf_robot::roots::AllowedRoots::any()),
+        Some(list) if list.is_empty() => Ok(kerf_robot::roots::AllowedRoots::any()),
+        Some(list) => {
+            let dirs: Vec<std::path::PathBuf> = list.iter().map(Into::into).collect();
+            kerf_robot::roots::AllowedRoots::only(&dirs).map_err(|reason| RosError::Param {
+                name: "allowed_file_roots".into(),
+                reason,
+            })
+        }
+    }
+}
+
 /// The parameters the harness reads (every planner node lists them among its known ones).
 pub const HARNESS_PARAMS: &[&str] = &["queue_depth", "plan_timeout"];
 
