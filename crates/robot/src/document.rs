@@ -88,16 +88,31 @@ pub fn check_depth(text: &str) -> Result<(), String> {
 ///
 /// # Returns
 /// The value, or the reason: the nesting check's, JSON's own error (with line and column) when
-/// the text is a JSON document, else the YAML parser's.
+/// the text is a JSON document, else the YAML parser's; at most [`MAX_ERROR_CHARS`]
+/// characters (a parser error quotes the offending value, which may be megabytes long).
 pub fn from_yaml_or_json<T: serde::de::DeserializeOwned>(text: &str) -> Result<T, String> {
     check_depth(text)?;
-    serde_yaml_ng::from_str(text).or_else(|yaml| {
-        if serde_json::from_str::<serde_json::Value>(text).is_ok() {
-            serde_json::from_str(text).map_err(|e| e.to_string())
-        } else {
-            Err(yaml.to_string())
-        }
-    })
+    serde_yaml_ng::from_str(text)
+        .or_else(|yaml| {
+            if serde_json::from_str::<serde_json::Value>(text).is_ok() {
+                serde_json::from_str(text).map_err(|e| e.to_string())
+            } else {
+                Err(yaml.to_string())
+            }
+        })
+        .map_err(cap_error)
+}
+
+/// Longest parser error passed on (characters).
+pub const MAX_ERROR_CHARS: usize = 400;
+
+/// `error` cut to [`MAX_ERROR_CHARS`] characters, saying so.
+fn cap_error(error: String) -> String {
+    if error.chars().count() <= MAX_ERROR_CHARS {
+        return error;
+    }
+    let head: String = error.chars().take(MAX_ERROR_CHARS).collect();
+    format!("{head}… (parser message cut at {MAX_ERROR_CHARS} characters)")
 }
 
 #[cfg(test)]
@@ -122,5 +137,22 @@ mod tests {
         assert!(check_depth(&deep).unwrap_err().contains("100001 levels"));
         assert!(check_depth(&"- ".repeat(50)).is_err());
         assert!(check_depth("points: [[1.4, -0.3, 1.7], [2.1, 0.3, 1.7]]\n").is_ok());
+    }
+
+    #[test]
+    fn parser_errors_never_echo_a_huge_value() {
+        #[derive(serde::Deserialize, Debug)]
+        #[allow(dead_code)]
+        struct R {
+            feedrate: f64,
+        }
+        let text = format!("feedrate: \"{}\"\n", "a".repeat(1 << 20));
+        let e = super::from_yaml_or_json::<R>(&text).unwrap_err();
+        assert!(
+            e.chars().count() < super::MAX_ERROR_CHARS + 60,
+            "{} chars",
+            e.len()
+        );
+        assert!(e.ends_with("(parser message cut at 400 characters)"), "{e}");
     }
 }

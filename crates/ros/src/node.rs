@@ -547,15 +547,21 @@ pub fn block_on_timeout<F: std::future::Future>(
     timeout: std::time::Duration,
 ) -> Option<F::Output> {
     let (tx, rx) = futures::channel::oneshot::channel::<()>();
+    // The timer thread ends as soon as the future does (`done` is dropped on return), so no
+    // thread outlives the call (the soak test counts them).
+    let (done, finished) = std::sync::mpsc::channel::<()>();
     std::thread::spawn(move || {
-        std::thread::sleep(timeout);
-        let _ = tx.send(());
+        if let Err(std::sync::mpsc::RecvTimeoutError::Timeout) = finished.recv_timeout(timeout) {
+            let _ = tx.send(());
+        }
     });
     let f = std::pin::pin!(f);
-    match futures::executor::block_on(futures::future::select(f, rx)) {
+    let out = match futures::executor::block_on(futures::future::select(f, rx)) {
         futures::future::Either::Left((out, _)) => Some(out),
         futures::future::Either::Right(_) => None,
-    }
+    };
+    drop(done);
+    out
 }
 
 impl Drop for KerfNode {

@@ -103,16 +103,29 @@ fn numbers(s: &str) -> Option<Vec<f64>> {
 fn number(line: usize, key: &str, value: &str) -> Result<f64, PlanError> {
     value
         .parse::<f64>()
-        .map_err(|_| line_err(line, format!("{key}: {value:?} is not a number")))
+        .map_err(|_| line_err(line, format!("{key}: {} is not a number", excerpt(value))))
 }
 
 fn count(line: usize, key: &str, value: &str) -> Result<u32, PlanError> {
     value.parse::<u32>().map_err(|_| {
         line_err(
             line,
-            format!("{key}: {value:?} is not a non-negative integer"),
+            format!("{key}: {} is not a non-negative integer", excerpt(value)),
         )
     })
+}
+
+/// Longest quotation of request text in an error message (characters).
+const EXCERPT_CHARS: usize = 60;
+
+/// `text` quoted for an error message: whole when short, else its first [`EXCERPT_CHARS`]
+/// characters and its length (an error never echoes a whole 4 MiB line back).
+fn excerpt(text: &str) -> String {
+    if text.chars().count() <= EXCERPT_CHARS {
+        return format!("{text:?}");
+    }
+    let head: String = text.chars().take(EXCERPT_CHARS).collect();
+    format!("{head:?}… ({} bytes)", text.len())
 }
 
 /// Parses the line format into a `CutRequest` message (defaults are applied later, by
@@ -149,7 +162,8 @@ pub fn parse_lines(text: &str) -> Result<msg::CutRequest, PlanError> {
             return Err(line_err(
                 n,
                 format!(
-                    "{line:?} is neither a CL point `x y z i j k` (six numbers) nor `key: value`"
+                    "{} is neither a CL point `x y z i j k` (six numbers) nor `key: value`",
+                    excerpt(line)
                 ),
             ));
         };
@@ -192,7 +206,10 @@ pub fn parse_lines(text: &str) -> Result<msg::CutRequest, PlanError> {
                 let v = numbers(value).filter(|v| v.len() == 7).ok_or_else(|| {
                     line_err(
                         n,
-                        format!("workpiece_pose: {value:?} is not seven numbers x y z qx qy qz qw"),
+                        format!(
+                            "workpiece_pose: {} is not seven numbers x y z qx qy qz qw",
+                            excerpt(value)
+                        ),
                     )
                 })?;
                 m.workpiece_pose = Pose {
@@ -213,9 +230,10 @@ pub fn parse_lines(text: &str) -> Result<msg::CutRequest, PlanError> {
                 return Err(line_err(
                     n,
                     format!(
-                        "unknown key {other:?}; the keys are the scalar fields of \
+                        "unknown key {}; the keys are the scalar fields of \
                          kerf_msgs/msg/CutRequest (request_id, feedrate, sample_period, \
-                         max_lead_angle, max_tilt_angle, mesh, ...)"
+                         max_lead_angle, max_tilt_angle, mesh, ...)",
+                        excerpt(other)
                     ),
                 ))
             }
