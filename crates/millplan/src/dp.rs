@@ -319,7 +319,7 @@ pub fn solve_within(
                 return None;
             }
             rewarded += 1;
-            if rewarded % BUDGET_STRIDE == 0 {
+            if rewarded.is_multiple_of(BUDGET_STRIDE) {
                 if let Err(e) = budget.check("the DP") {
                     error = Some(e.into());
                     return None;

@@ -70,6 +70,8 @@ pub fn execute(
 /// [`Plan::as_executed_with`] errors; [`MillPlanError::NotExecutable`] when
 /// the scaled trajectory fails `kerf_executor::check_executable` (the
 /// executor's own validation: the one executability check of kerf).
+// The plan, its trajectory and the evaluation's settings, passed through from the planner.
+#[allow(clippy::too_many_arguments)]
 pub(crate) fn executed(
     cell: &MillCell,
     plan: &Plan,

@@ -186,7 +186,7 @@ pub fn quaternion_interpolation_within(
     let mut positions = Vec::with_capacity(times.len());
     let mut previous = rtos.first().map(|r| r.q4);
     for (k, &t) in times.iter().enumerate() {
-        if k % crate::planner::BUDGET_STRIDE == 0 {
+        if k.is_multiple_of(crate::planner::BUDGET_STRIDE) {
             budget.check("the QI baseline")?;
         }
         let u = (law.eval(t)[0] / sigma).clamp(0.0, 1.0);

@@ -28,7 +28,7 @@ impl Context<'_> {
             |range: std::ops::Range<usize>| -> Result<Vec<CollisionReport>, Interrupt> {
                 let mut found = Vec::new();
                 for k in range {
-                    if k % BUDGET_STRIDE == 0 {
+                    if k.is_multiple_of(BUDGET_STRIDE) {
                         self.budget.check("the dense collision check")?;
                     }
                     found.extend(self.check_sample(world, s.times[k], s.u[k], &s.q[k]));
@@ -232,7 +232,7 @@ impl Context<'_> {
         world: Option<&CollisionWorld>,
     ) -> Result<(), PlanError> {
         for (k, (&u, q)) in u.iter().zip(q).enumerate() {
-            if k % BUDGET_STRIDE == 0 {
+            if k.is_multiple_of(BUDGET_STRIDE) {
                 self.budget.check("the geometric metrics")?;
             }
             let (c, o) = forward(q);

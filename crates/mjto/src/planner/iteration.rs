@@ -273,7 +273,7 @@ impl Context<'_> {
         };
         let splines = [&it.m[0], &it.m[1], &it.m[2], &it.q4, &it.q5, &it.q6];
         for (k, &t) in s.times.iter().enumerate() {
-            if k % super::BUDGET_STRIDE == 0 {
+            if k.is_multiple_of(super::BUDGET_STRIDE) {
                 self.budget.check("trajectory sampling")?;
             }
             let law = self.law.eval(t);
