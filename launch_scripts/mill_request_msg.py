@@ -18,7 +18,10 @@ import sys
 
 import yaml
 
-FIELDS = {"request_id", "points", "segments", "process", "limits", "initial", "planner", "policy_file"}
+FIELDS = {
+    "request_id", "points", "segments", "process", "limits", "initial", "planner", "policy_file",
+    "time_budget",
+}
 PROCESS = ["teeth", "tool_radius", "axial_depth", "kt", "kn", "entry_angle", "exit_angle"]
 INITIAL = {"spindle_rpm": 2000.0, "feed": 0.04, "g": 0.0}
 
@@ -60,6 +63,7 @@ def main(path):
         "has_initial_state": "initial" in r,
         "planner": r.get("planner", "ddpg"),
         "policy_file": r.get("policy_file", ""),
+        "time_budget": num(path, "time_budget", r.get("time_budget", 0.0)),
     }
     # Every field, so the message is complete also for readers without defaults; the fields
     # of a group whose flag is false are ignored by the node.
