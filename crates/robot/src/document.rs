@@ -1,13 +1,15 @@
 //! [`nesting_depth`]: how deeply a YAML or JSON document nests, found by one linear scan
 //! before any parser sees it. YAML parsers take time quadratic in the nesting depth (200 KB
 //! of `[` nested 10⁵ deep took 31 s), so kerf refuses documents nested deeper than
-//! [`MAX_DEPTH`] before parsing them.
+//! [`MAX_DEPTH`] before parsing them ([`check_depth`]: the scan, then the YAML parser's own
+//! events, stopped as soon as they nest too deep).
 
 /// Deepest nesting kerf accepts in a request document. kerf's requests nest three levels
 /// (`points: [[x, y, z], …]`, `process: {…}`); 32 leaves room for any hand-written layout.
 pub const MAX_DEPTH: usize = 32;
 
-/// An upper bound of the nesting depth of a YAML (or JSON) document (exact or one more): on
+/// An upper bound of the nesting depth of a JSON document, or of a YAML document whose quotes
+/// all start quoted scalars (exact or one more; [`check_depth`] covers the rest): on
 /// each line, the block level (1 for the document's root, plus one per two spaces of
 /// indentation, rounded up, plus one per chained `- ` entry) plus the open flow collections
 /// (`[`, `{` outside quotes and comments; a flow collection continued on later lines counts
@@ -68,7 +70,11 @@ pub fn nesting_depth(text: &str) -> usize {
     deepest
 }
 
-/// Checks a document against [`MAX_DEPTH`] before it is parsed.
+/// Checks a document against [`MAX_DEPTH`] before it is parsed: [`nesting_depth`], then the
+/// events of the YAML parser (libyaml, serde_yaml_ng's), read only until they nest deeper than
+/// the limit. The scan cannot tell every quote from YAML's point of view (`it's` is a plain
+/// scalar, not the start of a quoted one) and can under-count; the parser's events are exact,
+/// and stopping them at the limit keeps their cost linear.
 ///
 /// # Returns
 /// The reason it is refused ("nested N levels deep, over the limit of 32"), or `Ok`.
@@ -79,7 +85,69 @@ pub fn check_depth(text: &str) -> Result<(), String> {
             "the document is nested {depth} levels deep, over the limit of {MAX_DEPTH}"
         ));
     }
+    if let Some(line) = yaml_too_deep(text) {
+        return Err(format!(
+            "the document is nested more than {MAX_DEPTH} levels deep at line {line}, over the \
+             limit of {MAX_DEPTH}"
+        ));
+    }
     Ok(())
+}
+
+/// Frees a libyaml parser (boxed: libyaml keeps a pointer to it) when dropped.
+struct YamlParser(Box<std::mem::MaybeUninit<unsafe_libyaml::yaml_parser_t>>);
+
+impl Drop for YamlParser {
+    fn drop(&mut self) {
+        // SAFETY: only built after `yaml_parser_initialize` succeeded on this box.
+        unsafe { unsafe_libyaml::yaml_parser_delete(self.0.as_mut_ptr()) }
+    }
+}
+
+/// The line (1-based) where libyaml's events of `text` first nest deeper than [`MAX_DEPTH`];
+/// `None` when they never do, or when libyaml stops at a syntax error first (the parser that
+/// reads the document reports it, or the text is JSON that YAML cannot read).
+///
+/// # Performance
+/// Linear: libyaml's scanner runs at most 1024 characters ahead of the event that stops it.
+fn yaml_too_deep(text: &str) -> Option<u64> {
+    use unsafe_libyaml as unsafe_sys;
+    let mut boxed = Box::new(std::mem::MaybeUninit::<unsafe_sys::yaml_parser_t>::uninit());
+    // SAFETY: libyaml's API as serde_yaml_ng uses it: the parser is initialized in place in a
+    // box that does not move, reads `text` (which outlives it), is deleted once (`YamlParser`),
+    // and every event it returns is deleted.
+    unsafe {
+        if unsafe_sys::yaml_parser_initialize(boxed.as_mut_ptr()).fail {
+            return None;
+        }
+        let mut parser = YamlParser(boxed);
+        let p = parser.0.as_mut_ptr();
+        unsafe_sys::yaml_parser_set_encoding(p, unsafe_sys::YAML_UTF8_ENCODING);
+        unsafe_sys::yaml_parser_set_input_string(p, text.as_ptr(), text.len() as u64);
+        let mut depth = 0usize;
+        loop {
+            let mut event = std::mem::MaybeUninit::<unsafe_sys::yaml_event_t>::uninit();
+            if unsafe_sys::yaml_parser_parse(p, event.as_mut_ptr()).fail {
+                return None;
+            }
+            let event = event.as_mut_ptr();
+            let (kind, line) = ((*event).type_, (*event).start_mark.line);
+            unsafe_sys::yaml_event_delete(event);
+            match kind {
+                unsafe_sys::YAML_SEQUENCE_START_EVENT | unsafe_sys::YAML_MAPPING_START_EVENT => {
+                    depth += 1;
+                    if depth > MAX_DEPTH {
+                        return Some(line + 1);
+                    }
+                }
+                unsafe_sys::YAML_SEQUENCE_END_EVENT | unsafe_sys::YAML_MAPPING_END_EVENT => {
+                    depth = depth.saturating_sub(1);
+                }
+                unsafe_sys::YAML_STREAM_END_EVENT => return None,
+                _ => {}
+            }
+        }
+    }
 }
 
 /// Reads a request document: YAML, or JSON where YAML refuses it (JSON is nearly a subset of
@@ -122,5 +190,42 @@ mod tests {
         assert!(check_depth(&deep).unwrap_err().contains("100001 levels"));
         assert!(check_depth(&"- ".repeat(50)).is_err());
         assert!(check_depth("points: [[1.4, -0.3, 1.7], [2.1, 0.3, 1.7]]\n").is_ok());
+    }
+
+    /// Found by fuzzing (issue 11, item 7; fuzz/corpus/document/plain-quote-deep.yaml): a
+    /// quote inside a plain scalar (`it's`) made the scan skip the rest of the document as
+    /// quoted, so deep flow nesting after it reached the YAML parser (30 000 levels: 4.6 s in
+    /// a debug build, quadratic). libyaml's own events catch it, early and in linear time.
+    #[test]
+    fn nesting_the_scan_cannot_see_is_refused_by_the_parser_events() {
+        let n = 30_000;
+        let deep = format!("a: it's\nb: {}{}\n", "[".repeat(n), "]".repeat(n));
+        assert_eq!(nesting_depth(&deep), 1);
+        let start = std::time::Instant::now();
+        let e = check_depth(&deep).unwrap_err();
+        assert!(e.contains("more than 32 levels deep at line 2"), "{e}");
+        assert!(start.elapsed() < std::time::Duration::from_secs(1));
+        // Other quotes the scan takes for openers: a plain scalar with a quote mid-line,
+        // a block scalar, a `#` that starts no comment.
+        for text in [
+            format!("a: x 'y\nb: {}\n", "[".repeat(40)),
+            format!("a: |\n  'x\nb: {}\n", "[".repeat(40)),
+            format!("a: [b#c, {}]\n", "[".repeat(40)),
+        ] {
+            assert!(check_depth(&text).is_err(), "{text}");
+        }
+        // At the limit, YAML nesting is accepted; JSON that YAML cannot read still gets the scan.
+        assert!(check_depth(&format!(
+            "a: it's\nb: {}{}\n",
+            "[".repeat(31),
+            "]".repeat(31)
+        ))
+        .is_ok());
+        assert!(check_depth(&format!(
+            "{{\"a\": \"\\ud83d\\ude00\", \"b\": {}1{}}}",
+            "[".repeat(40),
+            "]".repeat(40)
+        ))
+        .is_err());
     }
 }
