@@ -166,30 +166,52 @@ pub fn load(reference: &str) -> Result<MeshData, PlanError> {
 
 /// Loads the file at `path` (already resolved); errors name `source_name`.
 fn load_path(path: &Path, source_name: &str) -> Result<MeshData, PlanError> {
-    let err = |reason: String| PlanError::Mesh {
-        source_name: source_name.to_owned(),
-        reason,
-    };
     let ext = path
         .extension()
         .and_then(|e| e.to_str())
         .map(str::to_ascii_lowercase)
         .unwrap_or_default();
     if ext != "stl" && ext != "obj" {
-        return Err(err(format!(
-            "unknown mesh format '.{ext}' of {}: expected .stl or .obj",
-            path.display()
-        )));
+        return Err(PlanError::Mesh {
+            source_name: source_name.to_owned(),
+            reason: format!(
+                "unknown mesh format '.{ext}' of {}: expected .stl or .obj",
+                path.display()
+            ),
+        });
     }
-    let bytes = kerf_robot::file::read_regular(path, MAX_MESH_BYTES).map_err(&err)?;
-    let mesh = if ext == "stl" {
-        parse_stl(&bytes)
-    } else {
-        let text = std::str::from_utf8(&bytes)
+    let bytes =
+        kerf_robot::file::read_regular(path, MAX_MESH_BYTES).map_err(|reason| PlanError::Mesh {
+            source_name: source_name.to_owned(),
+            reason,
+        })?;
+    parse(&bytes, &ext, source_name)
+}
+
+/// Parses and validates the contents of a mesh file, as [`load`] does after reading it.
+///
+/// # Arguments
+/// * `bytes` - the file's contents.
+/// * `format` - `stl` or `obj` (the file's extension, case-insensitive).
+/// * `source_name` - the mesh reference, used in error messages.
+///
+/// # Errors
+/// [`PlanError::Mesh`] naming `source_name`: an unknown format, the parse errors and the
+/// failures of [`MeshData::validated`] listed at [`load`].
+pub fn parse(bytes: &[u8], format: &str, source_name: &str) -> Result<MeshData, PlanError> {
+    let err = |reason: String| PlanError::Mesh {
+        source_name: source_name.to_owned(),
+        reason,
+    };
+    let mesh = match format.to_ascii_lowercase().as_str() {
+        "stl" => parse_stl(bytes),
+        "obj" => std::str::from_utf8(bytes)
             .map_err(|e| format!("not UTF-8 text (OBJ is a text format): {e}"))
-            .map_err(&err)?;
-        parse_obj(text)
+            .and_then(parse_obj),
+        other => Err(format!(
+            "unknown mesh format '{other}': expected stl or obj"
+        )),
     }
-    .map_err(&err)?;
+    .map_err(err)?;
     mesh.validated(source_name)
 }

@@ -398,6 +398,13 @@ impl CutRequest {
         arc_length.push(0.0);
         for i in 1..n {
             let d = (points[i] - points[i - 1]).norm();
+            if !(arc_length[i - 1] + d).is_finite() {
+                // Finite coordinates near f64::MAX overflow in the pose or the lengths.
+                return Err(PlanError::invalid(
+                    format!("points[{i}]"),
+                    format!("the path length to this point overflows (segment of {d} m): coordinates too large"),
+                ));
+            }
             if d < MIN_SEGMENT_LENGTH {
                 return Err(PlanError::invalid(
                     format!("points[{i}]"),
@@ -407,7 +414,19 @@ impl CutRequest {
                     ),
                 ));
             }
-            arc_length.push(arc_length[i - 1] + d);
+            let s = arc_length[i - 1] + d;
+            if s <= arc_length[i - 1] {
+                // A segment below the rounding of a huge path length leaves it unchanged.
+                return Err(PlanError::invalid(
+                    format!("points[{i}]"),
+                    format!(
+                        "the segment of {d:e} m does not lengthen the path of {:e} m so far \
+                         (f64 rounding): coordinates too large",
+                        arc_length[i - 1]
+                    ),
+                ));
+            }
+            arc_length.push(s);
         }
         let sigma = arc_length[n - 1];
         let mut u: Vec<f64> = arc_length.iter().map(|s| s / sigma).collect();

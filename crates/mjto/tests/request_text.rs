@@ -72,3 +72,41 @@ fn gfd_grids_are_bounded_as_a_product() {
     r.options.gfd.q6_steps = 21;
     assert!(r.validate().is_ok());
 }
+
+/// Found by fuzzing (issue 11, item 7; fuzz/corpus/cut_text/overflow-*.txt): finite
+/// coordinates near f64::MAX, alone or moved by the workpiece pose, gave an infinite or NaN
+/// path length that validation accepted, and a short segment after a huge one left the path
+/// length unchanged (repeated arc-length parameters). They are refused, naming the point.
+#[test]
+fn path_lengths_that_overflow_are_refused() {
+    let mut r = CutRequest::from_yaml(JSON).unwrap();
+    r.points = vec![[1e308, -1e308, 0.0], [-1e308, 1e308, 0.0]];
+    let e = r.validate().unwrap_err().to_string();
+    assert!(
+        e.contains("points[1]") && e.contains("coordinates too large"),
+        "{e}"
+    );
+    // Each point is fine, the pose moves them out of range.
+    r.points = vec![[1e308, 0.0, 0.0], [1.7e308, 0.0, 0.0]];
+    r.workpiece_pose.position = [1e308, 0.0, 0.0];
+    let e = r.validate().unwrap_err().to_string();
+    assert!(
+        e.contains("points[1]") && e.contains("coordinates too large"),
+        "{e}"
+    );
+    // A short segment after a huge one is lost in the rounding of the path length.
+    r.workpiece_pose.position = [0.0; 3];
+    r.points = vec![[0.6, 1.8e20, 0.0], [0.6, 0.2, 0.1], [0.7, 0.2, 0.1]];
+    r.axes = vec![[0.0, 0.0, 1.0]; 3];
+    let e = r.validate().unwrap_err().to_string();
+    assert!(
+        e.contains("points[2]") && e.contains("coordinates too large"),
+        "{e}"
+    );
+    // Large but representable lengths are not refused here (the machine's reach is checked
+    // by the planner).
+    r.points = vec![[1e100, 0.0, 0.0], [2e100, 0.0, 0.0]];
+    r.axes = vec![[0.0, 0.0, 1.0]; 2];
+    let v = r.validate().unwrap();
+    assert!(v.sigma.is_finite() && v.sigma > 0.0);
+}
