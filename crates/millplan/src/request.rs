@@ -45,6 +45,10 @@ pub const MAX_POINTS: usize = 10_000;
 /// direct evaluation of a plan scale linearly with it).
 pub const MAX_SEGMENTS: usize = 10_000;
 
+/// Largest |coordinate| of a path point (m): far beyond any robot's reach (the IRB 6660 reaches
+/// 3.1 m), small enough that the path's spline and arc length stay well conditioned.
+pub const MAX_COORDINATE: f64 = 1000.0;
+
 /// Default initial spindle speed \[rpm\] (seed 004's IVP Ω0).
 pub const DEFAULT_INITIAL_RPM: f64 = 2000.0;
 /// Default initial feed [m/s] (seed 004's IVP f0).
@@ -439,7 +443,19 @@ impl MillRequest {
         }
         for (i, p) in self.points.iter().enumerate() {
             for (c, v) in p.iter().enumerate() {
-                check_finite(&format!("points[{i}][{c}] [m]"), *v)?;
+                let name = format!("points[{i}][{c}] [m]");
+                check_finite(&name, *v)?;
+                if v.abs() > MAX_COORDINATE {
+                    // Found by fuzzing: 1e20 m ran the path's arc-length refinement through
+                    // all its steps before failing (seconds per request).
+                    return Err(MillPlanError::InvalidParameter {
+                        name,
+                        value: *v,
+                        reason: format!(
+                            "more than {MAX_COORDINATE} m from the robot base: outside any cell"
+                        ),
+                    });
+                }
             }
         }
         for (i, w) in self.points.windows(2).enumerate() {

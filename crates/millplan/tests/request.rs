@@ -509,3 +509,16 @@ fn teeth_are_bounded() {
     let e = r.validate().unwrap_err().to_string();
     assert!(e.contains("teeth") && e.contains("1..=100"), "{e}");
 }
+
+#[test]
+fn coordinates_beyond_any_cell_are_refused_by_name() {
+    let r = MillRequest {
+        points: vec![[1.4, -0.3, 1.7], [1e20, 0.3, 1.7]],
+        ..MillRequest::default()
+    };
+    let e = r.validate().unwrap_err().to_string();
+    assert!(
+        e.contains("points[1][0] [m]") && e.contains("outside any cell"),
+        "{e}"
+    );
+}
