@@ -177,6 +177,7 @@ pub fn cut_request(u: &mut Unstructured) -> Result<msg::CutRequest> {
         has_reference_standoff: u.arbitrary()?,
         reference_standoff: float(u)?,
         clearance: if u.arbitrary()? { 0.0 } else { float(u)? },
+        time_budget: if u.arbitrary()? { 0.0 } else { float(u)? },
     })
 }
 
@@ -212,6 +213,7 @@ pub fn mill_request(u: &mut Unstructured) -> Result<msg::MillRequest> {
         initial_g: float(u)?,
         planner: string(u, &["ddpg", "fixed_g", "dp", "naive"])?,
         policy_file: string(u, &["crates/millplan/policies/ddpg.json"])?,
+        time_budget: if u.arbitrary()? { 0.0 } else { float(u)? },
     })
 }
 

@@ -198,6 +198,7 @@ fn mill_request() -> msg::MillRequest {
         initial_g: 0.0,
         planner: "naive".into(),
         policy_file: String::new(),
+        time_budget: 30.0,
     }
 }
 
