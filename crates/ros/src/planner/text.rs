@@ -76,6 +76,6 @@ mod tests {
         assert!(super::check_text_size("request_id: a\n").is_ok());
         let big = "#".repeat(super::MAX_TEXT_REQUEST_BYTES + 1);
         let e = super::check_text_size(&big).unwrap_err();
-        assert!(e.contains("over the limit of 16777216 bytes"), "{e}");
+        assert!(e.contains("over the limit of 4194304 bytes"), "{e}");
     }
 }
