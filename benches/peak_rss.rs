@@ -5,11 +5,12 @@
 //! in-process with a client node, reads VmRSS, sends the request on the node's text topic,
 //! waits for its answer and prints the answer's status with VmRSS and VmHWM (the process's
 //! peak: node, client and the DDS traffic of both). Cases:
-//! * `cut-points`: the largest text request (4 MiB, ~60 000 CL points in the line format),
-//!   parsed and refused for its answer size;
+//! * `cut-points`: the largest text request (4 MiB, ~60 000 CL points 0.1 mm apart in the
+//!   line format, sampled every 8 ms: under the answer limit), parsed and planned;
 //! * `cut-samples`: case 1 sampled so that its answer has 6 900 points (the most an answer
 //!   carries is 6 990), planned;
-//! * `mill-segments`: the default path in 6 988 segments (6 990 trajectory points), ddpg.
+//! * `mill-segments`: the default path in 4 413 segments, the most whose answer fits in
+//!   4 MiB (4 415 trajectory points and the segment table), ddpg.
 //!
 //! Run: `cargo bench --bench peak_rss`.
 #![allow(clippy::unwrap_used, clippy::expect_used)] // a bench binary reports failures by panicking
@@ -96,7 +97,7 @@ fn run_case(case: &str) {
     let text = match case {
         "cut-points" => {
             let mut t = String::from(
-                "request_id: cut-points\nfeedrate: 0.3\nsample_period: 0.004\n\
+                "request_id: cut-points\nfeedrate: 0.3\nsample_period: 0.008\n\
                  max_lead_angle: 0.1\nmax_tilt_angle: 0.1\n\
                  mesh: package://kerf/urdf/meshes/bpillar.obj\n",
             );
@@ -122,7 +123,7 @@ fn run_case(case: &str) {
                     &format!("sample_period: {}", 2.529 / 6899.0),
                 )
         }
-        _ => "request_id: mill-segments\nplanner: ddpg\nsegments: 6988\n\
+        _ => "request_id: mill-segments\nplanner: ddpg\nsegments: 4413\n\
               points: [[1.4, -0.3, 1.7], [1.6, -0.1, 1.7], [1.8, 0.1, 1.7], [2.1, 0.3, 1.7]]\n"
             .to_string(),
     };

@@ -79,6 +79,7 @@ use kerf_millplan::{planner::status, MillPlanError, MillPlanner, MillRequest, Pl
 use kerf_msgs::msg::{self, MillPlan};
 use kerf_robot::roots::AllowedRoots;
 use kerf_ros::{
+    planner::AnswerSize,
     planner::{self, AnswerKey, Failure, PlanningService, Topics},
     RosArgs, RosEnv, StopToken,
 };
@@ -146,6 +147,10 @@ pub fn run(args: &RosArgs, env: &RosEnv, stop: StopToken) -> Result<(), NodeErro
         Ok((service, harness))
     })
 }
+
+/// YAML bytes of one row of a `MillPlan`'s segment table (`kerf_msgs/msg/MillSegment`): 312
+/// measured on a 6 988-segment plan (`cargo bench --bench peak_rss`), rounded up.
+pub const SEGMENT_TEXT_BYTES: usize = 350;
 
 /// The milling planner as a planning service: mill requests in, `MillPlan` answers out.
 pub struct MillService {
@@ -246,12 +251,17 @@ impl PlanningService for MillService {
         )
     }
 
-    /// One point per segment plus the two at rest at the ends.
-    fn answer_points(&self, request: &MillRequest) -> Option<(usize, usize)> {
+    /// One point per segment plus the two at rest at the ends, and one row of the segment
+    /// table per segment.
+    fn answer_size(&self, request: &MillRequest) -> Option<AnswerSize> {
         let segments = request
             .segments
             .unwrap_or_else(|| self.planner.cell().path().segments().len());
-        Some((segments.checked_add(2)?, self.limits.len()))
+        Some(AnswerSize {
+            points: segments.checked_add(2)?,
+            joints: self.limits.len(),
+            extra_text_bytes: segments.checked_mul(SEGMENT_TEXT_BYTES)?,
+        })
     }
 
     fn requested_budget(&self, request: &MillRequest) -> Option<Duration> {

@@ -44,6 +44,7 @@ use kerf_mjto::{error::status, planner::Planner, CutRequest, LaserMachine, PlanE
 use kerf_msgs::msg::{self, CutPlan};
 use kerf_robot::roots::AllowedRoots;
 use kerf_ros::{
+    planner::AnswerSize,
     planner::{self, AnswerKey, Failure, PlanningService, Topics},
     RosArgs, RosEnv, StopToken,
 };
@@ -164,8 +165,12 @@ impl PlanningService for CutService {
         format!("{} CL points", request.points.len())
     }
 
-    fn answer_points(&self, request: &CutRequest) -> Option<(usize, usize)> {
-        Some((request.sample_count()?, self.limits.len()))
+    fn answer_size(&self, request: &CutRequest) -> Option<AnswerSize> {
+        Some(AnswerSize {
+            points: request.sample_count()?,
+            joints: self.limits.len(),
+            extra_text_bytes: 0,
+        })
     }
 
     fn requested_budget(&self, request: &CutRequest) -> Option<Duration> {

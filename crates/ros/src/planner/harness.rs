@@ -288,8 +288,8 @@ impl<S: PlanningService> PlannerNode<S> {
     /// the node's `plan_timeout` ([`Failure::OverBudget`]) or its answer would be too large
     /// ([`Failure::TooLarge`]).
     fn plan_job(&self, request: S::Request) -> Job<S::Request, S::Answer> {
-        if let Some((points, joints)) = self.service.answer_points(&request) {
-            if let Err(reason) = check_points(points, joints) {
+        if let Some(size) = self.service.answer_size(&request) {
+            if let Err(reason) = size.check() {
                 return Job::Answer(Box::new(self.service.failure(
                     &self.service.key(&request),
                     Failure::TooLarge,

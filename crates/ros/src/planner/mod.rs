@@ -43,7 +43,7 @@ pub use harness::{answer_text, run, work, Job};
 pub use main::node_main;
 pub use service::{AnswerKey, Failure, PlanAnswer, PlanningService, Topics, TRAJECTORY_TOPIC};
 pub use size::{
-    cdr_bytes, check_answer, check_points, max_answer_points, MAX_ANSWER_BYTES,
+    cdr_bytes, check_answer, check_points, max_answer_points, AnswerSize, MAX_ANSWER_BYTES,
     TEXT_BYTES_PER_JOINT_POINT,
 };
 pub use text::{check_text_size, yaml_field, TextRequestError, MAX_TEXT_REQUEST_BYTES};

@@ -73,7 +73,7 @@ pub enum Failure {
     /// may ask for less, never more): refused without planning, like an invalid request.
     OverBudget,
     /// The answer would be larger than what is published ([`super::MAX_ANSWER_BYTES`]):
-    /// refused before planning when [`PlanningService::answer_points`] tells, else after.
+    /// refused before planning when [`PlanningService::answer_size`] tells, else after.
     TooLarge,
 }
 
@@ -123,11 +123,12 @@ pub trait PlanningService: Send + Sync + 'static {
     /// A short description of a request for the log, e.g. `"12 CL points"`.
     fn describe(&self, request: &Self::Request) -> String;
 
-    /// The number of trajectory points and joints the plan of `request` will have, when it is
-    /// known before planning (the harness refuses a request whose answer would be over
-    /// [`super::MAX_ANSWER_BYTES`], [`Failure::TooLarge`]); `None` when not known (the answer
-    /// is checked after planning). A value the service's validation refuses may give `None`.
-    fn answer_points(&self, request: &Self::Request) -> Option<(usize, usize)>;
+    /// What the answer to `request` will carry (trajectory points, joints, other text that
+    /// grows with the request), when it is known before planning: the harness refuses a
+    /// request whose answer would be over [`super::MAX_ANSWER_BYTES`] ([`Failure::TooLarge`]).
+    /// `None` when not known (the answer is checked after planning). A value the service's
+    /// validation refuses may give `None`.
+    fn answer_size(&self, request: &Self::Request) -> Option<super::AnswerSize>;
 
     /// The request's own time budget, if it asks for one (its `time_budget` field). The
     /// harness refuses one over the node's `plan_timeout` ([`Failure::OverBudget`]); a value

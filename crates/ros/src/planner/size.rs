@@ -41,6 +41,54 @@ pub fn check_points(points: usize, joints: usize) -> Result<(), String> {
     Ok(())
 }
 
+/// What an answer will carry, estimated from its request before planning
+/// ([`super::PlanningService::answer_size`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct AnswerSize {
+    /// Trajectory points.
+    pub points: usize,
+    /// Joints per point.
+    pub joints: usize,
+    /// Text bytes of everything else that grows with the request (e.g. the milling plan's
+    /// per-segment table).
+    pub extra_text_bytes: usize,
+}
+
+impl AnswerSize {
+    /// The estimated size of the answer's YAML text, its largest sample (bytes).
+    pub fn text_bytes(&self) -> usize {
+        self.points
+            .saturating_mul(self.joints.max(1))
+            .saturating_mul(TEXT_BYTES_PER_JOINT_POINT)
+            .saturating_add(self.extra_text_bytes)
+    }
+
+    /// Checks the estimate against [`MAX_ANSWER_BYTES`].
+    ///
+    /// # Errors
+    /// The reason, naming the points, the estimated size and the limit.
+    pub fn check(&self) -> Result<(), String> {
+        let bytes = self.text_bytes();
+        if bytes > MAX_ANSWER_BYTES {
+            return Err(format!(
+                "its answer would carry {} trajectory points of {} joints{}, about {bytes} bytes \
+                 as text, over the limit of {MAX_ANSWER_BYTES} bytes (what DDS delivers \
+                 promptly; {} points at most): lengthen sample_period, use fewer segments, or \
+                 split the path",
+                self.points,
+                self.joints,
+                if self.extra_text_bytes > 0 {
+                    format!(" and {} bytes of per-segment data", self.extra_text_bytes)
+                } else {
+                    String::new()
+                },
+                max_answer_points(self.joints)
+            ));
+        }
+        Ok(())
+    }
+}
+
 /// The CDR size of a message (bytes), as published; `None` if it cannot be encoded.
 pub fn cdr_bytes<T: Serialize>(message: &T) -> Option<usize> {
     cdr_encoding::to_vec::<T, byteorder::LittleEndian>(message)
@@ -112,6 +160,26 @@ mod tests {
         let text = serde_yaml_ng::to_string(&t).unwrap();
         assert!(text.len() <= MAX_ANSWER_BYTES, "{} bytes", text.len());
         check_answer(&t, &text, &t).unwrap();
+    }
+
+    #[test]
+    fn estimates_count_the_points_and_the_extra_text() {
+        let fits = AnswerSize {
+            points: 6990,
+            joints: 6,
+            extra_text_bytes: 0,
+        };
+        assert!(fits.check().is_ok());
+        let e = AnswerSize {
+            extra_text_bytes: 100_000,
+            ..fits
+        }
+        .check()
+        .unwrap_err();
+        assert!(
+            e.contains("6990 trajectory points of 6 joints and 100000 bytes"),
+            "{e}"
+        );
     }
 
     #[test]
