@@ -29,17 +29,9 @@ use serde::de::DeserializeOwned;
 #[allow(dead_code)]
 #[path = "../tests/support/mod.rs"]
 mod support;
+use support::status_kib;
 
 const CASES: [&str; 3] = ["cut-points", "cut-samples", "mill-segments"];
-
-fn status_kib(key: &str) -> u64 {
-    let s = std::fs::read_to_string("/proc/self/status").unwrap();
-    s.lines()
-        .find_map(|l| l.strip_prefix(key))
-        .and_then(|v| v.split_whitespace().next())
-        .and_then(|v| v.parse().ok())
-        .unwrap()
-}
 
 fn case1() -> String {
     std::fs::read_to_string(concat!(

@@ -4,10 +4,8 @@
 #![allow(clippy::unwrap_used, clippy::expect_used)] // tests report failures by panicking
 
 use std::{
-    io::{BufRead, BufReader},
     process::{Command, Stdio},
-    sync::mpsc,
-    time::{Duration, Instant},
+    time::Duration,
 };
 
 const DOMAIN: &str = "48";
@@ -22,32 +20,14 @@ fn kerf() -> Command {
 
 mod support;
 
-use support::{assert_clean_exit, interrupt, Killed};
+use support::{assert_clean_exit, interrupt, Lines};
 
 #[test]
 fn launch_echo_and_ctrl_c() {
-    let child = kerf()
-        .args(["launch", "--robot", "laser_cutter"])
-        .stderr(Stdio::piped())
-        .spawn()
-        .expect("start kerf launch");
-    let mut launch = Killed(child);
-    let stderr = launch.0.stderr.take().expect("stderr");
-    let (tx, rx) = mpsc::channel();
-    std::thread::spawn(move || {
-        for line in BufReader::new(stderr).lines().map_while(Result::ok) {
-            let _ = tx.send(line);
-        }
-    });
-    let wait_line = |needle: &str| -> String {
-        let deadline = Instant::now() + Duration::from_secs(20);
-        while let Ok(line) = rx.recv_timeout(deadline.saturating_duration_since(Instant::now())) {
-            if line.contains(needle) {
-                return line;
-            }
-        }
-        panic!("kerf launch never printed {needle:?}");
-    };
+    let mut command = kerf();
+    command.args(["launch", "--robot", "laser_cutter"]);
+    let (mut launch, mut lines) = Lines::spawn(command);
+    let mut wait_line = |needle: &str| lines.wait_for(needle, Duration::from_secs(20));
     let ready = wait_line("ready");
     assert!(ready.contains("q1, q2, q3, q4, q5, q6"), "{ready}");
 

@@ -7,10 +7,8 @@
 #![allow(clippy::unwrap_used, clippy::expect_used)] // tests report failures by panicking
 
 use std::{
-    io::{BufRead, BufReader},
     path::Path,
-    process::{Command, Stdio},
-    sync::mpsc,
+    process::Command,
     time::{Duration, Instant},
 };
 
@@ -20,7 +18,7 @@ use ros2_client::ServiceMapping;
 
 #[allow(dead_code)] // shared with the other end-to-end tests
 mod support;
-use support::{assert_clean_exit, expect, interrupt, planner::mjto, Killed, PlannerClient, QUICK};
+use support::{assert_clean_exit, expect, interrupt, planner::mjto, Lines, PlannerClient, QUICK};
 
 const ROOT: &str = env!("CARGO_MANIFEST_DIR");
 
@@ -138,34 +136,10 @@ fn ctrl_c_mid_plan_exits_kerf_launch() {
             .env_remove("ROS_STATIC_PEERS");
         c
     };
-    let child = kerf()
-        .args(["launch", "--robot", "laser_cutter", "--with-planner"])
-        .stderr(Stdio::piped())
-        .spawn()
-        .expect("start kerf launch");
-    let mut launch = Killed(child);
-    let stderr = launch.0.stderr.take().expect("stderr");
-    let (tx, rx) = mpsc::channel();
-    std::thread::spawn(move || {
-        for line in BufReader::new(stderr).lines().map_while(Result::ok) {
-            let _ = tx.send(line);
-        }
-    });
-    let mut seen = Vec::new();
-    let mut wait_line = |needle: &str, within: Duration| -> String {
-        let deadline = Instant::now() + within;
-        while let Ok(line) = rx.recv_timeout(deadline.saturating_duration_since(Instant::now())) {
-            seen.push(line.clone());
-            if line.contains(needle) {
-                return line;
-            }
-        }
-        panic!(
-            "kerf launch never printed {needle:?}; it printed:\n{}",
-            seen.join("\n")
-        );
-    };
-    wait_line("serving cut requests", QUICK);
+    let mut command = kerf();
+    command.args(["launch", "--robot", "laser_cutter", "--with-planner"]);
+    let (mut launch, mut lines) = Lines::spawn(command);
+    lines.wait_for("serving cut requests", QUICK);
     let file = std::env::temp_dir().join(format!("kerf_deadline_{}.yaml", std::process::id()));
     let data = serde_yaml_ng::to_string(&kerf_msgs::std_msgs::StringMsg {
         data: text(&long_request("ctrl-c")),
@@ -182,7 +156,7 @@ fn ctrl_c_mid_plan_exits_kerf_launch() {
         "{}",
         String::from_utf8_lossy(&out.stderr)
     );
-    wait_line("request 'ctrl-c'", QUICK);
+    lines.wait_for("request 'ctrl-c'", QUICK);
     std::thread::sleep(Duration::from_secs(3));
     let t = Instant::now();
     interrupt(&launch.0);
@@ -191,7 +165,7 @@ fn ctrl_c_mid_plan_exits_kerf_launch() {
         "kerf launch exited {:.3} s after SIGINT, mid-plan",
         t.elapsed().as_secs_f64()
     );
-    let rest: Vec<String> = rx.try_iter().collect();
+    let rest = lines.rest();
     assert!(
         rest.iter().any(|l| l.contains("planning cancelled")),
         "the plan in progress was not answered as cancelled:\n{}",

@@ -16,7 +16,7 @@ use serde::Serialize;
 mod support;
 use support::{
     planner::{mill, mjto, Answer, Planner},
-    PlannerClient,
+    status_kib, PlannerClient,
 };
 
 const ROOT: &str = env!("CARGO_MANIFEST_DIR");
@@ -41,15 +41,6 @@ struct Case {
     text: String,
     id: String,
     status: u8,
-}
-
-fn status_line(key: &str) -> u64 {
-    let s = std::fs::read_to_string("/proc/self/status").unwrap();
-    s.lines()
-        .find_map(|l| l.strip_prefix(key))
-        .and_then(|v| v.split_whitespace().next())
-        .and_then(|v| v.parse().ok())
-        .unwrap()
 }
 
 fn threads() -> usize {
@@ -219,16 +210,16 @@ where
             );
             *counts.entry(name(c.status)).or_default() += 1;
         }
-        trend.push(status_line("VmRSS:") / 1024);
+        trend.push(status_kib("VmRSS:") / 1024);
         if batch == WARM_BATCHES - 1 {
-            rss_warm = status_line("VmRSS:");
+            rss_warm = status_kib("VmRSS:");
         }
     }
     client.assert_running();
     // The sender's DDS writer keeps acknowledged samples until its cache cleaning, every 6 s
     // (BENCHMARKS.md, "Large samples and memory"): measured after it.
     std::thread::sleep(Duration::from_secs(8));
-    let rss_end = status_line("VmRSS:");
+    let rss_end = status_kib("VmRSS:");
     println!("{node}: VmRSS per batch (MiB): {trend:?}");
     client.finish();
     let names = || -> Vec<String> {
@@ -253,7 +244,7 @@ where
          {rss_end} KiB at the end, VmHWM {} KiB; threads {threads_before} -> {}, fds \
          {fds_before} -> {}",
         node,
-        status_line("VmHWM:"),
+        status_kib("VmHWM:"),
         leftover.0,
         leftover.1
     );

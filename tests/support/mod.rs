@@ -35,7 +35,7 @@ pub use {
     },
     nodes::{client_node, loopback, spawn_node, wait_for_writer},
     planner::{expect, PlannerClient},
-    process::{assert_clean_exit, interrupt, Killed},
+    process::{assert_clean_exit, interrupt, status_kib, Killed, Lines},
     scratch::scratch,
     take::{take, take_newest},
 };

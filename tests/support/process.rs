@@ -40,3 +40,71 @@ pub fn assert_clean_exit(child: &mut Child, timeout: Duration) {
         std::thread::sleep(Duration::from_millis(20));
     }
 }
+
+/// The stderr lines of a child, read on their own thread as they come.
+pub struct Lines {
+    rx: std::sync::mpsc::Receiver<String>,
+    seen: Vec<String>,
+}
+
+impl Lines {
+    /// Starts `command` with its stderr piped and read line by line.
+    pub fn spawn(mut command: Command) -> (Killed, Lines) {
+        use std::io::{BufRead, BufReader};
+        let mut child = Killed(
+            command
+                .stderr(std::process::Stdio::piped())
+                .spawn()
+                .expect("start the child process"),
+        );
+        let stderr = child.0.stderr.take().expect("stderr");
+        let (tx, rx) = std::sync::mpsc::channel();
+        std::thread::spawn(move || {
+            for line in BufReader::new(stderr).lines().map_while(Result::ok) {
+                let _ = tx.send(line);
+            }
+        });
+        (
+            child,
+            Lines {
+                rx,
+                seen: Vec::new(),
+            },
+        )
+    }
+
+    /// The first line from now on that contains `needle`, waiting up to `within`; fails the
+    /// test, showing every line seen, if none comes.
+    pub fn wait_for(&mut self, needle: &str, within: Duration) -> String {
+        let deadline = Instant::now() + within;
+        while let Ok(line) = self
+            .rx
+            .recv_timeout(deadline.saturating_duration_since(Instant::now()))
+        {
+            self.seen.push(line.clone());
+            if line.contains(needle) {
+                return line;
+            }
+        }
+        panic!(
+            "the child never printed {needle:?}; it printed:\n{}",
+            self.seen.join("\n")
+        );
+    }
+
+    /// The lines that came since the last wait, without waiting.
+    pub fn rest(&mut self) -> Vec<String> {
+        self.rx.try_iter().collect()
+    }
+}
+
+/// A `/proc/self/status` field in KiB (`"VmRSS:"`, `"VmHWM:"`).
+pub fn status_kib(key: &str) -> u64 {
+    let status = std::fs::read_to_string("/proc/self/status").expect("/proc/self/status");
+    status
+        .lines()
+        .find_map(|l| l.strip_prefix(key))
+        .and_then(|v| v.split_whitespace().next())
+        .and_then(|v| v.parse().ok())
+        .unwrap_or_else(|| panic!("{key} missing from /proc/self/status"))
+}
