@@ -67,7 +67,11 @@ fn main() -> ExitCode {
     restore_default_sigpipe();
     let cli = Cli::parse();
     let result = match cli.command {
-        Command::Launch(a) => launch::run(a),
+        Command::Launch(a) => {
+            // The nodes' large buffers go back to the system when freed (kerf_ros::memory).
+            kerf_ros::memory::release_large_allocations();
+            launch::run(a)
+        }
         Command::Echo(a) => echo::run(a),
         Command::Pub(a) => publish::run(a),
         Command::Plan(a) => plan_cut::run(a),

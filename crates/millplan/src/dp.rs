@@ -192,12 +192,9 @@ pub fn solve(
     solve_within(cell, cache, spec, &Budget::unlimited())
 }
 
-/// Number of grid nodes rewarded between two checks of the time budget.
-const BUDGET_STRIDE: usize = 4096;
-
 /// [`solve`] under a time budget: checked per segment while the tables are
-/// built and every [`BUDGET_STRIDE`] grid nodes while the DP runs (after
-/// an interrupt every further node is skipped, so the DP ends at once).
+/// built and per row of the grid of every stage while the DP runs
+/// ([`crate::grid_dp::solve_grid_with_moves`]).
 ///
 /// # Errors
 /// As [`solve`], and [`MillPlanError::Interrupted`].
@@ -309,7 +306,6 @@ pub fn solve_within(
     let w = spec.weights;
     let mut forbidden = 0usize;
     let mut error: Option<MillPlanError> = None;
-    let mut rewarded = 0usize;
     let path = solve_grid_with_moves(
         n,
         [rpm.len(), feed.len(), g.len()],
@@ -317,13 +313,6 @@ pub fn solve_within(
         |t, [i, j, k]| {
             if error.is_some() {
                 return None;
-            }
-            rewarded += 1;
-            if rewarded.is_multiple_of(BUDGET_STRIDE) {
-                if let Err(e) = budget.check("the DP") {
-                    error = Some(e.into());
-                    return None;
-                }
             }
             let ro = ro.get(t * g.len() + k).copied().flatten();
             let (Some(ro), Some(re)) = (ro, re.get(j)) else {
@@ -367,6 +356,7 @@ pub fn solve_within(
             }
         },
         allowed,
+        budget,
     )?;
     if let Some(e) = error {
         return Err(e);

@@ -3,6 +3,8 @@
 //! node ([`solve_grid`]) and optionally a filter on moves
 //! ([`solve_grid_with_moves`]).
 
+use kerf_budget::Budget;
+
 use crate::error::MillPlanError;
 
 /// Result of the generic DP.
@@ -34,21 +36,30 @@ pub fn solve_grid<F>(
 where
     F: FnMut(usize, [usize; 3]) -> Option<f64>,
 {
-    solve_grid_with_moves(stages, dims, start, stage, |_, _, _| true)
+    solve_grid_with_moves(
+        stages,
+        dims,
+        start,
+        stage,
+        |_, _, _| true,
+        &Budget::unlimited(),
+    )
 }
 
 /// As [`solve_grid`], with a filter on moves: `allowed(t, x, y)` says
 /// whether the move from node x at stage t to node y at stage t + 1 is
-/// allowed (e.g. joint speeds, [`crate::joint_speed`]).
+/// allowed (e.g. joint speeds, [`crate::joint_speed`]), under a time budget
+/// checked per row of the grid (`dims[1] × dims[2]` nodes) of every stage.
 ///
 /// # Errors
-/// As [`solve_grid`].
+/// As [`solve_grid`], and [`MillPlanError::Interrupted`].
 pub fn solve_grid_with_moves<F, M>(
     stages: usize,
     dims: [usize; 3],
     start: [usize; 3],
     mut stage: F,
     allowed: M,
+    budget: &Budget,
 ) -> Result<Option<GridPath>, MillPlanError>
 where
     F: FnMut(usize, [usize; 3]) -> Option<f64>,
@@ -68,9 +79,10 @@ where
         });
     }
     let index = |i: usize, j: usize, k: usize| (i * dims[1] + j) * dims[2] + k;
-    let stage_table = |t: usize, stage: &mut F| -> Vec<f32> {
+    let stage_table = |t: usize, stage: &mut F| -> Result<Vec<f32>, MillPlanError> {
         let mut out = vec![f32::NEG_INFINITY; nodes];
         for i in 0..dims[0] {
+            budget.check("the DP")?;
             for j in 0..dims[1] {
                 for k in 0..dims[2] {
                     if let Some(r) = stage(t, [i, j, k]) {
@@ -81,16 +93,17 @@ where
                 }
             }
         }
-        out
+        Ok(out)
     };
     // Backward pass.
-    let mut next = stage_table(stages - 1, &mut stage);
+    let mut next = stage_table(stages - 1, &mut stage)?;
     let mut back: Vec<u8> = vec![u8::MAX; nodes * (stages - 1)];
     for t in (0..stages - 1).rev() {
-        let r = stage_table(t, &mut stage);
+        let r = stage_table(t, &mut stage)?;
         let mut value = vec![f32::NEG_INFINITY; nodes];
         let bt = &mut back[t * nodes..(t + 1) * nodes];
         for i in 0..dims[0] {
+            budget.check("the DP")?;
             for j in 0..dims[1] {
                 for k in 0..dims[2] {
                     let here = index(i, j, k);

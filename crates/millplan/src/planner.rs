@@ -398,7 +398,7 @@ impl MillPlanner {
     /// * `request` — the request; its own `time_budget` (if any) tightens `budget`.
     /// * `budget` — checked between units of work: each segment of the reachability check,
     ///   each step of the policy rollout, each indicator evaluation, each segment of the
-    ///   naive planner's verifications, every 4096 nodes of the DP, each stage after.
+    ///   naive planner's verifications, every row of the DP grid, each stage after.
     ///
     /// # Errors
     /// As [`Self::plan`], and [`MillPlanError::Interrupted`] when the budget runs out

@@ -18,6 +18,7 @@ mod env;
 mod error;
 mod inbox;
 mod logger;
+pub mod memory;
 pub mod names;
 mod node;
 mod params;

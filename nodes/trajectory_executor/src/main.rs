@@ -8,6 +8,7 @@ fn main() -> ExitCode {
     let result = (|| -> Result<(), String> {
         let args = RosArgs::parse(std::env::args().skip(1)).map_err(|e| e.to_string())?;
         let env = RosEnv::from_env().map_err(|e| e.to_string())?;
+        kerf_ros::memory::release_large_allocations();
         shutdown::install_handler()?;
         kerf_trajectory_executor::run(&args, &env, StopToken::new()).map_err(|e| e.to_string())
     })();

@@ -119,6 +119,22 @@ pub fn work<S: PlanningService>(
     }
 }
 
+/// Longest `request_id` a request may have (bytes).
+pub const MAX_REQUEST_ID_BYTES: usize = 256;
+
+/// The beginning of a request id over [`MAX_REQUEST_ID_BYTES`] (cut at a character boundary);
+/// `None` when it is within the limit.
+fn cut_request_id(id: &str) -> Option<String> {
+    if id.len() <= MAX_REQUEST_ID_BYTES {
+        return None;
+    }
+    let mut end = MAX_REQUEST_ID_BYTES;
+    while !id.is_char_boundary(end) {
+        end -= 1;
+    }
+    id.get(..end).map(str::to_string)
+}
+
 /// The YAML text of an answer, as published on the plan text topic (serde's YAML of the
 /// message: every field, in `.msg` order).
 pub fn answer_text<A: PlanAnswer>(answer: &A) -> String {
@@ -315,9 +331,28 @@ impl<S: PlanningService> PlannerNode<S> {
 
     /// Queues a job, or answers at once when the queue is full.
     fn submit(&mut self, job: Job<S::Request, S::Answer>, source: &str) {
-        let key = match &job {
+        let mut key = match &job {
             Job::Plan(r) => self.service.key(r),
             Job::Answer(m) => m.key(),
+        };
+        // A request id is echoed in the answer and in the log: a long one is refused, and
+        // the answer carries its beginning.
+        let job = match cut_request_id(&key.request_id) {
+            None => job,
+            Some(short) => {
+                let message = format!(
+                    "request_id is {} bytes, over the limit of {MAX_REQUEST_ID_BYTES}; this \
+                     answer carries its first {} bytes",
+                    key.request_id.len(),
+                    short.len()
+                );
+                key.request_id = short;
+                Job::Answer(Box::new(self.service.failure(
+                    &key,
+                    Failure::TooLarge,
+                    message,
+                )))
+            }
         };
         if self.pending.len() >= self.settings.queue_depth {
             let answer = match job {
@@ -412,5 +447,23 @@ impl<S: PlanningService> PlannerNode<S> {
             self.log
                 .error(&format!("request '{id}': plan text not published: {e}"));
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::{cut_request_id, MAX_REQUEST_ID_BYTES};
+
+    #[test]
+    fn long_request_ids_are_cut_at_a_character_boundary() {
+        assert_eq!(cut_request_id("job-17"), None);
+        assert_eq!(cut_request_id(&"a".repeat(MAX_REQUEST_ID_BYTES)), None);
+        let long = format!(
+            "{}é{}",
+            "a".repeat(MAX_REQUEST_ID_BYTES - 1),
+            "b".repeat(10)
+        );
+        let cut = cut_request_id(&long).unwrap();
+        assert_eq!(cut, "a".repeat(MAX_REQUEST_ID_BYTES - 1));
     }
 }

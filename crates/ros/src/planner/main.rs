@@ -26,6 +26,7 @@ pub fn node_main<E: std::fmt::Display>(
             ));
         }
         let env = RosEnv::from_env().map_err(|e| e.to_string())?;
+        crate::memory::release_large_allocations();
         shutdown::install_handler()?;
         run(&args, &env, StopToken::new()).map_err(|e| e.to_string())
     })();
