@@ -171,11 +171,14 @@ impl<Req: RosType + Serialize + Debug, Plan: Answer> PlannerClient<Req, Plan> {
                 qos::commands(),
             )
             .expect("trajectory subscription");
+        // Matching waits longer than QUICK: a parallel test of the same binary may keep both
+        // cores busy (policy training), and discovery once took over 30 s in a full run.
+        let matching = 3 * QUICK;
         for (matched, topic) in [
-            (client.wait_for_subscriber(&requests, QUICK), request),
-            (client.wait_for_subscriber(&texts, QUICK), request_text),
+            (client.wait_for_subscriber(&requests, matching), request),
+            (client.wait_for_subscriber(&texts, matching), request_text),
         ] {
-            assert!(matched, "{topic} not matched");
+            assert!(matched, "{topic} not matched within {matching:?}");
         }
         PlannerClient {
             requests,
