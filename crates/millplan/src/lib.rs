@@ -29,6 +29,7 @@ pub mod rollout;
 pub mod timing;
 
 // The joint trajectory (the executor's type), as planned and as executed.
+pub mod deviation;
 pub mod executed;
 pub mod planned;
 pub mod trajectory;
