@@ -105,7 +105,7 @@ pub fn executed_deviation(
     let steps = ((t1 - t0) / period).ceil() as usize;
     let mut off_path = Vec::with_capacity(steps + 1);
     let mut max_off_plane: f64 = 0.0;
-    let mut time_of_max = 0.0;
+    let (mut max_off_path, mut time_of_max) = (0.0, 0.0);
     let mut sample = kerf_executor::JointSample::default();
     let mut cursor = 0;
     for k in 0..=steps {
@@ -134,13 +134,12 @@ pub fn executed_deviation(
                 - trajectory.arc_length[cursor]);
         let u = path.parameter_at(s.clamp(0.0, total))?;
         let d = distance_to_path(cell, &tip, u)?;
-        if off_path.iter().all(|&m: &f64| d > m) {
-            time_of_max = tr;
+        if d > max_off_path {
+            (max_off_path, time_of_max) = (d, tr);
         }
         off_path.push(d);
     }
     let samples = off_path.len();
-    let max_off_path = off_path.iter().copied().fold(0.0, f64::max);
     off_path.sort_by(|a, b| a.total_cmp(b));
     let p99_off_path = off_path
         .get(((samples.saturating_sub(1)) as f64 * 0.99).round() as usize)
