@@ -23,7 +23,7 @@ use kerf_msgs::{
     std_msgs::StringMsg,
     RosType,
 };
-use kerf_ros::{qos, ros2_client::ServiceMapping, KerfNode};
+use kerf_ros::{planner::PlanAnswer, qos, ros2_client::ServiceMapping, KerfNode};
 use serde::de::DeserializeOwned;
 
 #[allow(dead_code)]
@@ -41,14 +41,13 @@ fn case1() -> String {
     .unwrap()
 }
 
-/// Sends `text` to `topic` and waits for one answer on `answers`; returns its status name
-/// and the seconds it took.
-fn round_trip<A: RosType + DeserializeOwned + 'static>(
+/// Sends `text` to `topic` and waits for one answer on `answers`; returns its status, point
+/// count and message, and the seconds it took.
+fn round_trip<A: PlanAnswer + DeserializeOwned>(
     client: &mut KerfNode,
     topic: &str,
     answers: &str,
     text: String,
-    status: impl Fn(&A) -> String,
 ) -> (String, f64) {
     let requests = client
         .publisher::<StringMsg>(topic, StringMsg::ROS_TYPE, qos::commands())
@@ -62,7 +61,13 @@ fn round_trip<A: RosType + DeserializeOwned + 'static>(
     requests.publish(StringMsg { data: text }).unwrap();
     loop {
         if let Ok(Some((a, _))) = plans.take() {
-            return (status(&a), t.elapsed().as_secs_f64());
+            let status = format!(
+                "{} ({} points): {:.120}",
+                a.status_name(),
+                a.trajectory().points.len(),
+                a.message()
+            );
+            return (status, t.elapsed().as_secs_f64());
         }
         assert!(t.elapsed() < Duration::from_secs(900), "no answer");
         std::thread::sleep(Duration::from_millis(2));
@@ -127,14 +132,6 @@ fn run_case(case: &str) {
             "/milling_planner/mill_request_text",
             "/milling_planner/mill_plan",
             text,
-            |a| {
-                format!(
-                    "{} ({} points): {:.120}",
-                    MillPlan::status_name(a.status).unwrap_or("?"),
-                    a.trajectory.points.len(),
-                    a.message
-                )
-            },
         )
     } else {
         round_trip::<CutPlan>(
@@ -142,14 +139,6 @@ fn run_case(case: &str) {
             "/mjto_planner/cut_request_text",
             "/mjto_planner/cut_plan",
             text,
-            |a| {
-                format!(
-                    "{} ({} points): {:.120}",
-                    CutPlan::status_name(a.status).unwrap_or("?"),
-                    a.trajectory.points.len(),
-                    a.message
-                )
-            },
         )
     };
     println!(

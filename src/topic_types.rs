@@ -12,7 +12,7 @@ use kerf_msgs::{
     trajectory_msgs::JointTrajectory,
     RosType,
 };
-use kerf_ros::{KerfNode, NodeSpec, RosArgs, RosEnv, StopToken};
+use kerf_ros::{KerfNode, RosEnv};
 use serde::{de::DeserializeOwned, Serialize};
 
 /// The types kerf can print and publish: every message kerf publishes or consumes.
@@ -130,22 +130,8 @@ pub fn discover(node: &KerfNode, topic: &str, timeout: f64, side: Side) -> Resul
 pub fn cli_node(command: &str) -> Result<KerfNode, String> {
     let env = RosEnv::from_env().map_err(|e| e.to_string())?;
     kerf_ros::shutdown::install_handler()?;
-    let args = RosArgs {
-        rosout_logs: false,
-        ..RosArgs::default()
-    };
-    let name = format!("kerf_{command}_{}", std::process::id());
-    KerfNode::new(
-        NodeSpec {
-            default_name: &name,
-            default_namespace: "/",
-            known_params: &[],
-        },
-        &args,
-        &env,
-        StopToken::new(),
-    )
-    .map_err(|e| e.to_string())
+    KerfNode::client(&format!("kerf_{command}_{}", std::process::id()), &env)
+        .map_err(|e| e.to_string())
 }
 
 #[cfg(test)]

@@ -14,25 +14,24 @@ use std::{
     time::{Duration, Instant},
 };
 
+use kerf_millplan::rng::SplitMix64;
+
 use crate::Target;
 
-/// A splitmix64 generator: tiny, fast, and the same sequence for the same seed everywhere.
+/// The mutator's generator: kerf's SplitMix64 (`kerf_millplan::rng`), the same sequence for
+/// the same seed everywhere.
 #[derive(Debug, Clone)]
-pub struct Rng(u64);
+pub struct Rng(SplitMix64);
 
 impl Rng {
     /// A generator starting from `seed`.
     pub fn new(seed: u64) -> Self {
-        Self(seed)
+        Self(SplitMix64::new(seed))
     }
 
     /// The next 64 random bits.
     pub fn next_u64(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(0x9e37_79b9_7f4a_7c15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
-        z ^ (z >> 31)
+        self.0.next_u64()
     }
 
     /// A number in `0..n` (0 when `n` is 0).

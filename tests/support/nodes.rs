@@ -6,9 +6,7 @@ use std::{
     time::{Duration, Instant},
 };
 
-use kerf_ros::{
-    ros2_client::ServiceMapping, DiscoveryRange, KerfNode, NodeSpec, RosArgs, RosEnv, StopToken,
-};
+use kerf_ros::{ros2_client::ServiceMapping, DiscoveryRange, KerfNode, RosArgs, RosEnv, StopToken};
 
 /// A loopback-only environment on `domain`.
 pub fn loopback(domain: u16, service_mapping: ServiceMapping) -> RosEnv {
@@ -21,20 +19,7 @@ pub fn loopback(domain: u16, service_mapping: ServiceMapping) -> RosEnv {
 
 /// A plain client node (no rosout, no parameters) named `name`.
 pub fn client_node(name: &str, env: &RosEnv) -> KerfNode {
-    KerfNode::new(
-        NodeSpec {
-            default_name: name,
-            default_namespace: "/",
-            known_params: &[],
-        },
-        &RosArgs {
-            rosout_logs: false,
-            ..RosArgs::default()
-        },
-        env,
-        StopToken::new(),
-    )
-    .expect("client node")
+    KerfNode::client(name, env).expect("client node")
 }
 
 /// Runs a node's `run(args, env, stop)` on its own thread (own Context) with the ROS arguments

@@ -98,13 +98,8 @@ impl Lines {
     }
 }
 
-/// A `/proc/self/status` field in KiB (`"VmRSS:"`, `"VmHWM:"`).
-pub fn status_kib(key: &str) -> u64 {
-    let status = std::fs::read_to_string("/proc/self/status").expect("/proc/self/status");
-    status
-        .lines()
-        .find_map(|l| l.strip_prefix(key))
-        .and_then(|v| v.split_whitespace().next())
-        .and_then(|v| v.parse().ok())
-        .unwrap_or_else(|| panic!("{key} missing from /proc/self/status"))
+/// A `/proc/self/status` field in KiB (`"VmRSS:"`, `"VmHWM:"`); fails the test if missing.
+pub fn status_kib(field: &str) -> u64 {
+    kerf_ros::memory::status_kib(field)
+        .unwrap_or_else(|| panic!("{field} missing from /proc/self/status"))
 }

@@ -34,10 +34,7 @@ use kerf_msgs::{
     std_msgs::StringMsg,
     trajectory_msgs::{JointTrajectory, JointTrajectoryPoint},
 };
-use kerf_ros::{
-    qos, ros2_client::qos::Reliability, DiscoveryRange, KerfNode, NodeSpec, RosArgs, RosEnv,
-    StopToken,
-};
+use kerf_ros::{qos, ros2_client::qos::Reliability, DiscoveryRange, KerfNode, RosEnv};
 use serde::{de::DeserializeOwned, Serialize};
 
 const TOPIC: &str = "/kerf_bench/large_samples";
@@ -115,20 +112,7 @@ fn env(domain: u16) -> RosEnv {
 }
 
 fn node(name: &str, domain: u16) -> KerfNode {
-    KerfNode::new(
-        NodeSpec {
-            default_name: name,
-            default_namespace: "/",
-            known_params: &[],
-        },
-        &RosArgs {
-            rosout_logs: false,
-            ..RosArgs::default()
-        },
-        &env(domain),
-        StopToken::new(),
-    )
-    .expect("node")
+    KerfNode::client(name, &env(domain)).expect("node")
 }
 
 fn profile(o: &Opts) -> kerf_ros::ros2_client::QosProfile {
@@ -142,14 +126,7 @@ fn profile(o: &Opts) -> kerf_ros::ros2_client::QosProfile {
 
 /// (VmRSS, VmHWM) of this process in KiB.
 fn memory_kib() -> (u64, u64) {
-    let s = std::fs::read_to_string("/proc/self/status").unwrap_or_default();
-    let field = |name: &str| {
-        s.lines()
-            .find(|l| l.starts_with(name))
-            .and_then(|l| l.split_whitespace().nth(1))
-            .and_then(|v| v.parse().ok())
-            .unwrap_or(0)
-    };
+    let field = |name: &str| kerf_ros::memory::status_kib(name).unwrap_or(0);
     (field("VmRSS:"), field("VmHWM:"))
 }
 

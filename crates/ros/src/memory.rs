@@ -38,8 +38,28 @@ pub fn release_large_allocations() -> bool {
     }
 }
 
+/// A field of this process's `/proc/self/status` in KiB (`"VmRSS:"`, `"VmHWM:"`).
+///
+/// # Returns
+/// `None` where the file or the field does not exist (not Linux).
+pub fn status_kib(field: &str) -> Option<u64> {
+    let status = std::fs::read_to_string("/proc/self/status").ok()?;
+    status
+        .lines()
+        .find_map(|l| l.strip_prefix(field))
+        .and_then(|v| v.split_whitespace().next())
+        .and_then(|v| v.parse().ok())
+}
+
 #[cfg(test)]
 mod tests {
+    #[test]
+    fn resident_memory_is_read() {
+        let rss = super::status_kib("VmRSS:").unwrap();
+        assert!(rss > 0 && rss <= super::status_kib("VmHWM:").unwrap());
+        assert_eq!(super::status_kib("NoSuchField:"), None);
+    }
+
     #[test]
     fn the_threshold_is_set_on_glibc() {
         let applied = super::release_large_allocations();

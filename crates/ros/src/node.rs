@@ -64,6 +64,27 @@ fn dds_err(what: String) -> impl FnOnce(ros2_client::CreateError) -> RosError {
 }
 
 impl KerfNode {
+    /// A plain node named `name` in `/`: no parameters, no rosout, no ROS arguments, its own
+    /// stop token (the client node of a tool, a test or a bench).
+    ///
+    /// # Errors
+    /// As [`Self::new`]: a bad name or a DDS failure.
+    pub fn client(name: &str, env: &RosEnv) -> Result<Self, RosError> {
+        Self::new(
+            NodeSpec {
+                default_name: name,
+                default_namespace: "/",
+                known_params: &[],
+            },
+            &RosArgs {
+                rosout_logs: false,
+                ..RosArgs::default()
+            },
+            env,
+            StopToken::new(),
+        )
+    }
+
     /// Creates the node from the process's ROS arguments and environment.
     ///
     /// # Arguments

@@ -7,35 +7,11 @@
 use std::time::{Duration, Instant};
 
 use kerf_msgs::{std_msgs::StringMsg, RosType};
-use kerf_ros::{qos, DiscoveryRange, KerfNode, NodeSpec, RosArgs, RosEnv, StopToken};
-
-fn node(name: &str, env: &RosEnv) -> KerfNode {
-    KerfNode::new(
-        NodeSpec {
-            default_name: name,
-            default_namespace: "/",
-            known_params: &[],
-        },
-        &RosArgs {
-            rosout_logs: false,
-            ..RosArgs::default()
-        },
-        env,
-        StopToken::new(),
-    )
-    .expect("node")
-}
+use kerf_ros::{qos, DiscoveryRange, KerfNode, RosEnv};
 
 /// VmRSS of this process in MiB.
 fn rss_mib() -> f64 {
-    let s = std::fs::read_to_string("/proc/self/status").unwrap();
-    let kib: f64 = s
-        .lines()
-        .find(|l| l.starts_with("VmRSS:"))
-        .and_then(|l| l.split_whitespace().nth(1))
-        .and_then(|v| v.parse().ok())
-        .unwrap();
-    kib / 1024.0
+    kerf_ros::memory::status_kib("VmRSS:").unwrap() as f64 / 1024.0
 }
 
 #[test]
@@ -47,8 +23,8 @@ fn large_samples_reach_a_plateau() {
         range: DiscoveryRange::Localhost,
         ..RosEnv::default()
     };
-    let mut rx = node("bounded_memory_rx", &env);
-    let mut tx = node("bounded_memory_tx", &env);
+    let mut rx = KerfNode::client("bounded_memory_rx", &env).expect("node");
+    let mut tx = KerfNode::client("bounded_memory_tx", &env).expect("node");
     let inbox = rx
         .inbox::<StringMsg>("/bounded_memory", StringMsg::ROS_TYPE, qos::commands())
         .unwrap();
