@@ -336,8 +336,8 @@ fn trains_a_policy_and_plans_with_it_as_the_library_does() {
     assert!(executed.total_time > lib.total_time, "at least the ramps");
     assert!(
         stdout.contains(&format!(
-            "{} of 101 trajectory intervals slowed",
-            lib_out.executed.scaling.stretched_intervals()
+            "{} of 100 segments slowed",
+            lib_out.executed.scaling.slowed_segments()
         )),
         "{stdout}"
     );
@@ -434,8 +434,8 @@ fn trains_a_policy_and_plans_with_it_as_the_library_does() {
         Some(executed.segments[37].feed)
     );
     assert_eq!(
-        p0["executed"]["time_scaling"]["stretched_intervals"].as_u64(),
-        Some(lib_out.executed.scaling.stretched_intervals() as u64)
+        p0["executed"]["time_scaling"]["slowed_segments"].as_u64(),
+        Some(lib_out.executed.scaling.slowed_segments() as u64)
     );
     let svg = std::fs::read_to_string(plots.join("mill_plan_fixed_g.svg")).expect("plan svg");
     for label in [

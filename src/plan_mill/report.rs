@@ -77,15 +77,22 @@ pub fn executed_line(o: &MillPlanOutput) -> String {
     format!(
         "as executed (time-scaled to the joint limits, from rest to rest): machining time \
          {:.6} s, chatter-free {}, max |μ|max {:.6}, min 1/K {:.6}, total reward {:.6}, {} of \
-         {} trajectory intervals slowed, lowest feed {:.5} m/s{cached}",
+         {} segments slowed, lowest feed {:.5} m/s, {} trajectory points, tool tip within \
+         {:.4} mm of the path{cached}",
         p.total_time,
         if p.chatter_free { "yes" } else { "no" },
         p.max_spectral_radius,
         p.min_condition_indicator,
         p.total_reward,
-        sc.stretched_intervals(),
-        sc.interval_stretch.len(),
-        lowest_feed
+        sc.slowed_segments(),
+        sc.segment_slowdown.len(),
+        lowest_feed,
+        sc.trajectory.points().len(),
+        o.executed
+            .deviation
+            .max_off_path
+            .max(o.executed.deviation.max_off_plane)
+            * 1e3
     )
 }
 

@@ -205,47 +205,74 @@ impl KnotVector {
     /// `N_{first + r, k}(u)` for `d = 0..=nderiv`, `r = 0..=k`.
     ///
     /// # Performance
-    /// O(k^2 + nderiv k) plus two small allocations per row.
+    /// O(k^2 + nderiv k) plus the allocation of the result
+    /// (`BSpline::eval` uses the allocation-free form).
     pub fn basis_derivs(&self, u: f64, nderiv: usize) -> (usize, Vec<Vec<f64>>) {
         let p = self.degree;
+        let w = p + 1;
+        let mut ders = vec![0.0; (nderiv + 1) * w];
+        let mut ndu = vec![0.0; w * w];
+        let mut scratch = vec![0.0; 4 * w];
+        let first = self.basis_derivs_into(u, nderiv, &mut ders, &mut ndu, &mut scratch);
+        (first, ders.chunks(w).map(<[f64]>::to_vec).collect())
+    }
+
+    /// [`KnotVector::basis_derivs`] into caller storage (no allocation):
+    /// `ders[d * (k + 1) + r]` receives the d-th derivative of
+    /// `N_{first + r, k}(u)`; `ndu` ((k + 1)² entries) and `scratch`
+    /// (4 (k + 1)) are work space. Returns `first`.
+    ///
+    /// # Panics
+    /// When a slice is shorter than stated (a caller bug; internal use).
+    pub(crate) fn basis_derivs_into(
+        &self,
+        u: f64,
+        nderiv: usize,
+        ders: &mut [f64],
+        ndu: &mut [f64],
+        scratch: &mut [f64],
+    ) -> usize {
+        let p = self.degree;
+        let w = p + 1;
         let u = if u.is_nan() { u } else { u.clamp(0.0, 1.0) };
         let i = self.span(u);
         let kn = &self.knots;
-        let mut ders = vec![vec![0.0; p + 1]; nderiv + 1];
+        ders[..(nderiv + 1) * w].fill(0.0);
+        ndu[..w * w].fill(0.0);
+        scratch[..4 * w].fill(0.0);
+        let (left, rest) = scratch.split_at_mut(w);
+        let (right, a) = rest.split_at_mut(w);
         // ndu: upper triangle = basis functions, lower triangle = knot
-        // differences (A2.3).
-        let mut ndu = vec![vec![0.0; p + 1]; p + 1];
-        let mut left = vec![0.0; p + 1];
-        let mut right = vec![0.0; p + 1];
-        ndu[0][0] = 1.0;
+        // differences (A2.3); ndu[j][r] is ndu[j * w + r].
+        ndu[0] = 1.0;
         for j in 1..=p {
             left[j] = u - kn[i + 1 - j];
             right[j] = kn[i + j] - u;
             let mut saved = 0.0;
             for r in 0..j {
-                ndu[j][r] = right[r + 1] + left[j - r];
-                let temp = ndu[r][j - 1] / ndu[j][r];
-                ndu[r][j] = saved + right[r + 1] * temp;
+                ndu[j * w + r] = right[r + 1] + left[j - r];
+                let temp = ndu[r * w + j - 1] / ndu[j * w + r];
+                ndu[r * w + j] = saved + right[r + 1] * temp;
                 saved = left[j - r] * temp;
             }
-            ndu[j][j] = saved;
+            ndu[j * w + j] = saved;
         }
         for j in 0..=p {
-            ders[0][j] = ndu[j][p];
+            ders[j] = ndu[j * w + p];
         }
         let n = nderiv.min(p);
-        let mut a = [vec![0.0; p + 1], vec![0.0; p + 1]];
+        // a[s][j] is a[s * w + j] (two rows).
         for r in 0..=p {
             let (mut s1, mut s2) = (0usize, 1usize);
-            a[0][0] = 1.0;
+            a[0] = 1.0;
             for k in 1..=n {
                 let mut d = 0.0;
                 let rk = r as isize - k as isize;
                 let pk = p - k;
                 if r >= k {
                     let rku = r - k;
-                    a[s2][0] = a[s1][0] / ndu[pk + 1][rku];
-                    d = a[s2][0] * ndu[rku][pk];
+                    a[s2 * w] = a[s1 * w] / ndu[(pk + 1) * w + rku];
+                    d = a[s2 * w] * ndu[rku * w + pk];
                 }
                 let j1: usize = if rk >= -1 { 1 } else { (-rk) as usize };
                 let j2: usize = if r as isize - 1 <= pk as isize {
@@ -255,25 +282,25 @@ impl KnotVector {
                 };
                 for j in j1..=j2 {
                     let idx = (rk + j as isize) as usize;
-                    a[s2][j] = (a[s1][j] - a[s1][j - 1]) / ndu[pk + 1][idx];
-                    d += a[s2][j] * ndu[idx][pk];
+                    a[s2 * w + j] = (a[s1 * w + j] - a[s1 * w + j - 1]) / ndu[(pk + 1) * w + idx];
+                    d += a[s2 * w + j] * ndu[idx * w + pk];
                 }
                 if r <= pk {
-                    a[s2][k] = -a[s1][k - 1] / ndu[pk + 1][r];
-                    d += a[s2][k] * ndu[r][pk];
+                    a[s2 * w + k] = -a[s1 * w + k - 1] / ndu[(pk + 1) * w + r];
+                    d += a[s2 * w + k] * ndu[r * w + pk];
                 }
-                ders[k][r] = d;
+                ders[k * w + r] = d;
                 std::mem::swap(&mut s1, &mut s2);
             }
         }
         let mut fac = p as f64;
-        for (k, row) in ders.iter_mut().enumerate().take(n + 1).skip(1) {
-            for v in row.iter_mut() {
+        for k in 1..=n {
+            for v in &mut ders[k * w..(k + 1) * w] {
                 *v *= fac;
             }
             fac *= (p - k) as f64;
         }
-        (i - p, ders)
+        i - p
     }
 
     /// [`KnotVector::basis_derivs`] after validating `u`.

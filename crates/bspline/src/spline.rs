@@ -4,6 +4,9 @@ use crate::derivative::{derivative_knots, derivative_operator};
 use crate::error::{check_finite, check_param, BsplineError};
 use crate::knots::KnotVector;
 
+/// Largest degree + 1 that [`BSpline::eval`] evaluates on the stack.
+const FAST_WIDTH: usize = 8;
+
 /// A scalar clamped B-spline `q(u) = Σ_{j=0}^{n} Θ_j N_{j,k}(u)` on
 /// u in [0, 1] (seed 001 eq. 5).
 #[derive(Debug, Clone, PartialEq)]
@@ -49,17 +52,32 @@ impl BSpline {
     /// # Performance
     /// O(k^2).
     pub fn eval(&self, u: f64) -> [f64; 4] {
-        let (first, ders) = self.kv.basis_derivs(u, 3);
+        let w = self.kv.degree() + 1;
         let mut out = [0.0; 4];
-        for (o, row) in out.iter_mut().zip(&ders) {
-            *o = self
-                .coeffs
-                .get(first..)
-                .unwrap_or(&[])
-                .iter()
-                .zip(row)
-                .map(|(c, n)| c * n)
-                .sum();
+        let mut combine = |first: usize, ders: &[f64]| {
+            for (o, row) in out.iter_mut().zip(ders.chunks(w)) {
+                *o = self
+                    .coeffs
+                    .get(first..)
+                    .unwrap_or(&[])
+                    .iter()
+                    .zip(row)
+                    .map(|(c, n)| c * n)
+                    .sum();
+            }
+        };
+        if w <= FAST_WIDTH {
+            // Stack storage: no allocation (the same arithmetic as basis_derivs).
+            let mut ders = [0.0; 4 * FAST_WIDTH];
+            let mut ndu = [0.0; FAST_WIDTH * FAST_WIDTH];
+            let mut scratch = [0.0; 4 * FAST_WIDTH];
+            let first = self
+                .kv
+                .basis_derivs_into(u, 3, &mut ders, &mut ndu, &mut scratch);
+            combine(first, &ders[..4 * w]);
+        } else {
+            let (first, ders) = self.kv.basis_derivs(u, 3);
+            combine(first, &ders.concat());
         }
         out
     }

@@ -54,6 +54,13 @@ use crate::error::{check_finite, MillError};
 
 /// Gauss–Legendre order per panel.
 const GL_ORDER: usize = 10;
+
+/// The Gauss–Legendre nodes and weights of order [`GL_ORDER`], computed once
+/// (every arc-length integral and its inversion uses them).
+fn gl_nodes() -> &'static (Vec<f64>, Vec<f64>) {
+    static NODES: std::sync::OnceLock<(Vec<f64>, Vec<f64>)> = std::sync::OnceLock::new();
+    NODES.get_or_init(|| gauss_legendre(GL_ORDER))
+}
 /// Panel doubling cap (P from 4 up to 4 · 2^13 panels per knot span).
 const MAX_DOUBLINGS: usize = 14;
 /// Newton/bisection cap of the arc-length inversion.
@@ -254,6 +261,21 @@ impl MillingPath {
         Ok(p)
     }
 
+    /// P(u) and P'(u) from one basis evaluation per coordinate.
+    ///
+    /// # Errors
+    /// [`MillError::Bspline`] for u outside [0, 1] or NaN.
+    pub fn point_and_derivative(&self, u: f64) -> Result<(Vector3<f64>, Vector3<f64>), MillError> {
+        let mut p = Vector3::zeros();
+        let mut d = Vector3::zeros();
+        for ((pc, dc), s) in p.iter_mut().zip(d.iter_mut()).zip(&self.curve) {
+            let e = s.try_eval(u)?;
+            *pc = e[0];
+            *dc = e[1];
+        }
+        Ok((p, d))
+    }
+
     /// Arc length s(u) from u = 0 \[m\].
     ///
     /// # Errors
@@ -348,11 +370,11 @@ impl MillingPath {
 
     /// ∫_a^b |P'(v)| dv by one GL rule.
     fn panel_integral(&self, a: f64, b: f64) -> f64 {
-        let (x, w) = gauss_legendre(GL_ORDER);
+        let (x, w) = gl_nodes();
         let h = 0.5 * (b - a);
         let m = 0.5 * (a + b);
         x.iter()
-            .zip(&w)
+            .zip(w)
             .map(|(xi, wi)| {
                 let u = m + h * xi;
                 let mut d = Vector3::zeros();

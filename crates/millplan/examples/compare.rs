@@ -28,16 +28,17 @@ use kerf_millplan::{execute, Executed, MillPlanError, MillPlanner};
 fn describe_executed(e: &Executed) {
     let s = &e.scaling;
     println!(
-        "  as executed: {:.3} s, {} of {} intervals slowed (largest stretch {:.2}, lowest feed \
-         {:.4} m/s), max |mu| {:.4}",
+        "  as executed: {:.3} s, {} of {} segments slowed (largest slowdown {:.2}, lowest feed \
+         {:.4} m/s), tool tip within {:.4} mm of the path, max |mu| {:.4}",
         s.duration(),
-        s.stretched_intervals(),
-        s.interval_stretch.len(),
-        s.interval_stretch.iter().copied().fold(0.0, f64::max),
+        s.slowed_segments(),
+        s.segment_slowdown.len(),
+        s.segment_slowdown.iter().copied().fold(0.0, f64::max),
         s.segment_feeds
             .iter()
             .copied()
             .fold(f64::INFINITY, f64::min),
+        e.deviation.max_off_path.max(e.deviation.max_off_plane) * 1e3,
         e.plan.max_spectral_radius
     );
 }

@@ -1,24 +1,26 @@
 //! What the robot runs of a plan (step 7 of
-//! [`crate::MillPlanner::plan`]): the planned trajectory time-scaled to the
-//! joints' velocity and acceleration limits ([`crate::timing::time_scale`])
-//! and the plan at the feeds that result ([`Plan::as_executed`]).
+//! [`crate::MillPlanner::plan`]): the dense trajectory of
+//! [`crate::timing::time_scale`] (smooth states along the path, within the
+//! joints' velocity, acceleration and jerk limits and the path tolerance),
+//! checked by the executor's own validation, its tool path measured at the
+//! control period ([`crate::deviation::executed_deviation`]), and the plan
+//! at the feeds that result ([`Plan::as_executed`]).
 
 use kerf_budget::Budget;
 use kerf_executor::{check_executable, ExecutorConfig};
 use kerf_mill::MillCell;
 
 use crate::cache::IndicatorCache;
+use crate::deviation::PathDeviation;
 use crate::error::MillPlanError;
 use crate::plan::{IndicatorProvenance, IndicatorSource, Plan};
-use crate::planned::planned_trajectory;
 use crate::reward::RewardWeights;
-use crate::timing::{time_scale, JointLimit, TimeScaling};
-use crate::trajectory::JointTrajectory;
+use crate::timing::{time_scale, JointLimit, TimeScaling, TrajectorySettings};
 
 /// The plan as the robot runs it (step 7 of [`crate::MillPlanner::plan`]).
 #[derive(Debug, Clone, PartialEq)]
 pub struct Executed {
-    /// The executable trajectory, its stretch per interval and the
+    /// The executable trajectory, the slowdown per segment and the
     /// segment times and feeds it runs ([`crate::timing::time_scale`]).
     pub scaling: TimeScaling,
     /// The plan at those feeds and times ([`Plan::as_executed`]): |μ|max
@@ -29,26 +31,29 @@ pub struct Executed {
     /// interpolation (only with [`IndicatorSource::Cache`]; the bound of
     /// [`crate::MillPlanOutput::indicator`] applies), ascending.
     pub cached_segments: Vec<usize>,
+    /// The tool path as the executor runs the trajectory, measured at its
+    /// control period: within the settings' path tolerance.
+    pub deviation: PathDeviation,
+    /// The settings the trajectory was built with (tolerance, control period).
+    pub settings: TrajectorySettings,
 }
 
-/// The plan's trajectory ([`crate::planned`]) and what the robot runs
-/// of it (step 7 of [`crate::MillPlanner::plan`]), for a plan evaluated outside
-/// the planner (e.g. the DP variants of the comparison), |μ|max direct.
+/// What the robot runs of a plan evaluated outside the planner (e.g. the DP
+/// variants of the comparison), |μ|max direct, default trajectory settings.
 ///
 /// # Errors
-/// As [`crate::MillPlanner::plan`]'s steps 6–7.
+/// As [`crate::MillPlanner::plan`]'s step 7.
 pub fn execute(
     cell: &MillCell,
     plan: &Plan,
     weights: &RewardWeights,
     threads: usize,
 ) -> Result<Executed, MillPlanError> {
-    let (trajectory, _) = planned_trajectory(cell, plan)?;
     let direct = IndicatorProvenance::direct(IndicatorSource::Direct, plan.segments.len(), "");
     executed(
         cell,
         plan,
-        &trajectory,
+        &TrajectorySettings::default(),
         weights,
         threads,
         &direct,
@@ -61,21 +66,22 @@ pub fn execute(
 ///
 /// # Arguments
 /// * `cell` — the request's cell (its robot's joint limits).
-/// * `plan` — the plan as planned; `trajectory` — its planned trajectory.
+/// * `plan` — the plan as planned; `settings` — of the trajectory.
 /// * `weights`, `threads` — of the re-evaluation ([`Plan::as_executed_with`]).
 /// * `indicator`, `cache` — where |μ|max comes from.
 ///
 /// # Errors
-/// A joint of `trajectory` the robot does not have; [`time_scale`] and
-/// [`Plan::as_executed_with`] errors; [`MillPlanError::NotExecutable`] when
-/// the scaled trajectory fails `kerf_executor::check_executable` (the
-/// executor's own validation: the one executability check of kerf).
-// The plan, its trajectory and the evaluation's settings, passed through from the planner.
+/// [`time_scale`] and [`Plan::as_executed_with`] errors;
+/// [`MillPlanError::NotExecutable`] when the trajectory fails
+/// `kerf_executor::check_executable` (the executor's own validation: the
+/// one executability check of kerf) or its measured tool path leaves the
+/// tolerance.
+// The plan, its settings and the evaluation's settings, passed through from the planner.
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn executed(
     cell: &MillCell,
     plan: &Plan,
-    trajectory: &JointTrajectory,
+    settings: &TrajectorySettings,
     weights: &RewardWeights,
     threads: usize,
     indicator: &IndicatorProvenance,
@@ -83,27 +89,27 @@ pub(crate) fn executed(
     budget: &Budget,
 ) -> Result<Executed, MillPlanError> {
     let joints = cell.robot().joints();
-    let limits = trajectory
-        .joint_names()
+    let limits = cell
+        .kinematics()
+        .joints()
         .iter()
-        .map(|name| {
+        .map(|k| {
             joints
                 .iter()
-                .find(|j| &j.name == name)
+                .find(|j| j.name == k.name)
                 .map(|j| JointLimit {
                     max_velocity: j.max_velocity,
                     max_acceleration: j.max_acceleration,
+                    max_jerk: j.max_jerk,
                 })
                 .ok_or_else(|| MillPlanError::InvalidConfig {
-                    name: "trajectory".to_string(),
-                    reason: format!("joint '{name}' is not a joint of the cell's robot"),
+                    name: "cell".to_string(),
+                    reason: format!("joint '{}' is not a joint of the cell's robot", k.name),
                 })
         })
         .collect::<Result<Vec<_>, _>>()?;
-    let times: Vec<f64> = plan.segments.iter().map(|s| s.time).collect();
-    let feeds: Vec<f64> = plan.segments.iter().map(|s| s.feed).collect();
-    budget.check("the time scaling")?;
-    let scaling = time_scale(trajectory, &times, &feeds, &limits)?;
+    budget.check("the executed trajectory")?;
+    let scaling = time_scale(cell, plan, &limits, settings, budget)?;
     budget.check("the executability check")?;
     // Judged by what the executor runs: its own validation, from rest at the first point.
     let not_executable = |reason: String| MillPlanError::NotExecutable { reason };
@@ -117,6 +123,7 @@ pub(crate) fn executed(
         &scaling.trajectory.request,
     )
     .map_err(|e| not_executable(e.to_string()))?;
+    let deviation = scaling.deviation;
     let (plan, cached_segments) = plan.as_executed_with(
         cell,
         weights,
@@ -131,5 +138,7 @@ pub(crate) fn executed(
         scaling,
         plan,
         cached_segments,
+        deviation,
+        settings: *settings,
     })
 }

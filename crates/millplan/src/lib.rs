@@ -26,6 +26,9 @@ pub mod plan;
 pub mod provenance;
 pub mod reward;
 pub mod rollout;
+pub mod slowdown;
+pub mod spline1d;
+pub mod time_law;
 pub mod timing;
 
 // The joint trajectory (the executor's type), as planned and as executed.
@@ -69,5 +72,5 @@ pub use planner::{default_policy_path, MillPlanner};
 pub use request::{MillRequest, PlannerKind};
 pub use reward::{RewardParts, RewardWeights};
 pub use status::status_of;
-pub use timing::{time_scale, JointLimit, TimeScaling};
+pub use timing::{time_scale, JointLimit, TimeScaling, TrajectorySettings};
 pub use trajectory::{JointTrajectory, TrajectoryPoint, TrajectoryRequest};

@@ -78,6 +78,7 @@ use crate::planned::planned_trajectory;
 use crate::policy::Policy;
 use crate::request::{MillRequest, PlannerKind, RequestProcess};
 use crate::rl::Environment;
+use crate::timing::TrajectorySettings;
 
 pub use crate::executed::{execute, Executed};
 pub use crate::output::{MillPlanOutput, PlanningPhases};
@@ -126,6 +127,7 @@ pub struct MillPlanner {
     env_config: EnvConfig,
     eval_threads: usize,
     indicator_source: IndicatorSource,
+    trajectory_settings: TrajectorySettings,
     models: Mutex<Vec<(RequestModel, Arc<MillCell>, bool)>>,
     policies: Mutex<HashMap<PathBuf, CachedPolicy>>,
 }
@@ -170,6 +172,7 @@ impl MillPlanner {
             env_config: EnvConfig::default(),
             eval_threads: default_eval_threads(),
             indicator_source: IndicatorSource::Direct,
+            trajectory_settings: TrajectorySettings::default(),
             models: Mutex::new(Vec::new()),
             policies: Mutex::new(HashMap::new()),
         })
@@ -254,6 +257,25 @@ impl MillPlanner {
     /// Where the plan's |μ|max comes from ([`MillPlanner::with_indicator_source`]).
     pub fn indicator_source(&self) -> IndicatorSource {
         self.indicator_source
+    }
+
+    /// With the settings of the executed trajectory (path tolerance,
+    /// control period, ramp time, point limit; [`TrajectorySettings`]).
+    ///
+    /// # Errors
+    /// [`MillPlanError::InvalidParameter`] for a bad setting.
+    pub fn with_trajectory_settings(
+        mut self,
+        settings: TrajectorySettings,
+    ) -> Result<Self, MillPlanError> {
+        settings.validate()?;
+        self.trajectory_settings = settings;
+        Ok(self)
+    }
+
+    /// The settings of the executed trajectory.
+    pub fn trajectory_settings(&self) -> &TrajectorySettings {
+        &self.trajectory_settings
     }
 
     /// The environment settings.
@@ -537,7 +559,7 @@ impl MillPlanner {
         let executed = executed(
             &cell,
             &plan,
-            &trajectory,
+            &self.trajectory_settings,
             weights,
             self.eval_threads,
             &indicator,

@@ -1,148 +1,244 @@
-//! The trajectory a robot can run: the plan's joint trajectory from rest to
-//! rest, time-scaled so that its cubic Hermite interpolation (what the
-//! trajectory executor runs: positions and velocities at every point) stays
-//! within every joint's velocity and acceleration limit.
+//! The trajectory a robot runs for a plan (issue 13, item 1): dense joint
+//! samples with positions, velocities and accelerations, so that the
+//! executor's own interpolation (quintic Hermite, as JTC's
+//! `interpolation_method: splines` with accelerations) keeps the tool tip
+//! within a stated tolerance of the path, from rest to rest, within every
+//! joint's velocity, acceleration and jerk limit.
 //!
-//! The plan is timed by its feeds ([`crate::planned`]); the
-//! environment and the DP bound joint SPEEDS between segment midpoints, not
-//! accelerations, and a change of g from one segment to the next can ask a
-//! wrist joint for several times its acceleration limit. Such a trajectory
-//! would be refused by the executor. [`time_scale`] slows it down where it
-//! must (never speeds it up) and says by how much: the feed actually run
-//! in each segment follows ([`TimeScaling::segment_feeds`]), and the
-//! planner re-evaluates |μ|max at that feed
-//! ([`crate::planner::MillPlanOutput::executed`]).
+//! # Why not one point per segment
+//! With one point per segment midpoint, g steps of up to 0.2 rad between
+//! points swing the wrist, and joint-space interpolation of the swing
+//! leaves the path by millimetres (measured by
+//! [`crate::deviation::executed_deviation`]: 4.0 mm for the ddpg plan).
 //!
-//! # Steps
-//! 1. Ramps: the robot starts and ends at rest, so the first and the last
-//!    interval (path start → first midpoint, last midpoint → path end) take
-//!    twice their planned time (from rest to the planned velocity over the
-//!    interval's length at half the mean speed), with zero velocity at the
-//!    two end points.
-//! 2. Velocities at the interior points: the derivative of the parabola
-//!    through each point and its two neighbours at the CURRENT times
-//!    ([`three_point_velocity`], Fornberg 1988).
-//! 3. Each interval's need r_i = max over its joints of |v|/v_max and
-//!    sqrt(|a|/a_max) of its Hermite cubic ([`hermite_extremes`]). Where
-//!    r_i > 1 the interval is stretched by r_i (at most 4× per round; the
-//!    velocities of step 2 change with the neighbours' times, so this
-//!    repeats).
-//! 4. After [`LOCAL_ROUNDS`] rounds without success, every interval is
-//!    stretched by the largest remaining need: stretching ALL times by s
-//!    divides every three-point velocity by s and every Hermite
-//!    acceleration by s², so one such round always ends it.
+//! # Steps of [`time_scale`]
+//! 1. **Smooth states along the path.** g(s) is the cubic spline through
+//!    the segments' g at their arc-length midpoints, with zero slope at the
+//!    path's ends ([`crate::spline1d::CubicSpline`]); f(s) joins the
+//!    segments' feeds with the smootherstep profile
+//!    ([`crate::spline1d::StepProfile`]); both pass exactly through the
+//!    planned values at every midpoint, where each segment was evaluated.
+//!    The spindle speed follows the same profile as the feed
+//!    ([`ExecutedProfiles`]).
+//! 2. **Geometry.** Knots in arc length — initially every segment's ends
+//!    and midpoint — carry the IK solution at (s, g(s)), each nearest the
+//!    previous knot's (one continuous branch). Per joint, the natural cubic
+//!    spline Q_j(s) through the knots gives Q_j' and Q_j''.
+//! 3. **Time law** s(t) ([`crate::time_law`]): ṡ = f(s) R(t) / c(s), from
+//!    rest to rest over the ramp time, slowed by c(s) ≥ 1.
+//! 4. **Samples.** At each knot: t = t(s), q̇ = Q' ṡ, q̈ = Q'' ṡ² + Q' s̈ (the
+//!    chain rule). Consecutive samples are joined by the executor's quintic
+//!    Hermite polynomial ([`kerf_executor::spline::coefficients`]).
+//! 5. **Checks on what the executor runs.** For every piece: the exact
+//!    largest |velocity|, |acceleration| and |jerk| of each joint's quintic
+//!    (extremes at the ends and the real roots of the next derivative), and
+//!    the tool tip by forward kinematics at every control period inside the
+//!    piece (at least 3 samples): its distance from the path curve (the
+//!    closest point by Gauss–Newton, [`crate::deviation`]) and from the
+//!    milling plane.
+//! 6. **Repair.** A piece whose tip leaves [`SPLIT_FRACTION`] of the
+//!    tolerance is split at its middle time (a new knot, step 2). A piece
+//!    that needs r = max_j(|v|/v_max, √(|a|/a_max), ∛(|j|/j_max)) > 1 raises c
+//!    on its arc-length span by r (at most 4× per round), and the ramp time
+//!    by r when it lies in a ramp. After [`LOCAL_ROUNDS`] rounds, c and the
+//!    ramp time are multiplied by the largest r: an exact uniform slowdown
+//!    (v/r, a/r², j/r³, [`crate::time_law`]). Steps 2–6 repeat until nothing
+//!    is split or slowed.
+//! 7. **The executor's own check.** The trajectory goes through the
+//!    executor's validation and interpolation at every control period
+//!    ([`crate::deviation`]); a piece with a sample beyond the tolerance is
+//!    split and steps 2–7 repeat, so what is returned has been measured
+//!    within the tolerance ([`TimeScaling::deviation`]).
 //!
-//! No interval is ever shortened: the executed time of every segment is at
-//! least its planned time.
-//!
-//! Jerk is not limited (the executor's cubic Hermite interpolation has
-//! piecewise-constant jerk and acceleration steps at the points).
+//! The executed feed of a segment is the planned one divided by c at its
+//! midpoint ([`TimeScaling::segment_feeds`]; the ramps' passage through
+//! every feed from 0 is not counted, as a start from rest must); its time
+//! is the time between its ends on the law ([`TimeScaling::segment_times`]).
+//! No segment runs faster than planned: c ≥ 1 and f never leaves the range
+//! of its two neighbouring planned feeds.
 
+use kerf_budget::Budget;
+use kerf_executor::spline::{coefficients, Interpolation, Knot};
+use kerf_mill::{condition_number, MillCell};
+
+use crate::deviation::{distance_to_path, measure, PathDeviation};
 use crate::error::MillPlanError;
+use crate::plan::Plan;
+use crate::slowdown::SlowdownField;
+use crate::spline1d::{CubicSpline, StepProfile};
+use crate::time_law::TimeLaw;
 use crate::trajectory::{JointTrajectory, TrajectoryPoint, TrajectoryRequest};
 
-/// Local stretching rounds before the uniform round of step 4.
-pub const LOCAL_ROUNDS: usize = 200;
+/// Rounds of local slowdown (step 6) before the uniform one.
+pub const LOCAL_ROUNDS: usize = 24;
 
-/// Largest stretch of one interval in one local round.
-const MAX_ROUND_STRETCH: f64 = 4.0;
+/// Most rounds of steps 2–6 before the trajectory is given up.
+pub const MAX_ROUNDS: usize = 80;
 
-/// Relative margin the scaled trajectory keeps below each limit (the
-/// executor accepts values up to the limit × (1 + 1e-9)).
-const MARGIN: f64 = 1e-6;
+/// A piece is split when its sampled tip deviation exceeds this fraction of
+/// the tolerance (the rest is the margin for the executor's own sampling).
+pub const SPLIT_FRACTION: f64 = 0.8;
 
-/// A joint's limits for [`time_scale`].
+/// Tip samples per piece in the rounds (step 5).
+const SAMPLES_PER_PIECE: usize = 3;
+
+/// Largest slowdown of one piece in one round.
+const MAX_ROUND_FACTOR: f64 = 4.0;
+
+/// Relative margin kept below each limit (the executor accepts values up to
+/// the limit × (1 + 1e-9)).
+const MARGIN: f64 = 1e-4;
+
+/// Shortest ramp time before the law is given up \[s\].
+const MIN_RAMP_TIME: f64 = 1e-3;
+
+/// A joint's limits.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct JointLimit {
     /// Largest speed \[rad/s\], > 0.
     pub max_velocity: f64,
     /// Largest acceleration \[rad/s²\], > 0; `None`: not limited.
     pub max_acceleration: Option<f64>,
+    /// Largest jerk \[rad/s³\], > 0; `None`: not limited.
+    pub max_jerk: Option<f64>,
 }
 
-/// Extremes of one joint's cubic Hermite segment (see [`hermite_extremes`]).
+/// Settings of [`time_scale`] (builder style: `TrajectorySettings::default().with_…`).
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct HermiteExtremes {
-    /// Acceleration at the segment's start and end (it is linear in
-    /// between) \[rad/s²\].
-    pub accelerations: [(f64, f64); 2],
-    /// Time from the segment's start \[s\] and value of the largest |velocity|
-    /// \[rad/s\] (at an end or at the parabola's vertex).
-    pub peak_velocity: (f64, f64),
+pub struct TrajectorySettings {
+    /// Largest distance of the executed tool tip from the path \[m\], > 0
+    /// (default 5e-5: 0.05 mm).
+    pub path_tolerance: f64,
+    /// The executor's control period \[s\], > 0 (default 0.004, the
+    /// executor's default): the tip is checked at this period.
+    pub control_period: f64,
+    /// Initial ramp time T_r from rest and to rest \[s\], > 0 (default 0.5;
+    /// lengthened where the joints need it, shortened for short paths).
+    pub ramp_time: f64,
+    /// Most trajectory points (default 6 000; the planner node's answer
+    /// limit is 6 990 six-joint points).
+    pub max_points: usize,
 }
 
-/// The acceleration at both ends and the largest speed of the cubic Hermite
-/// segment of duration `h` from (`p0`, `v0`) to (`p1`, `v1`).
-///
-/// With Δ = p1 − p0, the cubic is p0 + v0 τ + c2 τ² + c3 τ³ with
-/// c2 = (3Δ/h − 2 v0 − v1)/h and c3 = (−2Δ/h + v0 + v1)/h²: its
-/// acceleration 2 c2 + 6 c3 τ is linear and its velocity a parabola,
-/// whose extreme is at an end or at the vertex τ = −c2/(3 c3).
-///
-/// # Returns
-/// `(τ, value)` pairs: τ = 0 and τ = h for the accelerations.
-pub fn hermite_extremes(h: f64, p0: f64, p1: f64, v0: f64, v1: f64) -> HermiteExtremes {
-    let d = p1 - p0;
-    let c2 = (3.0 * d / h - 2.0 * v0 - v1) / h;
-    let c3 = (-2.0 * d / h + v0 + v1) / (h * h);
-    let velocity = |tau: f64| v0 + 2.0 * c2 * tau + 3.0 * c3 * tau * tau;
-    let mut peak = if v1.abs() > v0.abs() {
-        (h, v1)
-    } else {
-        (0.0, v0)
-    };
-    if c3 != 0.0 {
-        let vertex = -c2 / (3.0 * c3);
-        if vertex > 0.0 && vertex < h {
-            let v = velocity(vertex);
-            if v.abs() > peak.1.abs() {
-                peak = (vertex, v);
-            }
+impl Default for TrajectorySettings {
+    fn default() -> Self {
+        Self {
+            path_tolerance: 5e-5,
+            control_period: 0.004,
+            ramp_time: 0.5,
+            max_points: 6000,
         }
     }
-    HermiteExtremes {
-        accelerations: [(0.0, 2.0 * c2), (h, 2.0 * c2 + 6.0 * c3 * h)],
-        peak_velocity: peak,
+}
+
+impl TrajectorySettings {
+    /// With the path tolerance \[m\].
+    pub fn with_path_tolerance(mut self, tolerance: f64) -> Self {
+        self.path_tolerance = tolerance;
+        self
+    }
+
+    /// With the control period \[s\].
+    pub fn with_control_period(mut self, period: f64) -> Self {
+        self.control_period = period;
+        self
+    }
+
+    /// With the initial ramp time \[s\].
+    pub fn with_ramp_time(mut self, ramp_time: f64) -> Self {
+        self.ramp_time = ramp_time;
+        self
+    }
+
+    /// With the most trajectory points.
+    pub fn with_max_points(mut self, points: usize) -> Self {
+        self.max_points = points;
+        self
+    }
+
+    /// Checks every setting.
+    ///
+    /// # Errors
+    /// [`MillPlanError::InvalidParameter`] naming the first bad one.
+    pub fn validate(&self) -> Result<(), MillPlanError> {
+        let positive = |name: &str, v: f64| {
+            if v.is_finite() && v > 0.0 {
+                Ok(())
+            } else {
+                Err(MillPlanError::InvalidParameter {
+                    name: name.to_string(),
+                    value: v,
+                    reason: "must be finite and > 0".to_string(),
+                })
+            }
+        };
+        positive("path tolerance [m]", self.path_tolerance)?;
+        positive("control period [s]", self.control_period)?;
+        positive("ramp time [s]", self.ramp_time)?;
+        if self.max_points < 3 {
+            return Err(MillPlanError::InvalidParameter {
+                name: "most trajectory points".to_string(),
+                value: self.max_points as f64,
+                reason: "must be >= 3".to_string(),
+            });
+        }
+        Ok(())
     }
 }
 
-/// The derivative at the middle point of the parabola through
-/// (t − h1, qm), (t, q), (t + h2, qp): the non-uniform three-point
-/// difference −h2/(h1(h1+h2)) qm + (h2−h1)/(h1 h2) q + h1/(h2(h1+h2)) qp
-/// (Fornberg 1988, "Generation of finite difference formulas on
-/// arbitrarily spaced grids").
-pub fn three_point_velocity(h1: f64, h2: f64, qm: f64, q: f64, qp: f64) -> f64 {
-    -h2 / (h1 * (h1 + h2)) * qm + (h2 - h1) / (h1 * h2) * q + h1 / (h2 * (h1 + h2)) * qp
+/// The smooth state profiles of step 1 (what a spindle and feed controller
+/// follows between the segment midpoints).
+#[derive(Debug, Clone, PartialEq)]
+pub struct ExecutedProfiles {
+    /// g(s) \[rad\].
+    pub g: CubicSpline,
+    /// f(s) \[m/s\], before the slowdown.
+    pub feed: StepProfile,
+    /// Ω(s) \[rpm\].
+    pub rpm: StepProfile,
 }
 
 /// The result of [`time_scale`].
 #[derive(Debug, Clone, PartialEq)]
 pub struct TimeScaling {
-    /// The executable trajectory: the planned points, from rest to rest,
-    /// at the scaled times, with the three-point velocities at those times
-    /// (the arc lengths and segments of the planned one).
+    /// The executable trajectory: dense points with positions, velocities
+    /// and accelerations, from rest to rest, with their arc lengths and
+    /// plan segments.
     pub trajectory: JointTrajectory,
-    /// Per interval between consecutive points: the factor on its planned
-    /// duration (≥ 1), the ramps' factor 2 not included.
-    pub interval_stretch: Vec<f64>,
+    /// The profiles of step 1.
+    pub profiles: ExecutedProfiles,
+    /// Per plan segment: the slowdown c at its midpoint (1: at the planned
+    /// feed).
+    pub segment_slowdown: Vec<f64>,
     /// Per plan segment: the time it is machined in \[s\], ramps included.
     pub segment_times: Vec<f64>,
-    /// Per plan segment: the feed it is machined at \[m/s\], length over
-    /// its time WITHOUT the ramps' factor 2 (a start or stop from rest
-    /// passes through every feed from 0; only the stretch of step 3–4
-    /// changes the feed): equal to the planned feed where nothing was
-    /// stretched.
+    /// Per plan segment: the feed at its midpoint \[m/s\], the planned one
+    /// divided by the slowdown there (the ramps not counted).
     pub segment_feeds: Vec<f64>,
-    /// Local rounds used (step 3).
+    /// Rounds of steps 2–6.
     pub rounds: usize,
-    /// Whether the uniform round of step 4 was needed.
+    /// Whether a uniform slowdown was needed.
     pub uniform: bool,
+    /// The final ramp time \[s\].
+    pub ramp_time: f64,
+    /// Largest sampled distance of the interpolated tip from the path or the
+    /// plane \[m\] (step 5).
+    pub sampled_deviation: f64,
+    /// Smallest condition indicator 1/K over the trajectory points, and the
+    /// arc length where it is \[m\].
+    pub min_condition_indicator: (f64, f64),
+    /// The tool path as the executor runs the trajectory, at every control
+    /// period (step 7): within the path tolerance.
+    pub deviation: PathDeviation,
 }
 
 impl TimeScaling {
-    /// Intervals whose duration was stretched (factor > 1).
-    pub fn stretched_intervals(&self) -> usize {
-        self.interval_stretch.iter().filter(|c| **c > 1.0).count()
+    /// Segments run slower than planned (slowdown > 1 at the midpoint).
+    pub fn slowed_segments(&self) -> usize {
+        self.segment_slowdown
+            .iter()
+            .filter(|c| **c > 1.0 + 1e-9)
+            .count()
     }
 
     /// The executable trajectory's duration, from rest to rest \[s\].
@@ -156,240 +252,489 @@ impl TimeScaling {
     }
 }
 
-/// Time-scales a planned trajectory (module documentation).
+/// One geometry knot: arc length and joints.
+#[derive(Debug, Clone, Copy)]
+struct GeoKnot {
+    s: f64,
+    /// The path's spline parameter at s.
+    u: f64,
+    q: [f64; 6],
+}
+
+/// The samples of step 4 and the per-piece outcome of step 5.
+struct Evaluation {
+    times: Vec<f64>,
+    velocities: Vec<[f64; 6]>,
+    accelerations: Vec<[f64; 6]>,
+    need: Vec<f64>,
+    deviation: Vec<f64>,
+}
+
+/// Builds the executed trajectory of `plan` (module documentation).
 ///
 /// # Arguments
-/// * `planned` — the plan's trajectory: path start, the N segment
-///   midpoints, path end (N + 2 points, times strictly increasing from 0);
-/// * `segment_times_planned`, `segment_feeds_planned` — the N segments'
-///   planned times \[s\] and feeds \[m/s\] (the trajectory's intervals are
-///   the times' halves: T_0/2, (T_0 + T_1)/2, …, T_{N−1}/2, checked to
-///   1e-9 relative);
-/// * `limits` — one per joint of `planned`.
+/// * `cell` — the request's cell (path, kinematics, g range).
+/// * `plan` — the plan: one entry per path segment, in order, feeds > 0.
+/// * `limits` — one per joint of the cell's robot, in its order.
+/// * `settings` — tolerance, control period, ramp time, point limit.
+/// * `budget` — checked every round.
 ///
 /// # Returns
-/// The executable trajectory and the segment times and feeds it runs.
+/// The trajectory and its segment times and feeds.
 ///
 /// # Errors
-/// [`MillPlanError::InvalidConfig`] for a trajectory whose side tables or
-/// points do not match its joints ([`JointTrajectory::check`]), fewer than
-/// 3 points, a point count other than N + 2, intervals that are not the
-/// segments' halves, a limit count other than the joint count, a
-/// non-positive or NaN limit, times not strictly increasing, or a
-/// non-finite value on the way.
+/// [`MillPlanError::InvalidParameter`] for bad settings;
+/// [`MillPlanError::InvalidConfig`] for a plan without segments, out of
+/// order, a non-positive feed, bad limits; [`MillPlanError::NotExecutable`]
+/// when g(s) leaves the cell's g range between two midpoints, when the
+/// tolerance would need more than `max_points` points or pieces shorter
+/// than a quarter control period (a branch change of the IK), or when the
+/// rounds run out; IK errors along the path; [`MillPlanError::Interrupted`].
 ///
 /// # Performance
-/// One round is O(points × joints); the default plans need tens of rounds
-/// (well under a millisecond).
+/// O(points × joints) per round plus one IK per new knot and one forward
+/// kinematics per control period; a few rounds for the default plans.
 pub fn time_scale(
-    planned: &JointTrajectory,
-    segment_times_planned: &[f64],
-    segment_feeds_planned: &[f64],
+    cell: &MillCell,
+    plan: &Plan,
     limits: &[JointLimit],
+    settings: &TrajectorySettings,
+    budget: &Budget,
 ) -> Result<TimeScaling, MillPlanError> {
+    settings.validate()?;
     let bad = |reason: String| MillPlanError::InvalidConfig {
-        name: "trajectory time scaling".to_string(),
+        name: "executed trajectory".to_string(),
         reason,
     };
-    planned.check()?;
-    let points = planned.points();
-    let m = points.len();
-    let n = segment_times_planned.len();
-    if m < 3 || m != n + 2 || segment_feeds_planned.len() != n {
+    let path = cell.path();
+    let n = plan.segments.len();
+    if n == 0 || n != path.segments().len() {
         return Err(bad(format!(
-            "{m} trajectory points, {n} segment times and {} segment feeds (expected N + 2 \
-             points with N >= 1)",
-            segment_feeds_planned.len()
+            "{n} plan segments for a path of {} segments",
+            path.segments().len()
         )));
     }
-    if limits.len() != planned.joint_names().len() {
-        return Err(bad(format!(
-            "{} joint limits for {} joints",
-            limits.len(),
-            planned.joint_names().len()
-        )));
+    if limits.len() != 6 {
+        return Err(bad(format!("{} joint limits for 6 joints", limits.len())));
     }
     for (j, l) in limits.iter().enumerate() {
         let positive = |v: f64| v.is_finite() && v > 0.0;
-        if !positive(l.max_velocity) || !l.max_acceleration.is_none_or(positive) {
+        if !positive(l.max_velocity)
+            || !l.max_acceleration.is_none_or(positive)
+            || !l.max_jerk.is_none_or(positive)
+        {
             return Err(bad(format!(
-                "joint {j}: limits {:?} are not positive and finite",
-                l
+                "joint {j}: limits {l:?} are not positive and finite"
             )));
         }
     }
-    for (k, p) in points.iter().enumerate() {
-        if let Some(j) = p.positions.iter().position(|q| !q.is_finite()) {
+    // Step 1: knots at 0, the midpoints, L.
+    let length = path.total_length();
+    let mut boundaries = vec![0.0];
+    let mut x = vec![0.0];
+    for (i, seg) in plan.segments.iter().enumerate() {
+        if seg.segment != i {
+            return Err(bad(format!("plan entry {i} is segment {}", seg.segment)));
+        }
+        if !(seg.feed.is_finite() && seg.feed > 0.0) {
             return Err(bad(format!(
-                "non-finite position of joint {j} at point {k}"
+                "segment {i} has feed {} m/s (> 0 needed)",
+                seg.feed
             )));
         }
+        let start = *boundaries.last().unwrap_or(&0.0);
+        let l = path.segment(i)?.length;
+        x.push(start + 0.5 * l);
+        boundaries.push(start + l);
     }
-    let planned_h: Vec<f64> = points
-        .windows(2)
-        .map(|w| w[1].time_from_start - w[0].time_from_start)
-        .collect();
-    if let Some(k) = planned_h.iter().position(|h| !(h.is_finite() && *h > 0.0)) {
-        return Err(bad(format!(
-            "times not strictly increasing between points {k} and {}",
-            k + 1
-        )));
+    x.push(length);
+    let ends = |v: &dyn Fn(usize) -> f64| -> Vec<f64> {
+        let mut out = vec![v(0)];
+        out.extend((0..n).map(v));
+        out.push(v(n - 1));
+        out
+    };
+    let g_profile = CubicSpline::new("g(s)", &x, &ends(&|i| plan.segments[i].g), Some((0.0, 0.0)))?;
+    let profiles = ExecutedProfiles {
+        g: g_profile,
+        feed: StepProfile::new("f(s)", &x, &ends(&|i| plan.segments[i].feed))?,
+        rpm: StepProfile::new("spindle speed(s)", &x, &ends(&|i| plan.segments[i].rpm))?,
+    };
+    let (g, feed) = (&profiles.g, &profiles.feed);
+    let [g_lo, g_hi] = cell.state_limits().redundancy_angle;
+    let (lo, hi) = g.range();
+    if lo < g_lo - 1e-12 || hi > g_hi + 1e-12 {
+        return Err(MillPlanError::NotExecutable {
+            reason: format!(
+                "the smooth redundancy angle g(s) through the plan's values reaches [{lo:.4}, \
+                 {hi:.4}] rad, outside the range [{g_lo}, {g_hi}]"
+            ),
+        });
     }
-    for (i, h) in planned_h.iter().enumerate() {
-        let half = |k: usize| segment_times_planned.get(k).map_or(0.0, |t| 0.5 * t);
-        let expected = if i == 0 {
-            half(0)
+    // Step 2: initial knots at every segment's ends and midpoint.
+    let mut knots: Vec<GeoKnot> = Vec::with_capacity(2 * n + 1);
+    let mut reference = plan.segments[0].joints;
+    for k in 0..=2 * n {
+        let s = if k % 2 == 0 {
+            boundaries[k / 2]
         } else {
-            half(i - 1) + half(i)
+            x[k / 2 + 1]
         };
-        if (h - expected).abs() > 1e-9 * expected {
-            return Err(bad(format!(
-                "interval {i} lasts {h} s, the segment times give {expected} s"
-            )));
-        }
+        let q = cell.joints_at(s.min(length), g.eval(s).value, Some(&reference))?;
+        reference = q;
+        knots.push(GeoKnot {
+            s,
+            u: path.parameter_at(s.min(length))?,
+            q,
+        });
     }
-    // Step 1: the ramps.
-    let mut base = planned_h.clone();
-    base[0] *= 2.0;
-    base[m - 2] *= 2.0;
-    let mut stretch = vec![1.0; m - 1];
-    let mut rounds = 0;
+    let mut slowdown =
+        SlowdownField::new(length, n).ok_or_else(|| bad(format!("path length {length} m")))?;
+    let mut ramp_time = settings.ramp_time;
     let mut uniform = false;
-    let (times, velocities) = loop {
-        let h: Vec<f64> = base.iter().zip(&stretch).map(|(b, c)| b * c).collect();
-        let (times, velocities) = timed(points, &h, limits.len());
-        let need = needs(points, &h, &velocities, limits);
-        if let Some(i) = need.iter().position(|r| !r.is_finite()) {
-            return Err(bad(format!(
-                "non-finite velocity or acceleration in interval {i}"
-            )));
+    let mut rounds = 0;
+    let scaling = loop {
+        budget.check("the executed trajectory")?;
+        rounds += 1;
+        if rounds > MAX_ROUNDS {
+            return Err(MillPlanError::NotExecutable {
+                reason: format!(
+                    "the trajectory did not settle within the limits and the path tolerance in \
+                     {MAX_ROUNDS} rounds"
+                ),
+            });
         }
-        let worst = need.iter().copied().fold(0.0, f64::max);
-        if worst <= 1.0 {
-            break (times, velocities);
-        }
-        if rounds < LOCAL_ROUNDS {
-            // Step 3.
-            for (c, r) in stretch.iter_mut().zip(&need) {
-                if *r > 1.0 {
-                    *c *= (r * (1.0 + MARGIN)).min(MAX_ROUND_STRETCH);
+        let step = settings.control_period.min(ramp_time / 64.0);
+        let Some(law) = TimeLaw::new(feed, &slowdown, length, ramp_time, step) else {
+            ramp_time *= 0.5;
+            if ramp_time < MIN_RAMP_TIME {
+                return Err(MillPlanError::NotExecutable {
+                    reason: format!(
+                        "no time law from rest to rest on this {length} m path (ramp time \
+                         below {MIN_RAMP_TIME} s, or feeds too low)"
+                    ),
+                });
+            }
+            continue;
+        };
+        let eval = evaluate(cell, &knots, &law, limits)?;
+        let mut split: Vec<usize> = (0..knots.len() - 1)
+            .filter(|&k| eval.deviation[k] > SPLIT_FRACTION * settings.path_tolerance)
+            .collect();
+        let worst = eval.need.iter().copied().fold(0.0, f64::max);
+        if split.is_empty() && worst <= 1.0 {
+            // Step 7: the executor's own interpolation at every control period.
+            let mut scaling = finish(
+                cell,
+                plan,
+                &knots,
+                &boundaries,
+                &x,
+                &law,
+                &eval,
+                &profiles,
+                &slowdown,
+                rounds,
+                uniform,
+            )?;
+            let (deviation, over) = measure(
+                cell,
+                &scaling.trajectory,
+                settings.control_period,
+                settings.path_tolerance,
+            )?;
+            if over.is_empty() {
+                scaling.deviation = deviation;
+                break scaling;
+            }
+            // Split the pieces the samples found outside.
+            for t in over {
+                let k = eval
+                    .times
+                    .partition_point(|x| *x <= t)
+                    .clamp(1, knots.len() - 1)
+                    - 1;
+                if split.last() != Some(&k) {
+                    split.push(k);
                 }
             }
-            rounds += 1;
-        } else if !uniform {
-            // Step 4: exact for a uniform stretch (v ∝ 1/s, a ∝ 1/s²).
-            for c in &mut stretch {
-                *c *= worst * (1.0 + MARGIN);
+        }
+        // Step 6: split.
+        if knots.len() + split.len() > settings.max_points {
+            return Err(MillPlanError::NotExecutable {
+                reason: format!(
+                    "keeping the tool tip within {} mm of the path needs more than {} trajectory \
+                     points",
+                    settings.path_tolerance * 1e3,
+                    settings.max_points
+                ),
+            });
+        }
+        for &k in split.iter().rev() {
+            let (ta, tb) = (eval.times[k], eval.times[k + 1]);
+            if tb - ta < 0.25 * settings.control_period {
+                return Err(MillPlanError::NotExecutable {
+                    reason: format!(
+                        "the tool tip leaves the path by {:.4} mm between arc lengths {:.5} and \
+                         {:.5} m even with points {:.2e} s apart (an IK branch change?)",
+                        eval.deviation[k] * 1e3,
+                        knots[k].s,
+                        knots[k + 1].s,
+                        tb - ta
+                    ),
+                });
             }
-            uniform = true;
-        } else {
-            return Err(bad(format!(
-                "the uniform stretch left a need of {worst} (numerical failure)"
-            )));
+            let s = law.at_time(0.5 * (ta + tb)).s;
+            if !(s > knots[k].s && s < knots[k + 1].s) {
+                continue;
+            }
+            let q = cell.joints_at(s, g.eval(s).value, Some(&knots[k].q))?;
+            let u = path.parameter_at(s)?;
+            knots.insert(k + 1, GeoKnot { s, u, q });
+        }
+        // Step 6: slow down.
+        if worst > 1.0 {
+            if rounds <= LOCAL_ROUNDS {
+                let mut ramp_need: f64 = 1.0;
+                let mut spans = Vec::new();
+                for (k, r) in eval.need.iter().enumerate() {
+                    if *r > 1.0 {
+                        let factor = (r * (1.0 + MARGIN)).min(MAX_ROUND_FACTOR);
+                        spans.push((knots[k].s, knots[k + 1].s, factor));
+                        let (ta, tb) = (eval.times[k], eval.times[k + 1]);
+                        if ta < law.ramp_time() || tb > law.duration() - law.ramp_time() {
+                            ramp_need = ramp_need.max(factor);
+                        }
+                    }
+                }
+                slowdown.raise(&spans);
+                ramp_time *= ramp_need;
+            } else {
+                let factor = worst * (1.0 + MARGIN);
+                slowdown.scale(factor);
+                ramp_time *= factor;
+                uniform = true;
+            }
         }
     };
-    // Segment k's first half lies in interval k, its second half in k + 1.
-    let mut segment_times = Vec::with_capacity(n);
-    let mut segment_feeds = Vec::with_capacity(n);
-    for (k, (&planned_time, &feed)) in segment_times_planned
-        .iter()
-        .zip(segment_feeds_planned)
-        .enumerate()
-    {
-        let ramp_first = if k == 0 { 2.0 } else { 1.0 };
-        let ramp_second = if k + 1 == m - 2 { 2.0 } else { 1.0 };
-        segment_times
-            .push(0.5 * planned_time * (stretch[k] * ramp_first + stretch[k + 1] * ramp_second));
-        // l / (T (c_k + c_{k+1}) / 2): exactly the planned feed when unstretched.
-        segment_feeds.push(feed * (2.0 / (stretch[k] + stretch[k + 1])));
+    Ok(scaling)
+}
+
+/// Steps 2 (the Q splines), 4 and 5 for the current knots and law.
+fn evaluate(
+    cell: &MillCell,
+    knots: &[GeoKnot],
+    law: &TimeLaw,
+    limits: &[JointLimit],
+) -> Result<Evaluation, MillPlanError> {
+    let m = knots.len();
+    let s: Vec<f64> = knots.iter().map(|k| k.s).collect();
+    let mut splines = Vec::with_capacity(6);
+    for j in 0..6 {
+        let q: Vec<f64> = knots.iter().map(|k| k.q[j]).collect();
+        splines.push(CubicSpline::new("joint path Q(s)", &s, &q, None)?);
     }
-    let out_points = points
+    let mut times = Vec::with_capacity(m);
+    let mut velocities = Vec::with_capacity(m);
+    let mut accelerations = Vec::with_capacity(m);
+    let mut states = Vec::with_capacity(m);
+    for (k, knot) in knots.iter().enumerate() {
+        let p = if k == 0 {
+            law.at_time(0.0)
+        } else if k + 1 == m {
+            law.at_time(law.duration())
+        } else {
+            law.at_arc_length(knot.s)
+        };
+        let mut v = [0.0; 6];
+        let mut a = [0.0; 6];
+        for j in 0..6 {
+            let d = splines[j].eval(knot.s);
+            v[j] = d.d1 * p.speed;
+            a[j] = d.d2 * p.speed * p.speed + d.d1 * p.acceleration;
+        }
+        if v.iter().chain(&a).any(|x| !x.is_finite()) {
+            return Err(MillPlanError::NotExecutable {
+                reason: format!(
+                    "non-finite joint velocity or acceleration at arc length {} m",
+                    knot.s
+                ),
+            });
+        }
+        times.push(p.time);
+        velocities.push(v);
+        accelerations.push(a);
+        states.push(p);
+    }
+    if let Some(k) = times.windows(2).position(|w| w[1] <= w[0]) {
+        return Err(MillPlanError::NotExecutable {
+            reason: format!(
+                "trajectory times not increasing at arc length {} m ({} then {} s)",
+                knots[k].s,
+                times[k],
+                times[k + 1]
+            ),
+        });
+    }
+    let path = cell.path();
+    let origin = path.point(0.0)?;
+    let normal = path.normal();
+    let mut need = Vec::with_capacity(m - 1);
+    let mut deviation = Vec::with_capacity(m - 1);
+    for k in 0..m - 1 {
+        let h = times[k + 1] - times[k];
+        let mut c = [[0.0; 6]; 6];
+        let mut r: f64 = 0.0;
+        for j in 0..6 {
+            let k0 = Knot {
+                p: knots[k].q[j],
+                v: velocities[k][j],
+                a: accelerations[k][j],
+            };
+            let k1 = Knot {
+                p: knots[k + 1].q[j],
+                v: velocities[k + 1][j],
+                a: accelerations[k + 1][j],
+            };
+            c[j] = coefficients(Interpolation::Quintic, k0, k1, h);
+            r = r.max(piece_need(&c[j], h, &limits[j]));
+        }
+        need.push(r);
+        // The tip at 3 interior times of the piece: its distance from the path curve and
+        // from the plane (the interpolation error is a smooth bump over the piece; the
+        // executor's own sampling at every control period is measured after, step 7).
+        let samples = SAMPLES_PER_PIECE;
+        let mut worst: f64 = 0.0;
+        for i in 1..=samples {
+            let x = i as f64 / (samples + 1) as f64;
+            let mut q = [0.0; 6];
+            for j in 0..6 {
+                q[j] = kerf_executor::spline::evaluate(&c[j], h * x).0;
+            }
+            let tip = cell.kinematics().tcp_pose(&q)?.translation.vector;
+            let guess = knots[k].u + x * (knots[k + 1].u - knots[k].u);
+            let (off_path, _) = distance_to_path(cell, &tip, guess)?;
+            let off_plane = (tip - origin).dot(&normal).abs();
+            worst = worst.max(off_path).max(off_plane);
+        }
+        deviation.push(worst);
+    }
+    Ok(Evaluation {
+        times,
+        velocities,
+        accelerations,
+        need,
+        deviation,
+    })
+}
+
+/// r of step 6 for one joint's quintic `c` over [0, h].
+fn piece_need(c: &[f64; 6], h: f64, limit: &JointLimit) -> f64 {
+    use kerf_executor::roots::extrema;
+    let v = [c[1], 2.0 * c[2], 3.0 * c[3], 4.0 * c[4], 5.0 * c[5]];
+    let a = [2.0 * c[2], 6.0 * c[3], 12.0 * c[4], 20.0 * c[5]];
+    let jerk = [6.0 * c[3], 24.0 * c[4], 60.0 * c[5]];
+    let peak = |p: &[f64]| {
+        let ((_, lo), (_, hi)) = extrema(p, 0.0, h);
+        lo.abs().max(hi.abs())
+    };
+    let scaled = |value: f64, max: f64| value / (max * (1.0 - MARGIN));
+    let mut r = scaled(peak(&v), limit.max_velocity);
+    if let Some(amax) = limit.max_acceleration {
+        r = r.max(scaled(peak(&a), amax).sqrt());
+    }
+    if let Some(jmax) = limit.max_jerk {
+        r = r.max(scaled(peak(&jerk), jmax).cbrt());
+    }
+    if r.is_finite() {
+        r
+    } else {
+        f64::INFINITY
+    }
+}
+
+/// The result from the settled knots and law.
+#[allow(clippy::too_many_arguments)]
+fn finish(
+    cell: &MillCell,
+    plan: &Plan,
+    knots: &[GeoKnot],
+    boundaries: &[f64],
+    midpoints: &[f64],
+    law: &TimeLaw,
+    eval: &Evaluation,
+    profiles: &ExecutedProfiles,
+    slowdown: &SlowdownField,
+    rounds: usize,
+    uniform: bool,
+) -> Result<TimeScaling, MillPlanError> {
+    let n = plan.segments.len();
+    let names: Vec<String> = cell
+        .kinematics()
+        .joints()
         .iter()
-        .zip(times.iter().zip(&velocities))
-        .map(|(p, (&t, v))| TrajectoryPoint {
-            positions: p.positions.clone(),
-            velocities: v.clone(),
-            time_from_start: t,
-            ..TrajectoryPoint::default()
-        })
+        .map(|j| j.name.clone())
         .collect();
+    let mut points = Vec::with_capacity(knots.len());
+    let mut arc_length = Vec::with_capacity(knots.len());
+    let mut segment = Vec::with_capacity(knots.len());
+    let mut min_ci = (f64::INFINITY, 0.0);
+    for (k, knot) in knots.iter().enumerate() {
+        points.push(TrajectoryPoint {
+            positions: knot.q.to_vec(),
+            velocities: eval.velocities[k].to_vec(),
+            accelerations: eval.accelerations[k].to_vec(),
+            time_from_start: eval.times[k],
+            ..TrajectoryPoint::default()
+        });
+        arc_length.push(knot.s);
+        let seg = boundaries[1..].partition_point(|b| *b <= knot.s).min(n - 1);
+        segment.push(seg);
+        let j = cell.kinematics().jacobian(&knot.q)?;
+        let ci = 1.0 / condition_number(&j, cell.characteristic_length())?;
+        if ci < min_ci.0 {
+            min_ci = (ci, knot.s);
+        }
+    }
+    let segment_times = (0..n)
+        .map(|i| law.at_arc_length(boundaries[i + 1]).time - law.at_arc_length(boundaries[i]).time)
+        .collect();
+    let segment_slowdown: Vec<f64> = (0..n).map(|i| slowdown.eval(midpoints[i + 1]).0).collect();
+    let segment_feeds = plan
+        .segments
+        .iter()
+        .zip(&segment_slowdown)
+        .map(|(s, c)| s.feed / c)
+        .collect();
+    let sampled_deviation = eval.deviation.iter().copied().fold(0.0, f64::max);
     Ok(TimeScaling {
         trajectory: JointTrajectory {
             request: TrajectoryRequest {
-                joint_names: planned.joint_names().to_vec(),
-                points: out_points,
-                start_time: planned.request.start_time,
+                joint_names: names,
+                points,
+                start_time: None,
             },
-            arc_length: planned.arc_length.clone(),
-            segment: planned.segment.clone(),
+            arc_length,
+            segment,
         },
-        interval_stretch: stretch,
+        profiles: profiles.clone(),
+        segment_slowdown,
         segment_times,
         segment_feeds,
         rounds,
         uniform,
+        ramp_time: law.ramp_time(),
+        sampled_deviation,
+        min_condition_indicator: min_ci,
+        deviation: PathDeviation::default(),
     })
 }
 
-/// Times from the interval durations `h` and the velocities of step 1–2
-/// (zero at the ends, three-point in between) of `joints` joints.
-fn timed(points: &[TrajectoryPoint], h: &[f64], joints: usize) -> (Vec<f64>, Vec<Vec<f64>>) {
-    let m = points.len();
-    let mut times = Vec::with_capacity(m);
-    let mut t = 0.0;
-    times.push(t);
-    for d in h {
-        t += d;
-        times.push(t);
-    }
-    let mut velocities = vec![vec![0.0; joints]; m];
-    for k in 1..m - 1 {
-        for (j, v) in velocities[k].iter_mut().enumerate() {
-            *v = three_point_velocity(
-                h[k - 1],
-                h[k],
-                points[k - 1].positions[j],
-                points[k].positions[j],
-                points[k + 1].positions[j],
-            );
-        }
-    }
-    (times, velocities)
-}
-
-/// Per interval, r_i of step 3 (≤ 1: within every limit).
-fn needs(
-    points: &[TrajectoryPoint],
-    h: &[f64],
-    velocities: &[Vec<f64>],
-    limits: &[JointLimit],
-) -> Vec<f64> {
-    (0..h.len())
-        .map(|i| {
-            let mut r: f64 = 0.0;
-            for (j, l) in limits.iter().enumerate() {
-                let e = hermite_extremes(
-                    h[i],
-                    points[i].positions[j],
-                    points[i + 1].positions[j],
-                    velocities[i][j],
-                    velocities[i + 1][j],
-                );
-                let mut ratios = vec![e.peak_velocity.1.abs() / (l.max_velocity * (1.0 - MARGIN))];
-                if let Some(amax) = l.max_acceleration {
-                    for (_, a) in e.accelerations {
-                        ratios.push((a.abs() / (amax * (1.0 - MARGIN))).sqrt());
-                    }
-                }
-                for x in ratios {
-                    // f64::max would drop a NaN.
-                    if !x.is_finite() {
-                        return f64::NAN;
-                    }
-                    r = r.max(x);
-                }
-            }
-            r
-        })
-        .collect()
+/// The derivative at the middle point of the parabola through
+/// (t − h1, qm), (t, q), (t + h2, qp): the non-uniform three-point
+/// difference −h2/(h1(h1+h2)) qm + (h2−h1)/(h1 h2) q + h1/(h2(h1+h2)) qp
+/// (Fornberg 1988, "Generation of finite difference formulas on
+/// arbitrarily spaced grids").
+pub fn three_point_velocity(h1: f64, h2: f64, qm: f64, q: f64, qp: f64) -> f64 {
+    -h2 / (h1 * (h1 + h2)) * qm + (h2 - h1) / (h1 * h2) * q + h1 / (h2 * (h1 + h2)) * qp
 }

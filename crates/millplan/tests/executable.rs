@@ -79,7 +79,10 @@ fn planner_outputs_pass_the_executors_validation() {
         };
         let out = planner().plan(&request).expect(kind);
         let t = &out.executed.scaling.trajectory;
-        assert_eq!(t.points().len(), out.plan.segments.len() + 2, "{kind}");
+        assert!(
+            t.points().len() > out.plan.segments.len() + 2,
+            "{kind}: dense samples"
+        );
         assert_executable(&cell, t, kind);
     }
 }
@@ -99,14 +102,15 @@ fn an_executed_dp_plan_passes_the_executors_validation() {
     let plan = Plan::evaluate(&cell, &weights, &r.states, "dp").expect("plan");
     let executed = execute(&cell, &plan, &weights, 2).expect("executed");
     // The DP's g steps are slowed to the joint limits.
-    assert!(executed.scaling.stretched_intervals() > 0);
+    assert!(executed.scaling.slowed_segments() > 0);
     assert_executable(&cell, &executed.scaling.trajectory, "dp (narrow ranges)");
     // The check is not vacuous: the same trajectory run twice as fast
-    // (times halved, velocities doubled: accelerations x4) is refused.
+    // (times halved, velocities doubled, accelerations x4) is refused.
     let mut fast = executed.scaling.trajectory.request.clone();
     for p in &mut fast.points {
         p.time_from_start *= 0.5;
         p.velocities.iter_mut().for_each(|v| *v *= 2.0);
+        p.accelerations.iter_mut().for_each(|a| *a *= 4.0);
     }
     let first = fast.points[0].positions.clone();
     let refused = kerf_executor::validate(

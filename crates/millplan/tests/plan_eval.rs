@@ -398,7 +398,7 @@ fn executed_plan_in_cache_and_direct_modes() {
     let c = cached.plan(&request).expect("cached ddpg");
     assert!(d.executed.cached_segments.is_empty());
     assert_eq!(d.executed.scaling, c.executed.scaling);
-    assert!(d.executed.scaling.stretched_intervals() > 0);
+    assert!(d.executed.scaling.slowed_segments() > 0);
     let bound = c.indicator.error_bound.expect("bound");
     let mut changed_and_cached = 0;
     for (a, b) in d

@@ -110,10 +110,11 @@ pub fn request_from_msg(m: &msg::MillRequest) -> Result<MillRequest, MillPlanErr
     })
 }
 
-/// Checks that a trajectory is publishable: six joint names, one position and velocity per
-/// joint and point, finite values, times from 0 strictly increasing, and at rest (every
-/// velocity zero) at the first and the last point (an executor cannot step the velocity at
-/// the start, and kerf's refuses a trajectory that does not end at rest).
+/// Checks that a trajectory is publishable: six joint names, one position, velocity and
+/// acceleration per joint and point, finite values, times from 0 strictly increasing, and at
+/// rest (every velocity and acceleration zero) at the first and the last point (an executor
+/// cannot step the velocity at the start, and kerf's refuses a trajectory that does not end
+/// at rest).
 ///
 /// # Errors
 /// A sentence naming the first defect (a planner bug: the node answers INTERNAL_ERROR rather
@@ -146,7 +147,11 @@ pub fn check_trajectory(t: &kerf_millplan::JointTrajectory) -> Result<(), String
         }
     }
     for (k, p) in t.points.iter().enumerate() {
-        for (what, values) in [("position", &p.positions), ("velocity", &p.velocities)] {
+        for (what, values) in [
+            ("position", &p.positions),
+            ("velocity", &p.velocities),
+            ("acceleration", &p.accelerations),
+        ] {
             if values.len() != t.joint_names.len() {
                 return Err(format!(
                     "{} {what} value(s) at point {k} (t = {} s) for {} joints",
@@ -167,14 +172,19 @@ pub fn check_trajectory(t: &kerf_millplan::JointTrajectory) -> Result<(), String
     }
     let last = t.points.len() - 1;
     for (k, end) in [(0, "first"), (last, "last")] {
-        let v = &t.points[k].velocities;
-        if let Some(j) = v.iter().position(|v| *v != 0.0) {
-            return Err(format!(
-                "the {end} point (t = {} s) is not at rest: velocity of {} is {} rad/s",
-                t.points[k].time_from_start,
-                t.joint_names.get(j).map(String::as_str).unwrap_or("?"),
-                v[j]
-            ));
+        let p = &t.points[k];
+        for (what, values, unit) in [
+            ("velocity", &p.velocities, "rad/s"),
+            ("acceleration", &p.accelerations, "rad/s^2"),
+        ] {
+            if let Some(j) = values.iter().position(|v| *v != 0.0) {
+                return Err(format!(
+                    "the {end} point (t = {} s) is not at rest: {what} of {} is {} {unit}",
+                    p.time_from_start,
+                    t.joint_names.get(j).map(String::as_str).unwrap_or("?"),
+                    values[j]
+                ));
+            }
         }
     }
     Ok(())
@@ -290,8 +300,11 @@ pub fn success_message(out: &MillPlanOutput) -> String {
     };
     format!(
         "planned {} segments with {}{policy}: machining time {:.3} s as executed from rest to \
-         rest ({:.3} s at the planned feeds; {} of {} trajectory intervals slowed to the joints' \
-         velocity/acceleration limits, lowest feed {:.4} m/s), max |mu| {:.4} as executed \
+         rest ({:.3} s at the planned feeds; {} of {} segments slowed to the joints' \
+         velocity/acceleration/jerk limits, lowest feed {:.4} m/s; {} trajectory points, tool tip \
+         within {:.4} mm of the path and {:.4} mm of the plane at every {} ms control period, \
+         tolerance {:.4} mm), \
+         max |mu| {:.4} as executed \
          ({:.4} as planned) ({}), min condition indicator {:.3}, total reward {:.3} as executed \
          ({:.3} as planned); indicator cache {} for planning; {}{executed_cache}; planning took \
          {:.3} s{jumps}",
@@ -299,9 +312,14 @@ pub fn success_message(out: &MillPlanOutput) -> String {
         out.planner.name(),
         e.total_time,
         p.total_time,
-        scaling.stretched_intervals(),
-        scaling.interval_stretch.len(),
+        scaling.slowed_segments(),
+        scaling.segment_slowdown.len(),
         lowest_feed,
+        scaling.trajectory.points().len(),
+        out.executed.deviation.max_off_path * 1e3,
+        out.executed.deviation.max_off_plane * 1e3,
+        out.executed.settings.control_period * 1e3,
+        out.executed.settings.path_tolerance * 1e3,
         e.max_spectral_radius,
         p.max_spectral_radius,
         chatter_text(e, p),
