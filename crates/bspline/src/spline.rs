@@ -52,7 +52,7 @@ impl BSpline {
     /// # Performance
     /// O(k^2).
     pub fn eval(&self, u: f64) -> [f64; 4] {
-        let [out] = self.eval_coefficients([&self.coeffs], u);
+        let [out] = self.eval_coefficients([&self.coeffs], u, 3);
         out
     }
 
@@ -60,7 +60,13 @@ impl BSpline {
     /// lists `coeffs` (each of `n_coeffs` entries; a shorter list contributes zeros), from one
     /// basis evaluation (on the stack for degree < 8; the arithmetic of
     /// [`KnotVector::basis_derivs`]).
-    fn eval_coefficients<const N: usize>(&self, coeffs: [&[f64]; N], u: f64) -> [[f64; 4]; N] {
+    fn eval_coefficients<const N: usize>(
+        &self,
+        coeffs: [&[f64]; N],
+        u: f64,
+        nderiv: usize,
+    ) -> [[f64; 4]; N] {
+        let nderiv = nderiv.min(3);
         let w = self.kv.degree() + 1;
         let mut out = [[0.0; 4]; N];
         let mut combine = |first: usize, ders: &[f64]| {
@@ -82,10 +88,10 @@ impl BSpline {
             let mut scratch = [0.0; 4 * FAST_WIDTH];
             let first = self
                 .kv
-                .basis_derivs_into(u, 3, &mut ders, &mut ndu, &mut scratch);
-            combine(first, &ders[..4 * w]);
+                .basis_derivs_into(u, nderiv, &mut ders, &mut ndu, &mut scratch);
+            combine(first, &ders[..(nderiv + 1) * w]);
         } else {
-            let (first, ders) = self.kv.basis_derivs(u, 3);
+            let (first, ders) = self.kv.basis_derivs(u, nderiv);
             combine(first, &ders.concat());
         }
         out
@@ -94,7 +100,7 @@ impl BSpline {
     /// [`BSpline::eval`] of several splines that share this spline's knot vector, with one
     /// basis evaluation for all: `out[i]` is `[q, q_u, q_uu, q_uuu]` of the spline with this
     /// knot vector and the coefficients `coeffs[i]` (a curve's coordinates, fitted on one
-    /// knot vector).
+    /// knot vector), derivatives above `nderiv` (≤ 3) left 0 (not computed).
     ///
     /// # Errors
     /// [`BsplineError::NotFinite`] / [`BsplineError::ParameterOutOfRange`] for u;
@@ -106,6 +112,7 @@ impl BSpline {
         &self,
         coeffs: [&[f64]; N],
         u: f64,
+        nderiv: usize,
     ) -> Result<[[f64; 4]; N], BsplineError> {
         let u = check_param(u)?;
         let n = self.kv.n_coeffs();
@@ -116,7 +123,7 @@ impl BSpline {
                 got: c.len(),
             });
         }
-        Ok(self.eval_coefficients(coeffs, u))
+        Ok(self.eval_coefficients(coeffs, u, nderiv))
     }
 
     /// [`BSpline::eval`] after validating u.

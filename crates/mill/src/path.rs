@@ -246,11 +246,12 @@ impl MillingPath {
         Ok(Vector3::new(c[0][0], c[1][0], c[2][0]))
     }
 
-    /// Value and first three derivatives of the three coordinates at u, from one basis
-    /// evaluation (the coordinates share their knot vector: [`fit_curve`]).
+    /// Value and first derivative of the three coordinates at u (entries 0 and 1 of each
+    /// row), from one basis evaluation (the coordinates share their knot vector:
+    /// [`fit_curve`]).
     fn coordinates(&self, u: f64) -> Result<[[f64; 4]; 3], MillError> {
         let [x, y, z] = &self.curve;
-        Ok(x.eval_shared([x.coeffs(), y.coeffs(), z.coeffs()], u)?)
+        Ok(x.eval_shared([x.coeffs(), y.coeffs(), z.coeffs()], u, 1)?)
     }
 
     /// Derivative P'(u) [m per unit u].

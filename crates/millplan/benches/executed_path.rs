@@ -6,6 +6,10 @@
 //! `cargo bench -p kerf_millplan --bench executed_path`
 #![allow(clippy::unwrap_used, clippy::expect_used)] // a bench binary reports failures by panicking
 
+#[path = "common/mod.rs"]
+mod common;
+
+use common::thread_cpu_time;
 use kerf_millplan::deviation::executed_deviation;
 use kerf_millplan::{MillPlanner, MillRequest};
 
@@ -15,7 +19,15 @@ fn main() {
         "| planner | points | executed time (s) | off the path: max / p99 (mm) | off the plane: max (mm) | at t (s) |"
     );
     println!("|---|---:|---:|---|---:|---:|");
+    // KERF_BENCH_PLANNERS=fixed_g,naive runs only those (for profiling).
+    let only = std::env::var("KERF_BENCH_PLANNERS").ok();
     for name in ["ddpg", "fixed_g", "dp", "naive"] {
+        if only
+            .as_deref()
+            .is_some_and(|o| !o.split(',').any(|x| x == name))
+        {
+            continue;
+        }
         let request = MillRequest {
             planner: name.to_string(),
             ..MillRequest::default()
@@ -74,21 +86,34 @@ fn breakdown(planner: &MillPlanner, out: &kerf_millplan::MillPlanOutput) {
         })
         .collect();
     let settings = TrajectorySettings::default();
-    let runs = 5;
-    let start = Instant::now();
+    let runs: usize = std::env::var("KERF_BENCH_RUNS")
+        .ok()
+        .and_then(|r| r.parse().ok())
+        .unwrap_or(5);
+    let (start, cpu) = (Instant::now(), thread_cpu_time());
     for _ in 0..runs {
         time_scale(cell, &out.plan, &limits, &settings, &Budget::unlimited()).unwrap();
     }
     let build = start.elapsed().as_secs_f64() / runs as f64;
-    let start = Instant::now();
+    let build_cpu = cpu
+        .zip(thread_cpu_time())
+        .map(|(a, b)| (b - a) / runs as f64);
+    let (start, cpu) = (Instant::now(), thread_cpu_time());
     for _ in 0..runs {
         executed_deviation(cell, &out.executed.scaling.trajectory, 0.004).unwrap();
     }
     let measure = start.elapsed().as_secs_f64() / runs as f64;
+    let measure_cpu = cpu
+        .zip(thread_cpu_time())
+        .map(|(a, b)| (b - a) / runs as f64);
+    let ms = |x: Option<f64>| x.map_or("?".to_string(), |v| format!("{:.1}", v * 1e3));
     eprintln!(
-        "  {}: time_scale {:.1} ms, executed_deviation {:.1} ms (mean of {runs})",
+        "  {}: time_scale {:.1} ms wall / {} ms CPU (of which the measurement at the control \
+         period, executed_deviation: {:.1} ms wall / {} ms CPU), mean of {runs}",
         out.planner.name(),
         build * 1e3,
-        measure * 1e3
+        ms(build_cpu),
+        measure * 1e3,
+        ms(measure_cpu)
     );
 }

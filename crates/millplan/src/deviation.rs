@@ -98,11 +98,13 @@ pub fn executed_deviation(
     trajectory: &JointTrajectory,
     period: f64,
 ) -> Result<PathDeviation, MillPlanError> {
-    Ok(measure(cell, trajectory, period, f64::INFINITY)?.0)
+    Ok(measure(cell, trajectory, period, f64::INFINITY, None)?.0)
 }
 
 /// [`executed_deviation`] and the times (s from the start) of the samples whose distance
-/// from the path or the plane exceeds `tolerance` \[m\].
+/// from the path or the plane exceeds `tolerance` \[m\]; `params` are the path's spline
+/// parameters at the trajectory's points when the caller has them (else computed from the
+/// arc lengths).
 ///
 /// # Errors
 /// As [`executed_deviation`].
@@ -111,6 +113,7 @@ pub(crate) fn measure(
     trajectory: &JointTrajectory,
     period: f64,
     tolerance: f64,
+    params: Option<&[f64]>,
 ) -> Result<(PathDeviation, Vec<f64>), MillPlanError> {
     if !(period.is_finite() && period > 0.0) {
         return Err(MillPlanError::InvalidParameter {
@@ -133,11 +136,14 @@ pub(crate) fn measure(
     let total = path.total_length();
     let points = trajectory.points();
     // The spline parameter of every point, the guesses between them linear in time.
-    let params = trajectory
-        .arc_length
-        .iter()
-        .map(|s| path.parameter_at(s.clamp(0.0, total)))
-        .collect::<Result<Vec<f64>, _>>()?;
+    let params = match params {
+        Some(p) if p.len() == points.len() => p.to_vec(),
+        _ => trajectory
+            .arc_length
+            .iter()
+            .map(|s| path.parameter_at(s.clamp(0.0, total)))
+            .collect::<Result<Vec<f64>, _>>()?,
+    };
     let (t0, t1) = (prepared.start_time(), prepared.end_time());
     let steps = ((t1 - t0) / period).ceil() as usize;
     let mut off_path = Vec::with_capacity(steps + 1);

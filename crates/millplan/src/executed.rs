@@ -7,7 +7,6 @@
 //! at the feeds that result ([`Plan::as_executed`]).
 
 use kerf_budget::Budget;
-use kerf_executor::{check_executable, ExecutorConfig};
 use kerf_mill::MillCell;
 
 use crate::cache::IndicatorCache;
@@ -71,11 +70,10 @@ pub fn execute(
 /// * `indicator`, `cache` — where |μ|max comes from.
 ///
 /// # Errors
-/// [`time_scale`] and [`Plan::as_executed_with`] errors;
-/// [`MillPlanError::NotExecutable`] when the trajectory fails
-/// `kerf_executor::check_executable` (the executor's own validation: the
-/// one executability check of kerf) or its measured tool path leaves the
-/// tolerance.
+/// [`time_scale`] errors (among them [`MillPlanError::NotExecutable`] when the
+/// trajectory fails `kerf_executor::check_executable`, the executor's own
+/// validation, which its step 7 runs before measuring the tool path) and
+/// [`Plan::as_executed_with`] errors.
 // The plan, its settings and the evaluation's settings, passed through from the planner.
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn executed(
@@ -110,19 +108,6 @@ pub(crate) fn executed(
         .collect::<Result<Vec<_>, _>>()?;
     budget.check("the executed trajectory")?;
     let scaling = time_scale(cell, plan, &limits, settings, budget)?;
-    budget.check("the executability check")?;
-    // Judged by what the executor runs: its own validation, from rest at the first point.
-    let not_executable = |reason: String| MillPlanError::NotExecutable { reason };
-    let model = cell
-        .robot()
-        .executor_limits()
-        .map_err(|e| not_executable(e.to_string()))?;
-    check_executable(
-        &model,
-        &ExecutorConfig::default(),
-        &scaling.trajectory.request,
-    )
-    .map_err(|e| not_executable(e.to_string()))?;
     let deviation = scaling.deviation;
     let (plan, cached_segments) = plan.as_executed_with(
         cell,

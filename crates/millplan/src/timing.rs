@@ -434,11 +434,13 @@ pub fn time_scale(
                 rounds,
                 uniform,
             )?;
+            let params: Vec<f64> = knots.iter().map(|k| k.u).collect();
             let (deviation, over) = measure(
                 cell,
                 &scaling.trajectory,
                 settings.control_period,
                 settings.path_tolerance,
+                Some(&params),
             )?;
             if over.is_empty() {
                 scaling.deviation = deviation;
@@ -626,22 +628,36 @@ fn evaluate(
 }
 
 /// r of step 6 for one joint's quintic `c` over [0, h].
+///
+/// A polynomial's largest |value| on [0, h] is bounded by Σ |c_i| h^i; where that bound is
+/// already below half the limit, the exact extremes (roots of the next derivative) are not
+/// needed: the contribution is reported as that bound's ratio (≤ 0.5, so it never triggers a
+/// slowdown and never hides one).
 fn piece_need(c: &[f64; 6], h: f64, limit: &JointLimit) -> f64 {
     use kerf_executor::roots::extrema;
     let v = [c[1], 2.0 * c[2], 3.0 * c[3], 4.0 * c[4], 5.0 * c[5]];
     let a = [2.0 * c[2], 6.0 * c[3], 12.0 * c[4], 20.0 * c[5]];
     let jerk = [6.0 * c[3], 24.0 * c[4], 60.0 * c[5]];
-    let peak = |p: &[f64]| {
+    let ratio = |p: &[f64], max: f64| {
+        let scale = max * (1.0 - MARGIN);
+        let mut bound = 0.0;
+        let mut power = 1.0;
+        for x in p {
+            bound += x.abs() * power;
+            power *= h;
+        }
+        if bound <= 0.5 * scale {
+            return bound / scale;
+        }
         let ((_, lo), (_, hi)) = extrema(p, 0.0, h);
-        lo.abs().max(hi.abs())
+        lo.abs().max(hi.abs()) / scale
     };
-    let scaled = |value: f64, max: f64| value / (max * (1.0 - MARGIN));
-    let mut r = scaled(peak(&v), limit.max_velocity);
+    let mut r = ratio(&v, limit.max_velocity);
     if let Some(amax) = limit.max_acceleration {
-        r = r.max(scaled(peak(&a), amax).sqrt());
+        r = r.max(ratio(&a, amax).sqrt());
     }
     if let Some(jmax) = limit.max_jerk {
-        r = r.max(scaled(peak(&jerk), jmax).cbrt());
+        r = r.max(ratio(&jerk, jmax).cbrt());
     }
     if r.is_finite() {
         r
