@@ -6,7 +6,7 @@
 //! `cargo bench -p kerf_millplan --bench executed_path`
 #![allow(clippy::unwrap_used, clippy::expect_used)] // a bench binary reports failures by panicking
 
-#[path = "common/mod.rs"]
+#[allow(dead_code)] // each bench uses some of the shared helpers
 mod common;
 
 use common::thread_cpu_time;
