@@ -25,6 +25,89 @@ pub struct PathDeviation {
     pub samples: usize,
 }
 
+/// Samples per block of [`measure`] (the unit of its threads and of its warm start).
+const BLOCK: usize = 256;
+
+/// One measured sample: time from the start, distances from the path and the plane.
+struct Sample {
+    time: f64,
+    off_path: f64,
+    off_plane: f64,
+}
+
+/// What every block of [`measure`] reads.
+struct Context<'a> {
+    cell: &'a MillCell,
+    points: &'a [crate::trajectory::TrajectoryPoint],
+    params: &'a [f64],
+    origin: Vector3<f64>,
+    normal: Vector3<f64>,
+    t0: f64,
+    t1: f64,
+    period: f64,
+    steps: usize,
+}
+
+impl Context<'_> {
+    /// The samples of block `b`: the executor's interpolation at each control period, the tip
+    /// by forward kinematics, its closest point on the path (warm-started from the block's
+    /// previous two samples) and its distance from the plane.
+    fn block(
+        &self,
+        prepared: &kerf_executor::ValidatedTrajectory,
+        b: usize,
+    ) -> Result<Vec<Sample>, MillPlanError> {
+        let points = self.points;
+        let from = b * BLOCK;
+        let to = ((b + 1) * BLOCK).min(self.steps + 1);
+        let mut out = Vec::with_capacity(to.saturating_sub(from));
+        let mut sample = kerf_executor::JointSample::default();
+        let first_time = (from as f64 * self.period).min(self.t1 - self.t0);
+        let mut cursor = points
+            .partition_point(|p| p.time_from_start <= first_time)
+            .saturating_sub(1)
+            .min(points.len().saturating_sub(2));
+        let mut previous: [Option<f64>; 2] = [None, None];
+        for k in from..to {
+            let t = (self.t0 + k as f64 * self.period).min(self.t1);
+            prepared.sample_into(t, &mut sample);
+            let mut q = [0.0; 6];
+            for (qj, v) in q.iter_mut().zip(&sample.positions) {
+                *qj = *v;
+            }
+            let tip = self.cell.kinematics().tcp_pose(&q)?.translation.vector;
+            let off_plane = (tip - self.origin).dot(&self.normal).abs();
+            let tr = t - self.t0;
+            while cursor + 2 < points.len() && points[cursor + 1].time_from_start <= tr {
+                cursor += 1;
+            }
+            let next = (cursor + 1).min(points.len() - 1);
+            let (a, b) = (&points[cursor], &points[next]);
+            let span = b.time_from_start - a.time_from_start;
+            let w = if span > 0.0 {
+                ((tr - a.time_from_start) / span).clamp(0.0, 1.0)
+            } else {
+                0.0
+            };
+            let linear = self.params[cursor] + w * (self.params[next] - self.params[cursor]);
+            // Warm start: the foot points of the last two samples, extrapolated (consecutive
+            // samples are one control period apart), when they agree with the linear guess.
+            let guess = match (previous[0], previous[1]) {
+                (Some(a), Some(b)) if ((2.0 * b - a) - linear).abs() < 1e-3 => 2.0 * b - a,
+                _ => linear,
+            };
+            let (off_path, u) = distance_to_path(self.cell, &tip, guess)?;
+            previous = [previous[1], Some(u)];
+            out.push(Sample {
+                time: tr,
+                off_path,
+                off_plane,
+            });
+        }
+        Ok(out)
+    }
+}
+
 /// Most closest-point iterations (Gauss–Newton on |P(u) − x|²).
 const CLOSEST_ITERATIONS: usize = 12;
 
@@ -98,13 +181,14 @@ pub fn executed_deviation(
     trajectory: &JointTrajectory,
     period: f64,
 ) -> Result<PathDeviation, MillPlanError> {
-    Ok(measure(cell, trajectory, period, f64::INFINITY, None)?.0)
+    Ok(measure(cell, trajectory, period, f64::INFINITY, None, 1)?.0)
 }
 
 /// [`executed_deviation`] and the times (s from the start) of the samples whose distance
 /// from the path or the plane exceeds `tolerance` \[m\]; `params` are the path's spline
 /// parameters at the trajectory's points when the caller has them (else computed from the
-/// arc lengths).
+/// arc lengths). The samples are measured in blocks of [`BLOCK`] on `threads` threads (the
+/// result is the same for every thread count).
 ///
 /// # Errors
 /// As [`executed_deviation`].
@@ -114,6 +198,7 @@ pub(crate) fn measure(
     period: f64,
     tolerance: f64,
     params: Option<&[f64]>,
+    threads: usize,
 ) -> Result<(PathDeviation, Vec<f64>), MillPlanError> {
     if !(period.is_finite() && period > 0.0) {
         return Err(MillPlanError::InvalidParameter {
@@ -146,50 +231,68 @@ pub(crate) fn measure(
     };
     let (t0, t1) = (prepared.start_time(), prepared.end_time());
     let steps = ((t1 - t0) / period).ceil() as usize;
+    let blocks = (steps + 1).div_ceil(BLOCK);
+    let context = Context {
+        cell,
+        points,
+        params: &params,
+        origin,
+        normal,
+        t0,
+        t1,
+        period,
+        steps,
+    };
+    // Blocks are independent (each starts its warm start afresh), so the result does not
+    // depend on how many threads share them.
+    let workers = threads.clamp(1, blocks.max(1));
+    let results: Vec<Result<Vec<Sample>, MillPlanError>> = if workers == 1 {
+        vec![(0..blocks).try_fold(Vec::new(), |mut all, b| {
+            all.extend(context.block(&prepared, b)?);
+            Ok(all)
+        })]
+    } else {
+        std::thread::scope(|scope| {
+            let handles: Vec<_> = (0..workers)
+                .map(|w| {
+                    let context = &context;
+                    // The executor's trajectory keeps a sampling cursor: one copy per thread.
+                    let prepared = prepared.clone();
+                    scope.spawn(move || {
+                        let (from, to) = (w * blocks / workers, (w + 1) * blocks / workers);
+                        (from..to).try_fold(Vec::new(), |mut all, b| {
+                            all.extend(context.block(&prepared, b)?);
+                            Ok(all)
+                        })
+                    })
+                })
+                .collect();
+            handles
+                .into_iter()
+                .map(|h| {
+                    h.join().unwrap_or_else(|_| {
+                        Err(MillPlanError::NotExecutable {
+                            reason: "a tool-path measurement thread panicked".to_string(),
+                        })
+                    })
+                })
+                .collect()
+        })
+    };
     let mut off_path = Vec::with_capacity(steps + 1);
     let mut max_off_plane: f64 = 0.0;
     let (mut max_off_path, mut time_of_max) = (0.0, 0.0);
-    let mut sample = kerf_executor::JointSample::default();
-    let mut cursor = 0;
     let mut over = Vec::new();
-    let mut previous: [Option<f64>; 2] = [None, None];
-    for k in 0..=steps {
-        let t = (t0 + k as f64 * period).min(t1);
-        prepared.sample_into(t, &mut sample);
-        let mut q = [0.0; 6];
-        for (qj, v) in q.iter_mut().zip(&sample.positions) {
-            *qj = *v;
-        }
-        let tip = cell.kinematics().tcp_pose(&q)?.translation.vector;
-        let off_plane = (tip - origin).dot(&normal).abs();
-        max_off_plane = max_off_plane.max(off_plane);
-        let tr = t - t0;
-        while cursor + 2 < points.len() && points[cursor + 1].time_from_start <= tr {
-            cursor += 1;
-        }
-        let next = (cursor + 1).min(points.len() - 1);
-        let (a, b) = (&points[cursor], &points[next]);
-        let span = b.time_from_start - a.time_from_start;
-        let w = if span > 0.0 {
-            ((tr - a.time_from_start) / span).clamp(0.0, 1.0)
-        } else {
-            0.0
-        };
-        let linear = params[cursor] + w * (params[next] - params[cursor]);
-        // Warm start: the foot points of the last two samples, extrapolated (consecutive
-        // samples are one control period apart), when they agree with the linear guess.
-        let guess = match (previous[0], previous[1]) {
-            (Some(a), Some(b)) if ((2.0 * b - a) - linear).abs() < 1e-3 => 2.0 * b - a,
-            _ => linear,
-        };
-        let (d, u) = distance_to_path(cell, &tip, guess)?;
-        previous = [previous[1], Some(u)];
-        if d > max_off_path {
-            (max_off_path, time_of_max) = (d, tr);
-        }
-        off_path.push(d);
-        if d.max(off_plane) > tolerance {
-            over.push(tr);
+    for result in results {
+        for sample in result? {
+            max_off_plane = max_off_plane.max(sample.off_plane);
+            if sample.off_path > max_off_path {
+                (max_off_path, time_of_max) = (sample.off_path, sample.time);
+            }
+            off_path.push(sample.off_path);
+            if sample.off_path.max(sample.off_plane) > tolerance {
+                over.push(sample.time);
+            }
         }
     }
     let samples = off_path.len();

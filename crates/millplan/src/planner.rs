@@ -563,7 +563,7 @@ impl MillPlanner {
         let step = Instant::now();
         budget.check("the planned trajectory")?;
         let (trajectory, branch_jumps) = planned_trajectory(&cell, &plan)?;
-        let mut settings = self.trajectory_settings;
+        let mut settings = self.trajectory_settings.with_threads(self.eval_threads);
         if let Some(tolerance) = request.path_tolerance() {
             settings.path_tolerance = tolerance;
         }

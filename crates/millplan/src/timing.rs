@@ -118,6 +118,10 @@ pub struct TrajectorySettings {
     /// Most trajectory points (default 6 000; the planner node's answer
     /// limit is 6 990 six-joint points).
     pub max_points: usize,
+    /// Threads of the measurement at every control period (step 7), ≥ 1
+    /// (default 1; the planner uses its evaluation threads). The result is
+    /// the same for every count.
+    pub threads: usize,
 }
 
 impl Default for TrajectorySettings {
@@ -127,6 +131,7 @@ impl Default for TrajectorySettings {
             control_period: 0.004,
             ramp_time: 0.5,
             max_points: 6000,
+            threads: 1,
         }
     }
 }
@@ -147,6 +152,12 @@ impl TrajectorySettings {
     /// With the initial ramp time \[s\].
     pub fn with_ramp_time(mut self, ramp_time: f64) -> Self {
         self.ramp_time = ramp_time;
+        self
+    }
+
+    /// With the threads of the measurement (0 is taken as 1).
+    pub fn with_threads(mut self, threads: usize) -> Self {
+        self.threads = threads.max(1);
         self
     }
 
@@ -441,6 +452,7 @@ pub fn time_scale(
                 settings.control_period,
                 settings.path_tolerance,
                 Some(&params),
+                settings.threads,
             )?;
             if over.is_empty() {
                 scaling.deviation = deviation;

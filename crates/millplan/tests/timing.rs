@@ -166,6 +166,22 @@ fn a_zigzag_of_g_is_slowed_to_the_joint_limits_and_stays_on_the_path() {
 }
 
 #[test]
+fn the_measurement_is_the_same_on_any_number_of_threads() {
+    let cell = MillCell::default_cell().unwrap();
+    let p = plan(&cell, |_| 0.05, |i| -0.4 + 0.1 * ((i % 4) as f64 - 1.5));
+    let one = scale(&cell, &p, &TrajectorySettings::default());
+    for threads in [2, 3] {
+        let many = scale(
+            &cell,
+            &p,
+            &TrajectorySettings::default().with_threads(threads),
+        );
+        assert_eq!(one, many, "{threads} threads");
+    }
+    assert!(one.deviation.samples > 1000);
+}
+
+#[test]
 fn a_tighter_tolerance_needs_more_samples() {
     let cell = MillCell::default_cell().unwrap();
     let p = plan(&cell, |_| 0.06, |i| if i % 2 == 0 { -0.3 } else { -0.5 });
