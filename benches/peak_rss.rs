@@ -9,7 +9,7 @@
 //!   line format, sampled every 8 ms: under the answer limit), parsed and planned;
 //! * `cut-samples`: case 1 sampled so that its answer has 6 900 points (the most an answer
 //!   carries is 6 990), planned;
-//! * `mill-segments`: the default path in 4 413 segments, the most whose answer fits in
+//! * `mill-segments`: the default path in 2 706 segments, the most whose answer fits in
 //!   4 MiB (4 415 trajectory points and the segment table), ddpg.
 //!
 //! Run: `cargo bench --bench peak_rss`.
@@ -120,7 +120,7 @@ fn run_case(case: &str) {
                     &format!("sample_period: {}", 2.529 / 6899.0),
                 )
         }
-        _ => "request_id: mill-segments\nplanner: ddpg\nsegments: 4413\n\
+        _ => "request_id: mill-segments\nplanner: ddpg\nsegments: 2706\n\
               points: [[1.4, -0.3, 1.7], [1.6, -0.1, 1.7], [1.8, 0.1, 1.7], [2.1, 0.3, 1.7]]\n"
             .to_string(),
     };

@@ -258,7 +258,10 @@ impl PlanningService for MillService {
             .segments
             .unwrap_or_else(|| self.planner.cell().path().segments().len());
         Some(AnswerSize {
-            points: segments.checked_add(2)?,
+            // The executed trajectory has at least every segment's ends and midpoint (more
+            // where the path tolerance needs them: the answer's own size is checked again
+            // before it is published).
+            points: segments.checked_mul(2)?.checked_add(1)?,
             joints: self.limits.len(),
             extra_text_bytes: segments.checked_mul(SEGMENT_TEXT_BYTES)?,
         })
