@@ -10,7 +10,7 @@
 //! * `cut-samples`: case 1 sampled so that its answer has 6 900 points (the most an answer
 //!   carries is 6 990), planned;
 //! * `mill-segments`: the default path in 2 706 segments, the most whose answer fits in
-//!   4 MiB (4 415 trajectory points and the segment table), ddpg.
+//!   4 MiB (at least 5 413 trajectory points and the segment table), ddpg.
 //!
 //! Run: `cargo bench --bench peak_rss`.
 #![allow(clippy::unwrap_used, clippy::expect_used)] // a bench binary reports failures by panicking
