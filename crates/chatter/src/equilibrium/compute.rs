@@ -5,7 +5,7 @@ use std::f64::consts::PI;
 use nalgebra::{Matrix2, Matrix4, Vector2, Vector4};
 
 use super::engagement::engagement_breakpoints;
-use super::geometry::{Ctx, Traj};
+use super::geometry::{Ctx, Traj, TrajBounds};
 use super::tracks::{build_tracks, chip_at};
 use super::{engaged, Equilibrium, EquilibriumSettings};
 use crate::error::{check_non_negative, ChatterError};
@@ -133,6 +133,7 @@ impl Equilibrium {
                 acc_start: &acc_start,
                 acc_end: &acc_end,
                 period,
+                bounds: TrajBounds::of(&times, &pos, &vel),
             };
             tracks = build_tracks(&ctx, &traj, &times, &engaged_steps)?;
             // Forces at step start, midpoint, end.
@@ -208,6 +209,7 @@ impl Equilibrium {
             vel = new_vel;
             residual = if scale > 0.0 { diff / scale } else { 0.0 };
             if residual <= settings.tolerance {
+                let bounds = TrajBounds::of(&times, &pos, &vel);
                 let traj = Traj {
                     times: &times,
                     pos: &pos,
@@ -215,6 +217,7 @@ impl Equilibrium {
                     acc_start: &acc_start,
                     acc_end: &acc_end,
                     period,
+                    bounds,
                 };
                 tracks = build_tracks(&ctx, &traj, &times, &engaged_steps)?;
                 return Ok(Self {
@@ -229,6 +232,7 @@ impl Equilibrium {
                     vel,
                     acc_start,
                     acc_end,
+                    bounds,
                     tracks,
                     iterations: iteration,
                     residual,
@@ -251,6 +255,7 @@ impl Equilibrium {
             acc_start: &self.acc_start,
             acc_end: &self.acc_end,
             period: self.period,
+            bounds: self.bounds,
         }
     }
 

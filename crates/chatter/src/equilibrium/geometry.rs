@@ -18,6 +18,54 @@ pub(super) struct Traj<'a> {
     pub(super) acc_start: &'a [Vector2<f64>],
     pub(super) acc_end: &'a [Vector2<f64>],
     pub(super) period: f64,
+    /// Bounds of the interpolated position (for the chip lower bound of
+    /// [`super::tracks`]).
+    pub(super) bounds: TrajBounds,
+}
+
+/// Bounds of the interpolated position õ(t) of a [`Traj`]: a Lipschitz
+/// constant L and the jump J at the period's wrap, so that for any two
+/// times `|õ(a) − õ(b)| ≤ L · d(a, b) + J` with d the distance of a and b
+/// on the circle of circumference T.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(super) struct TrajBounds {
+    /// L [m/s], a bound of `|dõ/dt|` of the cubic Hermite interpolant. On a
+    /// step, `dõ/dt = (p₁ − p₀)/h · 6s(1 − s) + v₀ (3s² − 4s + 1) +
+    /// v₁ (3s² − 2s)`, whose three factors are at most 1.5, 1 and 1 in
+    /// modulus on [0, 1], so `L = 1.5 max |p₁ − p₀|/h + 2 max |v|`; NaN if
+    /// a node is not finite (then nothing is bounded).
+    pub(super) lipschitz: f64,
+    /// J [m]: `|õ(T⁻) − õ(0)|` (the periodic response closes up to rounding).
+    pub(super) wrap_jump: f64,
+}
+
+impl TrajBounds {
+    /// The bounds of the Hermite interpolant through the nodes.
+    pub(super) fn of(times: &[f64], pos: &[Vector2<f64>], vel: &[Vector2<f64>]) -> Self {
+        let (mut slope2, mut speed2, mut finite) = (0.0_f64, 0.0_f64, true);
+        for (k, w) in times.windows(2).enumerate() {
+            let d = (pos[k + 1] - pos[k]).norm_squared() / ((w[1] - w[0]) * (w[1] - w[0]));
+            finite &= d.is_finite();
+            slope2 = slope2.max(d);
+        }
+        for v in vel {
+            let v2 = v.norm_squared();
+            finite &= v2.is_finite();
+            speed2 = speed2.max(v2);
+        }
+        let wrap_jump = match (pos.first(), pos.last()) {
+            (Some(a), Some(b)) => (b - a).norm(),
+            _ => 0.0,
+        };
+        Self {
+            lipschitz: if finite {
+                1.5 * slope2.sqrt() + 2.0 * speed2.sqrt()
+            } else {
+                f64::NAN
+            },
+            wrap_jump,
+        }
+    }
 }
 
 impl Traj<'_> {
