@@ -137,6 +137,8 @@ struct DelayTrack {
     first: usize,
     tau: Vec<f64>,
     taudot: Vec<f64>,
+    /// Eq. 3-4 geometry at each node with its delay.
+    geometry: Vec<Geometry>,
 }
 
 /// The T-periodic equilibrium õ(t) (seed 004 eq. 1 with eq. 3-4) and the

@@ -41,7 +41,14 @@ pub(super) struct TrajBounds {
 
 impl TrajBounds {
     /// The bounds of the Hermite interpolant through the nodes.
-    pub(super) fn of(times: &[f64], pos: &[Vector2<f64>], vel: &[Vector2<f64>]) -> Self {
+    pub(super) fn of(traj_nodes: TrajNodes) -> Self {
+        let TrajNodes {
+            times,
+            pos,
+            vel,
+            acc_start,
+            acc_end,
+        } = traj_nodes;
         let (mut slope2, mut speed2, mut finite) = (0.0_f64, 0.0_f64, true);
         for (k, w) in times.windows(2).enumerate() {
             let d = (pos[k + 1] - pos[k]).norm_squared() / ((w[1] - w[0]) * (w[1] - w[0]));
@@ -53,6 +60,10 @@ impl TrajBounds {
             finite &= v2.is_finite();
             speed2 = speed2.max(v2);
         }
+        finite &= acc_start
+            .iter()
+            .chain(acc_end)
+            .all(|a| a.x.is_finite() && a.y.is_finite());
         let wrap_jump = match (pos.first(), pos.last()) {
             (Some(a), Some(b)) => (b - a).norm(),
             _ => 0.0,
@@ -66,6 +77,15 @@ impl TrajBounds {
             wrap_jump,
         }
     }
+}
+
+/// The node data of a [`Traj`] (for [`TrajBounds::of`]).
+pub(super) struct TrajNodes<'a> {
+    pub(super) times: &'a [f64],
+    pub(super) pos: &'a [Vector2<f64>],
+    pub(super) vel: &'a [Vector2<f64>],
+    pub(super) acc_start: &'a [Vector2<f64>],
+    pub(super) acc_end: &'a [Vector2<f64>],
 }
 
 impl Traj<'_> {
@@ -100,6 +120,30 @@ impl Traj<'_> {
             self.acc_end[k],
         );
         (p, v)
+    }
+
+    /// [`Traj::state`] at node k, t = `times[k]`, without the
+    /// interpolation: there `s = 0`, the Hermite weights are exactly
+    /// (1, 0, 0, 0) and the interpolant is the node value plus zeros, i.e.
+    /// the node value itself when it is finite and nonzero (all nodes
+    /// finite: [`TrajBounds::lipschitz`] not NaN). Otherwise, and at t = T
+    /// (which wraps to node 0), it interpolates: bit-identical either way.
+    pub(super) fn node_state(&self, k: usize) -> (Vector2<f64>, Vector2<f64>) {
+        let t = self.times[k];
+        let (p, v) = (self.pos[k], self.vel[k]);
+        let plain = t >= 0.0
+            && t < self.period
+            && k + 1 < self.times.len()
+            && !self.bounds.lipschitz.is_nan()
+            && p.x != 0.0
+            && p.y != 0.0
+            && v.x != 0.0
+            && v.y != 0.0;
+        if plain {
+            (p, v)
+        } else {
+            self.state(t)
+        }
     }
 }
 
