@@ -137,6 +137,8 @@ struct DelayTrack {
     first: usize,
     tau: Vec<f64>,
     taudot: Vec<f64>,
+    /// Eq. 3-4 geometry at each node with its delay.
+    geometry: Vec<Geometry>,
 }
 
 /// The T-periodic equilibrium õ(t) (seed 004 eq. 1 with eq. 3-4) and the
@@ -157,6 +159,8 @@ pub struct Equilibrium {
     /// Acceleration at the start / end of each step (one-sided at jumps).
     acc_start: Vec<Vector2<f64>>,
     acc_end: Vec<Vector2<f64>>,
+    /// Bounds of the interpolated position (order skipping in `chip_at`).
+    bounds: geometry::TrajBounds,
     tracks: Vec<DelayTrack>,
     iterations: usize,
     residual: f64,
@@ -288,7 +292,11 @@ impl Equilibrium {
     }
 
     /// The cut of tooth j at time t (module documentation): order-1 delay
-    /// from the RK4 track, higher orders by Newton, chip = minimum.
+    /// from the RK4 track, higher orders by Newton, chip = minimum. An order
+    /// whose chip provably exceeds the smallest found so far (a lower bound
+    /// from eq. 3-4 and the trajectory's Lipschitz bound, `tracks.rs`) is
+    /// not solved: the result is the same, bit for bit; only a Newton
+    /// failure of such an order is no longer reported.
     /// Outside the nominal engagement `in_contact` is false. At zero feed
     /// the chip is identically zero; the state is then the limit f → 0⁺
     /// (in contact over the whole engagement).

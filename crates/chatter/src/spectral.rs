@@ -250,14 +250,20 @@ where
                 // Invariant subspace: the Ritz values are exact eigenvalues.
                 return Ok(rho);
             }
+            let stable = (rho - previous_rho).abs() <= 1e-6 * rho;
+            previous_rho = rho;
+            if !stable && k < kmax {
+                // Not accepted whatever the residual, and no restart: the
+                // Ritz vector is not needed (a restart cycle always ends
+                // with a check at k = kmax, which computes it).
+                continue;
+            }
             let y = hessenberg_eigenvector(&hk, theta)?;
             let ynorm = y.iter().map(|z| z.norm_sqr()).sum::<f64>().sqrt();
             let last = y.last().map(|z| z.norm()).unwrap_or(f64::NAN);
             let residual = beta * last / ynorm;
             last_residual = residual / rho.max(f64::MIN_POSITIVE);
             let scale = rho.max(1e-12 * hk.norm());
-            let stable = (rho - previous_rho).abs() <= 1e-6 * rho;
-            previous_rho = rho;
             if residual <= opts.tolerance * scale && stable {
                 return Ok(rho);
             }

@@ -11,7 +11,8 @@
 //!   averages + `Discretization::new`) and the evaluation given it;
 //! * state-dependent at 3000 rpm, 0.04 m/s: the whole evaluation
 //!   (equilibrium + linearization + discretization + spectral radius), and
-//!   its two halves;
+//!   its two halves, and each of its five stages given the previous one's
+//!   result (group `cell indicator stage`: where the time goes);
 //! * lobe diagrams of 100 speeds (2000-4000 rpm) × scan + bisection on depth
 //!   (0-20 mm, 20 intervals, 1 µm): constant delay, and state-dependent at
 //!   0.04 m/s (`kerf_chatter::lobes::state_dependent_critical_depth`).
@@ -21,9 +22,9 @@ use std::hint::black_box;
 
 use criterion::{criterion_group, criterion_main, Criterion};
 use kerf_chatter::{
-    chatter_indicator, constant_delay_dde, indicator::indicator_dde,
+    chatter_indicator, constant_delay_dde, indicator::indicator_dde, linearize,
     lobes::state_dependent_critical_depth, stability_lobes, DelayModel, Discretization,
-    LobeOptions,
+    Equilibrium, LinearizeSettings, LobeOptions,
 };
 use kerf_mill::{condition_number, MillCell};
 
@@ -115,6 +116,44 @@ fn bench_cell_indicator(c: &mut Criterion) {
             })
         },
     );
+    // Where the time of one whole evaluation goes, stage by stage (each
+    // given the previous stage's result).
+    let mut stages = c.benchmark_group("cell indicator stage");
+    stages.bench_function("1 equilibrium (Equilibrium::compute)", |b| {
+        b.iter(|| {
+            Equilibrium::compute(
+                &modal,
+                &process,
+                black_box(rpm),
+                feed,
+                &settings.equilibrium,
+            )
+            .expect("equilibrium")
+        })
+    });
+    let eq = Equilibrium::compute(&modal, &process, rpm, feed, &settings.equilibrium)
+        .expect("equilibrium");
+    let lin = LinearizeSettings {
+        steps: m,
+        wall_term: settings.wall_term,
+    };
+    stages.bench_function("2 linearization (linearize)", |b| {
+        b.iter(|| linearize(black_box(&eq), &lin).expect("dde"))
+    });
+    stages.bench_function("3 equilibrium diagnostics", |b| {
+        b.iter(|| black_box(&eq).diagnostics().expect("diagnostics"))
+    });
+    let max_delay = sd_dde.max_delay().max(sd_dde.period);
+    stages.bench_function("4 Discretization::new", |b| {
+        b.iter(|| {
+            Discretization::new(&modal, black_box(sd_dde.period), m, max_delay).expect("disc")
+        })
+    });
+    let disc = Discretization::new(&modal, sd_dde.period, m, max_delay).expect("disc");
+    stages.bench_function("5 compile + Arnoldi (spectral_radius)", |b| {
+        b.iter(|| disc.spectral_radius(black_box(&sd_dde)).expect("rho"))
+    });
+    stages.finish();
     let rpms: Vec<f64> = (0..100)
         .map(|i| 2000.0 + 2000.0 * i as f64 / 99.0)
         .collect();

@@ -5,8 +5,8 @@ use std::f64::consts::PI;
 use nalgebra::{Matrix2, Matrix4, Vector2, Vector4};
 
 use super::engagement::engagement_breakpoints;
-use super::geometry::{Ctx, Traj};
-use super::tracks::{build_tracks, chip_at};
+use super::geometry::{Ctx, Traj, TrajBounds, TrajNodes};
+use super::tracks::{build_tracks, chip_with, AngleTable, Point};
 use super::{engaged, Equilibrium, EquilibriumSettings};
 use crate::error::{check_non_negative, ChatterError};
 use crate::model::{force_direction, MillingProcess, Modal2};
@@ -30,6 +30,22 @@ pub(super) fn system_matrix(minv: &Matrix2<f64>, modal: &Modal2) -> Matrix4<f64>
 pub(super) fn lift(minv: &Matrix2<f64>, f: &Vector2<f64>) -> Vector4<f64> {
     let a = minv * f;
     Vector4::new(0.0, 0.0, a.x, a.y)
+}
+
+/// One RK4 stage derivative `a w + g` for the [`system_matrix`]
+/// `a = [0, I; X, Y]` and a [`lift`]ed force `g = (0, 0, g₂, g₃)`, with
+/// nalgebra's floating-point operations on the nonzero entries: rows 2 and 3
+/// as `(((a_i0 w₀ + a_i1 w₁) + a_i2 w₂) + a_i3 w₃) + g_i` (its gemv goes
+/// column by column), rows 0 and 1 as `w₂ + g₀`, `w₃ + g₁`. nalgebra's
+/// `a * w + g` also adds the products with the zero entries, which can
+/// change only the sign of a zero (or give NaN for a non-finite w, where
+/// the iteration fails either way), and adding `g₀ = g₁ = +0` then gives
+/// the same bits: the result is bit-identical (tested), at half the
+/// multiplications.
+fn stage(a: &Matrix4<f64>, w: &Vector4<f64>, g: &Vector4<f64>) -> Vector4<f64> {
+    let row =
+        |i: usize| a[(i, 0)] * w[0] + a[(i, 1)] * w[1] + a[(i, 2)] * w[2] + a[(i, 3)] * w[3] + g[i];
+    Vector4::new(w[2] + g[0], w[3] + g[1], row(2), row(3))
 }
 
 impl Equilibrium {
@@ -106,15 +122,29 @@ impl Equilibrium {
             })
             .collect();
 
+        let angles = AngleTable::new(&ctx, &times, &engaged_steps);
+
         let minv = modal.mass_inverse()?;
         let a = system_matrix(&minv, modal);
-        // Monodromy of the RK4 map of the homogeneous system.
+        // Monodromy of the RK4 map of the homogeneous system. The step
+        // matrix depends on the step length only, and the grid has few
+        // distinct lengths (uniform pieces between breakpoints, up to
+        // rounding): each distinct value (bit for bit) is computed once.
         let mut phi_t = Matrix4::<f64>::identity();
+        let mut step_matrices: Vec<(u64, Matrix4<f64>)> = Vec::new();
         for k in 0..nsteps {
             let h = times[k + 1] - times[k];
-            let ah = a * h;
-            let ah2 = ah * ah;
-            let p = Matrix4::identity() + ah + ah2 * 0.5 + ah2 * ah / 6.0 + ah2 * ah2 / 24.0;
+            let p = match step_matrices.iter().find(|(bits, _)| *bits == h.to_bits()) {
+                Some((_, p)) => *p,
+                None => {
+                    let ah = a * h;
+                    let ah2 = ah * ah;
+                    let p =
+                        Matrix4::identity() + ah + ah2 * 0.5 + ah2 * ah / 6.0 + ah2 * ah2 / 24.0;
+                    step_matrices.push((h.to_bits(), p));
+                    p
+                }
+            };
             phi_t = p * phi_t;
         }
         let lu = (Matrix4::identity() - phi_t).lu();
@@ -133,46 +163,63 @@ impl Equilibrium {
                 acc_start: &acc_start,
                 acc_end: &acc_end,
                 period,
+                bounds: TrajBounds::of(TrajNodes {
+                    times: &times,
+                    pos: &pos,
+                    vel: &vel,
+                    acc_start: &acc_start,
+                    acc_end: &acc_end,
+                }),
             };
-            tracks = build_tracks(&ctx, &traj, &times, &engaged_steps)?;
+            tracks = build_tracks(&ctx, &traj, &times, &engaged_steps, &angles)?;
             // Forces at step start, midpoint, end.
             // Force of the teeth engaged on the step (the step's engaged set
             // decides, so a jump sitting on a node gets its one-sided value);
             // the end force of a step is the start force of the next unless
             // the engaged set changes there.
-            let force_at = |teeth: &[usize], t: f64| -> Result<Vector2<f64>, ChatterError> {
+            let force_at = |k: usize, point: Point| -> Result<Vector2<f64>, ChatterError> {
                 let mut f = zero;
-                for &j in teeth {
-                    let cs = chip_at(&ctx, &traj, &tracks, settings, &times, j, t)?;
+                let t = point.time(&times, k);
+                for &j in &engaged_steps[k] {
+                    let here = angles
+                        .here(&traj, k, j, point)
+                        .unwrap_or_else(|| ctx.here(&traj, j, t));
+                    let cs = chip_with(&ctx, &traj, &tracks, settings, &times, j, t, &here)?;
                     if cs.chip > 0.0 {
-                        f += force_direction(cs.phi, process.kt, process.kn)
-                            * (process.axial_depth * settings.force_law.value(cs.chip));
+                        let b = angles
+                            .force_direction(k, j, point)
+                            .unwrap_or_else(|| force_direction(cs.phi, process.kt, process.kn));
+                        f += b * (process.axial_depth * settings.force_law.value(cs.chip));
                     }
                 }
                 Ok(f)
             };
             let mut forces: Vec<[Vector2<f64>; 3]> = Vec::with_capacity(nsteps);
             for (k, teeth) in engaged_steps.iter().enumerate() {
-                let tm = 0.5 * (times[k] + times[k + 1]);
                 let fa = match (k.checked_sub(1), forces.last()) {
                     (Some(prev), Some(last)) if engaged_steps[prev] == *teeth => last[2],
-                    _ => force_at(teeth, times[k])?,
+                    _ => force_at(k, Point::Start)?,
                 };
-                forces.push([fa, force_at(teeth, tm)?, force_at(teeth, times[k + 1])?]);
+                forces.push([fa, force_at(k, Point::ForceMid)?, force_at(k, Point::End)?]);
             }
             // Shooting: particular solution from z = 0, then periodicity.
-            let step = |z: Vector4<f64>, k: usize, f: &[Vector2<f64>; 3]| {
+            // The lifted forces M⁻¹F of each step serve both passes.
+            let lifted: Vec<[Vector4<f64>; 3]> = forces
+                .iter()
+                .map(|f| [lift(&minv, &f[0]), lift(&minv, &f[1]), lift(&minv, &f[2])])
+                .collect();
+            let step = |z: Vector4<f64>, k: usize| {
                 let h = times[k + 1] - times[k];
-                let (ga, gm, gb) = (lift(&minv, &f[0]), lift(&minv, &f[1]), lift(&minv, &f[2]));
-                let k1 = a * z + ga;
-                let k2 = a * (z + k1 * (0.5 * h)) + gm;
-                let k3 = a * (z + k2 * (0.5 * h)) + gm;
-                let k4 = a * (z + k3 * h) + gb;
+                let [ga, gm, gb] = lifted[k];
+                let k1 = stage(&a, &z, &ga);
+                let k2 = stage(&a, &(z + k1 * (0.5 * h)), &gm);
+                let k3 = stage(&a, &(z + k2 * (0.5 * h)), &gm);
+                let k4 = stage(&a, &(z + k3 * h), &gb);
                 z + (k1 + k2 * 2.0 + k3 * 2.0 + k4) * (h / 6.0)
             };
             let mut z = Vector4::zeros();
-            for (k, f) in forces.iter().enumerate() {
-                z = step(z, k, f);
+            for k in 0..forces.len() {
+                z = step(z, k);
             }
             let mut z = lu.solve(&z).ok_or_else(|| ChatterError::Unsupported {
                 reason: "I - monodromy of the tool dynamics is singular (undamped resonance at a tooth-frequency harmonic)".to_string(),
@@ -188,7 +235,7 @@ impl Equilibrium {
                 new_pos.push(Vector2::new(z[0], z[1]));
                 new_vel.push(Vector2::new(z[2], z[3]));
                 acc_start[k] = accel(&z, &f[0]);
-                z = step(z, k, f);
+                z = step(z, k);
                 acc_end[k] = accel(&z, &f[2]);
             }
             new_pos.push(Vector2::new(z[0], z[1]));
@@ -208,6 +255,13 @@ impl Equilibrium {
             vel = new_vel;
             residual = if scale > 0.0 { diff / scale } else { 0.0 };
             if residual <= settings.tolerance {
+                let bounds = TrajBounds::of(TrajNodes {
+                    times: &times,
+                    pos: &pos,
+                    vel: &vel,
+                    acc_start: &acc_start,
+                    acc_end: &acc_end,
+                });
                 let traj = Traj {
                     times: &times,
                     pos: &pos,
@@ -215,8 +269,9 @@ impl Equilibrium {
                     acc_start: &acc_start,
                     acc_end: &acc_end,
                     period,
+                    bounds,
                 };
-                tracks = build_tracks(&ctx, &traj, &times, &engaged_steps)?;
+                tracks = build_tracks(&ctx, &traj, &times, &engaged_steps, &angles)?;
                 return Ok(Self {
                     process: *process,
                     feed,
@@ -229,6 +284,7 @@ impl Equilibrium {
                     vel,
                     acc_start,
                     acc_end,
+                    bounds,
                     tracks,
                     iterations: iteration,
                     residual,
@@ -251,6 +307,7 @@ impl Equilibrium {
             acc_start: &self.acc_start,
             acc_end: &self.acc_end,
             period: self.period,
+            bounds: self.bounds,
         }
     }
 
@@ -260,6 +317,50 @@ impl Equilibrium {
             feed: self.feed,
             omega: self.omega,
             period: self.period,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// [`stage`] gives the bits of nalgebra's `a * w + g`, zeros of either
+    /// sign included.
+    #[test]
+    fn stage_is_bit_identical_to_the_dense_product() {
+        let modal = Modal2 {
+            mass: Matrix2::new(31.0, 2.5, 2.5, 17.0),
+            damping: Matrix2::new(850.0, -120.0, -120.0, 400.0),
+            stiffness: Matrix2::new(1.68e6, -5.3e5, -5.3e5, 8.4e5),
+        };
+        let minv = modal.mass_inverse().unwrap();
+        let a = system_matrix(&minv, &modal);
+        let mut x: u64 = 0x2545_f491_4f6c_dd1d;
+        let mut next = || {
+            x ^= x << 13;
+            x ^= x >> 7;
+            x ^= x << 17;
+            match x % 7 {
+                0 => 0.0,
+                1 => -0.0,
+                _ => {
+                    ((x >> 11) as f64 / (1u64 << 53) as f64 - 0.5) * 10f64.powi((x % 9) as i32 - 6)
+                }
+            }
+        };
+        for _ in 0..20_000 {
+            let w = Vector4::new(next(), next(), next(), next());
+            let g = lift(&minv, &Vector2::new(next(), next()));
+            let dense = a * w + g;
+            let fast = stage(&a, &w, &g);
+            for i in 0..4 {
+                assert_eq!(
+                    dense[i].to_bits(),
+                    fast[i].to_bits(),
+                    "w {w:?} g {g:?} row {i}"
+                );
+            }
         }
     }
 }

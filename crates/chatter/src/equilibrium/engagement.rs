@@ -41,6 +41,6 @@ pub(super) fn engagement_breakpoints(
 
 /// Whether angle φ (any real) lies in the engagement [φ_en, φ_ex] (mod 2π).
 pub(crate) fn engaged(process: &MillingProcess, phi: f64) -> bool {
-    let p = phi.rem_euclid(2.0 * PI);
+    let p = super::interp::wrap(phi, 2.0 * PI);
     p >= process.entry_angle && p <= process.exit_angle
 }

@@ -18,6 +18,74 @@ pub(super) struct Traj<'a> {
     pub(super) acc_start: &'a [Vector2<f64>],
     pub(super) acc_end: &'a [Vector2<f64>],
     pub(super) period: f64,
+    /// Bounds of the interpolated position (for the chip lower bound of
+    /// [`super::tracks`]).
+    pub(super) bounds: TrajBounds,
+}
+
+/// Bounds of the interpolated position õ(t) of a [`Traj`]: a Lipschitz
+/// constant L and the jump J at the period's wrap, so that for any two
+/// times `|õ(a) − õ(b)| ≤ L · d(a, b) + J` with d the distance of a and b
+/// on the circle of circumference T.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(super) struct TrajBounds {
+    /// L [m/s], a bound of `|dõ/dt|` of the cubic Hermite interpolant. On a
+    /// step, `dõ/dt = (p₁ − p₀)/h · 6s(1 − s) + v₀ (3s² − 4s + 1) +
+    /// v₁ (3s² − 2s)`, whose three factors are at most 1.5, 1 and 1 in
+    /// modulus on [0, 1], so `L = 1.5 max |p₁ − p₀|/h + 2 max |v|`; NaN if
+    /// a node is not finite (then nothing is bounded).
+    pub(super) lipschitz: f64,
+    /// J [m]: `|õ(T⁻) − õ(0)|` (the periodic response closes up to rounding).
+    pub(super) wrap_jump: f64,
+}
+
+impl TrajBounds {
+    /// The bounds of the Hermite interpolant through the nodes.
+    pub(super) fn of(traj_nodes: TrajNodes) -> Self {
+        let TrajNodes {
+            times,
+            pos,
+            vel,
+            acc_start,
+            acc_end,
+        } = traj_nodes;
+        let (mut slope2, mut speed2, mut finite) = (0.0_f64, 0.0_f64, true);
+        for (k, w) in times.windows(2).enumerate() {
+            let d = (pos[k + 1] - pos[k]).norm_squared() / ((w[1] - w[0]) * (w[1] - w[0]));
+            finite &= d.is_finite();
+            slope2 = slope2.max(d);
+        }
+        for v in vel {
+            let v2 = v.norm_squared();
+            finite &= v2.is_finite();
+            speed2 = speed2.max(v2);
+        }
+        finite &= acc_start
+            .iter()
+            .chain(acc_end)
+            .all(|a| a.x.is_finite() && a.y.is_finite());
+        let wrap_jump = match (pos.first(), pos.last()) {
+            (Some(a), Some(b)) => (b - a).norm(),
+            _ => 0.0,
+        };
+        Self {
+            lipschitz: if finite {
+                1.5 * slope2.sqrt() + 2.0 * speed2.sqrt()
+            } else {
+                f64::NAN
+            },
+            wrap_jump,
+        }
+    }
+}
+
+/// The node data of a [`Traj`] (for [`TrajBounds::of`]).
+pub(super) struct TrajNodes<'a> {
+    pub(super) times: &'a [f64],
+    pub(super) pos: &'a [Vector2<f64>],
+    pub(super) vel: &'a [Vector2<f64>],
+    pub(super) acc_start: &'a [Vector2<f64>],
+    pub(super) acc_end: &'a [Vector2<f64>],
 }
 
 impl Traj<'_> {
@@ -52,6 +120,30 @@ impl Traj<'_> {
             self.acc_end[k],
         );
         (p, v)
+    }
+
+    /// [`Traj::state`] at node k, t = `times[k]`, without the
+    /// interpolation: there `s = 0`, the Hermite weights are exactly
+    /// (1, 0, 0, 0) and the interpolant is the node value plus zeros, i.e.
+    /// the node value itself when it is finite and nonzero (all nodes
+    /// finite: [`TrajBounds::lipschitz`] not NaN). Otherwise, and at t = T
+    /// (which wraps to node 0), it interpolates: bit-identical either way.
+    pub(super) fn node_state(&self, k: usize) -> (Vector2<f64>, Vector2<f64>) {
+        let t = self.times[k];
+        let (p, v) = (self.pos[k], self.vel[k]);
+        let plain = t >= 0.0
+            && t < self.period
+            && k + 1 < self.times.len()
+            && !self.bounds.lipschitz.is_nan()
+            && p.x != 0.0
+            && p.y != 0.0
+            && v.x != 0.0
+            && v.y != 0.0;
+        if plain {
+            (p, v)
+        } else {
+            self.state(t)
+        }
     }
 }
 

@@ -3,6 +3,16 @@
 
 use nalgebra::Vector2;
 
+/// `x.rem_euclid(y)` (y > 0) without the software `fmod` when x already
+/// lies in [0, y), where `x % y` is x exactly: bit-identical.
+pub(crate) fn wrap(x: f64, y: f64) -> f64 {
+    if x >= 0.0 && x < y {
+        x
+    } else {
+        x.rem_euclid(y)
+    }
+}
+
 /// Step of node `k` of a trajectory and the local parameter, for `t` in [0, T).
 pub(super) fn locate(times: &[f64], t: f64) -> usize {
     let n = times.len().saturating_sub(1).max(1);
