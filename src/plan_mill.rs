@@ -161,7 +161,10 @@ fn request_for(a: &MillArgs, request: &MillRequest, kind: PlannerKind) -> MillRe
         } else {
             None
         }),
-        PlannerKind::Dp | PlannerKind::Naive => None,
+        PlannerKind::Dp
+        | PlannerKind::Naive
+        | PlannerKind::Greedy
+        | PlannerKind::GreedyBestG => None,
     };
     r
 }

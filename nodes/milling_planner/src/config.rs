@@ -208,7 +208,10 @@ impl NodeConfig {
         match kind {
             PlannerKind::Ddpg => Some(&self.ddpg_policy_file),
             PlannerKind::FixedG => Some(&self.fixed_g_policy_file),
-            PlannerKind::Dp | PlannerKind::Naive => None,
+            PlannerKind::Dp
+            | PlannerKind::Naive
+            | PlannerKind::Greedy
+            | PlannerKind::GreedyBestG => None,
         }
     }
 }
