@@ -65,9 +65,9 @@ use crate::request::RequestProcess;
 pub const PATH_CACHE_MEMO: usize = 8;
 /// Largest spacing of the segment nodes, in segments.
 pub const SEGMENT_STRIDE: usize = 10;
-/// Largest spacing of the segment nodes along the path \[m\] (10 default
-/// segments of 7.8 mm).
-pub const SEGMENT_SPACING_M: f64 = 0.08;
+/// Largest spacing of the segment nodes along the path \[m\] (the default
+/// path: 0.93 m in 100 segments of 9.3 mm, so every 10th segment).
+pub const SEGMENT_SPACING_M: f64 = 0.1;
 /// Largest spacing of the spindle-speed nodes \[rpm\].
 pub const RPM_SPACING: f64 = 200.0;
 /// The feed nodes as fractions of [f_lo, f_max] (module documentation).
