@@ -7,6 +7,7 @@
 //! cargo bench -p kerf_millplan --bench baselines                 # the default request
 //! cargo bench -p kerf_millplan --bench baselines -- --shifted    # the shifted, turned path
 //! cargo bench -p kerf_millplan --bench baselines -- --planners greedy,greedy_best_g
+//! cargo bench -p kerf_millplan --bench baselines -- --planners greedy --candidates  # every fixed g
 //! ```
 //!
 //! The shifted path is the default path turned by 0.3 rad about the vertical through its
@@ -143,6 +144,9 @@ fn main() {
             Err(e) => println!("| {} | failed: {e} | | | | | | {:.1} |", r.name, r.seconds),
         }
     }
+    if args.iter().any(|a| a == "--candidates") {
+        candidates(&planner, &base);
+    }
     // The paper's claim, as executed: optimized g at least 5 % faster than g = 0, chatter-free.
     let time = |name: &str| {
         rows.iter()
@@ -163,4 +167,41 @@ fn main() {
             );
         }
     }
+}
+
+/// Every fixed g* of `greedy_best_g` on the request: the greedy ramp's plan, timed as planned
+/// and as executed (the duration of its trajectory, which ranks them).
+fn candidates(planner: &MillPlanner, request: &MillRequest) {
+    use kerf_budget::Budget;
+    use kerf_millplan::greedy::fixed_g_candidates_within;
+    let cell = planner
+        .cell()
+        .with_path(&request.path_spec(planner.cell().path().segments().len()))
+        .unwrap();
+    let all = fixed_g_candidates_within(
+        &cell,
+        request.initial_state(),
+        kerf_millplan::plan::default_eval_threads(),
+        planner.trajectory_settings(),
+        &Budget::unlimited(),
+    )
+    .unwrap();
+    println!();
+    println!("| g* (rad) | chatter-free as planned | max \\|μ\\|max | time as planned (s) | trajectory duration (s) |");
+    println!("|---:|---|---:|---:|---:|");
+    let mut sorted: Vec<_> = all.iter().collect();
+    sorted.sort_by(|a, b| a.g.total_cmp(&b.g));
+    for r in sorted {
+        println!(
+            "| {:+.1} | {} | {:.4} | {:.3} | {} |",
+            r.g,
+            if r.chatter_free { "yes" } else { "no" },
+            r.max_spectral_radius,
+            r.machining_time,
+            r.executed_time
+                .map(|t| format!("{t:.3}"))
+                .unwrap_or_else(|| "not executable".to_string())
+        );
+    }
+    println!();
 }

@@ -36,8 +36,11 @@
 //!   the default cell: a lower feed lowers r_e and raises |μ| (the feed
 //!   lower bound), so it is never optimal. The forbidden count is
 //!   reported ([`DpResult::forbidden_states`]).
-//! * |μ| comes from the cache (its stated error bound applies); the plan
-//!   is then re-evaluated directly by [`crate::plan::Plan::evaluate`].
+//! * |μ| comes from the cache (its stated error bound applies): the
+//!   committed cache of the default cell, or for any other path or process
+//!   the per-path cache the planner builds on first use
+//!   ([`crate::path_cache`], its measured error there); the plan is then
+//!   re-evaluated directly by [`crate::plan::Plan::evaluate`].
 //!   K (eq. 14) uses the cell's reference joints per (t, g), as the cache;
 //!   the environment's branch-continuous IK can land on another (wrist-
 //!   flipped) branch, with the same K and dynamics (`tests/cache.rs`).

@@ -225,7 +225,7 @@ pub fn solve_within(
         (rpm, feed) = (chosen.0, chosen.1);
         max_mu = max_mu.max(chosen.2);
         spectral_radii.push(chosen.2);
-        if !(chosen.2 < 1.0) {
+        if chosen.2.is_nan() || chosen.2 >= 1.0 {
             chatter_free = false;
         }
         states.push(PhysicalState {
