@@ -10,9 +10,11 @@
 //!
 //! # Grid ([`path_grid`])
 //!
-//! * segments: every [`SEGMENT_STRIDE`]-th (fewer when a segment is longer
-//!   than [`SEGMENT_SPACING_M`] / stride, so that the nodes are at most
-//!   that far apart along the path) and the last;
+//! * segments: every k-th and the last, k the largest stride that keeps
+//!   the nodes at most [`SEGMENT_SPACING_M`] apart along the path (k = 10
+//!   on the default path; a path of many short segments gets as few nodes
+//!   as one of a few long ones: the geometry, not the segment count, sets
+//!   how fast the dynamics change);
 //! * Ω: equally spaced over the cell's spindle range, at most
 //!   [`RPM_SPACING`] apart (11 nodes on 2000–4000 rpm);
 //! * f: [`FEED_FRACTIONS`] of [f_lo, f_max], f_lo = max(the range's
@@ -77,8 +79,6 @@ use crate::request::RequestProcess;
 
 /// Per-path caches a planner keeps (most recently used last).
 pub const PATH_CACHE_MEMO: usize = 8;
-/// Largest spacing of the segment nodes, in segments.
-pub const SEGMENT_STRIDE: usize = 10;
 /// Largest spacing of the segment nodes along the path \[m\] (the default
 /// path: 0.93 m in 100 segments of 9.3 mm, so every 10th segment).
 pub const SEGMENT_SPACING_M: f64 = 0.1;
@@ -120,12 +120,11 @@ pub fn path_grid(cell: &MillCell, g0: f64) -> Result<GridSpec, MillPlanError> {
         return Err(bad("segments", "the path has no segments".to_string()));
     }
     let longest = segments.iter().map(|s| s.length).fold(0.0, f64::max);
-    let by_length = if longest > 0.0 {
-        (SEGMENT_SPACING_M / longest).floor() as usize
+    let stride = if longest > 0.0 {
+        ((SEGMENT_SPACING_M / longest).floor() as usize).clamp(1, n)
     } else {
-        SEGMENT_STRIDE
+        n
     };
-    let stride = by_length.clamp(1, SEGMENT_STRIDE);
     let mut seg: Vec<usize> = (0..n).step_by(stride).collect();
     if seg.last() != Some(&(n - 1)) {
         seg.push(n - 1);

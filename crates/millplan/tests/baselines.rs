@@ -319,6 +319,23 @@ fn the_per_path_grid_follows_the_request() {
     let cell = cell.with_path(&request.path_spec(100)).unwrap();
     let grid = path_grid(&cell, 0.0).unwrap();
     assert_eq!(grid.segments, [0, 2, 4, 6, 8, 10, 12, 14, 16, 18, 19]);
+    // Many short segments: the same spacing along the path, not more nodes.
+    let request = MillRequest {
+        segments: Some(1000),
+        ..MillRequest::default()
+    };
+    let cell = cell.with_path(&request.path_spec(100)).unwrap();
+    let grid = path_grid(&cell, 0.0).unwrap();
+    assert_eq!(grid.segments.len(), 11, "{:?}", grid.segments);
+    let longest = cell
+        .path()
+        .segments()
+        .iter()
+        .map(|s| s.length)
+        .fold(0.0, f64::max);
+    for w in grid.segments.windows(2) {
+        assert!((w[1] - w[0]) as f64 * longest <= 0.1 + 1e-12, "{w:?}");
+    }
 }
 
 #[test]
