@@ -69,8 +69,7 @@ pub fn request_from_msg(m: &msg::MillRequest) -> Result<MillRequest, MillPlanErr
             | PlannerKind::GreedyBestG),
         ),
         Some(p),
-    ) =
-        (PlannerKind::parse(&planner), &policy_file)
+    ) = (PlannerKind::parse(&planner), &policy_file)
     {
         return Err(MillPlanError::InvalidConfig {
             name: "policy_file".to_string(),
