@@ -54,7 +54,8 @@
 //! process cannot use it: `dp` and `naive` then use a per-path cache of
 //! the request's own cell, built on first use under the request's budget
 //! and kept for the last 8 (path, process, grid) ([`crate::path_cache`];
-//! also when the default cache did not load); `ddpg` and `fixed_g`
+//! also when the default cache did not load, and when the request's
+//! spindle-speed range or largest feed reaches beyond its grid); `ddpg` and `fixed_g`
 //! evaluate directly (slower, same result); `greedy` and `greedy_best_g`
 //! always evaluate directly.
 //!
@@ -535,8 +536,8 @@ impl MillPlanner {
             }
             PlannerKind::Dp | PlannerKind::Naive => {
                 let cache = match &cache {
-                    Some(c) => c.clone(),
-                    None => self.path_cache(request, &cell, g0, budget)?,
+                    Some(c) if covers_speeds_and_feeds(c, cell.state_limits()) => c.clone(),
+                    _ => self.path_cache(request, &cell, g0, budget)?,
                 };
                 if kind == PlannerKind::Dp {
                     let spec = DpSpec {
@@ -630,6 +631,22 @@ impl MillPlanner {
             indicator,
         })
     }
+}
+
+/// Whether a cache's grid spans the spindle-speed range and the largest
+/// feed of `limits` (the DP and the naive planner treat states outside the
+/// grid as infeasible: a request that widens these ranges on the default
+/// path gets a per-path cache that spans them instead). The g range is not
+/// compared: the committed cache spans −3…3 rad of the default ±π (the DP
+/// does not plan the few g beyond: forbidden, conservative).
+fn covers_speeds_and_feeds(cache: &IndicatorCache, limits: &StateLimits) -> bool {
+    let grid = cache.grid();
+    let span = |nodes: &[f64]| (nodes.first().copied(), nodes.last().copied());
+    let (r0, r1) = span(&grid.rpm);
+    let (_, f1) = span(&grid.feed);
+    r0.is_some_and(|v| v <= limits.spindle_rpm[0])
+        && r1.is_some_and(|v| v >= limits.spindle_rpm[1])
+        && f1.is_some_and(|v| v >= limits.feed[1])
 }
 
 /// Samples of the redundancy-angle range tried per segment by the

@@ -261,6 +261,32 @@ fn dp_and_naive_plan_a_path_no_shipped_cache_covers() {
 }
 
 #[test]
+fn a_speed_range_beyond_the_shipped_cache_gets_a_per_path_cache() {
+    let planner = MillPlanner::with_default_cell().unwrap();
+    let request = |max_rpm: f64| MillRequest {
+        limits: Some(RequestLimits {
+            spindle_rpm: Some([3900.0, max_rpm]),
+            ..RequestLimits::default()
+        }),
+        initial: Some(RequestInitial {
+            spindle_rpm: Some(4000.0),
+            ..RequestInitial::default()
+        }),
+        planner: "naive".to_string(),
+        ..MillRequest::default()
+    };
+    // Within the shipped cache's 2000-4000 rpm: no per-path cache.
+    let out = planner.plan(&request(4000.0)).unwrap();
+    assert!(out.cache_used);
+    assert!(planner.path_caches().is_empty());
+    // Up to 4100 rpm: the shipped cache cannot say anything above 4000 rpm.
+    let out = planner.plan(&request(4100.0)).unwrap();
+    assert_eq!(planner.path_caches().len(), 1);
+    assert!(out.plan.chatter_free, "{}", out.plan.max_spectral_radius);
+    assert!(out.plan.segments.iter().all(|s| s.rpm <= 4100.0));
+}
+
+#[test]
 fn the_per_path_cache_build_honours_the_budget() {
     // The planner: a request whose budget ends during its path's cache build (or before)
     // is TIMEOUT, and nothing is kept.
