@@ -8,6 +8,8 @@
 //! cargo bench -p kerf_millplan --bench baselines -- --shifted    # the shifted, turned path
 //! cargo bench -p kerf_millplan --bench baselines -- --planners greedy,greedy_best_g
 //! cargo bench -p kerf_millplan --bench baselines -- --planners greedy --candidates  # every fixed g
+//! cargo bench -p kerf_millplan --bench baselines -- --planners dp --dp-accel  # + the DP with
+//! #   joint accelerations in its state (DpSpec::joint_acceleration_limits), default request only
 //! ```
 //!
 //! The shifted path is the default path turned by 0.3 rad about the vertical through its
@@ -144,6 +146,9 @@ fn main() {
             Err(e) => println!("| {} | failed: {e} | | | | | | {:.1} |", r.name, r.seconds),
         }
     }
+    if args.iter().any(|a| a == "--dp-accel") && !shifted {
+        dp_with_accelerations(&planner);
+    }
     if args.iter().any(|a| a == "--candidates") {
         candidates(&planner, &base);
     }
@@ -204,4 +209,53 @@ fn candidates(planner: &MillPlanner, request: &MillRequest) {
         );
     }
     println!();
+}
+
+/// The DP with joint accelerations in its state (`DpSpec::joint_acceleration_limits`) on the
+/// default request with the committed cache, evaluated directly and executed as the planner
+/// would (`kerf_millplan::execute`): one more row of the table.
+fn dp_with_accelerations(planner: &MillPlanner) {
+    use kerf_millplan::dp::{self, DpSpec};
+    use kerf_millplan::plan::{default_eval_threads, Plan};
+    let cell = planner.cell();
+    let cache = planner.cache().expect("the committed cache");
+    let weights = planner.env_config().weights;
+    for (name, accel) in [
+        ("dp (same, via dp::solve)", false),
+        ("dp, joint accelerations in the state", true),
+    ] {
+        let spec = DpSpec {
+            joint_acceleration_limits: accel,
+            ..DpSpec::full(cell, weights, false)
+        };
+        let start = Instant::now();
+        let r = dp::solve(cell, cache, &spec).unwrap();
+        let seconds = start.elapsed().as_secs_f64();
+        let plan = Plan::evaluate(cell, &weights, &r.states, name).unwrap();
+        let out = kerf_millplan::execute(cell, &plan, &weights, default_eval_threads()).unwrap();
+        let e = &out.plan;
+        let d = &out.deviation;
+        let g: Vec<f64> = plan.segments.iter().map(|s| s.g).collect();
+        eprintln!(
+            "{name}: DP {seconds:.1} s; planned {:.3} s (chatter-free {}, max |mu| {:.4}); \
+             g in [{:+.2}, {:+.2}]; slowed {}",
+            plan.total_time,
+            plan.chatter_free,
+            plan.max_spectral_radius,
+            g.iter().copied().fold(f64::INFINITY, f64::min),
+            g.iter().copied().fold(f64::NEG_INFINITY, f64::max),
+            out.scaling.slowed_segments()
+        );
+        println!(
+            "| {name} | {:.2} | {} | {:.4} | {:.3} / {:.3} | {:.3} / {:.3} | {:.3} | {seconds:.1} (DP) |",
+            e.total_time,
+            if e.chatter_free { "yes" } else { "no" },
+            e.max_spectral_radius,
+            e.min_condition_indicator,
+            out.scaling.min_condition_indicator.0,
+            d.max_off_path * 1e3,
+            d.max_off_plane * 1e3,
+            e.total_reward
+        );
+    }
 }
