@@ -268,32 +268,36 @@ impl IndicatorCache {
         // Set by the first worker that meets an error (the budget, or the
         // model): the others stop before their next column.
         let failed = AtomicBool::new(false);
-        std::thread::scope(|scope| {
-            for t in 0..threads {
-                let (columns, results, failed) = (&columns, &results, &failed);
-                scope.spawn(move || {
-                    for (k, (s, g)) in columns.iter().enumerate() {
-                        if k % threads != t {
-                            continue;
-                        }
-                        if failed.load(Ordering::Relaxed) {
-                            break;
-                        }
-                        let (Some(seg), Some(gv)) = (spec.segments.get(*s), spec.g.get(*g)) else {
-                            continue;
-                        };
-                        let col = build_column(cell, spec, *seg, *gv, budget);
-                        if col.is_err() {
-                            failed.store(true, Ordering::Relaxed);
-                        }
-                        if let Ok(mut r) = results.lock() {
-                            if let Some(slot) = r.get_mut(k) {
-                                *slot = Some(col);
-                            }
-                        }
+        let work = |t: usize| {
+            for (k, (s, g)) in columns.iter().enumerate() {
+                if k % threads != t {
+                    continue;
+                }
+                if failed.load(Ordering::Relaxed) {
+                    break;
+                }
+                let (Some(seg), Some(gv)) = (spec.segments.get(*s), spec.g.get(*g)) else {
+                    continue;
+                };
+                let col = build_column(cell, spec, *seg, *gv, budget);
+                if col.is_err() {
+                    failed.store(true, Ordering::Relaxed);
+                }
+                if let Ok(mut r) = results.lock() {
+                    if let Some(slot) = r.get_mut(k) {
+                        *slot = Some(col);
                     }
-                });
+                }
             }
+        };
+        std::thread::scope(|scope| {
+            // Workers 1.. on helper threads (one the OS refuses to start is
+            // not an error: its columns are built below), worker 0 here.
+            for t in 1..threads {
+                let work = &work;
+                let _ = std::thread::Builder::new().spawn_scoped(scope, move || work(t));
+            }
+            work(0);
         });
         let results = results
             .into_inner()
@@ -311,10 +315,14 @@ impl IndicatorCache {
         }
         let mut values = vec![f64::NAN; spec.node_count()];
         for ((s, g), res) in columns.iter().zip(results) {
-            let col = res.ok_or_else(|| MillPlanError::InvalidConfig {
-                name: "cache build".to_string(),
-                reason: "a column was not computed".to_string(),
-            })??;
+            let col = match res {
+                Some(col) => col?,
+                // A worker that did not start: its columns, here.
+                None => match (spec.segments.get(*s), spec.g.get(*g)) {
+                    (Some(seg), Some(gv)) => build_column(cell, spec, *seg, *gv, budget)?,
+                    _ => None,
+                },
+            };
             if let Some(col) = col {
                 for r in 0..spec.rpm.len() {
                     for f in 0..spec.feed.len() {

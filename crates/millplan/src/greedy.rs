@@ -344,28 +344,32 @@ pub fn fixed_g_candidates_within(
     let workers = threads
         .clamp(1, crate::plan::MAX_EVAL_THREADS)
         .min(feasible.len());
-    std::thread::scope(|scope| {
-        for w in 0..workers {
-            let (feasible, slots, limits) = (&feasible, &slots, &limits);
-            scope.spawn(move || {
-                for (k, g) in feasible.iter().enumerate() {
-                    if k % workers != w {
-                        continue;
-                    }
-                    let r = solve_within(cell, initial, *g, budget)
-                        .and_then(|r| with_executed_time(cell, r, limits, settings, budget));
-                    let stop = r.is_err();
-                    if let Ok(mut s) = slots.lock() {
-                        if let Some(slot) = s.get_mut(k) {
-                            *slot = Some(r);
-                        }
-                    }
-                    if stop {
-                        break;
-                    }
+    let work = |w: usize| {
+        for (k, g) in feasible.iter().enumerate() {
+            if k % workers != w {
+                continue;
+            }
+            let r = solve_within(cell, initial, *g, budget)
+                .and_then(|r| with_executed_time(cell, r, &limits, settings, budget));
+            let stop = r.is_err();
+            if let Ok(mut s) = slots.lock() {
+                if let Some(slot) = s.get_mut(k) {
+                    *slot = Some(r);
                 }
-            });
+            }
+            if stop {
+                break;
+            }
         }
+    };
+    std::thread::scope(|scope| {
+        // Workers 1.. on helper threads (one the OS refuses to start is not
+        // an error: its candidates are planned below), worker 0 here.
+        for w in 1..workers {
+            let work = &work;
+            let _ = std::thread::Builder::new().spawn_scoped(scope, move || work(w));
+        }
+        work(0);
     });
     let slots = slots
         .into_inner()
@@ -373,12 +377,24 @@ pub fn fixed_g_candidates_within(
             name: "planner greedy_best_g".to_string(),
             reason: "a worker thread panicked".to_string(),
         })?;
+    // The first error in candidate order wins, before the candidates the
+    // workers left after it.
+    let mut slots = slots;
+    if let Some(k) = slots.iter().position(|s| matches!(s, Some(Err(_)))) {
+        if let Some(Some(Err(e))) = slots.get_mut(k).map(Option::take) {
+            return Err(e);
+        }
+    }
     let mut results = Vec::with_capacity(slots.len());
-    for s in slots {
+    for (s, g) in slots.into_iter().zip(&feasible) {
         match s {
             Some(Ok(r)) => results.push(r),
             Some(Err(e)) => return Err(e),
-            None => budget.check("the greedy ramp")?,
+            // A worker that did not start: its candidates, here.
+            None => results.push(
+                solve_within(cell, initial, *g, budget)
+                    .and_then(|r| with_executed_time(cell, r, &limits, settings, budget))?,
+            ),
         }
     }
     Ok(results)
