@@ -2,7 +2,8 @@
 //!
 //! ```sh
 //! kerf plan mill --request FILE [--plots DIR] [--out plan.json|plan.yaml]
-//!                [--planners ddpg,fixed_g,dp,naive] [--ddpg-policy F] [--fixed-g-policy F]
+//!                [--planners ddpg,fixed_g,dp,naive,greedy,greedy_best_g]
+//!                [--ddpg-policy F] [--fixed-g-policy F]
 //!                [--indicator direct|cache] [--all-rows]
 //! ```
 //!
@@ -85,8 +86,8 @@ pub struct MillArgs {
     /// Write the plans as JSON (or YAML for .yaml/.yml) here.
     #[arg(long)]
     out: Option<PathBuf>,
-    /// Plan with these planners (comma-separated: ddpg, fixed_g, dp, naive) instead of the
-    /// request's.
+    /// Plan with these planners (comma-separated: ddpg, fixed_g, dp, naive, greedy,
+    /// greedy_best_g) instead of the request's.
     #[arg(long, value_delimiter = ',')]
     planners: Vec<String>,
     /// Policy of the ddpg planner (default: the request's policy_file, else the shipped one).
@@ -161,7 +162,9 @@ fn request_for(a: &MillArgs, request: &MillRequest, kind: PlannerKind) -> MillRe
         } else {
             None
         }),
-        PlannerKind::Dp | PlannerKind::Naive => None,
+        PlannerKind::Dp | PlannerKind::Naive | PlannerKind::Greedy | PlannerKind::GreedyBestG => {
+            None
+        }
     };
     r
 }

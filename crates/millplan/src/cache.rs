@@ -69,8 +69,10 @@
 //! truncated data, a checksum mismatch, or a fingerprint that differs from
 //! the cell's (a stale cache: the cell file was edited) is an error.
 
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Mutex;
 
+use kerf_budget::Budget;
 use kerf_chatter::indicator::chatter_indicator;
 use kerf_mill::MillCell;
 use serde::{Deserialize, Serialize};
@@ -173,7 +175,9 @@ fn build_column(
     spec: &GridSpec,
     segment: usize,
     g: f64,
+    budget: &Budget,
 ) -> Result<Option<Vec<f64>>, MillPlanError> {
+    budget.check("the indicator cache")?;
     let state = match cell.evaluate(segment, g, None) {
         Ok(s) => s,
         Err(e) if is_infeasible(&e) => return Ok(None),
@@ -183,6 +187,7 @@ fn build_column(
     let mut out = Vec::with_capacity(spec.rpm.len() * spec.feed.len());
     for &rpm in &spec.rpm {
         for &feed in &spec.feed {
+            budget.check("the indicator cache")?;
             let v = chatter_indicator(&state.modal, &process, rpm, feed, cell.indicator_settings())
                 .map(|i| i.spectral_radius)
                 // A failed indicator marks the node infeasible (NaN), never
@@ -212,11 +217,39 @@ impl IndicatorCache {
     /// # Performance
     /// One indicator evaluation per feasible node (≈ 0.5 ms release).
     pub fn build(cell: &MillCell, spec: &GridSpec, threads: usize) -> Result<Self, MillPlanError> {
-        spec.validate()?;
         if !(1..=2).contains(&threads) {
             return Err(MillPlanError::InvalidConfig {
                 name: "cache build threads".to_string(),
                 reason: format!("{threads}: must be 1 or 2"),
+            });
+        }
+        Self::build_within(cell, spec, threads, &Budget::unlimited())
+    }
+
+    /// [`IndicatorCache::build`] under a time budget, checked before every
+    /// node (one indicator evaluation, about 1 ms) on every worker thread,
+    /// with up to [`crate::plan::MAX_EVAL_THREADS`] threads (the per-path
+    /// caches of [`crate::path_cache`] use the planner's evaluation
+    /// threads). The result does not depend on the thread count.
+    ///
+    /// # Errors
+    /// As [`IndicatorCache::build`] (threads in 1..=`MAX_EVAL_THREADS`),
+    /// and [`MillPlanError::Interrupted`] when the budget runs out or is
+    /// cancelled (every worker stops at its next node).
+    pub fn build_within(
+        cell: &MillCell,
+        spec: &GridSpec,
+        threads: usize,
+        budget: &Budget,
+    ) -> Result<Self, MillPlanError> {
+        spec.validate()?;
+        if !(1..=crate::plan::MAX_EVAL_THREADS).contains(&threads) {
+            return Err(MillPlanError::InvalidConfig {
+                name: "cache build threads".to_string(),
+                reason: format!(
+                    "{threads}: must be in 1..={}",
+                    crate::plan::MAX_EVAL_THREADS
+                ),
             });
         }
         let n_seg = cell.path().segments().len();
@@ -232,26 +265,39 @@ impl IndicatorCache {
             .collect();
         let results: Mutex<Vec<Option<ColumnResult>>> =
             Mutex::new((0..columns.len()).map(|_| None).collect());
-        std::thread::scope(|scope| {
-            for t in 0..threads {
-                let (columns, results) = (&columns, &results);
-                scope.spawn(move || {
-                    for (k, (s, g)) in columns.iter().enumerate() {
-                        if k % threads != t {
-                            continue;
-                        }
-                        let (Some(seg), Some(gv)) = (spec.segments.get(*s), spec.g.get(*g)) else {
-                            continue;
-                        };
-                        let col = build_column(cell, spec, *seg, *gv);
-                        if let Ok(mut r) = results.lock() {
-                            if let Some(slot) = r.get_mut(k) {
-                                *slot = Some(col);
-                            }
-                        }
+        // Set by the first worker that meets an error (the budget, or the
+        // model): the others stop before their next column.
+        let failed = AtomicBool::new(false);
+        let work = |t: usize| {
+            for (k, (s, g)) in columns.iter().enumerate() {
+                if k % threads != t {
+                    continue;
+                }
+                if failed.load(Ordering::Relaxed) {
+                    break;
+                }
+                let (Some(seg), Some(gv)) = (spec.segments.get(*s), spec.g.get(*g)) else {
+                    continue;
+                };
+                let col = build_column(cell, spec, *seg, *gv, budget);
+                if col.is_err() {
+                    failed.store(true, Ordering::Relaxed);
+                }
+                if let Ok(mut r) = results.lock() {
+                    if let Some(slot) = r.get_mut(k) {
+                        *slot = Some(col);
                     }
-                });
+                }
             }
+        };
+        std::thread::scope(|scope| {
+            // Workers 1.. on helper threads (one the OS refuses to start is
+            // not an error: its columns are built below), worker 0 here.
+            for t in 1..threads {
+                let work = &work;
+                let _ = std::thread::Builder::new().spawn_scoped(scope, move || work(t));
+            }
+            work(0);
         });
         let results = results
             .into_inner()
@@ -259,12 +305,24 @@ impl IndicatorCache {
                 name: "cache build".to_string(),
                 reason: "a worker thread panicked".to_string(),
             })?;
+        // The first error in column order wins, before any "not computed"
+        // column (the workers stopped after an error).
+        let mut results = results;
+        if let Some(k) = results.iter().position(|r| matches!(r, Some(Err(_)))) {
+            if let Some(Some(Err(e))) = results.get_mut(k).map(Option::take) {
+                return Err(e);
+            }
+        }
         let mut values = vec![f64::NAN; spec.node_count()];
         for ((s, g), res) in columns.iter().zip(results) {
-            let col = res.ok_or_else(|| MillPlanError::InvalidConfig {
-                name: "cache build".to_string(),
-                reason: "a column was not computed".to_string(),
-            })??;
+            let col = match res {
+                Some(col) => col?,
+                // A worker that did not start: its columns, here.
+                None => match (spec.segments.get(*s), spec.g.get(*g)) {
+                    (Some(seg), Some(gv)) => build_column(cell, spec, *seg, *gv, budget)?,
+                    _ => None,
+                },
+            };
             if let Some(col) = col {
                 for r in 0..spec.rpm.len() {
                     for f in 0..spec.feed.len() {
@@ -293,6 +351,70 @@ impl IndicatorCache {
             error_bound_g_nodes: None,
             command: String::new(),
             data_checksum: format!("{:016x}", fnv1a(&bytes)),
+        };
+        Ok(Self { header, values })
+    }
+
+    /// The cache restricted to the nodes of `spec`, every one of which must
+    /// be a node of this cache (exact match of the node values): the values
+    /// are copied, nothing is evaluated. Used to choose the grid of a
+    /// per-path cache ([`crate::path_cache`]) by the error a coarser grid
+    /// would make at this cache's other nodes (`examples/path_cache_grid.rs`).
+    ///
+    /// # Errors
+    /// [`MillPlanError::InvalidConfig`] for a bad grid or a node of `spec`
+    /// that this cache does not have.
+    pub fn subgrid(&self, spec: &GridSpec) -> Result<Self, MillPlanError> {
+        spec.validate()?;
+        let grid = &self.header.grid;
+        let find = |name: &str, nodes: &[f64], v: f64| {
+            nodes
+                .iter()
+                .position(|n| *n == v)
+                .ok_or_else(|| MillPlanError::InvalidConfig {
+                    name: format!("cache subgrid {name}"),
+                    reason: format!("{v} is not a node of the cache"),
+                })
+        };
+        let seg_nodes: Vec<f64> = grid.segments.iter().map(|s| *s as f64).collect();
+        let map = |name: &str, nodes: &[f64], want: &[f64]| -> Result<Vec<usize>, MillPlanError> {
+            want.iter().map(|v| find(name, nodes, *v)).collect()
+        };
+        let want_seg: Vec<f64> = spec.segments.iter().map(|s| *s as f64).collect();
+        let (si, ri, fi, gi) = (
+            map("segments", &seg_nodes, &want_seg)?,
+            map("rpm", &grid.rpm, &spec.rpm)?,
+            map("feed", &grid.feed, &spec.feed)?,
+            map("g", &grid.g, &spec.g)?,
+        );
+        let mut values = vec![f64::NAN; spec.node_count()];
+        for (s, &os) in si.iter().enumerate() {
+            for (r, &or) in ri.iter().enumerate() {
+                for (f, &of) in fi.iter().enumerate() {
+                    for (g, &og) in gi.iter().enumerate() {
+                        let v = self
+                            .values
+                            .get(grid.index(os, or, of, og))
+                            .copied()
+                            .unwrap_or(f64::NAN);
+                        if let Some(slot) = values.get_mut(spec.index(s, r, f, g)) {
+                            *slot = v;
+                        }
+                    }
+                }
+            }
+        }
+        let bytes: Vec<u8> = values.iter().flat_map(|v| v.to_le_bytes()).collect();
+        let header = CacheHeader {
+            grid: spec.clone(),
+            infeasible_nodes: values.iter().filter(|v| v.is_nan()).count(),
+            error: None,
+            error_bound: None,
+            error_g_nodes: None,
+            error_bound_g_nodes: None,
+            command: String::new(),
+            data_checksum: format!("{:016x}", fnv1a(&bytes)),
+            ..self.header.clone()
         };
         Ok(Self { header, values })
     }

@@ -36,8 +36,11 @@
 //!   the default cell: a lower feed lowers r_e and raises |μ| (the feed
 //!   lower bound), so it is never optimal. The forbidden count is
 //!   reported ([`DpResult::forbidden_states`]).
-//! * |μ| comes from the cache (its stated error bound applies); the plan
-//!   is then re-evaluated directly by [`crate::plan::Plan::evaluate`].
+//! * |μ| comes from the cache (its stated error bound applies): the
+//!   committed cache of the default cell, or for any other path or process
+//!   the per-path cache the planner builds on first use
+//!   ([`crate::path_cache`], its measured error there); the plan is then
+//!   re-evaluated directly by [`crate::plan::Plan::evaluate`].
 //!   K (eq. 14) uses the cell's reference joints per (t, g), as the cache;
 //!   the environment's branch-continuous IK can land on another (wrist-
 //!   flipped) branch, with the same K and dynamics (`tests/cache.rs`).
@@ -81,7 +84,7 @@ use crate::reward::{
     efficiency_reward, operational_reward, stability_reward, ChatterMargin, RewardWeights,
 };
 
-pub use crate::grid_dp::{solve_grid, solve_grid_with_moves, GridPath};
+pub use crate::grid_dp::{solve_grid, solve_grid_with_history, solve_grid_with_moves, GridPath};
 
 /// The DP grid: node ranges on each axis, in multiples of the step bound
 /// from the initial state (so the IVP is a node).
@@ -112,6 +115,22 @@ pub struct DpSpec {
     /// ([`crate::joint_speed`]; joints of the cell's reference IK branch,
     /// compared over the equivalent wrist solutions).
     pub joint_speed_limits: bool,
+    /// Also forbid moves whose joint ACCELERATIONS at the planned feeds
+    /// exceed the robot's limits (issue 13, item 3: "the DP with the
+    /// executed timing in its cost, accelerations in its state"): the
+    /// previous g move is part of the state
+    /// ([`crate::grid_dp::solve_grid_with_history`], 3× the states), and
+    /// a move from segment t to t + 1 after one from t − 1 is allowed when
+    /// a_j = 2 ((q_{t+1} − q_t)/h₂ − (q_t − q_{t−1})/h₁) / (h₁ + h₂) (the
+    /// second derivative of the parabola through the three midpoints'
+    /// joints, Fornberg 1988, as the environment's acceleration shaping)
+    /// is within |a_j| ≤ a_max,j for every joint; h₁ is the midpoint
+    /// interval at the feed of segment t on both sides (the previous feed is
+    /// not in the state; it differs by at most one feed step), h₂ at the
+    /// feeds of the move. Segment 0 is not checked (the executed trajectory
+    /// starts from rest with its own ramp). Jerk limits are not modelled.
+    /// Off by default ([`DpSpec::full`]).
+    pub joint_acceleration_limits: bool,
 }
 
 impl DpSpec {
@@ -133,6 +152,7 @@ impl DpSpec {
             chatter_limit: None,
             chatter_margin: Some(ChatterMargin::default()),
             joint_speed_limits: true,
+            joint_acceleration_limits: false,
         }
     }
 }
@@ -299,6 +319,86 @@ pub fn solve_within(
         };
         joint_speed::midpoint_interval([*la, *lb], [*fa, *fb]) >= *need
     };
+    // Joint accelerations: a table over (t, k, p, dk, j, dj) of whether the
+    // move from (t, g_k, f_j) to (t + 1, g_{k+dk−1}, f_{j+dj−1}) after a g
+    // move coded p into (t, k) is within the acceleration limits (the
+    // field's documentation); empty when not asked for.
+    let nf = feed.len();
+    let acc_index = |t: usize, k: usize, p: usize, dk: usize, j: usize, dj: usize| {
+        ((((t * ng + k) * 3 + p) * 3 + dk) * nf + j) * 3 + dj
+    };
+    let mut acc_ok: Vec<bool> = Vec::new();
+    if spec.joint_acceleration_limits {
+        let acceleration_limits = acceleration_limits(cell);
+        acc_ok = vec![false; n * ng * 9 * nf * 3];
+        for t in 1..n.saturating_sub(1) {
+            budget.check("the DP's joint-acceleration table")?;
+            let (Some(l0), Some(l1), Some(l2)) =
+                (lengths.get(t - 1), lengths.get(t), lengths.get(t + 1))
+            else {
+                continue;
+            };
+            for k in 0..ng {
+                let Some(q1) = joints.get(t * ng + k) else {
+                    continue;
+                };
+                for p in 0..3usize {
+                    let Some(q0) = (k + 1)
+                        .checked_sub(p)
+                        .filter(|v| *v < ng)
+                        .and_then(|pk| joints.get((t - 1) * ng + pk))
+                    else {
+                        continue;
+                    };
+                    for dk in 0..3usize {
+                        let Some(q2) = (k + dk)
+                            .checked_sub(1)
+                            .filter(|v| *v < ng)
+                            .and_then(|nk| joints.get((t + 1) * ng + nk))
+                        else {
+                            continue;
+                        };
+                        let back_motion = joint_speed::smallest_motion(q0, q1);
+                        let ahead = joint_speed::smallest_motion(q1, q2);
+                        for (j, fj) in feed.iter().enumerate() {
+                            if *fj <= 0.0 {
+                                continue;
+                            }
+                            let h1 = joint_speed::midpoint_interval([*l0, *l1], [*fj, *fj]);
+                            for dj in 0..3usize {
+                                let Some(fn_) = (j + dj).checked_sub(1).and_then(|v| feed.get(v))
+                                else {
+                                    continue;
+                                };
+                                if *fn_ <= 0.0 {
+                                    continue;
+                                }
+                                let h2 = joint_speed::midpoint_interval([*l1, *l2], [*fj, *fn_]);
+                                let ok = (0..6).all(|q| {
+                                    let a = 2.0 * (ahead[q] / h2 - back_motion[q] / h1) / (h1 + h2);
+                                    a.is_finite() && a.abs() <= acceleration_limits[q]
+                                });
+                                if let Some(slot) = acc_ok.get_mut(acc_index(t, k, p, dk, j, dj)) {
+                                    *slot = ok;
+                                }
+                            }
+                        }
+                    }
+                }
+            }
+        }
+    }
+    let allowed3 = |t: usize, p: usize, x: [usize; 3], y: [usize; 3]| -> bool {
+        if t == 0 {
+            return true;
+        }
+        let dk = y[2] + 1 - x[2];
+        let dj = y[1] + 1 - x[1];
+        acc_ok
+            .get(acc_index(t, x[2], p, dk, x[1], dj))
+            .copied()
+            .unwrap_or(false)
+    };
     let re: Vec<f64> = feed
         .iter()
         .map(|f| efficiency_reward(*f, lim.feed[1]))
@@ -306,58 +406,57 @@ pub fn solve_within(
     let w = spec.weights;
     let mut forbidden = 0usize;
     let mut error: Option<MillPlanError> = None;
-    let path = solve_grid_with_moves(
-        n,
-        [rpm.len(), feed.len(), g.len()],
-        [i0, j0, k0],
-        |t, [i, j, k]| {
-            if error.is_some() {
-                return None;
-            }
-            let ro = ro.get(t * g.len() + k).copied().flatten();
-            let (Some(ro), Some(re)) = (ro, re.get(j)) else {
+    let stage = |t: usize, [i, j, k]: [usize; 3]| {
+        if error.is_some() {
+            return None;
+        }
+        let ro = ro.get(t * g.len() + k).copied().flatten();
+        let (Some(ro), Some(re)) = (ro, re.get(j)) else {
+            forbidden += 1;
+            return None;
+        };
+        if feed[j] <= 0.0 {
+            forbidden += 1;
+            return None;
+        }
+        match cache.try_query(t, rpm[i], feed[j], g[k]) {
+            Ok(Some(mu))
+                if spec
+                    .chatter_limit
+                    .is_some_and(|(l, from)| t >= from && mu >= l) =>
+            {
                 forbidden += 1;
-                return None;
-            };
-            if feed[j] <= 0.0 {
-                forbidden += 1;
-                return None;
+                None
             }
-            match cache.try_query(t, rpm[i], feed[j], g[k]) {
-                Ok(Some(mu))
-                    if spec
-                        .chatter_limit
-                        .is_some_and(|(l, from)| t >= from && mu >= l) =>
-                {
-                    forbidden += 1;
-                    None
-                }
-                Ok(Some(mu)) => match stability_reward(mu).and_then(|rs| {
-                    let penalty = match &spec.chatter_margin {
-                        Some(m) => m.penalty(mu)?,
-                        None => 0.0,
-                    };
-                    Ok(w.operational * ro + w.efficiency * re + w.stability * rs - penalty)
-                }) {
-                    Ok(r) => Some(r),
-                    Err(e) => {
-                        error.get_or_insert(e);
-                        None
-                    }
-                },
-                Ok(None) => {
-                    forbidden += 1;
-                    None
-                }
+            Ok(Some(mu)) => match stability_reward(mu).and_then(|rs| {
+                let penalty = match &spec.chatter_margin {
+                    Some(m) => m.penalty(mu)?,
+                    None => 0.0,
+                };
+                Ok(w.operational * ro + w.efficiency * re + w.stability * rs - penalty)
+            }) {
+                Ok(r) => Some(r),
                 Err(e) => {
                     error.get_or_insert(e);
                     None
                 }
+            },
+            Ok(None) => {
+                forbidden += 1;
+                None
             }
-        },
-        allowed,
-        budget,
-    )?;
+            Err(e) => {
+                error.get_or_insert(e);
+                None
+            }
+        }
+    };
+    let dims = [rpm.len(), feed.len(), g.len()];
+    let path = if spec.joint_acceleration_limits {
+        solve_grid_with_history(n, dims, [i0, j0, k0], stage, allowed, allowed3, budget)?
+    } else {
+        solve_grid_with_moves(n, dims, [i0, j0, k0], stage, allowed, budget)?
+    };
     if let Some(e) = error {
         return Err(e);
     }
@@ -383,4 +482,22 @@ pub fn solve_within(
         forbidden_states: forbidden,
         seconds: start_time.elapsed().as_secs_f64(),
     })
+}
+
+/// The joints' acceleration limits of the cell's robot \[rad/s²\], in the
+/// kinematic chain's order (infinite where the robot gives none, as the
+/// environment).
+fn acceleration_limits(cell: &MillCell) -> [f64; 6] {
+    let mut out = [f64::INFINITY; 6];
+    let joints = cell.robot().joints();
+    for (slot, k) in out.iter_mut().zip(cell.kinematics().joints()) {
+        if let Some(a) = joints
+            .iter()
+            .find(|j| j.name == k.name)
+            .and_then(|j| j.max_acceleration)
+        {
+            *slot = a;
+        }
+    }
+    out
 }

@@ -169,3 +169,152 @@ where
         nodes: path,
     }))
 }
+
+/// As [`solve_grid_with_moves`], with the previous move on the third axis
+/// (−1/0/+1 steps, coded 0/1/2) in the state, so that a move can be judged
+/// by three consecutive nodes (e.g. a second difference: joint
+/// accelerations, [`crate::dp`]'s `joint_acceleration_limits`):
+/// `allowed3(t, p, x, y)` says whether the move x → y at stage t is allowed
+/// after a move coded p on axis 2 into x (p = 1, no move, at stage 0).
+/// Three times the states of [`solve_grid_with_moves`] (value layers of
+/// 3 × nodes f32, one u8 backpointer per (stage, node, p)).
+///
+/// # Errors
+/// As [`solve_grid_with_moves`] (the state count includes the factor 3).
+pub fn solve_grid_with_history<F, M, A>(
+    stages: usize,
+    dims: [usize; 3],
+    start: [usize; 3],
+    mut stage: F,
+    allowed: M,
+    allowed3: A,
+    budget: &Budget,
+) -> Result<Option<GridPath>, MillPlanError>
+where
+    F: FnMut(usize, [usize; 3]) -> Option<f64>,
+    M: Fn(usize, [usize; 3], [usize; 3]) -> bool,
+    A: Fn(usize, usize, [usize; 3], [usize; 3]) -> bool,
+{
+    let nodes = dims[0] * dims[1] * dims[2];
+    if stages == 0 || nodes == 0 || (0..3).any(|a| start[a] >= dims[a]) {
+        return Err(MillPlanError::InvalidConfig {
+            name: "DP grid".to_string(),
+            reason: format!("stages {stages}, dims {dims:?}, start {start:?}"),
+        });
+    }
+    if nodes
+        .checked_mul(3 * stages)
+        .is_none_or(|v| v > (1usize << 31))
+    {
+        return Err(MillPlanError::InvalidConfig {
+            name: "DP grid".to_string(),
+            reason: "too many states".to_string(),
+        });
+    }
+    let index = |i: usize, j: usize, k: usize| (i * dims[1] + j) * dims[2] + k;
+    let mut stage_table = |t: usize| -> Result<Vec<f32>, MillPlanError> {
+        let mut out = vec![f32::NEG_INFINITY; nodes];
+        for i in 0..dims[0] {
+            budget.check("the DP")?;
+            for j in 0..dims[1] {
+                for k in 0..dims[2] {
+                    if let Some(r) = stage(t, [i, j, k]) {
+                        if r.is_finite() {
+                            out[index(i, j, k)] = r as f32;
+                        }
+                    }
+                }
+            }
+        }
+        Ok(out)
+    };
+    // V_{N-1}(x, p) = r(N-1, x) for every p.
+    let last = stage_table(stages - 1)?;
+    let mut next: Vec<f32> = last.iter().flat_map(|v| [*v; 3]).collect();
+    let mut back: Vec<u8> = vec![u8::MAX; nodes * 3 * (stages - 1)];
+    for t in (0..stages - 1).rev() {
+        let r = stage_table(t)?;
+        let mut value = vec![f32::NEG_INFINITY; nodes * 3];
+        let bt = &mut back[t * nodes * 3..(t + 1) * nodes * 3];
+        for i in 0..dims[0] {
+            budget.check("the DP")?;
+            for j in 0..dims[1] {
+                for k in 0..dims[2] {
+                    let here = index(i, j, k);
+                    let rv = r[here];
+                    if rv == f32::NEG_INFINITY {
+                        continue;
+                    }
+                    let x = [i, j, k];
+                    let mut best = [f32::NEG_INFINITY; 3];
+                    let mut best_m = [u8::MAX; 3];
+                    for di in 0..3usize {
+                        let Some(ni) = (i + di).checked_sub(1).filter(|v| *v < dims[0]) else {
+                            continue;
+                        };
+                        for dj in 0..3usize {
+                            let Some(nj) = (j + dj).checked_sub(1).filter(|v| *v < dims[1]) else {
+                                continue;
+                            };
+                            for dk in 0..3usize {
+                                let Some(nk) = (k + dk).checked_sub(1).filter(|v| *v < dims[2])
+                                else {
+                                    continue;
+                                };
+                                let v = next[index(ni, nj, nk) * 3 + dk];
+                                // Better than the best so far of some p, or skip.
+                                if v <= best[0] && v <= best[1] && v <= best[2] {
+                                    continue;
+                                }
+                                let y = [ni, nj, nk];
+                                if !allowed(t, x, y) {
+                                    continue;
+                                }
+                                for p in 0..3usize {
+                                    if v > best[p] && allowed3(t, p, x, y) {
+                                        best[p] = v;
+                                        best_m[p] = (di * 9 + dj * 3 + dk) as u8;
+                                    }
+                                }
+                            }
+                        }
+                    }
+                    for p in 0..3usize {
+                        if best[p] > f32::NEG_INFINITY {
+                            value[here * 3 + p] = rv + best[p];
+                            bt[here * 3 + p] = best_m[p];
+                        }
+                    }
+                }
+            }
+        }
+        next = value;
+    }
+    let s0 = index(start[0], start[1], start[2]) * 3 + 1;
+    if next.get(s0).is_none_or(|v| *v == f32::NEG_INFINITY) {
+        return Ok(None);
+    }
+    // Forward pass from (start, p = 1), re-summing the stage rewards in f64.
+    let mut path = Vec::with_capacity(stages);
+    let mut x = start;
+    let mut p = 1usize;
+    let mut total = 0.0;
+    for t in 0..stages {
+        path.push(x);
+        total += stage(t, x).unwrap_or(f64::NEG_INFINITY);
+        if t + 1 == stages {
+            break;
+        }
+        let m = back[t * nodes * 3 + index(x[0], x[1], x[2]) * 3 + p];
+        if m == u8::MAX {
+            return Ok(None);
+        }
+        let m = m as usize;
+        x = [x[0] + m / 9 - 1, x[1] + (m / 3) % 3 - 1, x[2] + m % 3 - 1];
+        p = m % 3;
+    }
+    Ok(Some(GridPath {
+        value: total,
+        nodes: path,
+    }))
+}

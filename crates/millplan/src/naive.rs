@@ -8,7 +8,9 @@
 //! FASTEST pair — the highest feed, then among equal feeds the lowest
 //! max |μ| — that is chatter-free (|μ|max < 1) at EVERY segment:
 //!
-//! 1. screen all pairs with the cache (max over the N segments);
+//! 1. screen all pairs with the cache (max over the N segments): the
+//!    committed cache of the default cell, or the request's per-path cache
+//!    ([`crate::path_cache`]) for any other path or process;
 //! 2. verify the best screened candidates by direct evaluation at every
 //!    segment (branch-continuous IK, as the plan), at most
 //!    [`MAX_VERIFICATIONS`] candidates, so the chosen pair is chatter-free

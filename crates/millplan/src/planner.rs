@@ -19,7 +19,10 @@
 //! 4. The planner: `ddpg`/`fixed_g` — greedy rollout of the policy in
 //!    [`MillEnv`] (α and weights of [`MillPlanner::env_config`]); `dp` —
 //!    [`crate::dp::solve`] over the full state ranges from the request's
-//!    initial state; `naive` — [`crate::naive::solve`] at g = g0.
+//!    initial state; `naive` — [`crate::naive::solve`] at g = g0;
+//!    `greedy` — [`crate::greedy::solve_within`] from the initial state at
+//!    g = g0; `greedy_best_g` — [`crate::greedy::best_fixed_g_within`]
+//!    (direct |μ|max, no cache: any path).
 //!    A policy is applied as it is to any request whose sizes fit: its
 //!    observations are normalized by the REQUEST's limits and number of segments,
 //!    so a policy trained on the default cell is only meaningful for
@@ -55,9 +58,13 @@
 //! uses it (queries outside its grid fall back to direct evaluation in the
 //! environment, and are infeasible states for the DP and the naive
 //! screening: conservative, never wrong). A request with another path or
-//! process cannot use it: `dp` and `naive` then return
-//! [`MillPlanError::InvalidConfig`] (building a cache for the request takes
-//! minutes); `ddpg` and `fixed_g` evaluate directly (slower, same result).
+//! process cannot use it: `dp` and `naive` then use a per-path cache of
+//! the request's own cell, built on first use under the request's budget
+//! and kept for the last 8 (path, process, grid) ([`crate::path_cache`];
+//! also when the default cache did not load, and when the request's
+//! spindle-speed range or largest feed reaches beyond its grid); `ddpg` and `fixed_g`
+//! evaluate directly (slower, same result); `greedy` and `greedy_best_g`
+//! always evaluate directly.
 //!
 //! # Trajectory
 //! Step 6 builds the planned joint trajectory ([`crate::planned`]: path
@@ -79,7 +86,9 @@ use crate::env::{EnvConfig, MillEnv, PhysicalState};
 use crate::error::MillPlanError;
 use crate::evaluation::evaluate_impl;
 use crate::executed::executed;
+use crate::greedy;
 use crate::naive;
+use crate::path_cache::{path_grid, PathCacheKey, PathCaches};
 use crate::plan::{default_eval_threads, IndicatorProvenance, IndicatorSource, Plan};
 use crate::planned::planned_trajectory;
 use crate::policy::Policy;
@@ -101,7 +110,9 @@ pub fn default_policy_path(planner: PlannerKind) -> Option<PathBuf> {
     match planner {
         PlannerKind::Ddpg => Some(dir.join("ddpg.safetensors")),
         PlannerKind::FixedG => Some(dir.join("fixed_g.safetensors")),
-        PlannerKind::Dp | PlannerKind::Naive => None,
+        PlannerKind::Dp | PlannerKind::Naive | PlannerKind::Greedy | PlannerKind::GreedyBestG => {
+            None
+        }
     }
 }
 
@@ -137,6 +148,7 @@ pub struct MillPlanner {
     trajectory_settings: TrajectorySettings,
     models: Mutex<Vec<(RequestModel, Arc<MillCell>, bool)>>,
     policies: Mutex<HashMap<PathBuf, CachedPolicy>>,
+    path_caches: PathCaches,
 }
 
 fn file_stamp(path: &Path) -> Option<(SystemTime, u64)> {
@@ -182,6 +194,7 @@ impl MillPlanner {
             trajectory_settings: TrajectorySettings::default(),
             models: Mutex::new(Vec::new()),
             policies: Mutex::new(HashMap::new()),
+            path_caches: PathCaches::new(),
         })
     }
 
@@ -379,6 +392,37 @@ impl MillPlanner {
         Ok((cell, same_model))
     }
 
+    /// The per-path indicator cache of a request whose cell the default
+    /// cache does not apply to ([`crate::path_cache`]): kept from an earlier
+    /// request with the same path, process and grid, else built on the
+    /// planner's evaluation threads under `budget`.
+    ///
+    /// # Errors
+    /// [`path_grid`] and [`PathCaches::get_or_build`] errors, among them
+    /// [`MillPlanError::Interrupted`].
+    fn path_cache(
+        &self,
+        request: &MillRequest,
+        cell: &MillCell,
+        g0: f64,
+        budget: &Budget,
+    ) -> Result<Arc<IndicatorCache>, MillPlanError> {
+        let key = PathCacheKey {
+            path: request.path_spec(self.cell.path().segments().len()),
+            process: request.process,
+            grid: path_grid(cell, g0)?,
+        };
+        let (cache, _) = self
+            .path_caches
+            .get_or_build(key, cell, self.eval_threads, budget)?;
+        Ok(cache)
+    }
+
+    /// The per-path indicator caches kept ([`crate::path_cache`]).
+    pub fn path_caches(&self) -> &PathCaches {
+        &self.path_caches
+    }
+
     /// Plans a request (module documentation).
     ///
     /// # Errors
@@ -386,8 +430,9 @@ impl MillPlanner {
     /// [`MillError::Unreachable`] / [`MillError::JointLimit`] with the
     /// segment (UNREACHABLE); [`MillPlanError::Policy`] for a missing or
     /// incompatible policy file or a rollout that leaves the feasible set;
-    /// [`MillPlanError::InvalidConfig`] when `dp`/`naive` need the cache
-    /// and it does not apply; chatter-model errors; see [`status_of`].
+    /// [`MillPlanError::InvalidConfig`] when `greedy_best_g` finds no
+    /// fixed g feasible on every segment, or `dp`/`naive` find no plan on
+    /// their grid; chatter-model errors; see [`status_of`].
     ///
     /// # Performance
     /// Dominated by the N direct indicator evaluations of step 5 and, for
@@ -497,21 +542,10 @@ impl MillPlanner {
                 rollout.states()
             }
             PlannerKind::Dp | PlannerKind::Naive => {
-                let cache = cache.clone().ok_or_else(|| MillPlanError::InvalidConfig {
-                    name: format!("planner {}", kind.name()),
-                    reason: if self.cache.is_none() {
-                        format!(
-                            "needs the default cell's indicator cache, which is not available \
-                             ({})",
-                            self.cache_note
-                        )
-                    } else {
-                        "needs the default cell's indicator cache; this request changes the \
-                         path/process (use ddpg or fixed_g, or build a cache for this cell with \
-                         `cargo run --release -p kerf_millplan --example build_cache`)"
-                            .to_string()
-                    },
-                })?;
+                let cache = match &cache {
+                    Some(c) if covers_speeds_and_feeds(c, cell.state_limits()) => c.clone(),
+                    _ => self.path_cache(request, &cell, g0, budget)?,
+                };
                 if kind == PlannerKind::Dp {
                     let spec = DpSpec {
                         initial: [rpm0, feed0, g0],
@@ -521,6 +555,19 @@ impl MillPlanner {
                 } else {
                     naive::solve_within(&cell, &cache, g0, budget)?.states
                 }
+            }
+            PlannerKind::Greedy => {
+                greedy::solve_within(&cell, [rpm0, feed0, g0], g0, budget)?.states
+            }
+            PlannerKind::GreedyBestG => {
+                greedy::best_fixed_g_within(
+                    &cell,
+                    [rpm0, feed0, g0],
+                    self.eval_threads,
+                    &self.trajectory_settings,
+                    budget,
+                )?
+                .states
             }
         };
         phases.planner = step.elapsed().as_secs_f64();
@@ -613,6 +660,22 @@ impl MillPlanner {
             indicator,
         })
     }
+}
+
+/// Whether a cache's grid spans the spindle-speed range and the largest
+/// feed of `limits` (the DP and the naive planner treat states outside the
+/// grid as infeasible: a request that widens these ranges on the default
+/// path gets a per-path cache that spans them instead). The g range is not
+/// compared: the committed cache spans −3…3 rad of the default ±π (the DP
+/// does not plan the few g beyond: forbidden, conservative).
+fn covers_speeds_and_feeds(cache: &IndicatorCache, limits: &StateLimits) -> bool {
+    let grid = cache.grid();
+    let span = |nodes: &[f64]| (nodes.first().copied(), nodes.last().copied());
+    let (r0, r1) = span(&grid.rpm);
+    let (_, f1) = span(&grid.feed);
+    r0.is_some_and(|v| v <= limits.spindle_rpm[0])
+        && r1.is_some_and(|v| v >= limits.spindle_rpm[1])
+        && f1.is_some_and(|v| v >= limits.feed[1])
 }
 
 /// Samples of the redundancy-angle range tried per segment by the

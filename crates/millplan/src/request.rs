@@ -17,7 +17,7 @@
 //!   redundancy_angle: [-3.14, 3.14]   # rad
 //!   step_bounds: {spindle_rpm: 20, feed: 0.001, redundancy_angle: 0.2}
 //! initial: {spindle_rpm: 2000, feed: 0.04, g: 0.0}   # optional, each field optional
-//! planner: ddpg            # ddpg | fixed_g | dp | naive (default ddpg)
+//! planner: ddpg            # ddpg | fixed_g | dp | naive | greedy | greedy_best_g (default ddpg)
 //! policy_file: crates/millplan/policies/ddpg.safetensors   # optional
 //! ```
 //!
@@ -68,19 +68,35 @@ pub enum PlannerKind {
     Dp,
     /// Constant spindle speed and feed ([`crate::naive`]).
     Naive,
+    /// The greedy ramp from the initial state at the step bounds, g held at
+    /// the initial g ([`crate::greedy::solve_within`]).
+    Greedy,
+    /// The greedy ramp with the best fixed g, reached from the initial g at
+    /// the step bound ([`crate::greedy::best_fixed_g_within`]).
+    GreedyBestG,
 }
 
 impl PlannerKind {
     /// Every planner, in the order of the comparison table.
-    pub const ALL: [PlannerKind; 4] = [Self::Ddpg, Self::FixedG, Self::Dp, Self::Naive];
+    pub const ALL: [PlannerKind; 6] = [
+        Self::Ddpg,
+        Self::FixedG,
+        Self::Dp,
+        Self::Naive,
+        Self::Greedy,
+        Self::GreedyBestG,
+    ];
 
-    /// The name used in requests (`ddpg`, `fixed_g`, `dp`, `naive`).
+    /// The name used in requests (`ddpg`, `fixed_g`, `dp`, `naive`,
+    /// `greedy`, `greedy_best_g`).
     pub fn name(&self) -> &'static str {
         match self {
             Self::Ddpg => "ddpg",
             Self::FixedG => "fixed_g",
             Self::Dp => "dp",
             Self::Naive => "naive",
+            Self::Greedy => "greedy",
+            Self::GreedyBestG => "greedy_best_g",
         }
     }
 
@@ -95,7 +111,10 @@ impl PlannerKind {
             .find(|k| k.name() == name)
             .ok_or_else(|| MillPlanError::InvalidConfig {
                 name: "planner".to_string(),
-                reason: format!("unknown planner `{name}`: must be ddpg, fixed_g, dp or naive"),
+                reason: format!(
+                    "unknown planner `{name}`: must be ddpg, fixed_g, dp, naive, greedy or \
+                     greedy_best_g"
+                ),
             })
     }
 }
@@ -240,7 +259,7 @@ pub struct MillRequest {
     /// Initial state (seed 004's IVP when absent).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub initial: Option<RequestInitial>,
-    /// `ddpg`, `fixed_g`, `dp` or `naive`.
+    /// `ddpg`, `fixed_g`, `dp`, `naive`, `greedy` or `greedy_best_g`.
     #[serde(default = "default_planner")]
     pub planner: String,
     /// The policy file of `ddpg`/`fixed_g` (relative paths: to the working

@@ -13,8 +13,8 @@ use kerf_millplan::cache::direct_indicator;
 use kerf_millplan::deviation::executed_deviation;
 use kerf_millplan::request::{RequestLimits, RequestProcess};
 use kerf_millplan::{
-    status_of, train, DdpgSettings, EnvConfig, Environment, MillEnv, MillPlanError, MillPlanOutput,
-    MillPlanner, MillRequest, PlannerKind, Policy, TrajectoryPoint, TrajectorySettings,
+    train, DdpgSettings, EnvConfig, Environment, MillEnv, MillPlanOutput, MillPlanner, MillRequest,
+    PlannerKind, Policy, TrajectoryPoint, TrajectorySettings,
 };
 
 fn planner() -> &'static MillPlanner {
@@ -317,7 +317,8 @@ fn dp_on_the_default_request_and_with_narrower_limits() {
         && (-1.0..=1.0).contains(&s.g)));
     // A narrower feed range cannot be faster.
     assert!(out2.plan.total_time >= out.plan.total_time - 1e-9);
-    // Another process: the cache does not apply; dp refuses clearly.
+    // Another process: the shipped cache does not apply; dp plans through a per-path cache of
+    // the request's cell (`path_cache`; narrowed speeds and feeds keep it small).
     let mut process = planner().cell().milling_process();
     process.radius = 0.03;
     let other = MillRequest {
@@ -330,12 +331,19 @@ fn dp_on_the_default_request_and_with_narrower_limits() {
             entry_angle: process.entry_angle,
             exit_angle: process.exit_angle,
         }),
+        limits: Some(RequestLimits {
+            spindle_rpm: Some([2000.0, 2200.0]),
+            feed: Some([0.02, 0.05]),
+            redundancy_angle: None,
+            step_bounds: None,
+        }),
         ..request
     };
-    let e = planner().plan(&other).expect_err("no cache for this cell");
-    assert!(matches!(e, MillPlanError::InvalidConfig { .. }));
-    assert!(e.to_string().contains("changes the path/process"), "{e}");
-    assert_eq!(status_of(&e), 1);
+    let with_other = planner();
+    let out3 = with_other.plan(&other).expect("dp with another process");
+    assert!(!out3.cache_used);
+    assert_eq!(with_other.path_caches().len(), 1);
+    check_plan(&with_other.cell().with_process(process).unwrap(), &out3);
 }
 
 /// A policy trained for 2 episodes on the default cell (tiny network),

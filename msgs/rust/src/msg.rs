@@ -369,6 +369,10 @@ impl MillRequest {
     pub const PLANNER_DP: &'static str = "dp";
     /// Constant feed and spindle speed.
     pub const PLANNER_NAIVE: &'static str = "naive";
+    /// Greedy ramp from the initial state at the step bounds, g held at the initial g.
+    pub const PLANNER_GREEDY: &'static str = "greedy";
+    /// The greedy ramp with the best fixed g, reached from the initial g at the step bound.
+    pub const PLANNER_GREEDY_BEST_G: &'static str = "greedy_best_g";
 }
 
 /// `kerf_msgs/msg/MillSegment`: one planned segment of a [`MillPlan`], with the model's

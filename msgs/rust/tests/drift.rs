@@ -469,6 +469,8 @@ fn rust_constants() -> ConstantTable {
                 c_str("PLANNER_FIXED_G", Mr::PLANNER_FIXED_G),
                 c_str("PLANNER_DP", Mr::PLANNER_DP),
                 c_str("PLANNER_NAIVE", Mr::PLANNER_NAIVE),
+                c_str("PLANNER_GREEDY", Mr::PLANNER_GREEDY),
+                c_str("PLANNER_GREEDY_BEST_G", Mr::PLANNER_GREEDY_BEST_G),
             ],
         ),
         (

@@ -80,8 +80,9 @@ impl NodeConfig {
     /// * `indicator_cache_file` (string): the |μ|max cache of the cell
     ///   (`kerf_millplan::IndicatorCache`). Unset = the shipped
     ///   `crates/millplan/data/indicator_cache.bin`, used when it was built for this cell and
-    ///   otherwise skipped with a warning (the `dp` and `naive` planners then refuse requests;
-    ///   `ddpg` and `fixed_g` evaluate directly). Set = it must load and fit the cell, else the
+    ///   otherwise skipped with a warning (the `dp` and `naive` planners then build a per-path
+    ///   cache on a request's first use, `kerf_millplan::path_cache`; `ddpg` and `fixed_g`
+    ///   evaluate directly). Set = it must load and fit the cell, else the
     ///   node does not start.
     /// * `ddpg_policy_file`, `fixed_g_policy_file` (strings): the policy (safetensors actor)
     ///   used by `ddpg` / `fixed_g` requests that name none; unset = the shipped
@@ -155,7 +156,7 @@ impl NodeConfig {
                         .err()
                         .map(|e| e.to_string())
                         .unwrap_or_else(|| "it changed while loading".to_string());
-                    format!("no indicator cache (dp and naive unavailable): {why}")
+                    format!("no indicator cache (dp and naive build per-path caches): {why}")
                 };
                 let source = MillCell::default_path().display().to_string();
                 (planner, source, note)
@@ -175,8 +176,8 @@ impl NodeConfig {
                             Err(e) => (
                                 None,
                                 format!(
-                                    "no indicator cache (dp and naive unavailable): the shipped \
-                                     one does not fit this cell: {e}"
+                                    "no indicator cache (dp and naive build per-path caches): the \
+                                     shipped one does not fit this cell: {e}"
                                 ),
                             ),
                         }
@@ -208,7 +209,10 @@ impl NodeConfig {
         match kind {
             PlannerKind::Ddpg => Some(&self.ddpg_policy_file),
             PlannerKind::FixedG => Some(&self.fixed_g_policy_file),
-            PlannerKind::Dp | PlannerKind::Naive => None,
+            PlannerKind::Dp
+            | PlannerKind::Naive
+            | PlannerKind::Greedy
+            | PlannerKind::GreedyBestG => None,
         }
     }
 }

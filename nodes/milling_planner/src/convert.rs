@@ -56,8 +56,8 @@ pub fn planner_name(field: &str) -> &str {
 /// Every value is passed on unchanged for the planner's validation (NaN, min > max, …).
 ///
 /// # Errors
-/// [`MillPlanError::InvalidConfig`] naming `policy_file` when one is given for `dp` or
-/// `naive`, which use no policy (`MillRequest.msg`: "Must be empty for dp and naive").
+/// [`MillPlanError::InvalidConfig`] naming `policy_file` when one is given for `dp`, `naive`,
+/// `greedy` or `greedy_best_g`, which use no policy (`MillRequest.msg`).
 pub fn request_from_msg(m: &msg::MillRequest) -> Result<MillRequest, MillPlanError> {
     let planner = planner_name(&m.planner).to_string();
     let policy_file = if m.policy_file.is_empty() {
@@ -65,8 +65,15 @@ pub fn request_from_msg(m: &msg::MillRequest) -> Result<MillRequest, MillPlanErr
     } else {
         Some(m.policy_file.clone())
     };
-    if let (Ok(kind @ (PlannerKind::Dp | PlannerKind::Naive)), Some(p)) =
-        (PlannerKind::parse(&planner), &policy_file)
+    if let (
+        Ok(
+            kind @ (PlannerKind::Dp
+            | PlannerKind::Naive
+            | PlannerKind::Greedy
+            | PlannerKind::GreedyBestG),
+        ),
+        Some(p),
+    ) = (PlannerKind::parse(&planner), &policy_file)
     {
         return Err(MillPlanError::InvalidConfig {
             name: "policy_file".to_string(),

@@ -53,7 +53,7 @@ fn shipped_cell_and_policies_by_default_and_replaced_by_parameters() {
         );
     } else {
         assert!(
-            c.cache_note.contains("dp and naive unavailable"),
+            c.cache_note.contains("dp and naive build per-path caches"),
             "{}",
             c.cache_note
         );
