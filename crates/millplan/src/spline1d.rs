@@ -262,6 +262,26 @@ impl StepProfile {
     }
 }
 
+/// A profile of either kind (the redundancy angle's: the cubic spline where it stays in range,
+/// else the smootherstep profile, which cannot leave the range of its values).
+#[derive(Debug, Clone, PartialEq)]
+pub enum Profile {
+    /// [`CubicSpline`].
+    Cubic(CubicSpline),
+    /// [`StepProfile`].
+    Step(StepProfile),
+}
+
+impl Profile {
+    /// y, y', y'' at `t`.
+    pub fn eval(&self, t: f64) -> Derivatives {
+        match self {
+            Profile::Cubic(c) => c.eval(t),
+            Profile::Step(p) => p.eval(t),
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -14,7 +14,9 @@
 //! # Steps of [`time_scale`]
 //! 1. **Smooth states along the path.** g(s) is the cubic spline through
 //!    the segments' g at their arc-length midpoints, with zero slope at the
-//!    path's ends ([`crate::spline1d::CubicSpline`]); f(s) joins the
+//!    path's ends ([`crate::spline1d::CubicSpline`]; where it would overshoot
+//!    the cell's g range, the smootherstep profile through the same values,
+//!    which cannot); f(s) joins the
 //!    segments' feeds with the smootherstep profile
 //!    ([`crate::spline1d::StepProfile`]); both pass exactly through the
 //!    planned values at every midpoint, where each segment was evaluated.
@@ -65,7 +67,7 @@ use crate::deviation::{distance_to_path, measure, PathDeviation};
 use crate::error::MillPlanError;
 use crate::plan::Plan;
 use crate::slowdown::SlowdownField;
-use crate::spline1d::{CubicSpline, StepProfile};
+use crate::spline1d::{CubicSpline, Profile, StepProfile};
 use crate::time_law::TimeLaw;
 use crate::trajectory::{JointTrajectory, TrajectoryPoint, TrajectoryRequest};
 
@@ -201,8 +203,9 @@ impl TrajectorySettings {
 /// follows between the segment midpoints).
 #[derive(Debug, Clone, PartialEq)]
 pub struct ExecutedProfiles {
-    /// g(s) \[rad\].
-    pub g: CubicSpline,
+    /// g(s) \[rad\]: the cubic spline, or the smootherstep profile where the
+    /// spline would leave the cell's g range.
+    pub g: Profile,
     /// f(s) \[m/s\], before the slowdown.
     pub feed: StepProfile,
     /// Ω(s) \[rpm\].
@@ -297,7 +300,7 @@ struct Evaluation {
 /// [`MillPlanError::InvalidParameter`] for bad settings;
 /// [`MillPlanError::InvalidConfig`] for a plan without segments, out of
 /// order, a non-positive feed, bad limits; [`MillPlanError::NotExecutable`]
-/// when g(s) leaves the cell's g range between two midpoints, when the
+/// when the
 /// tolerance would need more than `max_points` points or pieces shorter
 /// than a quarter control period (a branch change of the IK), or when the
 /// rounds run out; IK errors along the path; [`MillPlanError::Interrupted`].
@@ -365,23 +368,23 @@ pub fn time_scale(
         out.push(v(n - 1));
         out
     };
-    let g_profile = CubicSpline::new("g(s)", &x, &ends(&|i| plan.segments[i].g), Some((0.0, 0.0)))?;
+    let g_values = ends(&|i| plan.segments[i].g);
+    let cubic = CubicSpline::new("g(s)", &x, &g_values, Some((0.0, 0.0)))?;
+    let [g_lo, g_hi] = cell.state_limits().redundancy_angle;
+    let (lo, hi) = cubic.range();
+    // The spline overshoots between two values at the edge of the range: there the
+    // smootherstep profile, which stays between its values, is used instead.
+    let g_profile = if lo < g_lo - 1e-12 || hi > g_hi + 1e-12 {
+        Profile::Step(StepProfile::new("g(s)", &x, &g_values)?)
+    } else {
+        Profile::Cubic(cubic)
+    };
     let profiles = ExecutedProfiles {
         g: g_profile,
         feed: StepProfile::new("f(s)", &x, &ends(&|i| plan.segments[i].feed))?,
         rpm: StepProfile::new("spindle speed(s)", &x, &ends(&|i| plan.segments[i].rpm))?,
     };
     let (g, feed) = (&profiles.g, &profiles.feed);
-    let [g_lo, g_hi] = cell.state_limits().redundancy_angle;
-    let (lo, hi) = g.range();
-    if lo < g_lo - 1e-12 || hi > g_hi + 1e-12 {
-        return Err(MillPlanError::NotExecutable {
-            reason: format!(
-                "the smooth redundancy angle g(s) through the plan's values reaches [{lo:.4}, \
-                 {hi:.4}] rad, outside the range [{g_lo}, {g_hi}]"
-            ),
-        });
-    }
     // Step 2: initial knots at every segment's ends and midpoint.
     let mut knots: Vec<GeoKnot> = Vec::with_capacity(2 * n + 1);
     let mut reference = plan.segments[0].joints;

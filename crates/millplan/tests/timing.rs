@@ -10,6 +10,7 @@ use kerf_budget::Budget;
 use kerf_mill::MillCell;
 use kerf_millplan::deviation::executed_deviation;
 use kerf_millplan::plan::SegmentPlan;
+use kerf_millplan::spline1d::Profile;
 use kerf_millplan::timing::{three_point_velocity, time_scale, JointLimit, TrajectorySettings};
 use kerf_millplan::{MillPlanError, Plan, RewardParts, TimeScaling};
 
@@ -179,6 +180,29 @@ fn the_measurement_is_the_same_on_any_number_of_threads() {
         assert_eq!(one, many, "{threads} threads");
     }
     assert!(one.deviation.samples > 1000);
+}
+
+/// A plan whose g zig-zags between the two ends of a narrowed g range: the cubic spline through
+/// its values would leave the range, so the smootherstep profile (which cannot) is used.
+#[test]
+fn g_at_the_edges_of_its_range_stays_in_range() {
+    let default = MillCell::default_cell().unwrap();
+    let mut limits = *default.state_limits();
+    limits.redundancy_angle = [-0.5, -0.3];
+    let cell = default.with_state_limits(limits).unwrap();
+    let p = plan(&cell, |_| 0.04, |i| if i % 2 == 0 { -0.3 } else { -0.5 });
+    let sc = scale(&cell, &p, &TrajectorySettings::default());
+    assert!(matches!(sc.profiles.g, Profile::Step(_)));
+    let length = cell.path().total_length();
+    for k in 0..=4000 {
+        let g = sc.profiles.g.eval(length * k as f64 / 4000.0).value;
+        assert!((-0.5 - 1e-12..=-0.3 + 1e-12).contains(&g), "{g}");
+    }
+    assert!(sc.deviation.max_off_path <= 5e-5);
+    // Inside the default range the spline is kept.
+    let q = plan(&default, |_| 0.04, |i| if i % 2 == 0 { -0.3 } else { -0.5 });
+    let sq = scale(&default, &q, &TrajectorySettings::default());
+    assert!(matches!(sq.profiles.g, Profile::Cubic(_)));
 }
 
 #[test]

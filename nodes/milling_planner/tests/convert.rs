@@ -197,12 +197,12 @@ fn bad_values_reach_validation_and_are_named() {
         .unwrap_err();
     assert!(e.to_string().contains("at least 2 points"), "{e}");
     let mut m = message();
-    m.planner = "greedy".into();
+    m.planner = "fastest".into();
     let e = convert::request_from_msg(&m)
         .unwrap()
         .validate()
         .unwrap_err();
-    assert!(e.to_string().contains("unknown planner `greedy`"), "{e}");
+    assert!(e.to_string().contains("unknown planner `fastest`"), "{e}");
 }
 
 #[test]
@@ -245,7 +245,7 @@ fn errors_carry_their_status_and_the_planner_name() {
         value: f64::NAN,
         reason: "must be finite".into(),
     };
-    let m = convert::error_to_msg("e2", "greedy", &bad);
+    let m = convert::error_to_msg("e2", "fastest", &bad);
     assert_eq!(m.status, msg::MillPlan::INVALID_REQUEST);
     assert_eq!(m.planner, "");
     assert_eq!(convert::answer_planner("fixed_g"), "fixed_g");
