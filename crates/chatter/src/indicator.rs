@@ -226,10 +226,12 @@ fn finite(rho: f64) -> Result<f64, ChatterError> {
 /// [`ChatterError::NonFinite`]; [`ChatterError::Unsupported`].
 ///
 /// # Performance
-/// State-dependent, m = 40, 200 equilibrium nodes, dev profile
-/// (opt-level 1) on the 2-core build machine: about 1.4 ms (equilibrium 0.8 ms,
-/// linearization 0.2 ms, diagnostics 0.06 ms, discretization and Arnoldi
-/// 0.2-0.3 ms); constant delay about 0.25 ms. Release figures: BENCHMARKS.md.
+/// State-dependent, m = 40, 200 equilibrium nodes, release build on the
+/// 2-core build machine (the default cell's case of BENCHMARKS.md, "Chatter
+/// indicator per evaluation"): about 0.37 ms (equilibrium 0.22 ms,
+/// linearization 0.03 ms, diagnostics 0.01 ms, `Discretization::new` 0.02 ms,
+/// compile and Arnoldi 0.09 ms); constant delay about 0.13 ms. A dev build
+/// (opt-level 1) takes about three times as long.
 pub fn chatter_indicator(
     modal: &Modal2,
     process: &MillingProcess,
