@@ -22,6 +22,8 @@ pub mod grid_dp;
 pub mod grid_spec;
 pub mod joint_speed;
 pub mod naive;
+pub mod observation;
+pub mod path_distribution;
 pub mod plan;
 pub mod provenance;
 pub mod reward;

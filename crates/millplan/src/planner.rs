@@ -20,11 +20,14 @@
 //!    [`MillEnv`] (α and weights of [`MillPlanner::env_config`]); `dp` —
 //!    [`crate::dp::solve`] over the full state ranges from the request's
 //!    initial state; `naive` — [`crate::naive::solve`] at g = g0.
-//!    A policy is applied as it is to any request whose sizes fit: its
-//!    observations are normalized by the REQUEST's limits and number of segments,
-//!    so a policy trained on the default cell is only meaningful for
-//!    requests close to it (a rollout that leaves the feasible set is a
-//!    [`MillPlanError::Policy`] error).
+//!    A policy is applied to a request when it records the environment's
+//!    observation layout ([`crate::observation`]: path-independent
+//!    features, normalized by the REQUEST's limits) and action size, else
+//!    [`MillPlanError::Policy`]; the shipped policies are trained on a
+//!    distribution of planar paths ([`crate::path_distribution`]) and
+//!    evaluated on held-out ones (`BENCHMARKS.md`, "Policy that
+//!    generalizes"). A rollout that leaves the feasible set is a
+//!    [`MillPlanError::Policy`] error.
 //! 5. [`Plan::evaluate_with_threads`]: every segment evaluated directly
 //!    (|μ|max never from the cache) on [`MillPlanner::eval_threads`]
 //!    threads (the same plan, bit for bit, for every thread count), the
@@ -73,6 +76,7 @@ use crate::error::MillPlanError;
 use crate::evaluation::evaluate_impl;
 use crate::executed::executed;
 use crate::naive;
+use crate::observation::OBSERVATION_LAYOUT;
 use crate::plan::{default_eval_threads, IndicatorProvenance, IndicatorSource, Plan};
 use crate::planned::planned_trajectory;
 use crate::policy::Policy;
@@ -471,7 +475,7 @@ impl MillPlanner {
                 };
                 let mut env = MillEnv::new(cell.clone(), cache.clone(), config)?;
                 let policy = self.policy(&path)?;
-                policy.check_sizes(env.observation_dim(), env.action_dim())?;
+                policy.check_observation(&OBSERVATION_LAYOUT, env.action_dim())?;
                 let rollout = env.rollout(|obs, _| {
                     budget.check("the policy rollout")?;
                     policy.act(obs)

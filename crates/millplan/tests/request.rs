@@ -49,6 +49,7 @@ fn saved_actor(dir: &std::path::Path, obs: usize, act: usize) -> PathBuf {
         environment: format!("test actor {obs}x{act}"),
         episodes: 0,
         final_reward: None,
+        observation_layout: Vec::new(),
     };
     let mut policy = Policy::from_actor(&net, metadata).expect("policy");
     let path = dir.join(format!("actor_{obs}_{act}.safetensors"));
