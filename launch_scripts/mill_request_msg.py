@@ -11,7 +11,8 @@ limits, initial state) whole behind its has_* flag: a file's `process` must give
 fields (as the schema requires), its `limits` all three ranges and all three step bounds (the
 message has no per-field default; the script refuses a partial `limits`), and missing fields
 of `initial` take seed 004's initial value problem (2000 rpm, 0.04 m/s, 0 rad), as the
-planner does. Needs PyYAML (Debian: python3-yaml).
+planner does; a missing field of `tolerances` takes the planner's (path_tolerance 5e-5 m,
+min_condition_indicator 0 = no minimum). Needs PyYAML (Debian: python3-yaml).
 """
 import json
 import sys
@@ -20,10 +21,11 @@ import yaml
 
 FIELDS = {
     "request_id", "points", "segments", "process", "limits", "initial", "planner", "policy_file",
-    "time_budget",
+    "time_budget", "tolerances",
 }
 PROCESS = ["teeth", "tool_radius", "axial_depth", "kt", "kn", "entry_angle", "exit_angle"]
 INITIAL = {"spindle_rpm": 2000.0, "feed": 0.04, "g": 0.0}
+TOLERANCES = {"path_tolerance": 5e-5, "min_condition_indicator": 0.0}
 
 
 def fail(path, why):
@@ -64,6 +66,7 @@ def main(path):
         "planner": r.get("planner", "ddpg"),
         "policy_file": r.get("policy_file", ""),
         "time_budget": num(path, "time_budget", r.get("time_budget", 0.0)),
+        "has_tolerances": "tolerances" in r,
     }
     # Every field, so the message is complete also for readers without defaults; the fields
     # of a group whose flag is false are ignored by the node.
@@ -71,6 +74,7 @@ def main(path):
         "spindle_min_rpm", "spindle_max_rpm", "feed_min", "feed_max", "g_min", "g_max",
         "max_spindle_step_rpm", "max_feed_step", "max_g_step",
         "initial_spindle_rpm", "initial_feed", "initial_g",
+        "path_tolerance", "min_condition_indicator",
     ]
     msg.update({k: 0 if k == "teeth" else 0.0 for k in zeros})
     if "process" in r:
@@ -108,6 +112,12 @@ def main(path):
             fail(path, f"initial: unknown field(s) {', '.join(unknown)}")
         msg.update({f"initial_{k}": num(path, f"initial.{k}", i.get(k, d))
                     for k, d in INITIAL.items()})
+    if "tolerances" in r:
+        t = r["tolerances"] or {}
+        unknown = sorted(set(t) - set(TOLERANCES))
+        if unknown:
+            fail(path, f"tolerances: unknown field(s) {', '.join(unknown)}")
+        msg.update({k: num(path, f"tolerances.{k}", t.get(k, d)) for k, d in TOLERANCES.items()})
     # JSON is valid YAML, and ros2 topic pub reads it on one line.
     print(json.dumps(msg))
 

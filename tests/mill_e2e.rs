@@ -251,8 +251,32 @@ fn bad_requests_get_their_status_and_the_node_keeps_serving() {
         (
             "unknown-planner",
             MillPlan::INVALID_REQUEST,
-            Box::new(|m| m.planner = "greedy".into()),
-            s(&["unknown planner `greedy`"]),
+            Box::new(|m| m.planner = "fastest".into()),
+            s(&["unknown planner `fastest`"]),
+        ),
+        (
+            "zero-path-tolerance",
+            MillPlan::INVALID_REQUEST,
+            Box::new(|m| {
+                m.has_tolerances = true;
+                m.path_tolerance = 0.0;
+            }),
+            s(&["tolerances.path_tolerance [m]", "must be > 0"]),
+        ),
+        (
+            "unmeetable-condition",
+            MillPlan::ILL_CONDITIONED,
+            // No plan of this path keeps 1/K above 0.99 (a perfectly isotropic arm).
+            Box::new(|m| {
+                m.has_tolerances = true;
+                m.path_tolerance = 5e-5;
+                m.min_condition_indicator = 0.99;
+            }),
+            s(&[
+                "condition indicator 1/K falls to",
+                "arc length",
+                "below the requested minimum 0.99",
+            ]),
         ),
     ];
     for (id, _, mutate, _) in &cases {
@@ -333,7 +357,10 @@ fn bad_requests_get_their_status_and_the_node_keeps_serving() {
     expect(&naive, "after-naive", MillPlan::SUCCESS, &["naive"]);
     assert_eq!(naive.planner, "naive");
     assert_eq!(naive.segments.len(), 100);
-    assert_eq!(naive.trajectory.points.len(), 102);
+    assert!(naive.trajectory.points.len() > 102, "dense samples");
+    assert!(naive.max_path_deviation > 0.0 && naive.max_path_deviation <= naive.path_tolerance);
+    assert!(naive.max_plane_deviation <= naive.path_tolerance);
+    assert_eq!(naive.path_tolerance, 5e-5);
     let mut m = request_msg("after-ddpg", "ddpg");
     m.policy_file = trained.display().to_string();
     planner.send(m);
@@ -385,8 +412,17 @@ fn assert_same_plan(answer: &MillPlan, direct: &MillPlanOutput) {
     for (a, b) in answer.trajectory.points.iter().zip(run.points()) {
         assert_eq!(a.positions, b.positions.to_vec());
         assert_eq!(a.velocities, b.velocities.to_vec());
+        assert_eq!(a.accelerations, b.accelerations.to_vec());
         assert!((a.time_from_start.as_secs_f64() - b.time_from_start).abs() <= 1e-9);
     }
+    assert_eq!(
+        answer.max_path_deviation,
+        direct.executed.deviation.max_off_path
+    );
+    assert_eq!(
+        answer.max_plane_deviation,
+        direct.executed.deviation.max_off_plane
+    );
     let end = answer.trajectory.points.last().expect("points");
     assert!((end.time_from_start.as_secs_f64() - answer.machining_time).abs() <= 1e-9);
 }

@@ -214,6 +214,9 @@ pub fn mill_request(u: &mut Unstructured) -> Result<msg::MillRequest> {
         planner: string(u, &["ddpg", "fixed_g", "dp", "naive"])?,
         policy_file: string(u, &["crates/millplan/policies/ddpg.json"])?,
         time_budget: if u.arbitrary()? { 0.0 } else { float(u)? },
+        has_tolerances: u.arbitrary()?,
+        path_tolerance: positive(u, 5e-5)?,
+        min_condition_indicator: float(u)?,
     })
 }
 

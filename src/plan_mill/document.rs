@@ -27,6 +27,7 @@ fn trajectory_json(t: &JointTrajectory) -> Value {
             "time_from_start_s": p.time_from_start,
             "positions_rad": p.positions,
             "velocities_rad_per_s": p.velocities,
+            "accelerations_rad_per_s2": p.accelerations,
             "arc_length_m": s,
             "segment": g,
         })).collect::<Vec<_>>(),

@@ -52,22 +52,31 @@ impl BSpline {
     /// # Performance
     /// O(k^2).
     pub fn eval(&self, u: f64) -> [f64; 4] {
+        let [out] = self.eval_coefficients([&self.coeffs], u);
+        out
+    }
+
+    /// `[q, q_u, q_uu, q_uuu]` at u of the splines with this knot vector and the coefficient
+    /// lists `coeffs` (each of `n_coeffs` entries; a shorter list contributes zeros), from one
+    /// basis evaluation (on the stack for degree < 8; the arithmetic of
+    /// [`KnotVector::basis_derivs`]).
+    fn eval_coefficients<const N: usize>(&self, coeffs: [&[f64]; N], u: f64) -> [[f64; 4]; N] {
         let w = self.kv.degree() + 1;
-        let mut out = [0.0; 4];
+        let mut out = [[0.0; 4]; N];
         let mut combine = |first: usize, ders: &[f64]| {
-            for (o, row) in out.iter_mut().zip(ders.chunks(w)) {
-                *o = self
-                    .coeffs
-                    .get(first..)
-                    .unwrap_or(&[])
-                    .iter()
-                    .zip(row)
-                    .map(|(c, n)| c * n)
-                    .sum();
+            for (o, c) in out.iter_mut().zip(coeffs) {
+                for (v, row) in o.iter_mut().zip(ders.chunks(w)) {
+                    *v = c
+                        .get(first..)
+                        .unwrap_or(&[])
+                        .iter()
+                        .zip(row)
+                        .map(|(c, n)| c * n)
+                        .sum();
+                }
             }
         };
         if w <= FAST_WIDTH {
-            // Stack storage: no allocation (the same arithmetic as basis_derivs).
             let mut ders = [0.0; 4 * FAST_WIDTH];
             let mut ndu = [0.0; FAST_WIDTH * FAST_WIDTH];
             let mut scratch = [0.0; 4 * FAST_WIDTH];
@@ -80,6 +89,34 @@ impl BSpline {
             combine(first, &ders.concat());
         }
         out
+    }
+
+    /// [`BSpline::eval`] of several splines that share this spline's knot vector, with one
+    /// basis evaluation for all: `out[i]` is `[q, q_u, q_uu, q_uuu]` of the spline with this
+    /// knot vector and the coefficients `coeffs[i]` (a curve's coordinates, fitted on one
+    /// knot vector).
+    ///
+    /// # Errors
+    /// [`BsplineError::NotFinite`] / [`BsplineError::ParameterOutOfRange`] for u;
+    /// [`BsplineError::LengthMismatch`] for a coefficient list of another length.
+    ///
+    /// # Performance
+    /// One basis evaluation (O(k²), on the stack for degree < 8) and N dot products.
+    pub fn eval_shared<const N: usize>(
+        &self,
+        coeffs: [&[f64]; N],
+        u: f64,
+    ) -> Result<[[f64; 4]; N], BsplineError> {
+        let u = check_param(u)?;
+        let n = self.kv.n_coeffs();
+        if let Some(c) = coeffs.iter().find(|c| c.len() != n) {
+            return Err(BsplineError::LengthMismatch {
+                what: "B-spline coefficients".into(),
+                expected: n,
+                got: c.len(),
+            });
+        }
+        Ok(self.eval_coefficients(coeffs, u))
     }
 
     /// [`BSpline::eval`] after validating u.

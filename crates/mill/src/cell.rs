@@ -347,15 +347,24 @@ impl MillCell {
     /// inversion; [`MillError::Singular`] for a zero tangent.
     pub fn tool_pose_at(&self, s: f64, g: f64) -> Result<Isometry3<f64>, MillError> {
         let g = check_finite("redundancy angle g [rad]", g)?;
-        let u = self.path.parameter_at(s)?;
-        let p = self.path.point(u)?;
+        self.tool_pose_at_parameter(self.path.parameter_at(s)?, g)
+    }
+
+    /// [`MillCell::tool_pose_at`] at the path's spline parameter `u` instead of the arc
+    /// length (for a caller that already has u: the arc-length inversion is the costly part).
+    ///
+    /// # Errors
+    /// [`MillError::InvalidParameter`] for a non-finite g; [`MillError::Bspline`] for u
+    /// outside [0, 1]; [`MillError::Singular`] for a zero tangent.
+    pub fn tool_pose_at_parameter(&self, u: f64, g: f64) -> Result<Isometry3<f64>, MillError> {
+        let g = check_finite("redundancy angle g [rad]", g)?;
+        let (p, d) = self.path.point_and_derivative(u)?;
         let n = self.path.normal();
-        let d = self.path.derivative(u)?;
         let d = d - d.dot(&n) * n;
         let norm = d.norm();
         if norm.is_nan() || norm <= 0.0 {
             return Err(MillError::Singular {
-                what: format!("path tangent at arc length {s} m (zero speed)"),
+                what: format!("path tangent at spline parameter {u} (zero speed)"),
             });
         }
         Ok(crate::path::tool_pose(
@@ -381,6 +390,30 @@ impl MillCell {
         g: f64,
         reference: Option<&[f64; 6]>,
     ) -> Result<[f64; 6], MillError> {
+        self.check_g(g)?;
+        self.joints_at_parameter(self.path.parameter_at(s)?, g, reference)
+    }
+
+    /// [`MillCell::joints_at`] at the path's spline parameter `u` instead of the arc length.
+    ///
+    /// # Errors
+    /// As [`MillCell::tool_pose_at_parameter`]; [`MillError::InvalidParameter`] for g outside
+    /// the configured range; [`MillError::Unreachable`] / [`MillError::JointLimit`] with g.
+    pub fn joints_at_parameter(
+        &self,
+        u: f64,
+        g: f64,
+        reference: Option<&[f64; 6]>,
+    ) -> Result<[f64; 6], MillError> {
+        self.check_g(g)?;
+        let pose = self.tool_pose_at_parameter(u, g)?;
+        self.kinematics
+            .ik_nearest(&pose, reference.unwrap_or(&self.reference))
+            .map_err(|e| e.with_context(None, Some(g)))
+    }
+
+    /// g inside the configured range (1e-12 slack).
+    fn check_g(&self, g: f64) -> Result<(), MillError> {
         let [lo, hi] = self.limits.redundancy_angle;
         if !(g >= lo - 1e-12 && g <= hi + 1e-12) {
             return Err(MillError::InvalidParameter {
@@ -389,9 +422,6 @@ impl MillCell {
                 reason: format!("must be in [{lo}, {hi}]"),
             });
         }
-        let pose = self.tool_pose_at(s, g)?;
-        self.kinematics
-            .ik_nearest(&pose, reference.unwrap_or(&self.reference))
-            .map_err(|e| e.with_context(None, Some(g)))
+        Ok(())
     }
 }

@@ -242,11 +242,15 @@ impl MillingPath {
     /// # Errors
     /// [`MillError::Bspline`] for u outside [0, 1] or NaN.
     pub fn point(&self, u: f64) -> Result<Vector3<f64>, MillError> {
-        let mut p = Vector3::zeros();
-        for (c, s) in p.iter_mut().zip(&self.curve) {
-            *c = s.try_eval(u)?[0];
-        }
-        Ok(p)
+        let c = self.coordinates(u)?;
+        Ok(Vector3::new(c[0][0], c[1][0], c[2][0]))
+    }
+
+    /// Value and first three derivatives of the three coordinates at u, from one basis
+    /// evaluation (the coordinates share their knot vector: [`fit_curve`]).
+    fn coordinates(&self, u: f64) -> Result<[[f64; 4]; 3], MillError> {
+        let [x, y, z] = &self.curve;
+        Ok(x.eval_shared([x.coeffs(), y.coeffs(), z.coeffs()], u)?)
     }
 
     /// Derivative P'(u) [m per unit u].
@@ -254,26 +258,20 @@ impl MillingPath {
     /// # Errors
     /// [`MillError::Bspline`] for u outside [0, 1] or NaN.
     pub fn derivative(&self, u: f64) -> Result<Vector3<f64>, MillError> {
-        let mut p = Vector3::zeros();
-        for (c, s) in p.iter_mut().zip(&self.curve) {
-            *c = s.try_eval(u)?[1];
-        }
-        Ok(p)
+        let c = self.coordinates(u)?;
+        Ok(Vector3::new(c[0][1], c[1][1], c[2][1]))
     }
 
-    /// P(u) and P'(u) from one basis evaluation per coordinate.
+    /// P(u) and P'(u) from one basis evaluation.
     ///
     /// # Errors
     /// [`MillError::Bspline`] for u outside [0, 1] or NaN.
     pub fn point_and_derivative(&self, u: f64) -> Result<(Vector3<f64>, Vector3<f64>), MillError> {
-        let mut p = Vector3::zeros();
-        let mut d = Vector3::zeros();
-        for ((pc, dc), s) in p.iter_mut().zip(d.iter_mut()).zip(&self.curve) {
-            let e = s.try_eval(u)?;
-            *pc = e[0];
-            *dc = e[1];
-        }
-        Ok((p, d))
+        let c = self.coordinates(u)?;
+        Ok((
+            Vector3::new(c[0][0], c[1][0], c[2][0]),
+            Vector3::new(c[0][1], c[1][1], c[2][1]),
+        ))
     }
 
     /// Arc length s(u) from u = 0 \[m\].
@@ -376,12 +374,9 @@ impl MillingPath {
         x.iter()
             .zip(w)
             .map(|(xi, wi)| {
-                let u = m + h * xi;
-                let mut d = Vector3::zeros();
-                for (c, s) in d.iter_mut().zip(&self.curve) {
-                    *c = s.eval(u)[1];
-                }
-                wi * d.norm()
+                let u = (m + h * xi).clamp(0.0, 1.0);
+                let c = self.coordinates(u).unwrap_or([[f64::NAN; 4]; 3]);
+                wi * Vector3::new(c[0][1], c[1][1], c[2][1]).norm()
             })
             .sum::<f64>()
             * h

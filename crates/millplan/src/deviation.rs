@@ -146,6 +146,7 @@ pub(crate) fn measure(
     let mut sample = kerf_executor::JointSample::default();
     let mut cursor = 0;
     let mut over = Vec::new();
+    let mut previous: [Option<f64>; 2] = [None, None];
     for k in 0..=steps {
         let t = (t0 + k as f64 * period).min(t1);
         prepared.sample_into(t, &mut sample);
@@ -168,8 +169,15 @@ pub(crate) fn measure(
         } else {
             0.0
         };
-        let u = params[cursor] + w * (params[next] - params[cursor]);
-        let (d, _) = distance_to_path(cell, &tip, u)?;
+        let linear = params[cursor] + w * (params[next] - params[cursor]);
+        // Warm start: the foot points of the last two samples, extrapolated (consecutive
+        // samples are one control period apart), when they agree with the linear guess.
+        let guess = match (previous[0], previous[1]) {
+            (Some(a), Some(b)) if ((2.0 * b - a) - linear).abs() < 1e-3 => 2.0 * b - a,
+            _ => linear,
+        };
+        let (d, u) = distance_to_path(cell, &tip, guess)?;
+        previous = [previous[1], Some(u)];
         if d > max_off_path {
             (max_off_path, time_of_max) = (d, tr);
         }

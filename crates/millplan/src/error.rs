@@ -58,6 +58,22 @@ pub enum MillPlanError {
         /// The executor's reason.
         reason: String,
     },
+    /// The executed trajectory passes closer to a singularity than the request allows: its
+    /// condition indicator 1/K (seed 004 eq. 14) falls below the requested minimum.
+    #[error(
+        "the plan's condition indicator 1/K falls to {value:.4} at arc length {arc_length:.4} m \
+         (segment {segment}), below the requested minimum {minimum}"
+    )]
+    IllConditioned {
+        /// The smallest 1/K along the executed trajectory.
+        value: f64,
+        /// Where \[m\].
+        arc_length: f64,
+        /// The plan segment there.
+        segment: usize,
+        /// The requested minimum.
+        minimum: f64,
+    },
     /// Planning stopped before its end: the request's time budget ran out (status TIMEOUT) or
     /// the planner was cancelled (the node is stopping; INTERNAL_ERROR).
     #[error("{0}")]

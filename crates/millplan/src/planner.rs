@@ -34,12 +34,19 @@
 //!    totals.
 //! 6. The joint trajectory ([`crate::trajectory::JointTrajectory`],
 //!    [`crate::planned`]).
-//! 7. What the robot runs ([`MillPlanOutput::executed`]): the trajectory
-//!    from rest to rest, time-scaled to the joints' velocity and
-//!    acceleration limits ([`crate::timing::time_scale`]: slowed where
-//!    the planned timing asks too much of a joint, never sped up), and
-//!    the plan at the feeds that result, |μ|max re-evaluated directly
-//!    where a feed changed ([`Plan::as_executed`]).
+//! 7. What the robot runs ([`MillPlanOutput::executed`]): the dense
+//!    trajectory from rest to rest with smooth Ω, f and g along the path,
+//!    within the joints' velocity, acceleration and jerk limits and the
+//!    path tolerance (the request's `tolerances.path_tolerance`, else
+//!    [`MillPlanner::trajectory_settings`]; [`crate::timing::time_scale`]:
+//!    slowed where the planned feeds ask too much of a joint, never sped
+//!    up; the tool path measured with the executor's own interpolation at
+//!    its control period), and the plan at the feeds that result, |μ|max
+//!    re-evaluated directly where a feed changed ([`Plan::as_executed`]).
+//! 8. A request's `tolerances.min_condition_indicator`: the smallest 1/K
+//!    over the trajectory's points must reach it, else
+//!    [`MillPlanError::IllConditioned`] (status ILL_CONDITIONED) with the
+//!    value, the arc length and the segment.
 //!
 //! # When the indicator cache applies
 //! The cache ([`IndicatorCache`]) holds |μ|max of the DEFAULT cell. It
@@ -560,10 +567,14 @@ impl MillPlanner {
         let step = Instant::now();
         budget.check("the planned trajectory")?;
         let (trajectory, branch_jumps) = planned_trajectory(&cell, &plan)?;
+        let mut settings = self.trajectory_settings;
+        if let Some(tolerance) = request.path_tolerance() {
+            settings.path_tolerance = tolerance;
+        }
         let executed = executed(
             &cell,
             &plan,
-            &self.trajectory_settings,
+            &settings,
             weights,
             self.eval_threads,
             &indicator,
@@ -574,6 +585,24 @@ impl MillPlanner {
             budget,
         )?;
         phases.trajectory = step.elapsed().as_secs_f64();
+        if let Some(minimum) = request.min_condition_indicator() {
+            let (value, arc_length) = executed.scaling.min_condition_indicator;
+            if value < minimum {
+                let points = &executed.scaling.trajectory;
+                let segment = points
+                    .arc_length
+                    .iter()
+                    .position(|s| *s == arc_length)
+                    .and_then(|k| points.segment.get(k).copied())
+                    .unwrap_or(0);
+                return Err(MillPlanError::IllConditioned {
+                    value,
+                    arc_length,
+                    segment,
+                    minimum,
+                });
+            }
+        }
         Ok(MillPlanOutput {
             request_id: request.request_id.clone(),
             planner: kind,

@@ -199,6 +199,25 @@ pub struct RequestInitial {
     pub g: Option<f64>,
 }
 
+/// Tolerances of the executed plan (issue 13, items 1 and 2), each optional.
+#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RequestTolerances {
+    /// Largest distance of the executed tool tip from the path and from the milling plane
+    /// \[m\], in (0, [`MAX_PATH_TOLERANCE`]] (the planner's, 5e-5 m by default, when absent).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub path_tolerance: Option<f64>,
+    /// Smallest condition indicator 1/K (seed 004 eq. 14) allowed at every point of the
+    /// executed trajectory, in [0, 1); 0 or absent: no minimum. A plan below it is refused
+    /// ([`MillPlanError::IllConditioned`]).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub min_condition_indicator: Option<f64>,
+}
+
+/// Largest path tolerance a request may ask for \[m\]: the executed path is measured by a
+/// closest-point search that assumes the tool within a millimetre of the path.
+pub const MAX_PATH_TOLERANCE: f64 = 1e-3;
+
 /// A milling planning request (module documentation).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -234,6 +253,9 @@ pub struct MillRequest {
     /// [`MillPlanError::Interrupted`] (status TIMEOUT).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub time_budget: Option<f64>,
+    /// Tolerances of the executed plan (the planner's when absent).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub tolerances: Option<RequestTolerances>,
 }
 
 fn default_planner() -> String {
@@ -254,6 +276,7 @@ impl Default for MillRequest {
             planner: default_planner(),
             policy_file: None,
             time_budget: None,
+            tolerances: None,
         }
     }
 }
@@ -427,6 +450,7 @@ impl MillRequest {
     /// for a few points).
     pub fn validate(&self) -> Result<(), MillPlanError> {
         self.time_limit()?;
+        self.check_tolerances()?;
         if self.points.len() < 2 {
             return Err(MillPlanError::InvalidParameter {
                 name: "points (count)".to_string(),
@@ -586,6 +610,44 @@ impl MillRequest {
             value: seconds,
             reason,
         })
+    }
+
+    /// The request's path tolerance \[m\], if it gives one.
+    pub fn path_tolerance(&self) -> Option<f64> {
+        self.tolerances.and_then(|t| t.path_tolerance)
+    }
+
+    /// The request's minimum condition indicator, if it asks for one above 0.
+    pub fn min_condition_indicator(&self) -> Option<f64> {
+        self.tolerances
+            .and_then(|t| t.min_condition_indicator)
+            .filter(|v| *v > 0.0)
+    }
+
+    fn check_tolerances(&self) -> Result<(), MillPlanError> {
+        let Some(t) = self.tolerances else {
+            return Ok(());
+        };
+        if let Some(v) = t.path_tolerance {
+            if !(v.is_finite() && v > 0.0 && v <= MAX_PATH_TOLERANCE) {
+                return Err(MillPlanError::InvalidParameter {
+                    name: "tolerances.path_tolerance [m]".to_string(),
+                    value: v,
+                    reason: format!("must be > 0 and at most {MAX_PATH_TOLERANCE} m"),
+                });
+            }
+        }
+        if let Some(v) = t.min_condition_indicator {
+            if !(v.is_finite() && (0.0..1.0).contains(&v)) {
+                return Err(MillPlanError::InvalidParameter {
+                    name: "tolerances.min_condition_indicator".to_string(),
+                    value: v,
+                    reason: "must be in [0, 1) (1/K of seed 004 eq. 14; 0 = no minimum)"
+                        .to_string(),
+                });
+            }
+        }
+        Ok(())
     }
 
     /// The request's limits over `cell_limits`.

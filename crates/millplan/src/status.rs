@@ -24,6 +24,9 @@ pub const CHATTER_MODEL_ERROR: u8 = 4;
 pub const INTERNAL_ERROR: u8 = 6;
 /// The request's time budget ran out before the plan was finished.
 pub const TIMEOUT: u8 = 7;
+/// The executed plan passes closer to a singularity than the request's minimum condition
+/// indicator allows (value and arc length in the message).
+pub const ILL_CONDITIONED: u8 = 8;
 
 /// The name of a status value, `None` for an unknown one.
 pub fn status_name(value: u8) -> Option<&'static str> {
@@ -35,6 +38,7 @@ pub fn status_name(value: u8) -> Option<&'static str> {
         CHATTER_MODEL_ERROR => Some("CHATTER_MODEL_ERROR"),
         INTERNAL_ERROR => Some("INTERNAL_ERROR"),
         TIMEOUT => Some("TIMEOUT"),
+        ILL_CONDITIONED => Some("ILL_CONDITIONED"),
         _ => None,
     }
 }
@@ -49,6 +53,7 @@ pub fn status_name(value: u8) -> Option<&'static str> {
 /// | `Chatter`, `Mill(Chatter)` | CHATTER_MODEL_ERROR 4 |
 /// | `Io`, `Backend`, `Mill` of a non-finite value, non-convergence, a file or robot-model failure; `Interrupted` by a cancellation | INTERNAL_ERROR 6 |
 /// | `Interrupted` by the time budget | TIMEOUT 7 |
+/// | `IllConditioned` | ILL_CONDITIONED 8 |
 ///
 /// Value 5 (`QUEUE_FULL` of `kerf_msgs/msg/MillPlan`) belongs to the node
 /// (its request queue) and is not produced here.
@@ -78,6 +83,7 @@ pub fn status_of(error: &MillPlanError) -> u8 {
         | MillPlanError::Backend(_)
         | MillPlanError::NotExecutable { .. } => INTERNAL_ERROR,
         MillPlanError::Interrupted(i) if i.is_timeout() => TIMEOUT,
+        MillPlanError::IllConditioned { .. } => ILL_CONDITIONED,
         MillPlanError::Interrupted(_) => INTERNAL_ERROR,
     }
 }

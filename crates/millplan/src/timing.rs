@@ -380,13 +380,10 @@ pub fn time_scale(
         } else {
             x[k / 2 + 1]
         };
-        let q = cell.joints_at(s.min(length), g.eval(s).value, Some(&reference))?;
+        let u = path.parameter_at(s.min(length))?;
+        let q = cell.joints_at_parameter(u, g.eval(s).value, Some(&reference))?;
         reference = q;
-        knots.push(GeoKnot {
-            s,
-            u: path.parameter_at(s.min(length))?,
-            q,
-        });
+        knots.push(GeoKnot { s, u, q });
     }
     let mut slowdown =
         SlowdownField::new(length, n).ok_or_else(|| bad(format!("path length {length} m")))?;
@@ -488,8 +485,8 @@ pub fn time_scale(
             if !(s > knots[k].s && s < knots[k + 1].s) {
                 continue;
             }
-            let q = cell.joints_at(s, g.eval(s).value, Some(&knots[k].q))?;
             let u = path.parameter_at(s)?;
+            let q = cell.joints_at_parameter(u, g.eval(s).value, Some(&knots[k].q))?;
             knots.insert(k + 1, GeoKnot { s, u, q });
         }
         // Step 6: slow down.

@@ -12,7 +12,9 @@ use kerf_millplan::ddpg::DdpgSettings;
 use kerf_millplan::nets::{Mlp, OutputActivation};
 use kerf_millplan::planner::{status, status_name};
 use kerf_millplan::policy::{PolicyMetadata, POLICY_FORMAT};
-use kerf_millplan::request::{RequestInitial, RequestLimits, RequestProcess, RequestStepBounds};
+use kerf_millplan::request::{
+    RequestInitial, RequestLimits, RequestProcess, RequestStepBounds, RequestTolerances,
+};
 use kerf_millplan::rng::Rng;
 use kerf_millplan::{
     default_policy_path, status_of, MillPlanError, MillPlanner, MillRequest, PlannerKind, Policy,
@@ -89,6 +91,10 @@ fn full_request() -> MillRequest {
         planner: "fixed_g".to_string(),
         policy_file: Some("policies/x.safetensors".to_string()),
         time_budget: Some(12.5),
+        tolerances: Some(RequestTolerances {
+            path_tolerance: Some(2e-5),
+            min_condition_indicator: Some(0.25),
+        }),
     }
 }
 
@@ -434,6 +440,75 @@ fn missing_and_incompatible_policy_files() {
     }
 }
 
+/// Tolerances: a path tolerance <= 0, NaN or above 1 mm and a minimum condition indicator
+/// outside [0, 1) are refused by name; a minimum the plan cannot meet is ILL_CONDITIONED with
+/// the value and where; a tighter path tolerance is met and reported.
+#[test]
+fn tolerances_are_validated_and_enforced() {
+    for (tolerance, words) in [
+        (0.0, "must be > 0"),
+        (-1e-5, "must be > 0"),
+        (f64::NAN, "must be > 0"),
+        (2e-3, "at most 0.001 m"),
+    ] {
+        let r = MillRequest {
+            tolerances: Some(RequestTolerances {
+                path_tolerance: Some(tolerance),
+                min_condition_indicator: None,
+            }),
+            ..MillRequest::default()
+        };
+        expect_invalid(&r, "tolerances.path_tolerance [m]", words);
+    }
+    for value in [-0.1, 1.0, f64::INFINITY] {
+        let r = MillRequest {
+            tolerances: Some(RequestTolerances {
+                path_tolerance: None,
+                min_condition_indicator: Some(value),
+            }),
+            ..MillRequest::default()
+        };
+        expect_invalid(&r, "tolerances.min_condition_indicator", "[0, 1)");
+    }
+    // The naive plan's smallest 1/K along its trajectory, then a minimum just above it.
+    let naive = MillRequest {
+        planner: "naive".to_string(),
+        ..MillRequest::default()
+    };
+    let out = planner().plan(&naive).expect("naive");
+    let (lowest, at) = out.executed.scaling.min_condition_indicator;
+    assert!(
+        lowest > 0.0 && lowest < 1.0 && (0.0..=0.9).contains(&at),
+        "{lowest} at {at}"
+    );
+    let strict = MillRequest {
+        tolerances: Some(RequestTolerances {
+            path_tolerance: Some(1e-5),
+            min_condition_indicator: Some(lowest + 0.01),
+        }),
+        ..naive.clone()
+    };
+    let e = planner().plan(&strict).expect_err("below the minimum");
+    assert_eq!(status_of(&e), status::ILL_CONDITIONED, "{e}");
+    let text = e.to_string();
+    assert!(
+        text.contains(&format!("{lowest:.4}")) && text.contains("arc length"),
+        "{text}"
+    );
+    // Just below it: planned, within the tighter path tolerance.
+    let met = MillRequest {
+        tolerances: Some(RequestTolerances {
+            path_tolerance: Some(1e-5),
+            min_condition_indicator: Some(lowest - 0.01),
+        }),
+        ..naive
+    };
+    let out = planner().plan(&met).expect("met");
+    assert_eq!(out.executed.settings.path_tolerance, 1e-5);
+    let d = out.executed.deviation;
+    assert!(d.max_off_path <= 1e-5 && d.max_off_plane <= 1e-5, "{d:?}");
+}
+
 #[test]
 fn status_values_and_names() {
     assert_eq!(
@@ -443,10 +518,13 @@ fn status_values_and_names() {
             status::UNREACHABLE,
             status::POLICY_ERROR,
             status::CHATTER_MODEL_ERROR,
-            status::INTERNAL_ERROR
+            status::INTERNAL_ERROR,
+            status::TIMEOUT,
+            status::ILL_CONDITIONED
         ],
-        [0, 1, 2, 3, 4, 6]
+        [0, 1, 2, 3, 4, 6, 7, 8]
     );
+    assert_eq!(status_name(8), Some("ILL_CONDITIONED"));
     assert_eq!(status_name(2), Some("UNREACHABLE"));
     assert_eq!(status_name(5), None);
     let chatter = kerf_chatter::ChatterError::NotConverged {

@@ -199,6 +199,9 @@ fn mill_request() -> msg::MillRequest {
         planner: "naive".into(),
         policy_file: String::new(),
         time_budget: 30.0,
+        has_tolerances: true,
+        path_tolerance: 5e-5,
+        min_condition_indicator: 0.1,
     }
 }
 

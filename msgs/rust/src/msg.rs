@@ -349,6 +349,14 @@ pub struct MillRequest {
     pub policy_file: String,
     /// Time budget of the plan (s): 0 = the node's `plan_timeout`; else in (0, plan_timeout].
     pub time_budget: f64,
+    /// Whether the tolerances below are given; false = the node's (5e-5 m, no minimum 1/K).
+    pub has_tolerances: bool,
+    /// Largest distance of the executed tool tip from the path and the plane (m), in
+    /// (0, 1e-3].
+    pub path_tolerance: f64,
+    /// Smallest condition indicator 1/K allowed along the executed trajectory, in [0, 1);
+    /// 0 = no minimum.
+    pub min_condition_indicator: f64,
 }
 impl_ros_type!(MillRequest, "kerf_msgs", msg, "MillRequest");
 
@@ -415,6 +423,16 @@ pub struct MillPlan {
     pub min_condition_indicator: f64,
     /// Σ segment rewards (seed 004 eq. 12).
     pub total_reward: f64,
+    /// Largest distance of the executed tool tip from the path (m).
+    pub max_path_deviation: f64,
+    /// Largest distance of the executed tool tip from the milling plane (m).
+    pub max_plane_deviation: f64,
+    /// The tolerance both are within (m).
+    pub path_tolerance: f64,
+    /// Smallest condition indicator 1/K over the trajectory's points.
+    pub min_condition_indicator_path: f64,
+    /// Arc length where it is (m).
+    pub min_condition_arc_length: f64,
 }
 impl_ros_type!(MillPlan, "kerf_msgs", msg, "MillPlan");
 
@@ -435,6 +453,8 @@ impl MillPlan {
     pub const INTERNAL_ERROR: u8 = 6;
     /// The request's time budget ran out before the plan was finished.
     pub const TIMEOUT: u8 = 7;
+    /// The executed plan passes closer to a singularity than the request allows.
+    pub const ILL_CONDITIONED: u8 = 8;
 
     /// Name of a status value (`"SUCCESS"` …), or `None` for an unknown value.
     pub fn status_name(status: u8) -> Option<&'static str> {
@@ -447,6 +467,7 @@ impl MillPlan {
             Self::QUEUE_FULL => Some("QUEUE_FULL"),
             Self::INTERNAL_ERROR => Some("INTERNAL_ERROR"),
             Self::TIMEOUT => Some("TIMEOUT"),
+            Self::ILL_CONDITIONED => Some("ILL_CONDITIONED"),
             _ => None,
         }
     }
@@ -485,13 +506,14 @@ mod tests {
         assert_eq!(MillPlan::status_name(5), Some("QUEUE_FULL"));
         assert_eq!(MillPlan::status_name(6), Some("INTERNAL_ERROR"));
         assert_eq!(MillPlan::status_name(7), Some("TIMEOUT"));
-        assert_eq!(MillPlan::status_name(8), None);
+        assert_eq!(MillPlan::status_name(8), Some("ILL_CONDITIONED"));
+        assert_eq!(MillPlan::status_name(9), None);
         // Every name is distinct and round-trips through its code.
         let names: Vec<&str> = (0..=u8::MAX).filter_map(MillPlan::status_name).collect();
-        assert_eq!(names.len(), 8);
+        assert_eq!(names.len(), 9);
         let mut sorted = names.clone();
         sorted.sort_unstable();
         sorted.dedup();
-        assert_eq!(sorted.len(), 8);
+        assert_eq!(sorted.len(), 9);
     }
 }

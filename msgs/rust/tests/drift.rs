@@ -482,6 +482,7 @@ fn rust_constants() -> ConstantTable {
                 c_u8("QUEUE_FULL", Mp::QUEUE_FULL),
                 c_u8("INTERNAL_ERROR", Mp::INTERNAL_ERROR),
                 c_u8("TIMEOUT", Mp::TIMEOUT),
+                c_u8("ILL_CONDITIONED", Mp::ILL_CONDITIONED),
             ],
         ),
     ]

@@ -17,7 +17,9 @@
 
 use kerf_millplan::{
     planner::status,
-    request::{RequestInitial, RequestLimits, RequestProcess, RequestStepBounds},
+    request::{
+        RequestInitial, RequestLimits, RequestProcess, RequestStepBounds, RequestTolerances,
+    },
     MillPlanError, MillPlanOutput, MillRequest, PlannerKind,
 };
 use kerf_msgs::{msg, trajectory_msgs::JointTrajectory};
@@ -48,6 +50,8 @@ pub fn planner_name(field: &str) -> &str {
 /// * `has_limits` → `limits` with every range and step bound given, else `None`.
 /// * `has_initial_state` → `initial` with the three values, else `None` (seed 004's IVP).
 /// * `planner` "" → `ddpg`; `policy_file` "" → `None` (the node's default policy).
+/// * `has_tolerances` → `tolerances` with both values (a `min_condition_indicator` of 0 is no
+///   minimum), else `None` (the node's).
 ///
 /// Every value is passed on unchanged for the planner's validation (NaN, min > max, …).
 ///
@@ -107,6 +111,10 @@ pub fn request_from_msg(m: &msg::MillRequest) -> Result<MillRequest, MillPlanErr
         planner,
         policy_file,
         time_budget: (m.time_budget != 0.0).then_some(m.time_budget),
+        tolerances: m.has_tolerances.then_some(RequestTolerances {
+            path_tolerance: Some(m.path_tolerance),
+            min_condition_indicator: Some(m.min_condition_indicator),
+        }),
     })
 }
 
@@ -365,6 +373,11 @@ pub fn output_to_msg(out: &MillPlanOutput) -> msg::MillPlan {
         max_mu: p.max_spectral_radius,
         min_condition_indicator: p.min_condition_indicator,
         total_reward: p.total_reward,
+        max_path_deviation: out.executed.deviation.max_off_path,
+        max_plane_deviation: out.executed.deviation.max_off_plane,
+        path_tolerance: out.executed.settings.path_tolerance,
+        min_condition_indicator_path: out.executed.scaling.min_condition_indicator.0,
+        min_condition_arc_length: out.executed.scaling.min_condition_indicator.1,
     }
 }
 

@@ -43,6 +43,7 @@ fn flags_off_means_the_cell_and_empty_means_the_default() {
             planner: "ddpg".into(),
             policy_file: None,
             time_budget: None,
+            tolerances: None,
         }
     );
     let mut m = message();
@@ -51,6 +52,27 @@ fn flags_off_means_the_cell_and_empty_means_the_default() {
         convert::request_from_msg(&m).unwrap().time_budget,
         Some(4.0)
     );
+    // Tolerances: taken whole when flagged (then 0 is refused as a path tolerance).
+    let mut m = message();
+    m.path_tolerance = 2e-5;
+    assert_eq!(convert::request_from_msg(&m).unwrap().tolerances, None);
+    m.has_tolerances = true;
+    let r = convert::request_from_msg(&m).unwrap();
+    assert_eq!(
+        r.tolerances,
+        Some(kerf_millplan::request::RequestTolerances {
+            path_tolerance: Some(2e-5),
+            min_condition_indicator: Some(0.0),
+        })
+    );
+    assert_eq!(r.min_condition_indicator(), None);
+    r.validate().unwrap();
+    m.path_tolerance = 0.0;
+    let e = convert::request_from_msg(&m)
+        .unwrap()
+        .validate()
+        .unwrap_err();
+    assert!(e.to_string().contains("tolerances.path_tolerance"), "{e}");
     // Values of a group whose flag is false are ignored, even NaN.
     let mut m = message();
     m.teeth = 7;
@@ -332,6 +354,18 @@ fn assert_published_as_executed(m: &msg::MillPlan, out: &MillPlanOutput) {
     for (x, p) in out.executed.plan.segments.iter().zip(&out.plan.segments) {
         assert!(x.feed <= p.feed, "segment {}", p.segment);
     }
+    // The executed tool path and the conditioning along the trajectory.
+    let d = &out.executed.deviation;
+    assert_eq!(
+        (m.max_path_deviation, m.max_plane_deviation),
+        (d.max_off_path, d.max_off_plane)
+    );
+    assert_eq!(m.path_tolerance, out.executed.settings.path_tolerance);
+    assert!(m.max_path_deviation <= m.path_tolerance && m.max_plane_deviation <= m.path_tolerance);
+    assert_eq!(
+        (m.min_condition_indicator_path, m.min_condition_arc_length),
+        out.executed.scaling.min_condition_indicator
+    );
     // Within the robot's limits, as the executor interpolates it.
     let limits = robot_limits();
     assert_eq!(check_trajectory_msg(&limits, t), Ok(()));
