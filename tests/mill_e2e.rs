@@ -100,7 +100,7 @@ fn request_text(id: &str, planner: &str) -> String {
     )
 }
 
-/// Writes a valid actor with 5 observations and 2 actions (the milling environment has 25 and
+/// Writes a valid actor with 5 observations and 2 actions (the milling environment has 37 and
 /// 3), hidden layer 8.
 fn write_incompatible_policy(path: &Path) {
     let mut rng = Rng::new(5);

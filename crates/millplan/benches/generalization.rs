@@ -11,7 +11,9 @@
 //! cargo bench -p kerf_millplan --bench generalization -- --policy FILE --fixed-g-policy FILE
 //! ```
 //!
-//! Planners: `ddpg` (the policy), `fixed_g` (DDPG with g = 0), and on the default path `naive`
+//! Planners: `ddpg` (the policy), `ddpg, no 1/K minimum` (the same policy in the environment
+//! without `EnvConfig::min_condition_indicator`: what the policy does without the constraint),
+//! `fixed_g` (DDPG with g = 0), and on the default path `naive`
 //! and `dp` (they need the default cell's indicator cache: main has no per-path cache yet, so
 //! on held-out paths the baselines are `fixed_g` only). The goal line counts the held-out paths
 //! where the policy is chatter-free with min 1/K ≥ 0.3 and within 5 % of the best baseline's
@@ -20,7 +22,9 @@
 
 use kerf_mill::MillCell;
 use kerf_millplan::path_distribution::{held_out_paths, PathDistribution};
-use kerf_millplan::{default_policy_path, MillPlanOutput, MillPlanner, MillRequest, PlannerKind};
+use kerf_millplan::{
+    default_policy_path, EnvConfig, MillPlanOutput, MillPlanner, MillRequest, PlannerKind,
+};
 
 fn value(args: &[String], name: &str) -> Option<String> {
     args.iter()
@@ -49,6 +53,12 @@ fn main() {
             .to_string()
     });
     let planner = MillPlanner::with_default_cell().unwrap();
+    let unconstrained = MillPlanner::with_default_cell()
+        .unwrap()
+        .with_env_config(EnvConfig {
+            min_condition_indicator: None,
+            ..EnvConfig::default()
+        });
     let base = MillCell::default_cell().unwrap();
     let mut paths = vec![("default".to_string(), MillRequest::default().points)];
     for p in held_out_paths(&base, &PathDistribution::default()).unwrap() {
@@ -59,7 +69,7 @@ fn main() {
     }
     let mut rows = Vec::new();
     for (name, points) in &paths {
-        let mut planners = vec!["ddpg", "fixed_g"];
+        let mut planners = vec!["ddpg", "ddpg, no 1/K minimum", "fixed_g"];
         if name == "default" {
             planners.extend(["naive", "dp"]);
         }
@@ -67,15 +77,20 @@ fn main() {
             let request = MillRequest {
                 request_id: name.clone(),
                 points: points.clone(),
-                planner: kind.to_string(),
+                planner: kind.split(',').next().unwrap().to_string(),
                 policy_file: match kind {
-                    "ddpg" => Some(ddpg_policy.clone()),
+                    "ddpg" | "ddpg, no 1/K minimum" => Some(ddpg_policy.clone()),
                     "fixed_g" => Some(fixed_policy.clone()),
                     _ => None,
                 },
                 ..MillRequest::default()
             };
-            let out = planner.plan(&request).map_err(|e| e.to_string());
+            let which = if kind == "ddpg, no 1/K minimum" {
+                &unconstrained
+            } else {
+                &planner
+            };
+            let out = which.plan(&request).map_err(|e| e.to_string());
             if let Err(e) = &out {
                 eprintln!("{name} {kind}: {e}");
             }

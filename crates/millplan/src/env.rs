@@ -39,10 +39,11 @@
 //!   [`ChatterMargin::penalty`] (0 below |μ|max = 0.95). Without it the
 //!   optimum of eq. 12 chatters marginally (reward module); `None` gives
 //!   the paper's reward exactly.
-//! * **Observation** ([`crate::observation`], 25 entries, each in [−1, 1]):
+//! * **Observation** ([`crate::observation`], 37 entries, each in [−1, 1]):
 //!   path-independent features (distance left, local curvature, heading,
-//!   pose: position, 1/K, wrist angle, 1/K one segment ahead for three g),
-//!   Ω, f, g, the filter state and |μ|max, instead of the paper's segment
+//!   pose: position, 1/K, wrist angle, 1/K and tool-tip stiffness one
+//!   segment ahead for three g), Ω, f, g, the filter state, |μ|max and the
+//!   tool-tip stiffness, instead of the paper's segment
 //!   index (issue 13, item 4).
 //! * **Minimum condition indicator** (kerf's,
 //!   [`EnvConfig::min_condition_indicator`], default 0.35, off with
@@ -382,22 +383,44 @@ impl MillEnv {
             })?;
         let state = info.state;
         let lim = self.cell.state_limits();
-        let pose = info.evaluation.as_ref().map(|e| PoseFeatures {
-            condition_indicator: e.condition_indicator,
-            wrist_angle: e.joints[4],
-            chatter_indicator: e.spectral_radius,
-        });
+        let stiffness = |m: &kerf_chatter::model::Modal2| {
+            [
+                m.stiffness[(0, 0)],
+                m.stiffness[(1, 1)],
+                m.stiffness[(0, 1)],
+            ]
+        };
+        let pose = match info.evaluation.as_ref() {
+            None => None,
+            Some(e) => {
+                // The state's tool-tip dynamics on its own IK branch (its
+                // joints are the environment's current joints).
+                let cs = self
+                    .cell
+                    .evaluate(state.segment, state.g, Some(&self.joints))?;
+                Some(PoseFeatures {
+                    condition_indicator: e.condition_indicator,
+                    wrist_angle: e.joints[4],
+                    chatter_indicator: e.spectral_radius,
+                    stiffness: stiffness(&cs.modal),
+                })
+            }
+        };
         let mut condition_ahead = [0.0; 3];
+        let mut stiffness_ahead = [None; 3];
         if pose.is_some() {
             let next = (state.segment + 1).min(self.segment_count() - 1);
             let step = lim.max_redundancy_step;
-            for (c, dg) in condition_ahead.iter_mut().zip([-step, 0.0, step]) {
+            for (k, dg) in [-step, 0.0, step].into_iter().enumerate() {
                 let g = state.g + dg;
                 if g < lim.redundancy_angle[0] || g > lim.redundancy_angle[1] {
                     continue;
                 }
                 match self.cell.evaluate(next, g, Some(&self.joints)) {
-                    Ok(cs) => *c = cs.condition_indicator,
+                    Ok(cs) => {
+                        condition_ahead[k] = cs.condition_indicator;
+                        stiffness_ahead[k] = Some(stiffness(&cs.modal));
+                    }
                     Err(e) if is_infeasible(&e) => {}
                     Err(e) => return Err(e.into()),
                 }
@@ -414,6 +437,7 @@ impl MillEnv {
                 filter: self.filter,
                 pose,
                 condition_ahead,
+                stiffness_ahead,
             },
         )
     }

@@ -33,9 +33,18 @@
 //! | 18–20 | `spindle_speed`, `feed`, `redundancy_angle` | Ω, f, g | their state ranges |
 //! | 21–23 | `filter_{spindle,feed,g}` | the filter state â of eq. 11 (the last applied move) | ± the step bounds |
 //! | 24 | `chatter_indicator` | \|μ\|max of the state | [0.5, 1.5] |
+//! | 25–27 | `stiffness_{xx,yy,xy}` | tool-tip stiffness K of the state in the cutting frame (`kerf_mill::ToolTipDynamics`, seed 004 eq. 9–10) \[N/m\] | [0, 3e6] (xy: ±1.5e6) |
+//! | 28–36 | `stiffness_ahead_{minus,same,plus}_{xx,yy,xy}` | the same at the next segment for g − Δg_max, g, g + Δg_max (0 where infeasible) | as 25–27 |
 //!
-//! A violating state (no evaluation) observes 0 for entries 13–17 and 24;
-//! it is terminal, so DDPG never bootstraps from it.
+//! Why the stiffness: |μ|max at f_max depends on g through the tool-tip
+//! dynamics, and not monotonically (measured on held-out paths: along g it
+//! alternates between 0.84 and 1.10 within 0.4 rad); the stiffness of the
+//! lookahead states is what the policy can see of that dependence without
+//! evaluating the chatter indicator (a few µs per state instead of about a
+//! millisecond).
+//!
+//! A violating state (no evaluation) observes 0 for entries 13–17 and
+//! 24–36; it is terminal, so DDPG never bootstraps from it.
 //!
 //! The last segment has no next one: its lookahead entries repeat its own
 //! segment, its `curvature_ahead` is its curvature.
@@ -46,7 +55,7 @@ use nalgebra::Vector3;
 use crate::error::MillPlanError;
 
 /// Names of the observation entries, in order (module documentation).
-pub const OBSERVATION_LAYOUT: [&str; 25] = [
+pub const OBSERVATION_LAYOUT: [&str; 37] = [
     "remaining_length",
     "segment_length",
     "curvature",
@@ -72,6 +81,18 @@ pub const OBSERVATION_LAYOUT: [&str; 25] = [
     "filter_feed",
     "filter_g",
     "chatter_indicator",
+    "stiffness_xx",
+    "stiffness_yy",
+    "stiffness_xy",
+    "stiffness_ahead_minus_xx",
+    "stiffness_ahead_minus_yy",
+    "stiffness_ahead_minus_xy",
+    "stiffness_ahead_same_xx",
+    "stiffness_ahead_same_yy",
+    "stiffness_ahead_same_xy",
+    "stiffness_ahead_plus_xx",
+    "stiffness_ahead_plus_yy",
+    "stiffness_ahead_plus_xy",
 ];
 
 /// Length of an observation.
@@ -94,6 +115,9 @@ pub const WORKSPACE_HALF_EXTENT: [f64; 3] = [0.75, 0.75, 0.75];
 pub const CONDITION_SCALE: f64 = 0.7;
 /// |μ|max range of the map.
 pub const CHATTER_RANGE: [f64; 2] = [0.5, 1.5];
+/// Diagonal stiffness that maps to +1 \[N/m\] (the default cell's tool tip
+/// is 0.5e6–3e6 N/m in the cutting frame); the off-diagonal maps ± half of it.
+pub const STIFFNESS_SCALE: f64 = 3e6;
 
 /// The layout as owned strings (for the policy sidecar).
 pub fn layout() -> Vec<String> {
@@ -222,6 +246,9 @@ pub struct StateFeatures {
     /// 1/K at the next segment for g − Δg_max, g, g + Δg_max (0 where
     /// infeasible).
     pub condition_ahead: [f64; 3],
+    /// The tool-tip stiffness (xx, yy, xy) \[N/m\] at the same three
+    /// lookahead states (`None` where infeasible).
+    pub stiffness_ahead: [Option<[f64; 3]>; 3],
 }
 
 /// The pose part of a feasible state.
@@ -233,6 +260,20 @@ pub struct PoseFeatures {
     pub wrist_angle: f64,
     /// |μ|max.
     pub chatter_indicator: f64,
+    /// Tool-tip stiffness (xx, yy, xy) in the cutting frame \[N/m\].
+    pub stiffness: [f64; 3],
+}
+
+/// The three stiffness entries mapped to [−1, 1] (zeros for `None`).
+fn stiffness_entries(k: Option<[f64; 3]>) -> [f32; 3] {
+    match k {
+        Some([xx, yy, xy]) => [
+            normalize(xx, 0.0, STIFFNESS_SCALE),
+            normalize(yy, 0.0, STIFFNESS_SCALE),
+            normalize(xy, -0.5 * STIFFNESS_SCALE, 0.5 * STIFFNESS_SCALE),
+        ],
+        None => [0.0; 3],
+    }
 }
 
 /// The observation vector ([`OBSERVATION_LAYOUT`]).
@@ -300,6 +341,10 @@ pub fn observe(
         Some(p) => normalize(p.chatter_indicator, CHATTER_RANGE[0], CHATTER_RANGE[1]),
         None => 0.0,
     });
+    o.extend(stiffness_entries(state.pose.map(|p| p.stiffness)));
+    for k in state.stiffness_ahead {
+        o.extend(stiffness_entries(k));
+    }
     debug_assert_eq!(o.len(), OBSERVATION_DIM);
     Ok(o)
 }

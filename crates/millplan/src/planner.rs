@@ -23,7 +23,10 @@
 //!    A policy is applied to a request when it records the environment's
 //!    observation layout ([`crate::observation`]: path-independent
 //!    features, normalized by the REQUEST's limits) and action size, else
-//!    [`MillPlanError::Policy`]; the shipped policies are trained on a
+//!    [`MillPlanError::Policy`]. The environment keeps 1/K above
+//!    [`EnvConfig::min_condition_indicator`] (0.35), raised to a request's
+//!    `tolerances.min_condition_indicator` + 0.05 when that is higher. The
+//!    shipped policies are trained on a
 //!    distribution of planar paths ([`crate::path_distribution`]) and
 //!    evaluated on held-out ones (`BENCHMARKS.md`, "Policy that
 //!    generalizes"). A rollout that leaves the feasible set is a
@@ -473,20 +476,45 @@ impl MillPlanner {
                         })?
                     }
                 };
+                // A request's minimum 1/K raises the environment's (with the
+                // same margin for the dip between midpoints as the default,
+                // EnvConfig::min_condition_indicator), never lowers it.
+                let min_condition_indicator = match (
+                    self.env_config.min_condition_indicator,
+                    request.min_condition_indicator(),
+                ) {
+                    (Some(own), Some(asked)) => Some(own.max((asked + 0.05).min(0.999))),
+                    (own, _) => own,
+                };
                 let config = EnvConfig {
                     initial_rpm: rpm0,
                     initial_feed: feed0,
                     initial_g: g0,
                     fixed_g: kind == PlannerKind::FixedG,
+                    min_condition_indicator,
                     ..self.env_config
                 };
-                let mut env = MillEnv::new(cell.clone(), cache.clone(), config)?;
                 let policy = self.policy(&path)?;
-                policy.check_observation(&OBSERVATION_LAYOUT, env.action_dim())?;
-                let rollout = env.rollout(|obs, _| {
-                    budget.check("the policy rollout")?;
-                    policy.act(obs)
-                })?;
+                let run = |config: EnvConfig| -> Result<crate::env::Rollout, MillPlanError> {
+                    let mut env = MillEnv::new(cell.clone(), cache.clone(), config)?;
+                    policy.check_observation(&OBSERVATION_LAYOUT, env.action_dim())?;
+                    env.rollout(|obs, _| {
+                        budget.check("the policy rollout")?;
+                        policy.act(obs)
+                    })
+                };
+                let mut rollout = run(config)?;
+                if !rollout.completed
+                    && config.min_condition_indicator != self.env_config.min_condition_indicator
+                {
+                    // The request's minimum could not be kept: plan with the
+                    // environment's own, and step 8 reports where the plan
+                    // falls below the request's (ILL_CONDITIONED).
+                    rollout = run(EnvConfig {
+                        min_condition_indicator: self.env_config.min_condition_indicator,
+                        ..config
+                    })?;
+                }
                 if !rollout.completed {
                     let why = rollout.stop_reason();
                     return Err(MillPlanError::Policy {

@@ -24,7 +24,7 @@ fn env(config: EnvConfig) -> MillEnv {
 #[test]
 fn initial_value_problem_observation_and_reward() {
     let mut e = env(EnvConfig::default());
-    assert_eq!(e.observation_dim(), 25);
+    assert_eq!(e.observation_dim(), 37);
     assert_eq!(e.action_dim(), 3);
     assert_eq!(e.max_steps(), 99);
     let obs = e.reset().unwrap();

@@ -88,6 +88,20 @@ fn initial_observation_by_hand() {
             "{name}"
         );
     }
+    // Tool-tip stiffness in the cutting frame, of the state and one segment ahead.
+    let k = cs.modal.stiffness;
+    assert_eq!(at("stiffness_xx"), normalize(k[(0, 0)], 0.0, 3e6));
+    assert_eq!(at("stiffness_yy"), normalize(k[(1, 1)], 0.0, 3e6));
+    assert_eq!(at("stiffness_xy"), normalize(k[(0, 1)], -1.5e6, 1.5e6));
+    let ahead = c
+        .evaluate(1, 0.2, Some(&cs.joints))
+        .unwrap()
+        .modal
+        .stiffness;
+    assert_eq!(
+        at("stiffness_ahead_plus_yy"),
+        normalize(ahead[(1, 1)], 0.0, 3e6)
+    );
     // The filter starts at rest.
     assert_eq!(
         [at("filter_spindle"), at("filter_feed"), at("filter_g")],
@@ -234,7 +248,7 @@ fn policy_for_another_observation_is_a_policy_error() {
     let text = e.to_string();
     assert!(
         text.contains("trained for observations of 4 and actions of 3 entries")
-            && text.contains("the environment has 25 and 3"),
+            && text.contains("the environment has 37 and 3"),
         "{text}"
     );
     let unnamed = dir.join("unnamed.safetensors");
