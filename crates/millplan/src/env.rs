@@ -96,7 +96,9 @@ use crate::observation::{observe, PathFeatures, PoseFeatures, StateFeatures, OBS
 use crate::reward::step_reward;
 use crate::rl::{Environment, Transition};
 
-pub use crate::env_config::{EnvConfig, PROJECTION_BISECTIONS, REPAIR_STEPS};
+pub use crate::env_config::{
+    EnvConfig, PLANNER_JOINT_LIMIT_MARGIN, PROJECTION_BISECTIONS, REPAIR_STEPS,
+};
 pub use crate::rollout::{Evaluation, PhysicalState, Rollout, StepInfo};
 
 /// The environment (module documentation).
@@ -237,6 +239,15 @@ impl MillEnv {
                     reason: "must be finite and >= 0".to_string(),
                 });
             }
+        }
+        if !(config.joint_limit_margin.is_finite()
+            && (0.0..0.5).contains(&config.joint_limit_margin))
+        {
+            return Err(MillPlanError::InvalidParameter {
+                name: "joint limit margin [rad]".to_string(),
+                value: config.joint_limit_margin,
+                reason: "must be in [0, 0.5)".to_string(),
+            });
         }
         if let Some(c) = config.min_condition_indicator {
             if !(c.is_finite() && (0.0..1.0).contains(&c)) {
@@ -442,6 +453,28 @@ impl MillEnv {
         )
     }
 
+    /// Why the joints of a state at `next` violate
+    /// [`EnvConfig::joint_limit_margin`], if they do.
+    fn margin_violation(&self, next: &PhysicalState, joints: &[f64; 6]) -> Option<String> {
+        let m = self.config.joint_limit_margin;
+        if m <= 0.0 {
+            return None;
+        }
+        self.cell
+            .kinematics()
+            .joints()
+            .iter()
+            .zip(joints)
+            .find(|(r, q)| **q < r.lower + m || **q > r.upper - m)
+            .map(|(r, q)| {
+                format!(
+                    "joint {} = {q:.4} rad at segment {} (g = {:.3} rad) is within the margin \
+                     {m} rad of its limits [{}, {}]",
+                    r.name, next.segment, next.g, r.lower, r.upper
+                )
+            })
+    }
+
     /// Why 1/K of a state at `next` violates
     /// [`EnvConfig::min_condition_indicator`], if it does (never with
     /// [`EnvConfig::fixed_g`]: g cannot move away).
@@ -470,6 +503,9 @@ impl MillEnv {
             return Ok(eval);
         };
         if let Some(reason) = self.condition_violation(next, e.condition_indicator) {
+            return Ok(Err(reason));
+        }
+        if let Some(reason) = self.margin_violation(next, &e.joints) {
             return Ok(Err(reason));
         }
         Ok(match self.speed_violation(current, next, &e.joints) {
@@ -526,6 +562,7 @@ impl MillEnv {
         if self
             .condition_violation(next, cs.condition_indicator)
             .is_some()
+            || self.margin_violation(next, &cs.joints).is_some()
         {
             return Ok(false);
         }

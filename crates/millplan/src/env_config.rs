@@ -69,7 +69,21 @@ pub struct EnvConfig {
     /// "Policy that generalizes"). `None`: the paper's environment, where
     /// only the reward of eq. 15 keeps the robot away from singularities.
     pub min_condition_indicator: Option<f64>,
+    /// kerf's joint-limit margin \[rad\] (default 0: the limits of the
+    /// limits YAML as they are): a state reached by a step whose joints lie
+    /// within this margin of a joint's limit is infeasible (projection,
+    /// repair, else a terminal violation). The planner's rollouts use
+    /// [`PLANNER_JOINT_LIMIT_MARGIN`]. Why: the environment checks the joints
+    /// at segment midpoints; the executed trajectory runs g as a spline
+    /// between them and was measured 0.0006 rad past joint 5's limit on a
+    /// held-out path (the executor refuses that), so the planner keeps a
+    /// margin that training did not need.
+    pub joint_limit_margin: f64,
 }
+
+/// The joint-limit margin of the planner's rollouts \[rad\]
+/// ([`EnvConfig::joint_limit_margin`]).
+pub const PLANNER_JOINT_LIMIT_MARGIN: f64 = 0.01;
 
 /// Steps of the repair search of [`EnvConfig::min_condition_indicator`]
 /// on each side of the current g (resolution 1/8 of the g step bound).
@@ -100,6 +114,7 @@ impl Default for EnvConfig {
             min_feed: 0.01,
             acceleration_penalty: None,
             min_condition_indicator: Some(DEFAULT_MIN_CONDITION_INDICATOR),
+            joint_limit_margin: 0.0,
         }
     }
 }

@@ -25,7 +25,9 @@
 //!    features, normalized by the REQUEST's limits) and action size, else
 //!    [`MillPlanError::Policy`]. The environment keeps 1/K above
 //!    [`EnvConfig::min_condition_indicator`] (0.35), raised to a request's
-//!    `tolerances.min_condition_indicator` + 0.05 when that is higher. The
+//!    `tolerances.min_condition_indicator` + 0.05 when that is higher, and
+//!    for `ddpg` the joints 0.01 rad inside their limits
+//!    ([`crate::env::PLANNER_JOINT_LIMIT_MARGIN`]). The
 //!    shipped policies are trained on a
 //!    distribution of planar paths ([`crate::path_distribution`]) and
 //!    evaluated on held-out ones (`BENCHMARKS.md`, "Policy that
@@ -492,6 +494,14 @@ impl MillPlanner {
                     initial_g: g0,
                     fixed_g: kind == PlannerKind::FixedG,
                     min_condition_indicator,
+                    // g held (fixed_g) runs no spline between midpoints.
+                    joint_limit_margin: if kind == PlannerKind::FixedG {
+                        self.env_config.joint_limit_margin
+                    } else {
+                        self.env_config
+                            .joint_limit_margin
+                            .max(crate::env::PLANNER_JOINT_LIMIT_MARGIN)
+                    },
                     ..self.env_config
                 };
                 let policy = self.policy(&path)?;

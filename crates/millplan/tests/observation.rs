@@ -326,3 +326,52 @@ fn repair_moves_g_off_the_band_when_the_band_reaches_it() {
         assert!((w[1] - w[0]).abs() <= 0.2 + 1e-12);
     }
 }
+
+/// The joint-limit margin of the planner's rollouts: the walk of g towards the edge of the
+/// reachable band (joint 5 at its limit) stops 0.01 rad inside every limit; without the margin
+/// the walk gets closer; a bad margin is refused.
+#[test]
+fn joint_limit_margin_keeps_the_joints_inside() {
+    let closest = |joint_limit_margin: f64| {
+        let c = cell();
+        let mut env = MillEnv::new(
+            c.clone(),
+            None,
+            EnvConfig {
+                alpha: 1.0,
+                joint_limit_margin,
+                ..EnvConfig::default()
+            },
+        )
+        .unwrap();
+        let r = env.rollout(|_, _| Ok(vec![0.0, 0.0, -1.0])).unwrap();
+        assert!(r.completed, "{}", r.stop_reason());
+        let ranges = c.kinematics().joints();
+        r.steps
+            .iter()
+            .flat_map(|s| {
+                let q = s.evaluation.unwrap().joints;
+                ranges
+                    .iter()
+                    .zip(q)
+                    .map(|(j, q)| (q - j.lower).min(j.upper - q))
+                    .collect::<Vec<_>>()
+            })
+            .fold(f64::INFINITY, f64::min)
+    };
+    let with = closest(kerf_millplan::env::PLANNER_JOINT_LIMIT_MARGIN);
+    assert!(with >= 0.01, "{with}");
+    let without = closest(0.0);
+    assert!(without < 0.01, "{without}");
+    for bad in [-0.1, 0.5, f64::NAN] {
+        assert!(MillEnv::new(
+            cell(),
+            None,
+            EnvConfig {
+                joint_limit_margin: bad,
+                ..EnvConfig::default()
+            }
+        )
+        .is_err());
+    }
+}
