@@ -239,7 +239,7 @@ fn bad_requests_get_their_status_and_the_node_keeps_serving() {
             s(&[
                 "incompatible.safetensors",
                 "trained for observations of 5 and actions of 2 entries",
-                "the environment has 4 and 3",
+                "the environment has 37 and 3",
             ]),
         ),
         (

@@ -88,7 +88,7 @@ pub struct PathDistribution {
 
 impl Default for PathDistribution {
     /// Around the default path of seed 004 Table 1 (x 1.4–2.1 m, y ±0.3 m,
-    /// z 1.7 m, 0.92 m long): centres x 1.5–2.0, y ±0.4, z 1.3–1.8 m,
+    /// z 1.7 m, 0.93 m long): centres x 1.5–2.0, y ±0.4, z 1.3–1.8 m,
     /// chords 0.4–1.0 m, planes tilted up to 20°, bends up to 0.2 L,
     /// 100 segments, g0 = 0, 1/K ≥ 0.35.
     fn default() -> Self {

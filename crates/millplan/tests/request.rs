@@ -406,7 +406,7 @@ fn missing_and_incompatible_policy_files() {
     let e = planner().plan(&ddpg(&obs5, "ddpg")).expect_err("obs 5");
     assert_eq!(status_of(&e), status::POLICY_ERROR);
     assert!(
-        e.to_string().contains("observations of 5") && e.to_string().contains("has 4 and 3"),
+        e.to_string().contains("observations of 5") && e.to_string().contains("has 37 and 3"),
         "{e}"
     );
     // Wrong action size: a 3-action (ddpg) policy for fixed_g (2 actions).
