@@ -11,8 +11,9 @@
 //! replaces `s_pa` by what the paper's reward depends on and what decides
 //! it along a path: the local geometry of the path, the pose of the robot
 //! (conditioning, wrist angle), the chatter indicator of the current state,
-//! and the distance left. Measured in `BENCHMARKS.md` ("Policy that
-//! generalizes").
+//! and the distance left. Measured in `BENCHMARKS.md` ("Milling: a policy that
+//! generalizes": chatter-free on 5 of 10 held-out paths, min 1/K ≥ 0.348 on
+//! all).
 //!
 //! # Layout ([`OBSERVATION_LAYOUT`], recorded in the policy's sidecar)
 //! Every entry is mapped to [−1, 1] (clamped) as the DDPG networks expect

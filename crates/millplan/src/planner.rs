@@ -30,7 +30,7 @@
 //!    ([`crate::env::PLANNER_JOINT_LIMIT_MARGIN`]). The
 //!    shipped policies are trained on a
 //!    distribution of planar paths ([`crate::path_distribution`]) and
-//!    evaluated on held-out ones (`BENCHMARKS.md`, "Policy that
+//!    evaluated on held-out ones (`BENCHMARKS.md`, "Milling: a policy that
 //!    generalizes"). A rollout that leaves the feasible set is a
 //!    [`MillPlanError::Policy`] error.
 //! 5. [`Plan::evaluate_with_threads`]: every segment evaluated directly
