@@ -150,7 +150,7 @@ fn trains_a_policy_and_plans_with_it_as_the_library_does() {
     assert!(stdout.contains("greedy rollout"), "{stdout}");
     let weights = dir.join("p.safetensors");
     let policy = Policy::load(&weights).expect("the saved policy loads");
-    assert_eq!(policy.observation_dim(), 4);
+    assert_eq!(policy.observation_dim(), 37);
     assert_eq!(policy.action_dim(), 2, "fixed g: action (dΩ, df)");
     let meta = policy.metadata();
     assert_eq!(meta.hidden_sizes, vec![256, 256]);

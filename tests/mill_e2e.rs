@@ -100,7 +100,7 @@ fn request_text(id: &str, planner: &str) -> String {
     )
 }
 
-/// Writes a valid actor with 5 observations and 2 actions (the milling environment has 4 and
+/// Writes a valid actor with 5 observations and 2 actions (the milling environment has 37 and
 /// 3), hidden layer 8.
 fn write_incompatible_policy(path: &Path) {
     let mut rng = Rng::new(5);
@@ -118,6 +118,7 @@ fn write_incompatible_policy(path: &Path) {
         environment: "mill_e2e: an actor of other sizes".to_string(),
         episodes: 0,
         final_reward: None,
+        observation_layout: Vec::new(),
     };
     Policy::from_actor(&net, metadata)
         .unwrap()
@@ -238,7 +239,7 @@ fn bad_requests_get_their_status_and_the_node_keeps_serving() {
             s(&[
                 "incompatible.safetensors",
                 "trained for observations of 5 and actions of 2 entries",
-                "the environment has 4 and 3",
+                "the environment has 37 and 3",
             ]),
         ),
         (

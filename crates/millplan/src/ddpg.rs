@@ -334,9 +334,15 @@ pub struct TrainedAgent {
     history: Vec<EpisodeReport>,
     observation_dim: usize,
     action_dim: usize,
+    observation_layout: Vec<String>,
 }
 
 impl TrainedAgent {
+    /// The names of the observation entries of the environment trained on
+    /// ([`Environment::observation_layout`]; empty when it names none).
+    pub fn observation_layout(&self) -> &[String] {
+        &self.observation_layout
+    }
     /// The trained actor network A(s | wᵃ).
     pub fn actor(&self) -> &Mlp {
         &self.actor
@@ -661,6 +667,7 @@ pub fn train<E: Environment>(
         history,
         observation_dim,
         action_dim,
+        observation_layout: env.observation_layout(),
     })
 }
 

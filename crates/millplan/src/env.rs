@@ -39,8 +39,23 @@
 //!   [`ChatterMargin::penalty`] (0 below |μ|max = 0.95). Without it the
 //!   optimum of eq. 12 chatters marginally (reward module); `None` gives
 //!   the paper's reward exactly.
-//! * **Observation** (4 entries, each in [−1, 1]): `2t/(N−1) − 1`, and Ω, f,
-//!   g mapped linearly from their ranges to [−1, 1].
+//! * **Observation** ([`crate::observation`], 37 entries, each in [−1, 1]):
+//!   path-independent features (distance left, local curvature, heading,
+//!   pose: position, 1/K, wrist angle, 1/K and tool-tip stiffness one
+//!   segment ahead for three g), Ω, f, g, the filter state, |μ|max and the
+//!   tool-tip stiffness, instead of the paper's segment
+//!   index (issue 13, item 4).
+//! * **Minimum condition indicator** (kerf's,
+//!   [`EnvConfig::min_condition_indicator`], default 0.35, off with
+//!   [`EnvConfig::fixed_g`]): a state whose 1/K (seed 004 eq. 14) is below
+//!   it is infeasible like an IK failure: the g projection keeps the move
+//!   out of the near-singular band, and when the band reaches an unchanged g
+//!   the repair moves g by at most the step bound to the nearest feasible
+//!   value. Why: the reward of eq. 15 alone (w_o = 0.1) is worth at most
+//!   0.1 · 0.6 per step; the policy trained with it on main drove 1/K to
+//!   0.074 (issue 13, "Conditioning"). Measured both ways in
+//!   `BENCHMARKS.md` ("Milling: a policy that generalizes": the committed
+//!   policy without the minimum falls to 0.257–0.337 on 4 of 11 paths).
 //! * **Segment time** `l_t / f_t` (the segment's arc length over its feed).
 //!   The clip keeps f ≥ [`EnvConfig::min_feed`] (0.01 m/s by default,
 //!   kerf's); with `min_feed = 0` a zero feed (reachable through the
@@ -78,10 +93,13 @@ use kerf_mill::MillCell;
 use crate::cache::{is_infeasible, IndicatorCache};
 use crate::error::MillPlanError;
 use crate::joint_speed;
+use crate::observation::{observe, PathFeatures, PoseFeatures, StateFeatures, OBSERVATION_DIM};
 use crate::reward::step_reward;
 use crate::rl::{Environment, Transition};
 
-pub use crate::env_config::{EnvConfig, PROJECTION_BISECTIONS};
+pub use crate::env_config::{
+    EnvConfig, PLANNER_JOINT_LIMIT_MARGIN, PROJECTION_BISECTIONS, REPAIR_STEPS,
+};
 pub use crate::rollout::{Evaluation, PhysicalState, Rollout, StepInfo};
 
 /// The environment (module documentation).
@@ -104,6 +122,8 @@ pub struct MillEnv {
     /// between the two midpoints \[s\] (for
     /// [`EnvConfig::acceleration_penalty`]).
     previous: Option<([f64; 6], f64)>,
+    /// The path's observed geometry ([`crate::observation`]).
+    features: Arc<PathFeatures>,
 }
 
 fn check_range(name: &str, v: f64, lo: f64, hi: f64) -> Result<f64, MillPlanError> {
@@ -115,11 +135,6 @@ fn check_range(name: &str, v: f64, lo: f64, hi: f64) -> Result<f64, MillPlanErro
         });
     }
     Ok(v)
-}
-
-/// Maps `v` in [lo, hi] to [−1, 1].
-fn normalize(v: f64, lo: f64, hi: f64) -> f32 {
-    ((2.0 * (v - lo) / (hi - lo) - 1.0).clamp(-1.0, 1.0)) as f32
 }
 
 impl MillEnv {
@@ -226,7 +241,27 @@ impl MillEnv {
                 });
             }
         }
+        if !(config.joint_limit_margin.is_finite()
+            && (0.0..0.5).contains(&config.joint_limit_margin))
+        {
+            return Err(MillPlanError::InvalidParameter {
+                name: "joint limit margin [rad]".to_string(),
+                value: config.joint_limit_margin,
+                reason: "must be in [0, 0.5)".to_string(),
+            });
+        }
+        if let Some(c) = config.min_condition_indicator {
+            if !(c.is_finite() && (0.0..1.0).contains(&c)) {
+                return Err(MillPlanError::InvalidParameter {
+                    name: "minimum condition indicator 1/K [-]".to_string(),
+                    value: c,
+                    reason: "must be in [0, 1) (1/K of seed 004 eq. 14 is in (0, 1])".to_string(),
+                });
+            }
+        }
+        let features = Arc::new(PathFeatures::new(&cell)?);
         Ok(Self {
+            features,
             cell,
             cache,
             config,
@@ -345,16 +380,115 @@ impl MillEnv {
         }))
     }
 
-    /// The normalized observation of a state (module documentation).
-    pub fn observe(&self, state: &PhysicalState) -> Vec<f32> {
+    /// The observation of the current state ([`crate::observation`]).
+    ///
+    /// # Errors
+    /// [`MillPlanError::InvalidConfig`] before the first reset; cell-model
+    /// errors other than infeasibility of the lookahead.
+    pub fn observation(&self) -> Result<Vec<f32>, MillPlanError> {
+        let info = self
+            .current
+            .as_ref()
+            .ok_or_else(|| MillPlanError::InvalidConfig {
+                name: "environment".to_string(),
+                reason: "no state: call reset".to_string(),
+            })?;
+        let state = info.state;
         let lim = self.cell.state_limits();
-        let n = self.segment_count();
-        vec![
-            normalize(state.segment as f64, 0.0, (n - 1).max(1) as f64),
-            normalize(state.rpm, lim.spindle_rpm[0], lim.spindle_rpm[1]),
-            normalize(state.feed, lim.feed[0], lim.feed[1]),
-            normalize(state.g, lim.redundancy_angle[0], lim.redundancy_angle[1]),
-        ]
+        let stiffness = |m: &kerf_chatter::model::Modal2| {
+            [
+                m.stiffness[(0, 0)],
+                m.stiffness[(1, 1)],
+                m.stiffness[(0, 1)],
+            ]
+        };
+        let pose = match info.evaluation.as_ref() {
+            None => None,
+            Some(e) => {
+                // The state's tool-tip dynamics on its own IK branch (its
+                // joints are the environment's current joints).
+                let cs = self
+                    .cell
+                    .evaluate(state.segment, state.g, Some(&self.joints))?;
+                Some(PoseFeatures {
+                    condition_indicator: e.condition_indicator,
+                    wrist_angle: e.joints[4],
+                    chatter_indicator: e.spectral_radius,
+                    stiffness: stiffness(&cs.modal),
+                })
+            }
+        };
+        let mut condition_ahead = [0.0; 3];
+        let mut stiffness_ahead = [None; 3];
+        if pose.is_some() {
+            let next = (state.segment + 1).min(self.segment_count() - 1);
+            let step = lim.max_redundancy_step;
+            for (k, dg) in [-step, 0.0, step].into_iter().enumerate() {
+                let g = state.g + dg;
+                if g < lim.redundancy_angle[0] || g > lim.redundancy_angle[1] {
+                    continue;
+                }
+                match self.cell.evaluate(next, g, Some(&self.joints)) {
+                    Ok(cs) => {
+                        condition_ahead[k] = cs.condition_indicator;
+                        stiffness_ahead[k] = Some(stiffness(&cs.modal));
+                    }
+                    Err(e) if is_infeasible(&e) => {}
+                    Err(e) => return Err(e.into()),
+                }
+            }
+        }
+        observe(
+            &self.features,
+            lim,
+            &StateFeatures {
+                segment: state.segment,
+                rpm: state.rpm,
+                feed: state.feed,
+                g: state.g,
+                filter: self.filter,
+                pose,
+                condition_ahead,
+                stiffness_ahead,
+            },
+        )
+    }
+
+    /// Why the joints of a state at `next` violate
+    /// [`EnvConfig::joint_limit_margin`], if they do.
+    fn margin_violation(&self, next: &PhysicalState, joints: &[f64; 6]) -> Option<String> {
+        let m = self.config.joint_limit_margin;
+        if m <= 0.0 {
+            return None;
+        }
+        self.cell
+            .kinematics()
+            .joints()
+            .iter()
+            .zip(joints)
+            .find(|(r, q)| **q < r.lower + m || **q > r.upper - m)
+            .map(|(r, q)| {
+                format!(
+                    "joint {} = {q:.4} rad at segment {} (g = {:.3} rad) is within the margin \
+                     {m} rad of its limits [{}, {}]",
+                    r.name, next.segment, next.g, r.lower, r.upper
+                )
+            })
+    }
+
+    /// Why 1/K of a state at `next` violates
+    /// [`EnvConfig::min_condition_indicator`], if it does (never with
+    /// [`EnvConfig::fixed_g`]: g cannot move away).
+    fn condition_violation(&self, next: &PhysicalState, indicator: f64) -> Option<String> {
+        let min = self.config.min_condition_indicator?;
+        if self.config.fixed_g || indicator >= min {
+            return None;
+        }
+        Some(format!(
+            "condition indicator 1/K = {indicator:.3} at segment {} (g = {:.3} rad) is below \
+             the minimum {min} (near a singularity)",
+            next.segment, next.g
+        ))
     }
 
     /// [`MillEnv::evaluate_state`] of `next` (IK from the current joints)
@@ -369,6 +503,12 @@ impl MillEnv {
         let Ok(e) = &eval else {
             return Ok(eval);
         };
+        if let Some(reason) = self.condition_violation(next, e.condition_indicator) {
+            return Ok(Err(reason));
+        }
+        if let Some(reason) = self.margin_violation(next, &e.joints) {
+            return Ok(Err(reason));
+        }
         Ok(match self.speed_violation(current, next, &e.joints) {
             Some(reason) => Err(reason),
             None => eval,
@@ -420,6 +560,13 @@ impl MillEnv {
             Err(e) if is_infeasible(&e) => return Ok(false),
             Err(e) => return Err(e.into()),
         };
+        if self
+            .condition_violation(next, cs.condition_indicator)
+            .is_some()
+            || self.margin_violation(next, &cs.joints).is_some()
+        {
+            return Ok(false);
+        }
         Ok(self.speed_violation(current, next, &cs.joints).is_none())
     }
 
@@ -549,7 +696,11 @@ impl MillEnv {
 
 impl Environment for MillEnv {
     fn observation_dim(&self) -> usize {
-        4
+        OBSERVATION_DIM
+    }
+
+    fn observation_layout(&self) -> Vec<String> {
+        crate::observation::layout()
     }
 
     fn action_dim(&self) -> usize {
@@ -583,7 +734,7 @@ impl Environment for MillEnv {
         self.filter = [0.0; 3];
         self.previous = None;
         self.done = false;
-        Ok(self.observe(&state))
+        self.observation()
     }
 
     fn step(&mut self, action: &[f32]) -> Result<Transition, MillPlanError> {
@@ -672,6 +823,38 @@ impl Environment for MillEnv {
                 filter[2] = next.g - current.g;
             }
         }
+        // kerf's repair (EnvConfig::min_condition_indicator): when g
+        // unchanged is infeasible too (the near-singular band or the edge of
+        // the reachable set has reached it), the feasible g nearest the
+        // current one within the step bound, if any.
+        if eval.is_err()
+            && self.config.project_g
+            && !self.config.fixed_g
+            && self.config.min_condition_indicator.is_some()
+        {
+            let still = PhysicalState {
+                g: current.g,
+                ..next
+            };
+            if !self.feasible(&current, &still)? {
+                let step = lim.max_redundancy_step / REPAIR_STEPS as f64;
+                'search: for k in 1..=REPAIR_STEPS {
+                    for sign in [1.0, -1.0] {
+                        let g = current.g + sign * step * k as f64;
+                        if g < lim.redundancy_angle[0] || g > lim.redundancy_angle[1] {
+                            continue;
+                        }
+                        let candidate = PhysicalState { g, ..next };
+                        if self.feasible(&current, &candidate)? {
+                            next = candidate;
+                            eval = self.checked_evaluation(&current, &next)?;
+                            filter[2] = next.g - current.g;
+                            break 'search;
+                        }
+                    }
+                }
+            }
+        }
         self.filter = filter;
         let violated = eval.is_err();
         let before = self.joints;
@@ -690,7 +873,7 @@ impl Environment for MillEnv {
         self.current = Some(info);
         self.done = violated || next.segment + 1 >= self.segment_count();
         Ok(Transition {
-            observation: self.observe(&next),
+            observation: self.observation()?,
             reward,
             done: self.done,
         })

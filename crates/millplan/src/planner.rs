@@ -23,11 +23,19 @@
 //!    `greedy` — [`crate::greedy::solve_within`] from the initial state at
 //!    g = g0; `greedy_best_g` — [`crate::greedy::best_fixed_g_within`]
 //!    (direct |μ|max, no cache: any path).
-//!    A policy is applied as it is to any request whose sizes fit: its
-//!    observations are normalized by the REQUEST's limits and number of segments,
-//!    so a policy trained on the default cell is only meaningful for
-//!    requests close to it (a rollout that leaves the feasible set is a
-//!    [`MillPlanError::Policy`] error).
+//!    A policy is applied to a request when it records the environment's
+//!    observation layout ([`crate::observation`]: path-independent
+//!    features, normalized by the REQUEST's limits) and action size, else
+//!    [`MillPlanError::Policy`]. The environment keeps 1/K above
+//!    [`EnvConfig::min_condition_indicator`] (0.35), raised to a request's
+//!    `tolerances.min_condition_indicator` + 0.05 when that is higher, and
+//!    for `ddpg` the joints 0.01 rad inside their limits
+//!    ([`crate::env::PLANNER_JOINT_LIMIT_MARGIN`]). The
+//!    shipped policies are trained on a
+//!    distribution of planar paths ([`crate::path_distribution`]) and
+//!    evaluated on held-out ones (`BENCHMARKS.md`, "Milling: a policy that
+//!    generalizes"). A rollout that leaves the feasible set is a
+//!    [`MillPlanError::Policy`] error.
 //! 5. [`Plan::evaluate_with_threads`]: every segment evaluated directly
 //!    (|μ|max never from the cache) on [`MillPlanner::eval_threads`]
 //!    threads (the same plan, bit for bit, for every thread count), the
@@ -88,6 +96,7 @@ use crate::evaluation::evaluate_impl;
 use crate::executed::executed;
 use crate::greedy;
 use crate::naive;
+use crate::observation::OBSERVATION_LAYOUT;
 use crate::path_cache::{path_grid, PathCacheKey, PathCaches};
 use crate::plan::{default_eval_threads, IndicatorProvenance, IndicatorSource, Plan};
 use crate::planned::planned_trajectory;
@@ -514,20 +523,53 @@ impl MillPlanner {
                         })?
                     }
                 };
+                // A request's minimum 1/K raises the environment's (with the
+                // same margin for the dip between midpoints as the default,
+                // EnvConfig::min_condition_indicator), never lowers it.
+                let min_condition_indicator = match (
+                    self.env_config.min_condition_indicator,
+                    request.min_condition_indicator(),
+                ) {
+                    (Some(own), Some(asked)) => Some(own.max((asked + 0.05).min(0.999))),
+                    (own, _) => own,
+                };
                 let config = EnvConfig {
                     initial_rpm: rpm0,
                     initial_feed: feed0,
                     initial_g: g0,
                     fixed_g: kind == PlannerKind::FixedG,
+                    min_condition_indicator,
+                    // g held (fixed_g) runs no spline between midpoints.
+                    joint_limit_margin: if kind == PlannerKind::FixedG {
+                        self.env_config.joint_limit_margin
+                    } else {
+                        self.env_config
+                            .joint_limit_margin
+                            .max(crate::env::PLANNER_JOINT_LIMIT_MARGIN)
+                    },
                     ..self.env_config
                 };
-                let mut env = MillEnv::new(cell.clone(), cache.clone(), config)?;
                 let policy = self.policy(&path)?;
-                policy.check_sizes(env.observation_dim(), env.action_dim())?;
-                let rollout = env.rollout(|obs, _| {
-                    budget.check("the policy rollout")?;
-                    policy.act(obs)
-                })?;
+                let run = |config: EnvConfig| -> Result<crate::env::Rollout, MillPlanError> {
+                    let mut env = MillEnv::new(cell.clone(), cache.clone(), config)?;
+                    policy.check_observation(&OBSERVATION_LAYOUT, env.action_dim())?;
+                    env.rollout(|obs, _| {
+                        budget.check("the policy rollout")?;
+                        policy.act(obs)
+                    })
+                };
+                let mut rollout = run(config)?;
+                if !rollout.completed
+                    && config.min_condition_indicator != self.env_config.min_condition_indicator
+                {
+                    // The request's minimum could not be kept: plan with the
+                    // environment's own, and step 8 reports where the plan
+                    // falls below the request's (ILL_CONDITIONED).
+                    rollout = run(EnvConfig {
+                        min_condition_indicator: self.env_config.min_condition_indicator,
+                        ..config
+                    })?;
+                }
                 if !rollout.completed {
                     let why = rollout.stop_reason();
                     return Err(MillPlanError::Policy {

@@ -65,6 +65,12 @@ pub struct PolicyMetadata {
     /// Total reward of the last training episode (with exploration noise);
     /// `None` when no episode was recorded.
     pub final_reward: Option<f64>,
+    /// The name of each observation entry, in order
+    /// ([`crate::observation::OBSERVATION_LAYOUT`] for the milling
+    /// environment); empty in a sidecar written before issue 13 (the
+    /// planner refuses such a policy: [`Policy::check_observation`]).
+    #[serde(default)]
+    pub observation_layout: Vec<String>,
 }
 
 /// One dense layer of the plain forward pass.
@@ -145,6 +151,7 @@ impl Policy {
             final_reward: agent.history().last().map(|r| r.total_reward),
             settings,
             environment: environment.to_string(),
+            observation_layout: agent.observation_layout().to_vec(),
         };
         Self::from_actor(agent.actor(), metadata)
     }
@@ -371,6 +378,68 @@ impl Policy {
                     self.metadata.environment
                 ),
             });
+        }
+        Ok(())
+    }
+
+    /// Records the observation layout in the metadata (saved with the
+    /// sidecar by [`Policy::save`]).
+    ///
+    /// # Errors
+    /// [`MillPlanError::InvalidConfig`] when the layout's length is not the
+    /// policy's observation size.
+    pub fn set_observation_layout(&mut self, layout: Vec<String>) -> Result<(), MillPlanError> {
+        if layout.len() != self.metadata.observation_dim {
+            return Err(MillPlanError::InvalidConfig {
+                name: "observation layout".to_string(),
+                reason: format!(
+                    "{} names for a policy of {} observation entries",
+                    layout.len(),
+                    self.metadata.observation_dim
+                ),
+            });
+        }
+        self.metadata.observation_layout = layout;
+        Ok(())
+    }
+
+    /// Checks that the policy was trained for an environment's observation
+    /// layout (names and order) and action size: what the planner calls
+    /// before a rollout.
+    ///
+    /// # Errors
+    /// [`MillPlanError::Policy`] (status POLICY_ERROR) naming the sizes,
+    /// when the policy records no layout (written before issue 13's
+    /// path-independent observation), or at the first entry that differs.
+    pub fn check_observation(
+        &self,
+        layout: &[&str],
+        action_dim: usize,
+    ) -> Result<(), MillPlanError> {
+        self.check_sizes(layout.len(), action_dim)?;
+        let recorded = &self.metadata.observation_layout;
+        if recorded.is_empty() {
+            return Err(policy_error(
+                Path::new(&self.path),
+                format!(
+                    "records no observation layout (a policy written before the \
+                     path-independent observation); the planner observes {:?} (trained on: {})",
+                    layout, self.metadata.environment
+                ),
+            ));
+        }
+        if let Some(k) =
+            (0..layout.len()).find(|&k| recorded.get(k).map(String::as_str) != Some(layout[k]))
+        {
+            return Err(policy_error(
+                Path::new(&self.path),
+                format!(
+                    "observation entry {k} is \"{}\" in the policy, \"{}\" in the planner \
+                     (trained for another observation layout)",
+                    recorded.get(k).map(String::as_str).unwrap_or("<missing>"),
+                    layout[k]
+                ),
+            ));
         }
         Ok(())
     }

@@ -27,6 +27,12 @@ pub trait Environment {
     fn action_dim(&self) -> usize;
     /// Largest number of steps of one episode.
     fn max_steps(&self) -> usize;
+    /// The names of the observation entries, in order (recorded in a trained
+    /// policy's sidecar, [`crate::PolicyMetadata::observation_layout`]);
+    /// empty by default.
+    fn observation_layout(&self) -> Vec<String> {
+        Vec::new()
+    }
     /// Starts a new episode at the initial state (seed 004: the initial value
     /// problem) and returns its observation.
     ///

@@ -24,12 +24,16 @@ fn env(config: EnvConfig) -> MillEnv {
 #[test]
 fn initial_value_problem_observation_and_reward() {
     let mut e = env(EnvConfig::default());
-    assert_eq!(e.observation_dim(), 4);
+    assert_eq!(e.observation_dim(), 37);
     assert_eq!(e.action_dim(), 3);
     assert_eq!(e.max_steps(), 99);
     let obs = e.reset().unwrap();
-    // (segment 0, 2000 rpm in [2000, 4000], 0.04 m/s in [0, 0.06], g = 0 in [-pi, pi]).
-    assert_eq!(obs, vec![-1.0, -1.0, (2.0 * 0.04 / 0.06 - 1.0) as f32, 0.0]);
+    // The state part of the observation (kerf_millplan::observation): 2000 rpm in
+    // [2000, 4000], 0.04 m/s in [0, 0.06], g = 0 in [-pi, pi], the filter at rest.
+    assert_eq!(
+        obs[18..24].to_vec(),
+        vec![-1.0, (2.0 * 0.04 / 0.06 - 1.0) as f32, 0.0, 0.0, 0.0, 0.0]
+    );
     let s = e.state().unwrap();
     assert_eq!(
         s,
@@ -533,6 +537,15 @@ fn rollout_stop_reason_names_the_violation() {
             last.violation.as_deref().unwrap()
         )
     );
+    // g held at 0 machines every segment when the minimum condition
+    // indicator is off (with it, 1/K at g = 0 falls below 0.35 from
+    // segment 51 on, to 0.18: tests/observation.rs).
+    let mut e = env(EnvConfig {
+        alpha: 1.0,
+        project_g: false,
+        min_condition_indicator: None,
+        ..EnvConfig::default()
+    });
     let r = e.rollout(|_, _| Ok(vec![0.0, 0.0, 0.0])).unwrap();
     assert!(r.completed);
     assert_eq!(r.stop_reason(), "the rollout ended early");

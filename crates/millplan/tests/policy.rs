@@ -37,6 +37,7 @@ fn metadata(observation_dim: usize, action_dim: usize, hidden: Vec<usize>) -> Po
         environment: "test actor".to_string(),
         episodes: 0,
         final_reward: None,
+        observation_layout: Vec::new(),
     }
 }
 

@@ -51,6 +51,7 @@ fn saved_actor(dir: &std::path::Path, obs: usize, act: usize) -> PathBuf {
         environment: format!("test actor {obs}x{act}"),
         episodes: 0,
         final_reward: None,
+        observation_layout: Vec::new(),
     };
     let mut policy = Policy::from_actor(&net, metadata).expect("policy");
     let path = dir.join(format!("actor_{obs}_{act}.safetensors"));
@@ -405,7 +406,7 @@ fn missing_and_incompatible_policy_files() {
     let e = planner().plan(&ddpg(&obs5, "ddpg")).expect_err("obs 5");
     assert_eq!(status_of(&e), status::POLICY_ERROR);
     assert!(
-        e.to_string().contains("observations of 5") && e.to_string().contains("has 4 and 3"),
+        e.to_string().contains("observations of 5") && e.to_string().contains("has 37 and 3"),
         "{e}"
     );
     // Wrong action size: a 3-action (ddpg) policy for fixed_g (2 actions).
