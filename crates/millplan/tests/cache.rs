@@ -220,9 +220,10 @@ fn env_branch_continuity_gives_the_cache_reference_dynamics() {
         Some(std::sync::Arc::new(cache)),
         EnvConfig {
             alpha: 1.0,
-            // The sweep crosses the wrist region fast; joint speeds are not
-            // what this test is about.
+            // The sweep crosses the wrist region fast; joint speeds and the distance to the
+            // singular set are not what this test is about.
             joint_speed_limits: false,
+            min_condition_indicator: None,
             ..EnvConfig::default()
         },
     )
