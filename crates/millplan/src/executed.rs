@@ -14,7 +14,7 @@ use crate::deviation::PathDeviation;
 use crate::error::MillPlanError;
 use crate::plan::{IndicatorProvenance, IndicatorSource, Plan};
 use crate::reward::RewardWeights;
-use crate::timing::{time_scale, JointLimit, TimeScaling, TrajectorySettings};
+use crate::timing::{joint_limits, time_scale, TimeScaling, TrajectorySettings};
 
 /// The plan as the robot runs it (step 7 of [`crate::MillPlanner::plan`]).
 #[derive(Debug, Clone, PartialEq)]
@@ -86,26 +86,7 @@ pub(crate) fn executed(
     cache: Option<&IndicatorCache>,
     budget: &Budget,
 ) -> Result<Executed, MillPlanError> {
-    let joints = cell.robot().joints();
-    let limits = cell
-        .kinematics()
-        .joints()
-        .iter()
-        .map(|k| {
-            joints
-                .iter()
-                .find(|j| j.name == k.name)
-                .map(|j| JointLimit {
-                    max_velocity: j.max_velocity,
-                    max_acceleration: j.max_acceleration,
-                    max_jerk: j.max_jerk,
-                })
-                .ok_or_else(|| MillPlanError::InvalidConfig {
-                    name: "cell".to_string(),
-                    reason: format!("joint '{}' is not a joint of the cell's robot", k.name),
-                })
-        })
-        .collect::<Result<Vec<_>, _>>()?;
+    let limits = joint_limits(cell)?;
     budget.check("the executed trajectory")?;
     let scaling = time_scale(cell, plan, &limits, settings, budget)?;
     let deviation = scaling.deviation;

@@ -67,7 +67,7 @@ use crate::env::{EnvConfig, PhysicalState};
 use crate::error::MillPlanError;
 use crate::plan::{Plan, SegmentPlan};
 use crate::reward::RewardParts;
-use crate::timing::{time_scale, JointLimit, TrajectorySettings};
+use crate::timing::{joint_limits, time_scale, JointLimit, TrajectorySettings};
 
 /// Largest number of target g* tried by [`best_fixed_g_within`].
 pub const MAX_G_CANDIDATES: usize = 64;
@@ -450,34 +450,6 @@ pub fn best_fixed_g_within(
     best.evaluations = evaluations;
     best.candidates = candidates;
     Ok(best)
-}
-
-/// The joint limits of the cell's robot in the kinematic chain's order (as
-/// the planner's step 7).
-///
-/// # Errors
-/// [`MillPlanError::InvalidConfig`] for a joint of the chain the robot
-/// does not have.
-fn joint_limits(cell: &MillCell) -> Result<Vec<JointLimit>, MillPlanError> {
-    let joints = cell.robot().joints();
-    cell.kinematics()
-        .joints()
-        .iter()
-        .map(|k| {
-            joints
-                .iter()
-                .find(|j| j.name == k.name)
-                .map(|j| JointLimit {
-                    max_velocity: j.max_velocity,
-                    max_acceleration: j.max_acceleration,
-                    max_jerk: j.max_jerk,
-                })
-                .ok_or_else(|| MillPlanError::InvalidConfig {
-                    name: "cell".to_string(),
-                    reason: format!("joint '{}' is not a joint of the cell's robot", k.name),
-                })
-        })
-        .collect()
 }
 
 /// A greedy plan as a [`Plan`] for the time scaling (joints, Ω, f, g, |μ|,

@@ -105,6 +105,34 @@ pub struct JointLimit {
     pub max_jerk: Option<f64>,
 }
 
+/// The joint limits of the cell's robot in the kinematic chain's order (the
+/// order of the trajectory's joints).
+///
+/// # Errors
+/// [`MillPlanError::InvalidConfig`] for a joint of the chain the robot
+/// does not have.
+pub fn joint_limits(cell: &MillCell) -> Result<Vec<JointLimit>, MillPlanError> {
+    let joints = cell.robot().joints();
+    cell.kinematics()
+        .joints()
+        .iter()
+        .map(|k| {
+            joints
+                .iter()
+                .find(|j| j.name == k.name)
+                .map(|j| JointLimit {
+                    max_velocity: j.max_velocity,
+                    max_acceleration: j.max_acceleration,
+                    max_jerk: j.max_jerk,
+                })
+                .ok_or_else(|| MillPlanError::InvalidConfig {
+                    name: "cell".to_string(),
+                    reason: format!("joint '{}' is not a joint of the cell's robot", k.name),
+                })
+        })
+        .collect()
+}
+
 /// Settings of [`time_scale`] (builder style: `TrajectorySettings::default().with_…`).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct TrajectorySettings {
