@@ -20,27 +20,8 @@
 
 use std::time::Instant;
 
+use kerf_millplan::path_distribution::moved_points;
 use kerf_millplan::{MillPlanOutput, MillPlanner, MillRequest};
-
-/// The default path turned by `angle` about the vertical through its centroid, then moved by
-/// `shift` (m).
-fn moved_points(angle: f64, shift: [f64; 3]) -> Vec<[f64; 3]> {
-    let points = MillRequest::default().points;
-    let n = points.len() as f64;
-    let c = [0, 1, 2].map(|k| points.iter().map(|p| p[k]).sum::<f64>() / n);
-    let (s, co) = angle.sin_cos();
-    points
-        .iter()
-        .map(|p| {
-            let (x, y) = (p[0] - c[0], p[1] - c[1]);
-            [
-                c[0] + co * x - s * y + shift[0],
-                c[1] + s * x + co * y + shift[1],
-                p[2] + shift[2],
-            ]
-        })
-        .collect()
-}
 
 struct Row {
     name: String,
@@ -64,7 +45,7 @@ fn main() {
     let planner = MillPlanner::with_default_cell().unwrap();
     let base = if shifted {
         MillRequest {
-            points: moved_points(0.3, [-0.1, 0.05, -0.1]),
+            points: moved_points(&MillRequest::default().points, 0.3, [-0.1, 0.05, -0.1]),
             ..MillRequest::default()
         }
     } else {
@@ -128,7 +109,7 @@ fn main() {
         match &r.out {
             Ok(o) => {
                 let e = &o.executed.plan;
-                let d = &o.executed.deviation;
+                let d = &o.executed.scaling.deviation;
                 println!(
                     "| {} | {:.2} | {} | {:.4} | {:.3} / {:.3} | {:.3} / {:.3} | {:.3} | {:.1} |",
                     r.name,
@@ -234,7 +215,7 @@ fn dp_with_accelerations(planner: &MillPlanner) {
         let plan = Plan::evaluate(cell, &weights, &r.states, name).unwrap();
         let out = kerf_millplan::execute(cell, &plan, &weights, default_eval_threads()).unwrap();
         let e = &out.plan;
-        let d = &out.deviation;
+        let d = &out.scaling.deviation;
         let g: Vec<f64> = plan.segments.iter().map(|s| s.g).collect();
         eprintln!(
             "{name}: DP {seconds:.1} s; planned {:.3} s (chatter-free {}, max |mu| {:.4}); \

@@ -72,19 +72,10 @@ fn main() {
 /// of its tool path at the control period.
 fn breakdown(planner: &MillPlanner, out: &kerf_millplan::MillPlanOutput) {
     use kerf_budget::Budget;
-    use kerf_millplan::timing::{time_scale, JointLimit, TrajectorySettings};
+    use kerf_millplan::timing::{joint_limits, time_scale, TrajectorySettings};
     use std::time::Instant;
     let cell = planner.cell();
-    let limits: Vec<JointLimit> = cell
-        .robot()
-        .joints()
-        .iter()
-        .map(|j| JointLimit {
-            max_velocity: j.max_velocity,
-            max_acceleration: j.max_acceleration,
-            max_jerk: j.max_jerk,
-        })
-        .collect();
+    let limits = joint_limits(cell).unwrap();
     let settings = TrajectorySettings::default();
     let runs: usize = std::env::var("KERF_BENCH_RUNS")
         .ok()

@@ -13,28 +13,9 @@ use std::time::Instant;
 use kerf_budget::Budget;
 use kerf_mill::MillCell;
 use kerf_millplan::path_cache::path_grid;
+use kerf_millplan::path_distribution::moved_points;
 use kerf_millplan::plan::default_eval_threads;
 use kerf_millplan::{IndicatorCache, MillRequest};
-
-/// The default path turned by `angle` about the vertical through its centroid, then moved by
-/// `shift` (m).
-fn moved_points(angle: f64, shift: [f64; 3]) -> Vec<[f64; 3]> {
-    let points = MillRequest::default().points;
-    let n = points.len() as f64;
-    let c = [0, 1, 2].map(|k| points.iter().map(|p| p[k]).sum::<f64>() / n);
-    let (s, co) = angle.sin_cos();
-    points
-        .iter()
-        .map(|p| {
-            let (x, y) = (p[0] - c[0], p[1] - c[1]);
-            [
-                c[0] + co * x - s * y + shift[0],
-                c[1] + s * x + co * y + shift[1],
-                p[2] + shift[2],
-            ]
-        })
-        .collect()
-}
 
 fn main() {
     let base = MillCell::default_cell().unwrap();
@@ -45,7 +26,10 @@ fn main() {
     println!("|---|---|---:|---:|---:|---|---|");
     for (name, points) in [
         ("default", MillRequest::default().points),
-        ("shifted, turned", moved_points(0.3, [-0.1, 0.05, -0.1])),
+        (
+            "shifted, turned",
+            moved_points(&MillRequest::default().points, 0.3, [-0.1, 0.05, -0.1]),
+        ),
     ] {
         let request = MillRequest {
             points,

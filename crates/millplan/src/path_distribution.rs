@@ -118,6 +118,26 @@ pub struct SampledPath {
     pub cell: Arc<MillCell>,
 }
 
+/// `points` turned by `angle` \[rad\] about the vertical (base z) axis through their
+/// centroid, then moved by `shift` \[m\]: a copy of a path elsewhere in the cell (the
+/// baselines' "shifted, turned" path, which no shipped indicator cache covers).
+pub fn moved_points(points: &[[f64; 3]], angle: f64, shift: [f64; 3]) -> Vec<[f64; 3]> {
+    let n = points.len().max(1) as f64;
+    let c = [0, 1, 2].map(|k| points.iter().map(|p| p[k]).sum::<f64>() / n);
+    let (s, co) = angle.sin_cos();
+    points
+        .iter()
+        .map(|p| {
+            let (x, y) = (p[0] - c[0], p[1] - c[1]);
+            [
+                c[0] + co * x - s * y + shift[0],
+                c[1] + s * x + co * y + shift[1],
+                p[2] + shift[2],
+            ]
+        })
+        .collect()
+}
+
 /// One draw (not checked).
 pub fn draw(dist: &PathDistribution, rng: &mut SplitMix64) -> PathSpec {
     let tilt = rng.uniform(0.0, dist.max_tilt);

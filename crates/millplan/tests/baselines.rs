@@ -12,38 +12,18 @@ use kerf_chatter::indicator::chatter_indicator;
 use kerf_mill::MillCell;
 use kerf_millplan::greedy;
 use kerf_millplan::path_cache::path_grid;
+use kerf_millplan::path_distribution::moved_points;
 use kerf_millplan::request::{RequestInitial, RequestLimits};
 use kerf_millplan::{
     status, status_of, IndicatorCache, MillPlanOutput, MillPlanner, MillRequest, TrajectorySettings,
 };
 
-/// The default path turned by `angle` about the vertical through its centroid, then moved by
-/// `shift` (m) (as `benches/baselines.rs --shifted`).
-fn moved_points(angle: f64, shift: [f64; 3]) -> Vec<[f64; 3]> {
-    let points = MillRequest::default().points;
-    let n = points.len() as f64;
-    let c = [0, 1, 2].map(|k| points.iter().map(|p| p[k]).sum::<f64>() / n);
-    let (s, co) = angle.sin_cos();
-    points
-        .iter()
-        .map(|p| {
-            let (x, y) = (p[0] - c[0], p[1] - c[1]);
-            [
-                c[0] + co * x - s * y + shift[0],
-                c[1] + s * x + co * y + shift[1],
-                p[2] + shift[2],
-            ]
-        })
-        .collect()
-}
-
 /// A small request on the shifted, turned path: `segments` segments, Ω in 2000–2200 rpm (a
-/// per-path cache of 2 Ω × 4 f × 33 g nodes per segment node, about 20 g of them reachable).
-/// The g range stays the cell's: a plan at an end of a narrowed g range can be refused by the
-/// time scaling (its smooth g(s) overshoots the range).
+/// per-path cache of 2 Ω × 4 f × 33 g nodes per segment node, about 20 g of them reachable);
+/// the g range stays the cell's.
 fn small_shifted(planner: &str, segments: usize) -> MillRequest {
     MillRequest {
-        points: moved_points(0.3, [-0.1, 0.05, -0.1]),
+        points: moved_points(&MillRequest::default().points, 0.3, [-0.1, 0.05, -0.1]),
         segments: Some(segments),
         limits: Some(RequestLimits {
             spindle_rpm: Some([2000.0, 2200.0]),
@@ -195,8 +175,7 @@ fn greedy_best_g_holds_the_best_reachable_fixed_g() {
     assert_eq!(best.states[0].rpm, 2000.0);
     assert_eq!(best.states[0].feed, 0.04);
     // The choice: chatter-free first, then the shortest time as executed, among the
-    // candidates whose trajectory can be built (g* = ±0.4, at the ends of the range, cannot:
-    // the smooth g(s) through the plan's values overshoots the range, `timing::time_scale`).
+    // candidates whose trajectory can be built.
     let time = best.executed_time.unwrap();
     assert!(all[0].executed_time.is_some(), "g0 itself is executable");
     for r in all.iter().filter(|r| r.executed_time.is_some()) {
@@ -234,7 +213,7 @@ fn dp_and_naive_plan_a_path_no_shipped_cache_covers() {
         }
         // What the robot runs: executable (the planner checked it with the executor's
         // validation), on the path.
-        let d = &out.executed.deviation;
+        let d = &out.executed.scaling.deviation;
         let tol = out.executed.settings.path_tolerance;
         assert!(
             d.max_off_path <= tol && d.max_off_plane <= tol,

@@ -11,19 +11,13 @@ use kerf_mill::MillCell;
 use kerf_millplan::deviation::executed_deviation;
 use kerf_millplan::plan::SegmentPlan;
 use kerf_millplan::spline1d::Profile;
-use kerf_millplan::timing::{three_point_velocity, time_scale, JointLimit, TrajectorySettings};
+use kerf_millplan::timing::{
+    joint_limits, three_point_velocity, time_scale, JointLimit, TrajectorySettings,
+};
 use kerf_millplan::{MillPlanError, Plan, RewardParts, TimeScaling};
 
 fn limits(cell: &MillCell) -> Vec<JointLimit> {
-    cell.robot()
-        .joints()
-        .iter()
-        .map(|j| JointLimit {
-            max_velocity: j.max_velocity,
-            max_acceleration: j.max_acceleration,
-            max_jerk: j.max_jerk,
-        })
-        .collect()
+    joint_limits(cell).unwrap()
 }
 
 /// A plan of the cell's path with feed `feed(i)` and redundancy angle `g(i)` per segment
