@@ -65,36 +65,9 @@ where
     F: FnMut(usize, [usize; 3]) -> Option<f64>,
     M: Fn(usize, [usize; 3], [usize; 3]) -> bool,
 {
-    let nodes = dims[0] * dims[1] * dims[2];
-    if stages == 0 || nodes == 0 || (0..3).any(|a| start[a] >= dims[a]) {
-        return Err(MillPlanError::InvalidConfig {
-            name: "DP grid".to_string(),
-            reason: format!("stages {stages}, dims {dims:?}, start {start:?}"),
-        });
-    }
-    if nodes.checked_mul(stages).is_none_or(|v| v > (1usize << 31)) {
-        return Err(MillPlanError::InvalidConfig {
-            name: "DP grid".to_string(),
-            reason: "too many states".to_string(),
-        });
-    }
+    let nodes = check_grid(stages, dims, start, 1)?;
     let index = |i: usize, j: usize, k: usize| (i * dims[1] + j) * dims[2] + k;
-    let stage_table = |t: usize, stage: &mut F| -> Result<Vec<f32>, MillPlanError> {
-        let mut out = vec![f32::NEG_INFINITY; nodes];
-        for i in 0..dims[0] {
-            budget.check("the DP")?;
-            for j in 0..dims[1] {
-                for k in 0..dims[2] {
-                    if let Some(r) = stage(t, [i, j, k]) {
-                        if r.is_finite() {
-                            out[index(i, j, k)] = r as f32;
-                        }
-                    }
-                }
-            }
-        }
-        Ok(out)
-    };
+    let stage_table = |t: usize, stage: &mut F| stage_rewards(t, dims, &mut *stage, budget);
     // Backward pass.
     let mut next = stage_table(stages - 1, &mut stage)?;
     let mut back: Vec<u8> = vec![u8::MAX; nodes * (stages - 1)];
@@ -195,39 +168,9 @@ where
     M: Fn(usize, [usize; 3], [usize; 3]) -> bool,
     A: Fn(usize, usize, [usize; 3], [usize; 3]) -> bool,
 {
-    let nodes = dims[0] * dims[1] * dims[2];
-    if stages == 0 || nodes == 0 || (0..3).any(|a| start[a] >= dims[a]) {
-        return Err(MillPlanError::InvalidConfig {
-            name: "DP grid".to_string(),
-            reason: format!("stages {stages}, dims {dims:?}, start {start:?}"),
-        });
-    }
-    if nodes
-        .checked_mul(3 * stages)
-        .is_none_or(|v| v > (1usize << 31))
-    {
-        return Err(MillPlanError::InvalidConfig {
-            name: "DP grid".to_string(),
-            reason: "too many states".to_string(),
-        });
-    }
+    let nodes = check_grid(stages, dims, start, 3)?;
     let index = |i: usize, j: usize, k: usize| (i * dims[1] + j) * dims[2] + k;
-    let mut stage_table = |t: usize| -> Result<Vec<f32>, MillPlanError> {
-        let mut out = vec![f32::NEG_INFINITY; nodes];
-        for i in 0..dims[0] {
-            budget.check("the DP")?;
-            for j in 0..dims[1] {
-                for k in 0..dims[2] {
-                    if let Some(r) = stage(t, [i, j, k]) {
-                        if r.is_finite() {
-                            out[index(i, j, k)] = r as f32;
-                        }
-                    }
-                }
-            }
-        }
-        Ok(out)
-    };
+    let mut stage_table = |t: usize| stage_rewards(t, dims, &mut stage, budget);
     // V_{N-1}(x, p) = r(N-1, x) for every p.
     let last = stage_table(stages - 1)?;
     let mut next: Vec<f32> = last.iter().flat_map(|v| [*v; 3]).collect();
@@ -317,4 +260,68 @@ where
         value: total,
         nodes: path,
     }))
+}
+
+/// Checks a DP grid: at least one stage, a non-empty grid, the start inside it, and at most
+/// 2^31 states (`layers` value layers per node and stage).
+///
+/// # Returns
+/// The nodes per stage.
+///
+/// # Errors
+/// [`MillPlanError::InvalidConfig`] naming what is wrong.
+fn check_grid(
+    stages: usize,
+    dims: [usize; 3],
+    start: [usize; 3],
+    layers: usize,
+) -> Result<usize, MillPlanError> {
+    let nodes = dims[0] * dims[1] * dims[2];
+    if stages == 0 || nodes == 0 || (0..3).any(|a| start[a] >= dims[a]) {
+        return Err(MillPlanError::InvalidConfig {
+            name: "DP grid".to_string(),
+            reason: format!("stages {stages}, dims {dims:?}, start {start:?}"),
+        });
+    }
+    if nodes
+        .checked_mul(layers * stages)
+        .is_none_or(|v| v > (1usize << 31))
+    {
+        return Err(MillPlanError::InvalidConfig {
+            name: "DP grid".to_string(),
+            reason: "too many states".to_string(),
+        });
+    }
+    Ok(nodes)
+}
+
+/// The rewards of stage `t` at every node (f32; −∞ where `stage` gives none or a non-finite
+/// value), the budget checked per row of the first axis.
+///
+/// # Errors
+/// [`MillPlanError::Interrupted`] when the budget runs out.
+fn stage_rewards<F>(
+    t: usize,
+    dims: [usize; 3],
+    mut stage: F,
+    budget: &Budget,
+) -> Result<Vec<f32>, MillPlanError>
+where
+    F: FnMut(usize, [usize; 3]) -> Option<f64>,
+{
+    let index = |i: usize, j: usize, k: usize| (i * dims[1] + j) * dims[2] + k;
+    let mut out = vec![f32::NEG_INFINITY; dims[0] * dims[1] * dims[2]];
+    for i in 0..dims[0] {
+        budget.check("the DP")?;
+        for j in 0..dims[1] {
+            for k in 0..dims[2] {
+                if let Some(r) = stage(t, [i, j, k]) {
+                    if r.is_finite() {
+                        out[index(i, j, k)] = r as f32;
+                    }
+                }
+            }
+        }
+    }
+    Ok(out)
 }
