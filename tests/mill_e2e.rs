@@ -417,11 +417,11 @@ fn assert_same_plan(answer: &MillPlan, direct: &MillPlanOutput) {
     }
     assert_eq!(
         answer.max_path_deviation,
-        direct.executed.deviation.max_off_path
+        direct.executed.scaling.deviation.max_off_path
     );
     assert_eq!(
         answer.max_plane_deviation,
-        direct.executed.deviation.max_off_plane
+        direct.executed.scaling.deviation.max_off_plane
     );
     let end = answer.trajectory.points.last().expect("points");
     assert!((end.time_from_start.as_secs_f64() - answer.machining_time).abs() <= 1e-9);

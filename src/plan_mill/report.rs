@@ -88,11 +88,7 @@ pub fn executed_line(o: &MillPlanOutput) -> String {
         sc.segment_slowdown.len(),
         lowest_feed,
         sc.trajectory.points().len(),
-        o.executed
-            .deviation
-            .max_off_path
-            .max(o.executed.deviation.max_off_plane)
-            * 1e3
+        sc.deviation.max_off_path.max(sc.deviation.max_off_plane) * 1e3
     )
 }
 

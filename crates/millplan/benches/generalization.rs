@@ -120,7 +120,11 @@ fn main() {
                     e.plan.max_spectral_radius,
                     ci,
                     at,
-                    e.deviation.max_off_path.max(e.deviation.max_off_plane) * 1e3,
+                    e.scaling
+                        .deviation
+                        .max_off_path
+                        .max(e.scaling.deviation.max_off_plane)
+                        * 1e3,
                     e.plan.total_reward,
                     o.branch_jumps.len()
                 );

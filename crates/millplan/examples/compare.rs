@@ -38,7 +38,11 @@ fn describe_executed(e: &Executed) {
             .iter()
             .copied()
             .fold(f64::INFINITY, f64::min),
-        e.deviation.max_off_path.max(e.deviation.max_off_plane) * 1e3,
+        e.scaling
+            .deviation
+            .max_off_path
+            .max(e.scaling.deviation.max_off_plane)
+            * 1e3,
         e.plan.max_spectral_radius
     );
 }

@@ -10,7 +10,6 @@ use kerf_budget::Budget;
 use kerf_mill::MillCell;
 
 use crate::cache::IndicatorCache;
-use crate::deviation::PathDeviation;
 use crate::error::MillPlanError;
 use crate::plan::{IndicatorProvenance, IndicatorSource, Plan};
 use crate::reward::RewardWeights;
@@ -30,9 +29,6 @@ pub struct Executed {
     /// interpolation (only with [`IndicatorSource::Cache`]; the bound of
     /// [`crate::MillPlanOutput::indicator`] applies), ascending.
     pub cached_segments: Vec<usize>,
-    /// The tool path as the executor runs the trajectory, measured at its
-    /// control period: within the settings' path tolerance.
-    pub deviation: PathDeviation,
     /// The settings the trajectory was built with (tolerance, control period).
     pub settings: TrajectorySettings,
 }
@@ -89,7 +85,6 @@ pub(crate) fn executed(
     let limits = joint_limits(cell)?;
     budget.check("the executed trajectory")?;
     let scaling = time_scale(cell, plan, &limits, settings, budget)?;
-    let deviation = scaling.deviation;
     let (plan, cached_segments) = plan.as_executed_with(
         cell,
         weights,
@@ -104,7 +99,6 @@ pub(crate) fn executed(
         scaling,
         plan,
         cached_segments,
-        deviation,
         settings: *settings,
     })
 }

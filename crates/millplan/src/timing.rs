@@ -752,9 +752,12 @@ fn finish(
             min_ci = (ci, knot.s);
         }
     }
-    let segment_times = (0..n)
-        .map(|i| law.at_arc_length(boundaries[i + 1]).time - law.at_arc_length(boundaries[i]).time)
+    // The time at each segment boundary, once (each inner one ends a segment and starts the next).
+    let at: Vec<f64> = boundaries
+        .iter()
+        .map(|b| law.at_arc_length(*b).time)
         .collect();
+    let segment_times = at.windows(2).map(|w| w[1] - w[0]).collect();
     let segment_slowdown: Vec<f64> = (0..n).map(|i| slowdown.eval(midpoints[i + 1]).0).collect();
     let segment_feeds = plan
         .segments

@@ -53,7 +53,7 @@ fn every_planner_keeps_the_tool_on_the_path() {
             d.samples as f64 >= trajectory.duration() / PERIOD,
             "{kind}: {d:?}"
         );
-        assert_eq!(d, out.executed.deviation, "{kind}");
+        assert_eq!(d, out.executed.scaling.deviation, "{kind}");
     }
 }
 

@@ -38,14 +38,15 @@ fn default_planner_on_default_and_held_out_paths() {
             e.plan.total_time,
             e.plan.chatter_free,
             e.plan.max_spectral_radius,
-            e.deviation.max_off_path * 1e3,
-            e.deviation.max_off_plane * 1e3
+            e.scaling.deviation.max_off_path * 1e3,
+            e.scaling.deviation.max_off_plane * 1e3
         );
         assert!(min_ci >= 0.3, "{name}: min 1/K {min_ci} at {at} m");
         assert!(
-            e.deviation.max_off_path <= 0.05e-3 && e.deviation.max_off_plane <= 0.05e-3,
+            e.scaling.deviation.max_off_path <= 0.05e-3
+                && e.scaling.deviation.max_off_plane <= 0.05e-3,
             "{name}: {:?}",
-            e.deviation
+            e.scaling.deviation
         );
         assert!(
             out.branch_jumps.is_empty(),

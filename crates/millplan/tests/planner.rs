@@ -209,7 +209,7 @@ fn check_executed(cell: &MillCell, out: &MillPlanOutput) {
         d.max_off_path <= tolerance && d.max_off_plane <= tolerance,
         "{d:?}"
     );
-    assert_eq!(d, out.executed.deviation);
+    assert_eq!(d, out.executed.scaling.deviation);
     let duration = exec[n - 1].time_from_start;
     // The plan as executed.
     let e = &out.executed.plan;

@@ -505,7 +505,7 @@ fn tolerances_are_validated_and_enforced() {
     };
     let out = planner().plan(&met).expect("met");
     assert_eq!(out.executed.settings.path_tolerance, 1e-5);
-    let d = out.executed.deviation;
+    let d = out.executed.scaling.deviation;
     assert!(d.max_off_path <= 1e-5 && d.max_off_plane <= 1e-5, "{d:?}");
 }
 

@@ -355,7 +355,7 @@ fn assert_published_as_executed(m: &msg::MillPlan, out: &MillPlanOutput) {
         assert!(x.feed <= p.feed, "segment {}", p.segment);
     }
     // The executed tool path and the conditioning along the trajectory.
-    let d = &out.executed.deviation;
+    let d = &out.executed.scaling.deviation;
     assert_eq!(
         (m.max_path_deviation, m.max_plane_deviation),
         (d.max_off_path, d.max_off_plane)
@@ -425,7 +425,7 @@ fn assert_published_as_executed(m: &msg::MillPlan, out: &MillPlanOutput) {
         format!(
             "{} trajectory points, tool tip within {:.4} mm of the path",
             sc.trajectory.points().len(),
-            out.executed.deviation.max_off_path * 1e3
+            out.executed.scaling.deviation.max_off_path * 1e3
         ),
         format!(
             "max |mu| {:.4} as executed ({:.4} as planned)",
