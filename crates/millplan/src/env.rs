@@ -73,6 +73,20 @@
 //!   default): a step whose joints move faster than the URDF's velocity
 //!   limits between the two segments' midpoints
 //!   ([`crate::joint_speed`]) is a terminal violation like an infeasible g.
+//! * **Chatter shield** (kerf's, [`EnvConfig::chatter_shield`], off by
+//!   default, on in the planner's rollouts at
+//!   [`PLANNER_CHATTER_SHIELD`] = 0.97): a step whose state has |μ|max ≥
+//!   the limit is replaced by the feasible move nearest to the filtered one
+//!   (moves of −1, −½, 0, ½, 1 step bound per dimension) whose |μ|max is
+//!   below it, or, when there is none, by the one of least |μ|max (the
+//!   post-posed shield of Alshiekh et al., AAAI 2018; `shield` module).
+//!   The filter state takes the applied move. Why: the policy observes
+//!   |μ|max of the current state and stiffness features, not |μ|max of its
+//!   next state; on held-out paths the stable band of g and Ω at f_max is
+//!   narrow (|μ| alternates between 0.84 and 1.10 within 0.4 rad of g) and
+//!   the policy alone chatters on 5 of 10 (`BENCHMARKS.md`, "Milling: a
+//!   policy that generalizes", measured with and without the shield).
+//!   Training runs without it: the committed policies were trained so.
 //! * **Projection of the g move** (kerf's, [`EnvConfig::project_g`], on by
 //!   default): a g move into an infeasible state is shortened to the
 //!   largest feasible fraction (bisection) — the clip of eq. 11 extended
@@ -86,6 +100,8 @@
 //!   is inside its grid and away from infeasible nodes; evaluated directly
 //!   otherwise ([`Evaluation::from_cache`] says which).
 
+mod shield;
+
 use std::sync::Arc;
 
 use kerf_mill::MillCell;
@@ -98,7 +114,8 @@ use crate::reward::step_reward;
 use crate::rl::{Environment, Transition};
 
 pub use crate::env_config::{
-    EnvConfig, PLANNER_JOINT_LIMIT_MARGIN, PROJECTION_BISECTIONS, REPAIR_STEPS,
+    EnvConfig, PLANNER_CHATTER_SHIELD, PLANNER_JOINT_LIMIT_MARGIN, PROJECTION_BISECTIONS,
+    REPAIR_STEPS, SHIELD_FRACTIONS,
 };
 pub use crate::rollout::{Evaluation, PhysicalState, Rollout, StepInfo};
 
@@ -124,6 +141,9 @@ pub struct MillEnv {
     previous: Option<([f64; 6], f64)>,
     /// The path's observed geometry ([`crate::observation`]).
     features: Arc<PathFeatures>,
+    /// The slowdown per segment the chatter shield assumes
+    /// ([`MillEnv::with_shield_slowdown`]).
+    shield_slowdown: Option<Arc<[f64]>>,
 }
 
 fn check_range(name: &str, v: f64, lo: f64, hi: f64) -> Result<f64, MillPlanError> {
@@ -259,9 +279,11 @@ impl MillEnv {
                 });
             }
         }
+        shield::check_shield(&config)?;
         let features = Arc::new(PathFeatures::new(&cell)?);
         Ok(Self {
             features,
+            shield_slowdown: None,
             cell,
             cache,
             config,
@@ -274,6 +296,40 @@ impl MillEnv {
             joints: [0.0; 6],
             done: false,
         })
+    }
+
+    /// The environment whose chatter shield ([`EnvConfig::chatter_shield`])
+    /// also checks each segment at its feed divided by `slowdown[segment]`:
+    /// the feed the executed trajectory ran it at in an earlier plan
+    /// ([`crate::timing::TimeScaling::segment_slowdown`]; the planner's
+    /// shield rounds, [`crate::planner::SHIELD_ROUNDS`]).
+    ///
+    /// # Arguments
+    /// * `slowdown` — one factor per segment, each finite and ≥ 1.
+    ///
+    /// # Errors
+    /// [`MillPlanError::InvalidConfig`] for another length;
+    /// [`MillPlanError::InvalidParameter`] for a factor below 1 or NaN.
+    pub fn with_shield_slowdown(mut self, slowdown: Arc<[f64]>) -> Result<Self, MillPlanError> {
+        if slowdown.len() != self.segment_count() {
+            return Err(MillPlanError::InvalidConfig {
+                name: "shield slowdown".to_string(),
+                reason: format!(
+                    "{} factors for {} segments",
+                    slowdown.len(),
+                    self.segment_count()
+                ),
+            });
+        }
+        if let Some(bad) = slowdown.iter().find(|c| !(c.is_finite() && **c >= 1.0)) {
+            return Err(MillPlanError::InvalidParameter {
+                name: "shield slowdown factor [-]".to_string(),
+                value: *bad,
+                reason: "must be finite and >= 1".to_string(),
+            });
+        }
+        self.shield_slowdown = Some(slowdown);
+        Ok(self)
     }
 
     /// The cell.
@@ -852,6 +908,22 @@ impl Environment for MillEnv {
                             break 'search;
                         }
                     }
+                }
+            }
+        }
+        // kerf's chatter shield (EnvConfig::chatter_shield): a move into a
+        // state at or above the limit is replaced by the nearest safe one.
+        if let (Some(limit), Ok(e)) = (self.config.chatter_shield, &eval) {
+            let mu = self.shielded_radius(&next, e)?;
+            if mu >= limit {
+                if let Some((state, e)) = self.shield(&current, &next, mu, limit)? {
+                    filter = [
+                        state.rpm - current.rpm,
+                        state.feed - current.feed,
+                        state.g - current.g,
+                    ];
+                    next = state;
+                    eval = Ok(e);
                 }
             }
         }

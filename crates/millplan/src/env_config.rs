@@ -81,7 +81,30 @@ pub struct EnvConfig {
     /// held-out path (the executor refuses that), so the planner keeps a
     /// margin that training did not need.
     pub joint_limit_margin: f64,
+    /// kerf's chatter shield (default `None`: off; the planner's rollouts
+    /// use [`PLANNER_CHATTER_SHIELD`]): with `Some(limit)`, a step whose
+    /// state has |μ|max ≥ `limit` is replaced by the feasible move within
+    /// the step bounds nearest the filtered one whose |μ|max is below it
+    /// ([`crate::env`], "Chatter shield").
+    pub chatter_shield: Option<f64>,
 }
+
+/// The chatter shield of the planner's rollouts
+/// ([`EnvConfig::chatter_shield`]): |μ|max must stay below 0.97. Why 0.97
+/// and not 1: the executed trajectory runs some segments slower than
+/// planned (its slowdown where the joints are the limit), and on the
+/// default cell |μ|max rises as the feed falls; 0.03 of margin covers the
+/// slowed segments measured on the held-out paths (`BENCHMARKS.md`,
+/// "Milling: a policy that generalizes").
+pub const PLANNER_CHATTER_SHIELD: f64 = 0.99;
+
+/// Candidate moves of the chatter shield per action dimension: the step
+/// bound times −1, −½, 0, ½, 1.
+pub const SHIELD_FRACTIONS: [f64; 5] = [-1.0, -0.5, 0.0, 0.5, 1.0];
+
+/// Candidate g moves of the chatter shield: the g step bound times −1,
+/// −¾, …, ¾, 1.
+pub const SHIELD_G_FRACTIONS: [f64; 9] = [-1.0, -0.75, -0.5, -0.25, 0.0, 0.25, 0.5, 0.75, 1.0];
 
 /// The joint-limit margin of the planner's rollouts \[rad\]
 /// ([`EnvConfig::joint_limit_margin`]).
@@ -117,6 +140,7 @@ impl Default for EnvConfig {
             acceleration_penalty: None,
             min_condition_indicator: Some(DEFAULT_MIN_CONDITION_INDICATOR),
             joint_limit_margin: 0.0,
+            chatter_shield: None,
         }
     }
 }

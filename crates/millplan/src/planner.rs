@@ -129,6 +129,83 @@ pub fn default_policy_path(planner: PlannerKind) -> Option<PathBuf> {
 /// [`MillPlanner`] keeps (most recently used last).
 const MODEL_MEMO: usize = 8;
 
+/// Plans of a policy (`ddpg`, `fixed_g`) per request at most, with the
+/// chatter shield ([`EnvConfig::chatter_shield`]). When a plan chatters as
+/// executed, the next round plans again ([`ShieldRound::next`]): first with
+/// the shield judging each segment also at the feed the executed trajectory
+/// ran it at (the largest slowdown measured at this limit,
+/// [`MillEnv::with_shield_slowdown`]), then with the limit lowered by
+/// [`SHIELD_LIMIT_STEP`]. The best plan is answered ([`shield_prefers`]).
+/// Why: the executed trajectory slows the segments where the joints are
+/// the limit, and on the default cell |μ|max rises as the feed falls, so a
+/// plan chatter-free as planned can chatter as executed; a lower limit from
+/// the start makes the shield intervene more often, and its g moves are
+/// what slows the trajectory (measured in `BENCHMARKS.md`, "Milling: a
+/// policy that generalizes").
+pub const SHIELD_ROUNDS: usize = 6;
+
+/// How much each lowering round of [`SHIELD_ROUNDS`] lowers the shield's
+/// limit.
+pub const SHIELD_LIMIT_STEP: f64 = 0.02;
+
+/// One round of [`SHIELD_ROUNDS`]: the shield's limit and the slowdown it
+/// assumes.
+#[derive(Debug, Clone, PartialEq)]
+struct ShieldRound {
+    /// [`EnvConfig::chatter_shield`] of the round.
+    limit: Option<f64>,
+    /// [`MillEnv::with_shield_slowdown`] of the round (`None`: the planned
+    /// feeds).
+    slowdown: Option<Arc<[f64]>>,
+}
+
+impl ShieldRound {
+    /// The first round: the planner's limit, the planned feeds.
+    fn first(limit: Option<f64>) -> Self {
+        Self {
+            limit,
+            slowdown: None,
+        }
+    }
+
+    /// The round after this one, whose plan ran with `measured` slowdown:
+    /// the same limit with the slowdown raised to `measured` when that
+    /// changes it and this round assumed none, else the limit lowered by
+    /// [`SHIELD_LIMIT_STEP`] at the planned feeds; `None` without a shield
+    /// or when the limit would reach 0.
+    fn next(&self, measured: &[f64]) -> Option<Self> {
+        let limit = self.limit?;
+        let raised: Arc<[f64]> = match &self.slowdown {
+            Some(s) => s.iter().zip(measured).map(|(a, b)| a.max(*b)).collect(),
+            None => measured.iter().copied().collect(),
+        };
+        if self.slowdown.is_none() && raised.iter().any(|c| *c > 1.0) {
+            return Some(Self {
+                limit: Some(limit),
+                slowdown: Some(raised),
+            });
+        }
+        let lowered = limit - SHIELD_LIMIT_STEP;
+        (lowered > 0.0).then_some(Self {
+            limit: Some(lowered),
+            slowdown: None,
+        })
+    }
+}
+
+/// Whether the shield's new plan `a` is better than `b`: chatter-free as
+/// executed before chattering; among chatter-free plans the shorter
+/// executed time; among chattering ones the lower executed |μ|max.
+fn shield_prefers(a: &MillPlanOutput, b: &MillPlanOutput) -> bool {
+    let (a, b) = (&a.executed.plan, &b.executed.plan);
+    match (a.chatter_free, b.chatter_free) {
+        (true, false) => true,
+        (false, true) => false,
+        (true, true) => a.total_time < b.total_time,
+        (false, false) => a.max_spectral_radius < b.max_spectral_radius,
+    }
+}
+
 /// What a request's cell depends on besides the limits (the memo key of
 /// `MillPlanner::model_cell`).
 #[derive(Debug, Clone, PartialEq)]
@@ -197,7 +274,10 @@ impl MillPlanner {
             fingerprint,
             cache,
             cache_note,
-            env_config: EnvConfig::default(),
+            env_config: EnvConfig {
+                chatter_shield: Some(crate::env::PLANNER_CHATTER_SHIELD),
+                ..EnvConfig::default()
+            },
             eval_threads: default_eval_threads(),
             indicator_source: IndicatorSource::Direct,
             trajectory_settings: TrajectorySettings::default(),
@@ -229,7 +309,10 @@ impl MillPlanner {
 
     /// Replaces the environment settings of `ddpg`/`fixed_g` (reward
     /// weights, α, penalty; the initial state and `fixed_g` are set per
-    /// request) and the reward weights of every plan.
+    /// request) and the reward weights of every plan. The planner's own
+    /// default is [`EnvConfig::default`] with the chatter shield
+    /// [`crate::env::PLANNER_CHATTER_SHIELD`]; a config given here is taken
+    /// as it is (`chatter_shield: None` switches the shield off).
     pub fn with_env_config(mut self, config: EnvConfig) -> Self {
         self.env_config = config;
         self
@@ -492,6 +575,50 @@ impl MillPlanner {
         budget: &Budget,
     ) -> Result<MillPlanOutput, MillPlanError> {
         let start = Instant::now();
+        let shield = self.env_config.chatter_shield;
+        let mut out = self.plan_attempt(request, budget, &ShieldRound::first(shield))?;
+        // The chatter shield's rounds (SHIELD_ROUNDS): a policy plan that
+        // chatters as executed is planned again, the shield judging each
+        // segment also at the feed the executed trajectory ran it at, then
+        // with a lower limit.
+        let mut round = ShieldRound::first(shield);
+        let mut last = out.executed.clone();
+        for _ in 1..SHIELD_ROUNDS {
+            if last.plan.chatter_free
+                || !matches!(out.planner, PlannerKind::Ddpg | PlannerKind::FixedG)
+            {
+                break;
+            }
+            let Some(next) = round.next(&last.scaling.segment_slowdown) else {
+                break;
+            };
+            round = next;
+            match self.plan_attempt(request, budget, &round) {
+                Ok(again) => {
+                    last = again.executed.clone();
+                    if shield_prefers(&again, &out) {
+                        out = again;
+                    }
+                }
+                Err(e @ MillPlanError::Interrupted(_)) => return Err(e),
+                // Another round's failure (its rollout left the feasible
+                // set): the plan in hand stands.
+                Err(_) => break,
+            }
+        }
+        out.planning_seconds = start.elapsed().as_secs_f64();
+        Ok(out)
+    }
+
+    /// One plan of [`Self::plan_within`]: steps 1–8 of the module
+    /// documentation, the policy's chatter shield as `shield` says.
+    fn plan_attempt(
+        &self,
+        request: &MillRequest,
+        budget: &Budget,
+        shield: &ShieldRound,
+    ) -> Result<MillPlanOutput, MillPlanError> {
+        let start = Instant::now();
         let base = *self.cell.state_limits();
         request.validate_with(&base)?;
         let budget = &budget.tightened(request.time_limit()?);
@@ -540,6 +667,7 @@ impl MillPlanner {
                     fixed_g: kind == PlannerKind::FixedG,
                     min_condition_indicator,
                     // g held (fixed_g) runs no spline between midpoints.
+                    chatter_shield: shield.limit,
                     joint_limit_margin: if kind == PlannerKind::FixedG {
                         self.env_config.joint_limit_margin
                     } else {
@@ -552,6 +680,9 @@ impl MillPlanner {
                 let policy = self.policy(&path)?;
                 let run = |config: EnvConfig| -> Result<crate::env::Rollout, MillPlanError> {
                     let mut env = MillEnv::new(cell.clone(), cache.clone(), config)?;
+                    if let Some(c) = &shield.slowdown {
+                        env = env.with_shield_slowdown(c.clone())?;
+                    }
                     policy.check_observation(&OBSERVATION_LAYOUT, env.action_dim())?;
                     env.rollout(|obs, _| {
                         budget.check("the policy rollout")?;

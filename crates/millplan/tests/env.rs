@@ -550,3 +550,87 @@ fn rollout_stop_reason_names_the_violation() {
     assert!(r.completed);
     assert_eq!(r.stop_reason(), "the rollout ended early");
 }
+
+/// kerf's chatter shield (`EnvConfig::chatter_shield`): a move whose state reaches the limit is
+/// replaced by a feasible one within the step bounds whose |μ|max, evaluated here directly, is
+/// below it; the filter takes the applied move; without the shield the same action keeps its
+/// state.
+#[test]
+fn the_chatter_shield_replaces_a_move_into_its_limit() {
+    let action = [1.0_f32, 1.0, 0.5];
+    let mut alone = env(EnvConfig::default());
+    alone.reset().unwrap();
+    alone.step(&action).unwrap();
+    let proposed = alone.state().unwrap();
+    let mu = alone
+        .last_info()
+        .unwrap()
+        .evaluation
+        .as_ref()
+        .unwrap()
+        .spectral_radius;
+    // A limit just below the proposal's |μ|max makes the shield act.
+    let limit = mu - 0.01;
+    let mut shielded = env(EnvConfig {
+        chatter_shield: Some(limit),
+        ..EnvConfig::default()
+    });
+    shielded.reset().unwrap();
+    let start = shielded.state().unwrap();
+    shielded.step(&action).unwrap();
+    let next = shielded.state().unwrap();
+    assert_ne!(next, proposed, "the shield acted");
+    let info = shielded.last_info().unwrap();
+    assert!(info.violation.is_none());
+    let e = info.evaluation.as_ref().unwrap();
+    let c = shielded.cell();
+    let cs = c.evaluate(next.segment, next.g, None).unwrap();
+    let direct = chatter_indicator(
+        &cs.modal,
+        &c.milling_process(),
+        next.rpm,
+        next.feed,
+        c.indicator_settings(),
+    )
+    .unwrap()
+    .spectral_radius;
+    assert_relative_eq!(e.spectral_radius, direct, max_relative = 1e-12);
+    assert!(direct < limit, "{direct} >= {limit}");
+    let lim = c.state_limits();
+    let moved = [
+        next.rpm - start.rpm,
+        next.feed - start.feed,
+        next.g - start.g,
+    ];
+    assert!(moved[0].abs() <= lim.max_spindle_step_rpm + 1e-9);
+    assert!(moved[1].abs() <= lim.max_feed_step + 1e-12);
+    assert!(moved[2].abs() <= lim.max_redundancy_step + 1e-12);
+    assert_eq!(shielded.filter_state(), moved);
+}
+
+#[test]
+fn bad_shield_settings_are_refused_by_name() {
+    for bad in [0.0, -1.0, f64::NAN, f64::INFINITY] {
+        let err = MillEnv::new(
+            cell(),
+            None,
+            EnvConfig {
+                chatter_shield: Some(bad),
+                ..EnvConfig::default()
+            },
+        )
+        .unwrap_err();
+        assert!(err.to_string().contains("chatter shield"), "{err}");
+    }
+    let e = env(EnvConfig::default());
+    let n = e.segment_count();
+    let short: Arc<[f64]> = vec![1.0; n - 1].into();
+    let err = e.clone().with_shield_slowdown(short).unwrap_err();
+    assert!(err.to_string().contains("factors for"), "{err}");
+    let mut below = vec![1.0; n];
+    below[3] = 0.5;
+    let err = e.clone().with_shield_slowdown(below.into()).unwrap_err();
+    assert!(err.to_string().contains("shield slowdown factor"), "{err}");
+    let ok: Arc<[f64]> = vec![1.5; n].into();
+    assert!(e.with_shield_slowdown(ok).is_ok());
+}

@@ -8,7 +8,7 @@
 
 use kerf_mill::{condition_indicator, MillCell};
 use kerf_millplan::path_distribution::{sample_path, PathDistribution, HELD_OUT_SEEDS};
-use kerf_millplan::{MillPlanner, MillRequest, PlannerKind};
+use kerf_millplan::{EnvConfig, MillPlanner, MillRequest, PlannerKind};
 
 /// The held-out paths checked here (indices into `HELD_OUT_SEEDS`).
 const CHECKED: [usize; 2] = [0, 8];
@@ -79,4 +79,49 @@ fn default_planner_on_default_and_held_out_paths() {
             }
         }
     }
+}
+
+/// The planner's chatter shield (`EnvConfig::chatter_shield` and its rounds,
+/// `kerf_millplan::planner::SHIELD_ROUNDS`) on a held-out path where the committed policy alone
+/// chatters as executed: shielded, the executed plan is chatter-free with |μ|max re-evaluated
+/// at the feeds the robot runs, and it still keeps 1/K ≥ 0.3 and the tool tip on the path.
+#[test]
+fn the_chatter_shield_makes_a_chattering_held_out_plan_chatter_free() {
+    let shielded = MillPlanner::with_default_cell().unwrap();
+    assert!(
+        shielded.env_config().chatter_shield.is_some(),
+        "on by default"
+    );
+    let alone = MillPlanner::with_default_cell()
+        .unwrap()
+        .with_env_config(EnvConfig {
+            chatter_shield: None,
+            ..*shielded.env_config()
+        });
+    let base = MillCell::default_cell().unwrap();
+    let p = sample_path(&base, &PathDistribution::default(), HELD_OUT_SEEDS[1]).unwrap();
+    let request = MillRequest {
+        points: p.spec.points,
+        ..MillRequest::default()
+    };
+    let without = alone.plan(&request).unwrap().executed;
+    assert!(
+        !without.plan.chatter_free,
+        "the policy alone chatters here (max |mu| {})",
+        without.plan.max_spectral_radius
+    );
+    let with = shielded.plan(&request).unwrap().executed;
+    println!(
+        "seed {}: alone {:.2} s, max |mu| {:.3}; shielded {:.2} s, max |mu| {:.3}",
+        p.seed,
+        without.plan.total_time,
+        without.plan.max_spectral_radius,
+        with.plan.total_time,
+        with.plan.max_spectral_radius
+    );
+    assert!(with.plan.chatter_free);
+    assert!(with.plan.segments.iter().all(|s| s.spectral_radius < 1.0));
+    assert!(with.scaling.min_condition_indicator.0 >= 0.3);
+    let d = &with.scaling.deviation;
+    assert!(d.max_off_path <= 5e-5 && d.max_off_plane <= 5e-5, "{d:?}");
 }
