@@ -75,18 +75,21 @@
 //!   ([`crate::joint_speed`]) is a terminal violation like an infeasible g.
 //! * **Chatter shield** (kerf's, [`EnvConfig::chatter_shield`], off by
 //!   default, on in the planner's rollouts at
-//!   [`PLANNER_CHATTER_SHIELD`] = 0.97): a step whose state has |μ|max ≥
+//!   [`PLANNER_CHATTER_SHIELD`] = 0.99): a step whose state has |μ|max ≥
 //!   the limit is replaced by the feasible move nearest to the filtered one
-//!   (moves of −1, −½, 0, ½, 1 step bound per dimension) whose |μ|max is
-//!   below it, or, when there is none, by the one of least |μ|max (the
-//!   post-posed shield of Alshiekh et al., AAAI 2018; `shield` module).
-//!   The filter state takes the applied move. Why: the policy observes
-//!   |μ|max of the current state and stiffness features, not |μ|max of its
-//!   next state; on held-out paths the stable band of g and Ω at f_max is
+//!   (Ω and f moves of −1, −½, 0, ½, 1 step bound, g moves in quarters)
+//!   whose |μ|max is below it, or, when there is none, by the one of least
+//!   |μ|max (the post-posed shield of Alshiekh et al., AAAI 2018; `shield`
+//!   module). With [`MillEnv::with_shield_slowdown`] a state is also judged
+//!   at the feed an earlier executed trajectory ran its segment at. The
+//!   filter state takes the applied move. Why: the policy observes |μ|max
+//!   of the current state and stiffness features, not |μ|max of its next
+//!   state; on held-out paths the stable band of g and Ω at f_max is
 //!   narrow (|μ| alternates between 0.84 and 1.10 within 0.4 rad of g) and
-//!   the policy alone chatters on 5 of 10 (`BENCHMARKS.md`, "Milling: a
-//!   policy that generalizes", measured with and without the shield).
-//!   Training runs without it: the committed policies were trained so.
+//!   the policy alone chatters on 5 of 10 as executed (`BENCHMARKS.md`,
+//!   "Milling: a policy that generalizes", measured with and without the
+//!   shield). Training runs without it: the committed policies were trained
+//!   so.
 //! * **Projection of the g move** (kerf's, [`EnvConfig::project_g`], on by
 //!   default): a g move into an infeasible state is shortened to the
 //!   largest feasible fraction (bisection) — the clip of eq. 11 extended

@@ -35,7 +35,8 @@
 //!    distribution of planar paths ([`crate::path_distribution`]) and
 //!    evaluated on held-out ones (`BENCHMARKS.md`, "Milling: a policy that
 //!    generalizes"). A rollout that leaves the feasible set is a
-//!    [`MillPlanError::Policy`] error.
+//!    [`MillPlanError::Policy`] error. The policy's moves pass the chatter
+//!    shield ([`EnvConfig::chatter_shield`], [`crate::env::PLANNER_CHATTER_SHIELD`]).
 //! 5. [`Plan::evaluate_with_threads`]: every segment evaluated directly
 //!    (|μ|max never from the cache) on [`MillPlanner::eval_threads`]
 //!    threads (the same plan, bit for bit, for every thread count), the
@@ -55,6 +56,15 @@
 //!    over the trajectory's points must reach it, else
 //!    [`MillPlanError::IllConditioned`] (status ILL_CONDITIONED) with the
 //!    value, the arc length and the segment.
+//! 9. The shield's rounds (`ddpg`, `fixed_g`): a plan that chatters as
+//!    executed (step 7) is planned again from step 4, the shield judging
+//!    each segment also at its executed feed, then with a lower limit, at
+//!    most [`SHIELD_ROUNDS`] plans in all; the best is answered
+//!    ([`MillPlanOutput::phases`] are the answered plan's,
+//!    [`MillPlanOutput::planning_seconds`] all rounds'). A round that
+//!    runs out of the time budget ends the rounds with the plan in hand
+//!    (the first plan's timeout is TIMEOUT as always); a cancellation is
+//!    an error.
 //!
 //! # When the indicator cache applies
 //! The cache ([`IndicatorCache`]) holds |μ|max of the DEFAULT cell. It
@@ -583,6 +593,7 @@ impl MillPlanner {
         // with a lower limit.
         let mut round = ShieldRound::first(shield);
         let mut last = out.executed.clone();
+        let mut last_states = out.plan.states();
         for _ in 1..SHIELD_ROUNDS {
             if last.plan.chatter_free
                 || !matches!(out.planner, PlannerKind::Ddpg | PlannerKind::FixedG)
@@ -595,14 +606,26 @@ impl MillPlanner {
             round = next;
             match self.plan_attempt(request, budget, &round) {
                 Ok(again) => {
+                    // The same plan again: a lower limit will not change it
+                    // (no safe move within a step is left to the shield).
+                    let states = again.plan.states();
+                    let same = states == last_states;
+                    last_states = states;
                     last = again.executed.clone();
                     if shield_prefers(&again, &out) {
                         out = again;
                     }
+                    if same {
+                        break;
+                    }
                 }
-                Err(e @ MillPlanError::Interrupted(_)) => return Err(e),
-                // Another round's failure (its rollout left the feasible
-                // set): the plan in hand stands.
+                // Cancelled: the node is stopping.
+                Err(e @ MillPlanError::Interrupted(kerf_budget::Interrupt::Cancelled { .. })) => {
+                    return Err(e)
+                }
+                // The budget ran out in a later round, or its rollout left
+                // the feasible set: the plan in hand (complete, its chatter
+                // reported) stands.
                 Err(_) => break,
             }
         }

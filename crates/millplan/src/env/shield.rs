@@ -7,7 +7,7 @@
 //! the state the move leads to.
 
 use super::{EnvConfig, Evaluation, MillEnv, PhysicalState};
-use crate::env_config::{SHIELD_FRACTIONS, SHIELD_G_FRACTIONS};
+use crate::env_config::{SHIELD_FRACTIONS, SHIELD_G_FRACTIONS, SHIELD_MAX_EVALUATIONS};
 use crate::error::MillPlanError;
 
 impl MillEnv {
@@ -27,7 +27,8 @@ impl MillEnv {
     /// [`SHIELD_FRACTIONS`] per dimension (Δg = 0 with
     /// [`EnvConfig::fixed_g`]), clipped to the state ranges like eq. 11;
     /// "nearest" in the move normalized by the step bounds (Euclidean), ties
-    /// in the candidates' order. When none is below `limit`, the feasible
+    /// in the candidates' order, among the [`SHIELD_MAX_EVALUATIONS`]
+    /// nearest feasible ones. When none is below `limit`, the evaluated
     /// candidate of least |μ|max if it is below `proposed_mu`; `None` when
     /// no candidate improves on the proposal (the step stays as proposed).
     ///
@@ -35,7 +36,9 @@ impl MillEnv {
     /// Candidates are tried nearest first and the search stops at the first
     /// safe one; each costs an IK (feasibility, without the chatter model)
     /// and, when feasible, one |μ|max (the cache's, else a direct
-    /// evaluation, about 0.4 ms). At most 125 candidates (25 with g fixed).
+    /// evaluation, about 0.4 ms): at most [`SHIELD_MAX_EVALUATIONS`] of the
+    /// 225 candidates (25 with g fixed) are evaluated, the nearest feasible
+    /// ones.
     ///
     /// # Errors
     /// Cell-model errors other than infeasibility; chatter-model errors.
@@ -91,7 +94,11 @@ impl MillEnv {
         candidates.sort_by(|x, y| x.0.total_cmp(&y.0));
         let mut tried: Vec<PhysicalState> = Vec::with_capacity(candidates.len());
         let mut best: Option<(f64, (PhysicalState, Evaluation))> = None;
+        let mut evaluated = 0;
         for (_, state) in candidates {
+            if evaluated == SHIELD_MAX_EVALUATIONS {
+                break;
+            }
             // The clip can map several moves to one state.
             if state == *proposed || tried.contains(&state) {
                 continue;
@@ -100,6 +107,7 @@ impl MillEnv {
             if !self.feasible(current, &state)? {
                 continue;
             }
+            evaluated += 1;
             let Ok(e) = self.checked_evaluation(current, &state)? else {
                 continue;
             };
