@@ -347,13 +347,21 @@ fn dp_on_the_default_request_and_with_narrower_limits() {
 }
 
 /// A policy trained for 2 episodes on the default cell (tiny network),
-/// saved, then planned through a request: the plan's states are the greedy
-/// rollout of the same policy run here in a fresh environment.
+/// saved, then planned through a request by a planner without the chatter
+/// shield (`chatter_shield: None`; the shield is tested in `env.rs` and
+/// `generalization.rs`): the plan's states are the greedy rollout of the
+/// same policy run here in a fresh environment.
 #[test]
 fn ddpg_and_fixed_g_with_a_policy_trained_in_the_test() {
     let dir = temp_dir("ddpg");
     let cell = planner().cell().clone();
     let cache = planner().cache().cloned();
+    let unshielded = MillPlanner::with_default_cell()
+        .expect("planner")
+        .with_env_config(EnvConfig {
+            chatter_shield: None,
+            ..*planner().env_config()
+        });
     for (kind, fixed_g) in [(PlannerKind::Ddpg, false), (PlannerKind::FixedG, true)] {
         let config = EnvConfig {
             fixed_g,
@@ -373,7 +381,7 @@ fn ddpg_and_fixed_g_with_a_policy_trained_in_the_test() {
             policy_file: Some(path.display().to_string()),
             ..MillRequest::default()
         };
-        let out = planner().plan(&request).expect("plan");
+        let out = unshielded.plan(&request).expect("plan");
         assert_eq!(out.planner, kind);
         assert_eq!(out.policy_file.as_deref(), Some(path.as_path()));
         check_plan(&cell, &out);
@@ -402,7 +410,7 @@ fn ddpg_and_fixed_g_with_a_policy_trained_in_the_test() {
             assert!(out.plan.segments.iter().all(|s| s.g == 0.0));
         }
         // Planned again: the cached policy gives the same plan.
-        let again = planner().plan(&request).expect("plan again");
+        let again = unshielded.plan(&request).expect("plan again");
         assert_eq!(again.plan, out.plan);
         println!(
             "{}: time {:.3} s, max |mu| {:.4}, reward {:.3}, {:.3} s",
