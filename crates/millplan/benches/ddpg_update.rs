@@ -1,6 +1,7 @@
 //! Cost of DDPG (issue 5 figures): one update with seed 004 Table 2's
-//! sizes — batch 64, actor and critic 2×256, 4 observations, 3 actions
-//! (the milling environment) — and the training time it implies for
+//! sizes — batch 64, actor and critic 2×256 — with the milling environment's
+//! observation (37 path-independent entries, `kerf_millplan::observation`) and
+//! 3 actions — and the training time it implies for
 //! 1000 episodes × 100 steps (issue goal: ≤ 5 min on the 2-core machine).
 //!
 //! * `ddpg update, tuned`: under [`CpuTuning`] (one thread, FTZ/DAZ,
@@ -31,7 +32,7 @@ use kerf_millplan::nets::CpuTuning;
 use kerf_millplan::policy::Policy;
 use kerf_millplan::{Environment, MillPlanError, Transition};
 
-const OBS: usize = 4;
+const OBS: usize = kerf_millplan::observation::OBSERVATION_DIM;
 const ACT: usize = 3;
 
 #[allow(dead_code)] // each bench uses some of the shared helpers
@@ -57,7 +58,7 @@ fn time_updates(
     (wall, cpu)
 }
 
-/// A 4-observation, 3-action environment with trivial dynamics, to get a
+/// An OBS-observation, 3-action environment with trivial dynamics, to get a
 /// trained (one update) agent of the right sizes.
 struct Dummy {
     t: usize,
@@ -81,7 +82,13 @@ impl Environment for Dummy {
         self.t += 1;
         let x = self.t as f32 / 100.0;
         Ok(Transition {
-            observation: vec![x, action[0], action[1], action[2]],
+            observation: (0..OBS)
+                .map(|k| match k {
+                    0 => x,
+                    1..=3 => action[k - 1],
+                    _ => 0.0,
+                })
+                .collect(),
             reward: f64::from(-x * x),
             done: false,
         })
@@ -129,7 +136,7 @@ fn bench(c: &mut Criterion) {
         .with_steps_per_episode(2)
         .with_batch_size(1);
     let agent = train(&mut env, &small, &mut |_| {}).expect("train");
-    let obs = vec![0.1f32, -0.2, 0.3, 0.4];
+    let obs: Vec<f32> = (0..OBS).map(|k| 0.1 * (k % 5) as f32 - 0.2).collect();
     let start = Instant::now();
     for _ in 0..1000 {
         black_box(agent.act(black_box(&obs)).expect("act"));

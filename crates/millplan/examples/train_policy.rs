@@ -20,6 +20,8 @@
 //! executed, up to 2.7× the planned time),
 //! `--min-condition C` ([`kerf_millplan::EnvConfig::min_condition_indicator`],
 //! default 0.35; `none` switches the constraint off: the paper's environment),
+//! `--shield L` ([`kerf_millplan::EnvConfig::chatter_shield`] during training, default none:
+//! the committed policies were trained without it; the planner shields at plan time either way),
 //! `--out FILE` (default `crates/millplan/policies/{ddpg,fixed_g}.safetensors`).
 //! Writes FILE, its JSON sidecar and `FILE` with `.history.json` (one
 //! [`kerf_millplan::ddpg::EpisodeReport`] per episode, for seed 004 Fig. 5),
@@ -64,6 +66,7 @@ fn main() -> Result<(), MillPlanError> {
     let acceleration_penalty: f64 =
         value(&args, "--acceleration-penalty")?.unwrap_or(DEFAULT_ACCELERATION_PENALTY);
     let paths: usize = value(&args, "--paths")?.unwrap_or(47);
+    let shield: Option<f64> = value(&args, "--shield")?;
     let min_condition: Option<f64> = match value::<String>(&args, "--min-condition")? {
         None => Some(kerf_millplan::env_config::DEFAULT_MIN_CONDITION_INDICATOR),
         Some(v) if v == "none" => None,
@@ -86,6 +89,7 @@ fn main() -> Result<(), MillPlanError> {
         fixed_g,
         acceleration_penalty: Some(acceleration_penalty),
         min_condition_indicator: min_condition,
+        chatter_shield: shield,
         ..EnvConfig::default()
     };
     let started = std::time::Instant::now();
@@ -131,6 +135,9 @@ fn main() -> Result<(), MillPlanError> {
     }
     if acceleration_penalty != DEFAULT_ACCELERATION_PENALTY {
         flags.push_str(&format!(" --acceleration-penalty {acceleration_penalty}"));
+    }
+    if let Some(l) = shield {
+        flags.push_str(&format!(" --shield {l}"));
     }
     match min_condition {
         None => flags.push_str(" --min-condition none"),
