@@ -10,6 +10,8 @@
 //! cargo bench -p kerf_millplan --bench baselines -- --planners greedy --candidates  # every fixed g
 //! cargo bench -p kerf_millplan --bench baselines -- --planners dp --dp-accel  # + the DP with
 //! #   joint accelerations in its state (DpSpec::joint_acceleration_limits), default request only
+//! cargo bench -p kerf_millplan --bench baselines -- --planners dp --dp-executed  # + the DP with
+//! #   the executed timing in the loop (kerf_millplan::dp_executed), default request only
 //! ```
 //!
 //! The shifted path is the default path turned by 0.3 rad about the vertical through its
@@ -130,6 +132,9 @@ fn main() {
     if args.iter().any(|a| a == "--dp-accel") && !shifted {
         dp_with_accelerations(&planner);
     }
+    if args.iter().any(|a| a == "--dp-executed") && !shifted {
+        dp_executed(&planner);
+    }
     if args.iter().any(|a| a == "--candidates") {
         candidates(&planner, &base);
     }
@@ -234,6 +239,73 @@ fn dp_with_accelerations(planner: &MillPlanner) {
             e.max_spectral_radius,
             e.min_condition_indicator,
             out.scaling.min_condition_indicator.0,
+            d.max_off_path * 1e3,
+            d.max_off_plane * 1e3,
+            e.total_reward
+        );
+    }
+}
+
+/// The DP with the executed timing in the loop (`kerf_millplan::dp_executed::solve_executed`), plain
+/// and with joint accelerations in its state, on the default request with the committed cache:
+/// every round (moves held, as planned, as executed) and the answered round as one more row.
+fn dp_executed(planner: &MillPlanner) {
+    use kerf_budget::Budget;
+    use kerf_millplan::dp::DpSpec;
+    use kerf_millplan::dp_executed::solve_executed;
+    use kerf_millplan::plan::default_eval_threads;
+    let cell = planner.cell();
+    let cache = planner.cache().expect("the committed cache");
+    let weights = planner.env_config().weights;
+    for (name, accel) in [
+        ("dp, executed timing in the loop", false),
+        (
+            "dp, accelerations in the state and executed timing in the loop",
+            true,
+        ),
+    ] {
+        let spec = DpSpec {
+            joint_acceleration_limits: accel,
+            ..DpSpec::full(cell, weights, false)
+        };
+        let start = Instant::now();
+        let r = solve_executed(
+            cell,
+            cache,
+            &spec,
+            default_eval_threads(),
+            &Budget::unlimited(),
+        )
+        .unwrap();
+        let seconds = start.elapsed().as_secs_f64();
+        for (k, round) in r.rounds.iter().enumerate() {
+            let e = &round.executed.plan;
+            eprintln!(
+                "{name}, round {k}: {} moves held; planned {:.3} s, reward {:.3}; executed {:.3} s \
+                 (chatter-free {}, max |mu| {:.4}), reward {:.3}, {} segments slowed",
+                round.held.iter().filter(|h| **h).count(),
+                round.plan.total_time,
+                round.plan.total_reward,
+                e.total_time,
+                e.chatter_free,
+                e.max_spectral_radius,
+                e.total_reward,
+                round.executed.scaling.slowed_segments()
+            );
+        }
+        let best = r.best().unwrap();
+        let e = &best.executed.plan;
+        let d = &best.executed.scaling.deviation;
+        println!(
+            "| {name} (round {} of {}; {:.2} s as planned) | {:.2} | {} | {:.4} | {:.3} / {:.3} | {:.3} / {:.3} | {:.3} | {seconds:.1} (all rounds) |",
+            r.best,
+            r.rounds.len(),
+            best.plan.total_time,
+            e.total_time,
+            if e.chatter_free { "yes" } else { "no" },
+            e.max_spectral_radius,
+            e.min_condition_indicator,
+            best.executed.scaling.min_condition_indicator.0,
             d.max_off_path * 1e3,
             d.max_off_plane * 1e3,
             e.total_reward

@@ -224,6 +224,23 @@ pub fn solve_within(
     spec: &DpSpec,
     budget: &Budget,
 ) -> Result<DpResult, MillPlanError> {
+    solve_holding(cell, cache, spec, &[], budget)
+}
+
+/// [`solve_within`] with g held on some moves: `held[t]` forbids every
+/// move from segment t to t + 1 that changes g (missing entries: not held).
+/// [`crate::dp_executed`] holds g where the executed trajectory of an
+/// earlier plan had to slow down.
+///
+/// # Errors
+/// As [`solve_within`].
+pub fn solve_holding(
+    cell: &MillCell,
+    cache: &IndicatorCache,
+    spec: &DpSpec,
+    held: &[bool],
+    budget: &Budget,
+) -> Result<DpResult, MillPlanError> {
     let start_time = Instant::now();
     spec.weights.validate()?;
     if let Some(m) = &spec.chatter_margin {
@@ -304,6 +321,9 @@ pub fn solve_within(
         }
     }
     let allowed = |t: usize, x: [usize; 3], y: [usize; 3]| -> bool {
+        if x[2] != y[2] && held.get(t).copied().unwrap_or(false) {
+            return false;
+        }
         if !spec.joint_speed_limits {
             return true;
         }

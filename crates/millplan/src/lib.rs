@@ -14,6 +14,7 @@ pub mod cache;
 pub mod cache_file;
 pub mod direct;
 pub mod dp;
+pub mod dp_executed;
 pub mod env;
 pub mod env_config;
 pub mod evaluation;
