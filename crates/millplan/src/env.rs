@@ -147,6 +147,8 @@ pub struct MillEnv {
     /// The slowdown per segment the chatter shield assumes
     /// ([`MillEnv::with_shield_slowdown`]).
     shield_slowdown: Option<Arc<[f64]>>,
+    /// The moves whose g the planner holds ([`MillEnv::with_held_g`]).
+    held_g: Option<Arc<[bool]>>,
 }
 
 fn check_range(name: &str, v: f64, lo: f64, hi: f64) -> Result<f64, MillPlanError> {
@@ -287,6 +289,7 @@ impl MillEnv {
         Ok(Self {
             features,
             shield_slowdown: None,
+            held_g: None,
             cell,
             cache,
             config,
@@ -333,6 +336,42 @@ impl MillEnv {
         }
         self.shield_slowdown = Some(slowdown);
         Ok(self)
+    }
+
+    /// The environment with g held on some moves: `held[t]` makes the
+    /// step from segment t to t + 1 keep g (the policy's and the filter's g
+    /// move are set to 0, and the chatter shield offers no g move); only
+    /// the repair of [`EnvConfig::min_condition_indicator`] still moves g
+    /// when keeping it is infeasible. The planner's shield rounds hold g
+    /// around segments an earlier executed trajectory slowed into chatter
+    /// ([`crate::planner::SHIELD_ROUNDS`]).
+    ///
+    /// # Errors
+    /// [`MillPlanError::InvalidConfig`] unless there is one entry per
+    /// segment.
+    pub fn with_held_g(mut self, held: Arc<[bool]>) -> Result<Self, MillPlanError> {
+        if held.len() != self.segment_count() {
+            return Err(MillPlanError::InvalidConfig {
+                name: "held g moves".to_string(),
+                reason: format!(
+                    "{} entries for {} segments",
+                    held.len(),
+                    self.segment_count()
+                ),
+            });
+        }
+        self.held_g = Some(held);
+        Ok(self)
+    }
+
+    /// Whether the move from `segment` to the next keeps g
+    /// ([`MillEnv::with_held_g`]).
+    fn holds_g(&self, segment: usize) -> bool {
+        self.held_g
+            .as_ref()
+            .and_then(|h| h.get(segment))
+            .copied()
+            .unwrap_or(false)
     }
 
     /// The cell.
@@ -844,6 +883,9 @@ impl Environment for MillEnv {
         let mut filter = self.filter;
         for (f, r) in filter.iter_mut().zip(raw) {
             *f = alpha * r + (1.0 - alpha) * *f;
+        }
+        if self.holds_g(current.segment) {
+            filter[2] = 0.0;
         }
         let next = PhysicalState {
             segment: current.segment + 1,

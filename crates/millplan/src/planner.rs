@@ -58,7 +58,8 @@
 //!    value, the arc length and the segment.
 //! 9. The shield's rounds (`ddpg`, `fixed_g`): a plan that chatters as
 //!    executed (step 7) is planned again from step 4, the shield judging
-//!    each segment also at its executed feed, then with a lower limit, at
+//!    each segment also at its executed feed and g held around the
+//!    segments slowed into chatter, then with a lower limit, at
 //!    most [`SHIELD_ROUNDS`] plans in all; the best is answered
 //!    ([`MillPlanOutput::phases`] are the answered plan's,
 //!    [`MillPlanOutput::planning_seconds`] all rounds'). A round that
@@ -143,9 +144,10 @@ const MODEL_MEMO: usize = 8;
 /// chatter shield ([`EnvConfig::chatter_shield`]). When a plan chatters as
 /// executed, the next round plans again ([`ShieldRound::next`]): first with
 /// the shield judging each segment also at the feed the executed trajectory
-/// ran it at (the largest slowdown measured at this limit,
-/// [`MillEnv::with_shield_slowdown`]), then with the limit lowered by
-/// [`SHIELD_LIMIT_STEP`]. The best plan is answered ([`shield_prefers`]).
+/// ran it at ([`MillEnv::with_shield_slowdown`]) and g held around the
+/// segments it slowed into chatter ([`MillEnv::with_held_g`]), then with
+/// the limit lowered by [`SHIELD_LIMIT_STEP`]. The best plan is answered
+/// ([`shield_prefers`]).
 /// Why: the executed trajectory slows the segments where the joints are
 /// the limit, and on the default cell |μ|max rises as the feed falls, so a
 /// plan chatter-free as planned can chatter as executed; a lower limit from
@@ -158,8 +160,8 @@ pub const SHIELD_ROUNDS: usize = 6;
 /// limit.
 pub const SHIELD_LIMIT_STEP: f64 = 0.02;
 
-/// One round of [`SHIELD_ROUNDS`]: the shield's limit and the slowdown it
-/// assumes.
+/// One round of [`SHIELD_ROUNDS`]: the shield's limit, the slowdown it
+/// assumes and the moves whose g it holds.
 #[derive(Debug, Clone, PartialEq)]
 struct ShieldRound {
     /// [`EnvConfig::chatter_shield`] of the round.
@@ -167,41 +169,72 @@ struct ShieldRound {
     /// [`MillEnv::with_shield_slowdown`] of the round (`None`: the planned
     /// feeds).
     slowdown: Option<Arc<[f64]>>,
+    /// [`MillEnv::with_held_g`] of the round (`None`: no move held).
+    held: Option<Arc<[bool]>>,
 }
 
 impl ShieldRound {
-    /// The first round: the planner's limit, the planned feeds.
+    /// The first round: the planner's limit, the planned feeds, no move held.
     fn first(limit: Option<f64>) -> Self {
         Self {
             limit,
             slowdown: None,
+            held: None,
         }
     }
 
-    /// The round after this one, whose plan ran with `measured` slowdown:
-    /// the same limit with the slowdown raised to `measured` when that
-    /// changes it and this round assumed none, else the limit lowered by
-    /// [`SHIELD_LIMIT_STEP`] at the planned feeds; `None` without a shield
-    /// or when the limit would reach 0.
-    fn next(&self, measured: &[f64]) -> Option<Self> {
+    /// The round after this one, whose plan ran as `executed`:
+    /// * after a round at the planned feeds, the same limit with the
+    ///   executed slowdown and g held on the moves from [`HOLD_REACH`]
+    ///   segments before to one after every segment that the executed
+    ///   trajectory slowed (by more than
+    ///   [`crate::dp_executed::SLOWDOWN_TOLERANCE`]) and that chatters as
+    ///   executed, when there is either;
+    /// * else the limit lowered by [`SHIELD_LIMIT_STEP`], at the planned
+    ///   feeds with no move held;
+    ///
+    /// `None` without a shield or when the limit would reach 0.
+    fn next(&self, executed: &crate::executed::Executed) -> Option<Self> {
         let limit = self.limit?;
-        let raised: Arc<[f64]> = match &self.slowdown {
+        let measured = &executed.scaling.segment_slowdown;
+        let slowdown: Arc<[f64]> = match &self.slowdown {
             Some(s) => s.iter().zip(measured).map(|(a, b)| a.max(*b)).collect(),
             None => measured.iter().copied().collect(),
         };
-        if self.slowdown.is_none() && raised.iter().any(|c| *c > 1.0) {
+        let mut held: Vec<bool> = match &self.held {
+            Some(h) => h.to_vec(),
+            None => vec![false; measured.len()],
+        };
+        for (i, (segment, c)) in executed.plan.segments.iter().zip(measured).enumerate() {
+            if segment.spectral_radius >= 1.0 && *c > crate::dp_executed::SLOWDOWN_TOLERANCE {
+                let end = (i + 1).min(held.len().saturating_sub(1));
+                for slot in held
+                    .iter_mut()
+                    .take(end + 1)
+                    .skip(i.saturating_sub(HOLD_REACH))
+                {
+                    *slot = true;
+                }
+            }
+        }
+        let slowed = slowdown.iter().any(|c| *c > 1.0);
+        let holds = held.iter().any(|h| *h);
+        if self.slowdown.is_none() && self.held.is_none() && (slowed || holds) {
             return Some(Self {
                 limit: Some(limit),
-                slowdown: Some(raised),
+                slowdown: slowed.then_some(slowdown),
+                held: holds.then(|| held.into()),
             });
         }
         let lowered = limit - SHIELD_LIMIT_STEP;
-        (lowered > 0.0).then_some(Self {
-            limit: Some(lowered),
-            slowdown: None,
-        })
+        (lowered > 0.0).then_some(Self::first(Some(lowered)))
     }
 }
+
+/// Moves held before a segment slowed into chatter ([`ShieldRound::next`]):
+/// the executed g(s) is a cubic spline through the midpoints, so a move
+/// shapes the neighbouring intervals too.
+const HOLD_REACH: usize = 2;
 
 /// Whether the shield's new plan `a` is better than `b`: chatter-free as
 /// executed before chattering; among chatter-free plans the shorter
@@ -600,7 +633,7 @@ impl MillPlanner {
             {
                 break;
             }
-            let Some(next) = round.next(&last.scaling.segment_slowdown) else {
+            let Some(next) = round.next(&last) else {
                 break;
             };
             round = next;
@@ -705,6 +738,9 @@ impl MillPlanner {
                     let mut env = MillEnv::new(cell.clone(), cache.clone(), config)?;
                     if let Some(c) = &shield.slowdown {
                         env = env.with_shield_slowdown(c.clone())?;
+                    }
+                    if let Some(h) = &shield.held {
+                        env = env.with_held_g(h.clone())?;
                     }
                     policy.check_observation(&OBSERVATION_LAYOUT, env.action_dim())?;
                     env.rollout(|obs, _| {

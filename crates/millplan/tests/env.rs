@@ -634,3 +634,27 @@ fn bad_shield_settings_are_refused_by_name() {
     let ok: Arc<[f64]> = vec![1.5; n].into();
     assert!(e.with_shield_slowdown(ok).is_ok());
 }
+
+/// `MillEnv::with_held_g`: a held move keeps g whatever the policy asks (the shield offers no g
+/// move there either); the next, unheld move follows the action again; a wrong length is refused.
+#[test]
+fn held_moves_keep_g() {
+    let e = env(EnvConfig {
+        chatter_shield: Some(0.99),
+        ..EnvConfig::default()
+    });
+    let n = e.segment_count();
+    let short: Arc<[bool]> = vec![true; n - 1].into();
+    let err = e.clone().with_held_g(short).unwrap_err();
+    assert!(err.to_string().contains("entries for"), "{err}");
+    let mut held = vec![false; n];
+    held[0] = true;
+    let mut e = e.with_held_g(held.into()).unwrap();
+    e.reset().unwrap();
+    let g0 = e.state().unwrap().g;
+    e.step(&[0.0, 0.0, 1.0]).unwrap();
+    assert_eq!(e.state().unwrap().g, g0, "held: g kept");
+    assert_eq!(e.filter_state()[2], 0.0);
+    e.step(&[0.0, 0.0, 1.0]).unwrap();
+    assert!(e.state().unwrap().g > g0, "not held: g follows the action");
+}

@@ -25,7 +25,7 @@ impl MillEnv {
     /// The feasible state nearest to `proposed` whose |μ|max is below
     /// `limit`, among the moves (ΔΩ, Δf, Δg) = the step bounds times
     /// [`SHIELD_FRACTIONS`] per dimension (Δg = 0 with
-    /// [`EnvConfig::fixed_g`]), clipped to the state ranges like eq. 11;
+    /// [`EnvConfig::fixed_g`] and on a held move, [`MillEnv::with_held_g`]), clipped to the state ranges like eq. 11;
     /// "nearest" in the move normalized by the step bounds (Euclidean), ties
     /// in the candidates' order, among the [`SHIELD_MAX_EVALUATIONS`]
     /// nearest feasible ones. When none is below `limit`, the evaluated
@@ -60,7 +60,7 @@ impl MillEnv {
             proposed.feed - current.feed,
             proposed.g - current.g,
         ];
-        let g_fractions: &[f64] = if self.config.fixed_g {
+        let g_fractions: &[f64] = if self.config.fixed_g || self.holds_g(current.segment) {
             &[0.0]
         } else {
             &SHIELD_G_FRACTIONS
