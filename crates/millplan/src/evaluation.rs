@@ -14,7 +14,7 @@ use kerf_mill::{CellState, MillCell};
 use crate::cache::{is_infeasible, IndicatorCache};
 use crate::env::PhysicalState;
 use crate::error::MillPlanError;
-use crate::plan::{Plan, SegmentPlan};
+use crate::plan::{Plan, SegmentInput, SegmentPlan};
 use crate::provenance::{IndicatorProvenance, IndicatorSource};
 use crate::reward::{step_reward, RewardWeights};
 
@@ -44,9 +44,145 @@ pub(crate) fn evaluate_impl(
             reason: format!("{} states for {n} segments", states.len()),
         });
     }
-    let lim = cell.state_limits();
-    // Step 1: checks and cell states, in order, up to the first error.
-    let mut cell_states: Vec<CellState> = Vec::with_capacity(n);
+    let (cell_states, first_error) = cell_states_in_order(cell, states, planner, budget)?;
+    // Step 2: cached values where the cache applies, the rest directly.
+    let k = cell_states.len();
+    let cached = match cache {
+        Some(c) => cached_values(cell, states, &cell_states, c)?,
+        None => vec![None; k],
+    };
+    let direct: Vec<usize> = (0..k).filter(|i| cached[*i].is_none()).collect();
+    let direct_mus = spectral_radii(cell, states, &cell_states, &direct, threads, budget);
+    assemble(
+        cell,
+        weights,
+        states,
+        planner,
+        &cell_states,
+        first_error,
+        &cached,
+        direct_mus,
+        cache,
+    )
+}
+
+/// [`evaluate_impl`] with direct |μ|max (no cache), running `alongside` on
+/// its own thread while the |μ|max are evaluated (the planner's steps 6–7:
+/// the executed trajectory and the re-evaluation of the segments it slows
+/// read the segments' Ω, f, g and cell states, never their |μ|max).
+///
+/// `alongside` gets the segments as [`SegmentInput`]s once step 1 (the
+/// sequential chain of cell states) has succeeded for every segment; when it
+/// has not, the evaluation fails anyway (with the error of the sequential
+/// evaluation) and `alongside` is not run. The plan and its provenance are
+/// those of [`evaluate_impl`] with no cache, bit for bit (the same
+/// functions of the same inputs; the threads only change when each value is
+/// computed).
+///
+/// # Returns
+/// The plan, its provenance, `alongside`'s result (`None` only when it was
+/// not run) and the wall time \[s\] from the call until the plan's |μ|max
+/// were all known (the evaluation's share of the overlapped time).
+///
+/// # Errors
+/// As [`evaluate_impl`]; `alongside`'s own errors are its result's.
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn evaluate_direct_alongside<T: Send>(
+    cell: &MillCell,
+    weights: &RewardWeights,
+    states: &[PhysicalState],
+    planner: &str,
+    threads: usize,
+    budget: &Budget,
+    alongside: impl FnOnce(&[SegmentInput]) -> T + Send,
+) -> Result<(Plan, IndicatorProvenance, Option<T>, f64), MillPlanError> {
+    let start = std::time::Instant::now();
+    if threads == 0 {
+        return Err(MillPlanError::InvalidParameter {
+            name: "evaluation threads".to_string(),
+            value: 0.0,
+            reason: "must be >= 1".to_string(),
+        });
+    }
+    weights.validate()?;
+    let n = cell.path().segments().len();
+    if states.len() != n {
+        return Err(MillPlanError::InvalidConfig {
+            name: format!("plan `{planner}`"),
+            reason: format!("{} states for {n} segments", states.len()),
+        });
+    }
+    let (cell_states, first_error) = cell_states_in_order(cell, states, planner, budget)?;
+    let k = cell_states.len();
+    let cached = vec![None; k];
+    let direct: Vec<usize> = (0..k).collect();
+    let complete = first_error.is_none() && k == n;
+    let (direct_mus, beside, evaluated) = if complete {
+        let inputs: Vec<SegmentInput> = states
+            .iter()
+            .zip(&cell_states)
+            .map(|(s, cs)| SegmentInput {
+                segment: s.segment,
+                rpm: s.rpm,
+                feed: s.feed,
+                g: s.g,
+                joints: cs.joints,
+            })
+            .collect();
+        // The closure is taken by whichever thread runs it (the helper, or
+        // this one when no helper thread could be started).
+        let task = std::sync::Mutex::new(Some(alongside));
+        let run = || {
+            let f = task.lock().unwrap_or_else(|e| e.into_inner()).take();
+            f.map(|f| f(&inputs))
+        };
+        std::thread::scope(|scope| {
+            let helper = std::thread::Builder::new()
+                .name("plan-trajectory".to_string())
+                .spawn_scoped(scope, run)
+                .ok();
+            let mus = spectral_radii(cell, states, &cell_states, &direct, threads, budget);
+            let evaluated = start.elapsed().as_secs_f64();
+            let beside = match helper {
+                Some(h) => match h.join() {
+                    Ok(r) => r,
+                    Err(panic) => std::panic::resume_unwind(panic),
+                },
+                None => run(),
+            };
+            (mus, beside, evaluated)
+        })
+    } else {
+        let mus = spectral_radii(cell, states, &cell_states, &direct, threads, budget);
+        (mus, None, start.elapsed().as_secs_f64())
+    };
+    let (plan, provenance) = assemble(
+        cell,
+        weights,
+        states,
+        planner,
+        &cell_states,
+        first_error,
+        &cached,
+        direct_mus,
+        None,
+    )?;
+    Ok((plan, provenance, beside, evaluated))
+}
+
+/// Step 1 of [`evaluate_impl`]: the checks and cell states, in order, up
+/// to the first error (returned beside them: a |μ| error at an earlier
+/// segment precedes it, step 3).
+///
+/// # Errors
+/// An interrupt of `budget` (checked per segment).
+fn cell_states_in_order(
+    cell: &MillCell,
+    states: &[PhysicalState],
+    planner: &str,
+    budget: &Budget,
+) -> Result<(Vec<CellState>, Option<MillPlanError>), MillPlanError> {
+    let mut cell_states: Vec<CellState> = Vec::with_capacity(states.len());
     let mut first_error: Option<MillPlanError> = None;
     let mut reference: Option<[f64; 6]> = None;
     for (i, s) in states.iter().enumerate() {
@@ -64,17 +200,32 @@ pub(crate) fn evaluate_impl(
             }
         }
     }
-    // Step 2: cached values where the cache applies, the rest directly.
+    Ok((cell_states, first_error))
+}
+
+/// Step 3 of [`evaluate_impl`]: the plan from the cell states, the cached
+/// values (`cached`, one per cell state) and the direct |μ|max of the
+/// others (`direct_mus`, in segment order, stopping after an error); in
+/// segment order, so that a |μ| error at segment j precedes a step-1 error
+/// (`first_error`) at a later segment (sequential order).
+#[allow(clippy::too_many_arguments)]
+fn assemble(
+    cell: &MillCell,
+    weights: &RewardWeights,
+    states: &[PhysicalState],
+    planner: &str,
+    cell_states: &[CellState],
+    first_error: Option<MillPlanError>,
+    cached: &[Option<(f64, f64)>],
+    direct_mus: Vec<Result<f64, MillPlanError>>,
+    cache: Option<&IndicatorCache>,
+) -> Result<(Plan, IndicatorProvenance), MillPlanError> {
+    let n = cell.path().segments().len();
+    let lim = cell.state_limits();
     let k = cell_states.len();
-    let cached = match cache {
-        Some(c) => cached_values(cell, states, &cell_states, c)?,
-        None => vec![None; k],
-    };
-    let direct: Vec<usize> = (0..k).filter(|i| cached[*i].is_none()).collect();
-    let mut direct_mus =
-        spectral_radii(cell, states, &cell_states, &direct, threads, budget).into_iter();
+    let mut direct_mus = direct_mus.into_iter();
     let mut mus: Vec<Result<f64, MillPlanError>> = Vec::with_capacity(k);
-    for value in &cached {
+    for value in cached {
         match value {
             Some((v, _)) => mus.push(Ok(*v)),
             None => match direct_mus.next() {

@@ -92,18 +92,20 @@ use crate::cache::{cell_fingerprint, is_infeasible, IndicatorCache};
 use crate::dp::{self, DpSpec};
 use crate::env::{EnvConfig, MillEnv, PhysicalState};
 use crate::error::MillPlanError;
-use crate::evaluation::evaluate_impl;
+use crate::evaluation::evaluate_direct_alongside;
 use crate::executed::executed;
 use crate::greedy;
 use crate::naive;
 use crate::observation::OBSERVATION_LAYOUT;
 use crate::path_cache::{path_grid, PathCacheKey, PathCaches};
-use crate::plan::{default_eval_threads, IndicatorProvenance, IndicatorSource, Plan};
+use crate::plan::{
+    default_eval_threads, IndicatorProvenance, IndicatorSource, Plan, Reevaluation, SegmentInput,
+};
 use crate::planned::planned_trajectory;
 use crate::policy::Policy;
 use crate::request::{MillRequest, PlannerKind, RequestProcess};
 use crate::rl::Environment;
-use crate::timing::TrajectorySettings;
+use crate::timing::{joint_limits, time_scale_inputs, TrajectorySettings};
 
 pub use crate::executed::{execute, Executed};
 pub use crate::output::{MillPlanOutput, PlanningPhases};
@@ -616,60 +618,118 @@ impl MillPlanner {
         let step = Instant::now();
         let weights = &self.env_config.weights;
         let segments = states.len();
-        let (plan, indicator) = match (self.indicator_source, &cache) {
-            (IndicatorSource::Cache, Some(c)) => Plan::evaluate_cached(
-                &cell,
-                weights,
-                &states,
-                kind.name(),
-                self.eval_threads,
-                c,
-                budget,
-            )?,
-            (source, _) => {
-                let (plan, _) = evaluate_impl(
-                    &cell,
-                    weights,
-                    &states,
-                    kind.name(),
-                    self.eval_threads,
-                    None,
-                    budget,
-                )?;
-                let reason = if source == IndicatorSource::Cache {
-                    if self.cache.is_none() {
-                        format!("cache requested, but {}", self.cache_note)
-                    } else {
-                        "cache requested, but this request changes the path/process".to_string()
-                    }
-                } else {
-                    String::new()
-                };
-                (plan, IndicatorProvenance::direct(source, segments, &reason))
-            }
-        };
-        phases.evaluation = step.elapsed().as_secs_f64();
-        let step = Instant::now();
-        budget.check("the planned trajectory")?;
-        let (trajectory, branch_jumps) = planned_trajectory(&cell, &plan)?;
         let mut settings = self.trajectory_settings.with_threads(self.eval_threads);
         if let Some(tolerance) = request.path_tolerance() {
             settings.path_tolerance = tolerance;
         }
-        let executed = executed(
-            &cell,
-            &plan,
-            &settings,
-            weights,
-            self.eval_threads,
-            &indicator,
-            match self.indicator_source {
-                IndicatorSource::Cache => cache.as_deref(),
-                IndicatorSource::Direct => None,
-            },
-            budget,
-        )?;
-        phases.trajectory = step.elapsed().as_secs_f64();
+        let (plan, indicator, trajectory, branch_jumps, executed) =
+            match (self.indicator_source, &cache) {
+                (IndicatorSource::Cache, Some(c)) => {
+                    let (plan, indicator) = Plan::evaluate_cached(
+                        &cell,
+                        weights,
+                        &states,
+                        kind.name(),
+                        self.eval_threads,
+                        c,
+                        budget,
+                    )?;
+                    phases.evaluation = step.elapsed().as_secs_f64();
+                    let step = Instant::now();
+                    budget.check("the planned trajectory")?;
+                    let (trajectory, branch_jumps) = planned_trajectory(&cell, &plan)?;
+                    let executed = executed(
+                        &cell,
+                        &plan,
+                        &settings,
+                        weights,
+                        self.eval_threads,
+                        &indicator,
+                        Some(c),
+                        budget,
+                    )?;
+                    phases.trajectory = step.elapsed().as_secs_f64();
+                    (plan, indicator, trajectory, branch_jumps, executed)
+                }
+                (source, _) => {
+                    let reason = if source == IndicatorSource::Cache {
+                        if self.cache.is_none() {
+                            format!("cache requested, but {}", self.cache_note)
+                        } else {
+                            "cache requested, but this request changes the path/process".to_string()
+                        }
+                    } else {
+                        String::new()
+                    };
+                    let indicator = IndicatorProvenance::direct(source, segments, &reason);
+                    // Step 7 up to the executed plan's assembly, on its own thread while
+                    // the |μ|max of step 5 are evaluated: it reads Ω, f, g and the cell
+                    // states of the segments, never their |μ|max (module documentation,
+                    // "Overlap").
+                    let beside = |inputs: &[SegmentInput]| {
+                        let limits = joint_limits(&cell)?;
+                        budget.check("the executed trajectory")?;
+                        let scaling = time_scale_inputs(&cell, inputs, &limits, &settings, budget)?;
+                        let reevaluation = Reevaluation::new(
+                            &cell,
+                            kind.name(),
+                            inputs,
+                            &scaling.segment_feeds,
+                            &scaling.segment_times,
+                            self.eval_threads,
+                            None,
+                            budget,
+                        )?;
+                        Ok::<_, MillPlanError>((scaling, reevaluation))
+                    };
+                    let (plan, _, beside, evaluated) = evaluate_direct_alongside(
+                        &cell,
+                        weights,
+                        &states,
+                        kind.name(),
+                        self.eval_threads,
+                        budget,
+                        beside,
+                    )?;
+                    phases.evaluation = evaluated;
+                    // In the order of the sequential steps: the planned trajectory's
+                    // errors before the executed trajectory's.
+                    budget.check("the planned trajectory")?;
+                    let (trajectory, branch_jumps) = planned_trajectory(&cell, &plan)?;
+                    let executed = match beside {
+                        Some(result) => {
+                            let (scaling, reevaluation) = result?;
+                            let (executed_plan, cached_segments) = plan.with_reevaluation(
+                                &cell,
+                                weights,
+                                &scaling.segment_feeds,
+                                &scaling.segment_times,
+                                &indicator,
+                                reevaluation,
+                            )?;
+                            Executed {
+                                scaling,
+                                plan: executed_plan,
+                                cached_segments,
+                                settings,
+                            }
+                        }
+                        // Not run (only when the evaluation failed, which returned above).
+                        None => executed(
+                            &cell,
+                            &plan,
+                            &settings,
+                            weights,
+                            self.eval_threads,
+                            &indicator,
+                            None,
+                            budget,
+                        )?,
+                    };
+                    phases.trajectory = (step.elapsed().as_secs_f64() - evaluated).max(0.0);
+                    (plan, indicator, trajectory, branch_jumps, executed)
+                }
+            };
         if let Some(minimum) = request.min_condition_indicator() {
             let (value, arc_length) = executed.scaling.min_condition_indicator;
             if value < minimum {
