@@ -71,6 +71,12 @@ pub(crate) fn evaluate_impl(
 /// the executed trajectory and the re-evaluation of the segments it slows
 /// read the segments' Ω, f, g and cell states, never their |μ|max).
 ///
+/// `known`: a [`Prefetch`] that evaluated |μ|max of states while the planner
+/// produced them; its values for the longest prefix of `states` it saw
+/// unchanged are used as they are (the same function of the same inputs:
+/// the cell states of a prefix depend on that prefix only), the rest is
+/// evaluated here.
+///
 /// `alongside` gets the segments as [`SegmentInput`]s once step 1 (the
 /// sequential chain of cell states) has succeeded for every segment; when it
 /// has not, the evaluation fails anyway (with the error of the sequential
@@ -94,6 +100,7 @@ pub(crate) fn evaluate_direct_alongside<T: Send>(
     planner: &str,
     threads: usize,
     budget: &Budget,
+    known: Option<Prefetch>,
     alongside: impl FnOnce(&[SegmentInput]) -> T + Send,
 ) -> Result<(Plan, IndicatorProvenance, Option<T>, f64), MillPlanError> {
     let start = std::time::Instant::now();
@@ -115,7 +122,9 @@ pub(crate) fn evaluate_direct_alongside<T: Send>(
     let (cell_states, first_error) = cell_states_in_order(cell, states, planner, budget)?;
     let k = cell_states.len();
     let cached = vec![None; k];
-    let direct: Vec<usize> = (0..k).collect();
+    // |μ|max the prefetch already has for a prefix of these very states.
+    let known = known.map(|p| p.finish(states)).unwrap_or_default();
+    let direct: Vec<usize> = (known.len().min(k)..k).collect();
     let complete = first_error.is_none() && k == n;
     let (direct_mus, beside, evaluated) = if complete {
         let inputs: Vec<SegmentInput> = states
@@ -156,6 +165,14 @@ pub(crate) fn evaluate_direct_alongside<T: Send>(
         let mus = spectral_radii(cell, states, &cell_states, &direct, threads, budget);
         (mus, None, start.elapsed().as_secs_f64())
     };
+    // In segment order: the known prefix, then the direct values (which stop
+    // after their first error, as a sequential evaluation would).
+    let mus: Vec<Result<f64, MillPlanError>> = known
+        .into_iter()
+        .take(k)
+        .map(Ok)
+        .chain(direct_mus)
+        .collect();
     let (plan, provenance) = assemble(
         cell,
         weights,
@@ -164,10 +181,122 @@ pub(crate) fn evaluate_direct_alongside<T: Send>(
         &cell_states,
         first_error,
         &cached,
-        direct_mus,
+        mus,
         None,
     )?;
     Ok((plan, provenance, beside, evaluated))
+}
+
+/// Direct |μ|max evaluated on a helper thread while a planner produces its
+/// states one by one (the ddpg/fixed_g rollout: the states arrive about
+/// every 0.1 ms, an evaluation takes about 0.5 ms, so the core the rollout
+/// leaves idle evaluates the first segments before step 5 starts).
+///
+/// States are [`Prefetch::send`] in segment order; segment 0 starts a new
+/// chain (a rollout run again). Each state's cell state is computed as in
+/// step 1 of [`evaluate_impl`] (IK nearest the previous state's joints), so
+/// a value is step 5's own for the same prefix of states;
+/// [`Prefetch::finish`] keeps the values of the longest prefix of the final
+/// states that the helper saw bit for bit. A state that fails its checks,
+/// its cell state or its indicator ends the chain (step 5 evaluates it and
+/// reports its error itself). Dropping a `Prefetch` stops the helper after
+/// its current evaluation.
+#[derive(Debug)]
+pub(crate) struct Prefetch {
+    sender: Option<std::sync::mpsc::Sender<PhysicalState>>,
+    stop: std::sync::Arc<AtomicBool>,
+    helper: Option<std::thread::JoinHandle<Vec<(PhysicalState, f64)>>>,
+}
+
+impl Prefetch {
+    /// Starts the helper thread for `cell` (`None` when no thread can be
+    /// started: step 5 then evaluates everything).
+    pub(crate) fn start(cell: std::sync::Arc<MillCell>) -> Option<Self> {
+        let (sender, receiver) = std::sync::mpsc::channel::<PhysicalState>();
+        let stop = std::sync::Arc::new(AtomicBool::new(false));
+        let flag = stop.clone();
+        let helper = std::thread::Builder::new()
+            .name("plan-prefetch".to_string())
+            .spawn(move || {
+                let mut chain: Vec<(PhysicalState, f64)> = Vec::new();
+                let mut reference: Option<[f64; 6]> = None;
+                while let Ok(state) = receiver.recv() {
+                    if flag.load(Ordering::Acquire) {
+                        break;
+                    }
+                    if state.segment == 0 {
+                        chain.clear();
+                        reference = None;
+                    }
+                    if state.segment != chain.len() {
+                        // The chain ended at an earlier state; wait for a new one.
+                        continue;
+                    }
+                    let value = check_state(&cell, state.segment, &state, "prefetch")
+                        .and_then(|()| {
+                            Ok(cell.evaluate(state.segment, state.g, reference.as_ref())?)
+                        })
+                        .and_then(|cs| Ok((spectral_radius(&cell, &state, &cs)?, cs.joints)));
+                    if let Ok((mu, joints)) = value {
+                        reference = Some(joints);
+                        chain.push((state, mu));
+                    }
+                }
+                chain
+            })
+            .ok()?;
+        Some(Self {
+            sender: Some(sender),
+            stop,
+            helper: Some(helper),
+        })
+    }
+
+    /// Hands the helper the next state.
+    pub(crate) fn send(&self, state: &PhysicalState) {
+        if let Some(s) = &self.sender {
+            // A helper that has stopped leaves the state to step 5.
+            let _ = s.send(*state);
+        }
+    }
+
+    /// No more states: the helper finishes those it has (until
+    /// [`Prefetch::finish`]).
+    pub(crate) fn close(&mut self) {
+        self.sender = None;
+    }
+
+    /// Stops the helper after its current evaluation and returns |μ|max of
+    /// the longest prefix of `states` it evaluated from the same states,
+    /// bit for bit.
+    pub(crate) fn finish(mut self, states: &[PhysicalState]) -> Vec<f64> {
+        self.stop.store(true, Ordering::Release);
+        self.sender = None;
+        let chain = match self.helper.take().map(|h| h.join()) {
+            Some(Ok(chain)) => chain,
+            Some(Err(panic)) => std::panic::resume_unwind(panic),
+            None => Vec::new(),
+        };
+        let same = |a: &PhysicalState, b: &PhysicalState| {
+            a.segment == b.segment
+                && a.rpm.to_bits() == b.rpm.to_bits()
+                && a.feed.to_bits() == b.feed.to_bits()
+                && a.g.to_bits() == b.g.to_bits()
+        };
+        chain
+            .into_iter()
+            .zip(states)
+            .take_while(|((seen, _), state)| same(seen, state))
+            .map(|((_, mu), _)| mu)
+            .collect()
+    }
+}
+
+impl Drop for Prefetch {
+    fn drop(&mut self) {
+        self.stop.store(true, Ordering::Release);
+        self.sender = None;
+    }
 }
 
 /// Step 1 of [`evaluate_impl`]: the checks and cell states, in order, up

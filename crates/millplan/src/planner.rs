@@ -92,7 +92,7 @@ use crate::cache::{cell_fingerprint, is_infeasible, IndicatorCache};
 use crate::dp::{self, DpSpec};
 use crate::env::{EnvConfig, MillEnv, PhysicalState};
 use crate::error::MillPlanError;
-use crate::evaluation::evaluate_direct_alongside;
+use crate::evaluation::{evaluate_direct_alongside, Prefetch};
 use crate::executed::executed;
 use crate::greedy;
 use crate::naive;
@@ -514,6 +514,7 @@ impl MillPlanner {
             None
         };
         let mut policy_file = None;
+        let mut prefetch: Option<Prefetch> = None;
         let states: Vec<PhysicalState> = match kind {
             PlannerKind::Ddpg | PlannerKind::FixedG => {
                 let path = match &request.policy_file {
@@ -552,11 +553,21 @@ impl MillPlanner {
                     ..self.env_config
                 };
                 let policy = self.policy(&path)?;
+                // Step 5 evaluates |μ|max directly: a helper thread starts on the
+                // states as the rollout makes them ("Overlap" in the module
+                // documentation), when there is a second evaluation thread.
+                let direct = !(self.indicator_source == IndicatorSource::Cache && cache.is_some());
+                if direct && self.eval_threads > 1 {
+                    prefetch = Prefetch::start(cell.clone());
+                }
                 let run = |config: EnvConfig| -> Result<crate::env::Rollout, MillPlanError> {
                     let mut env = MillEnv::new(cell.clone(), cache.clone(), config)?;
                     policy.check_observation(&OBSERVATION_LAYOUT, env.action_dim())?;
-                    env.rollout(|obs, _| {
+                    env.rollout(|obs, state| {
                         budget.check("the policy rollout")?;
+                        if let Some(p) = &prefetch {
+                            p.send(state);
+                        }
                         policy.act(obs)
                     })
                 };
@@ -583,7 +594,13 @@ impl MillPlanner {
                     });
                 }
                 policy_file = Some(path);
-                rollout.states()
+                let states = rollout.states();
+                // The last state is not handed to the policy: send it here.
+                if let (Some(p), Some(last)) = (&mut prefetch, states.last()) {
+                    p.send(last);
+                    p.close();
+                }
+                states
             }
             PlannerKind::Dp | PlannerKind::Naive => {
                 let cache = match &cache {
@@ -689,6 +706,7 @@ impl MillPlanner {
                         kind.name(),
                         self.eval_threads,
                         budget,
+                        prefetch.take(),
                         beside,
                     )?;
                     phases.evaluation = evaluated;
