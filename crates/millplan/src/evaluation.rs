@@ -138,29 +138,69 @@ pub(crate) fn evaluate_direct_alongside<T: Send>(
                 joints: cs.joints,
             })
             .collect();
-        // The closure is taken by whichever thread runs it (the helper, or
-        // this one when no helper thread could be started).
-        let task = std::sync::Mutex::new(Some(alongside));
-        let run = || {
-            let f = task.lock().unwrap_or_else(|e| e.into_inner()).take();
-            f.map(|f| f(&inputs))
-        };
-        std::thread::scope(|scope| {
-            let helper = std::thread::Builder::new()
-                .name("plan-trajectory".to_string())
-                .spawn_scoped(scope, run)
-                .ok();
-            let mus = spectral_radii(cell, states, &cell_states, &direct, threads, budget);
+        let workers = threads.clamp(1, MAX_EVAL_THREADS);
+        if workers == 1 {
+            // One thread: the evaluation, then `alongside` (sequential).
+            let mus = spectral_radii(cell, states, &cell_states, &direct, 1, budget);
             let evaluated = start.elapsed().as_secs_f64();
-            let beside = match helper {
-                Some(h) => match h.join() {
-                    Ok(r) => r,
-                    Err(panic) => std::panic::resume_unwind(panic),
-                },
-                None => run(),
+            (mus, Some(alongside(&inputs)), evaluated)
+        } else {
+            // `alongside` runs on a thread of its own, which then joins the
+            // evaluation of what is left; the calling thread and `workers − 2`
+            // helpers evaluate from the start. The closure is taken by whichever
+            // thread runs it (that thread, or this one when it could not start).
+            let eval = |j: usize| {
+                budget.check("the chatter indicator")?;
+                spectral_radius(cell, &states[direct[j]], &cell_states[direct[j]])
             };
-            (mus, beside, evaluated)
-        })
+            let queue = Queue::new(&eval, direct.len());
+            let task = std::sync::Mutex::new(Some(alongside));
+            let run = || {
+                let f = task.lock().unwrap_or_else(|e| e.into_inner()).take();
+                f.map(|f| f(&inputs))
+            };
+            // Each worker's results and when it found the queue empty.
+            let work = || (queue.work(), start.elapsed().as_secs_f64());
+            std::thread::scope(|scope| {
+                let chain = std::thread::Builder::new()
+                    .name("plan-trajectory".to_string())
+                    .spawn_scoped(scope, || {
+                        let beside = run();
+                        (beside, work())
+                    })
+                    .ok();
+                let helpers: Vec<_> = (2..workers)
+                    .filter_map(|k| {
+                        std::thread::Builder::new()
+                            .name(format!("plan-eval-{k}"))
+                            .spawn_scoped(scope, work)
+                            .ok()
+                    })
+                    .collect();
+                let (mut all, mut evaluated) = work();
+                for h in helpers {
+                    match h.join() {
+                        Ok((done, at)) => {
+                            all.extend(done);
+                            evaluated = evaluated.max(at);
+                        }
+                        Err(panic) => std::panic::resume_unwind(panic),
+                    }
+                }
+                let beside = match chain {
+                    Some(h) => match h.join() {
+                        Ok((beside, (done, at))) => {
+                            all.extend(done);
+                            evaluated = evaluated.max(at);
+                            beside
+                        }
+                        Err(panic) => std::panic::resume_unwind(panic),
+                    },
+                    None => run(),
+                };
+                (queue.results(all, &direct), beside, evaluated)
+            })
+        }
     } else {
         let mus = spectral_radii(cell, states, &cell_states, &direct, threads, budget);
         (mus, None, start.elapsed().as_secs_f64())
@@ -611,66 +651,100 @@ pub(crate) fn spectral_radii(
         }
         return out;
     }
-    let next = AtomicUsize::new(0);
-    let failed = AtomicBool::new(false);
-    let work = || {
-        let mut done = Vec::new();
-        while !failed.load(Ordering::Acquire) {
-            let j = next.fetch_add(1, Ordering::AcqRel);
-            if j >= n {
-                break;
-            }
-            let r = eval(j);
-            if r.is_err() {
-                failed.store(true, Ordering::Release);
-            }
-            done.push((j, r));
-        }
-        done
-    };
-    let mut slots: Vec<Option<Result<f64, MillPlanError>>> = (0..n).map(|_| None).collect();
-    std::thread::scope(|scope| {
+    let queue = Queue::new(&eval, n);
+    let all = std::thread::scope(|scope| {
         let helpers: Vec<_> = (1..workers)
             .filter_map(|k| {
                 std::thread::Builder::new()
                     .name(format!("plan-eval-{k}"))
-                    .spawn_scoped(scope, work)
+                    .spawn_scoped(scope, || queue.work())
                     .ok()
             })
             .collect();
-        let mut all = work();
+        let mut all = queue.work();
         for h in helpers {
             match h.join() {
                 Ok(done) => all.extend(done),
                 Err(panic) => std::panic::resume_unwind(panic),
             }
         }
+        all
+    });
+    queue.results(all, indices)
+}
+
+/// The shared work of [`spectral_radii`]'s workers: indices 0..n handed out
+/// in increasing order from a counter; after the first error no new one
+/// starts, so every index below the lowest failing one is evaluated.
+struct Queue<'a> {
+    eval: &'a (dyn Fn(usize) -> Result<f64, MillPlanError> + Sync),
+    n: usize,
+    next: AtomicUsize,
+    failed: AtomicBool,
+}
+
+impl<'a> Queue<'a> {
+    fn new(eval: &'a (dyn Fn(usize) -> Result<f64, MillPlanError> + Sync), n: usize) -> Self {
+        Self {
+            eval,
+            n,
+            next: AtomicUsize::new(0),
+            failed: AtomicBool::new(false),
+        }
+    }
+
+    /// One worker: evaluates indices until none is left (or one failed).
+    fn work(&self) -> Vec<(usize, Result<f64, MillPlanError>)> {
+        let mut done = Vec::new();
+        while !self.failed.load(Ordering::Acquire) {
+            let j = self.next.fetch_add(1, Ordering::AcqRel);
+            if j >= self.n {
+                break;
+            }
+            let r = (self.eval)(j);
+            if r.is_err() {
+                self.failed.store(true, Ordering::Release);
+            }
+            done.push((j, r));
+        }
+        done
+    }
+
+    /// Every worker's results in index order, stopping after the first
+    /// error (`indices`: the segments, for the message of a missing one).
+    fn results(
+        &self,
+        all: Vec<(usize, Result<f64, MillPlanError>)>,
+        indices: &[usize],
+    ) -> Vec<Result<f64, MillPlanError>> {
+        let mut slots: Vec<Option<Result<f64, MillPlanError>>> =
+            (0..self.n).map(|_| None).collect();
         for (j, r) in all {
             slots[j] = Some(r);
         }
-    });
-    let mut out = Vec::with_capacity(n);
-    for (j, slot) in slots.into_iter().enumerate() {
-        match slot {
-            Some(r) => {
-                let failed = r.is_err();
-                out.push(r);
-                if failed {
+        let mut out = Vec::with_capacity(self.n);
+        for (j, slot) in slots.into_iter().enumerate() {
+            match slot {
+                Some(r) => {
+                    let failed = r.is_err();
+                    out.push(r);
+                    if failed {
+                        break;
+                    }
+                }
+                None => {
+                    // Only after a failing index (see above); reported as an
+                    // error rather than dropped, should that ever not hold.
+                    out.push(Err(MillPlanError::InvalidConfig {
+                        name: format!("plan evaluation of segment {}", indices[j]),
+                        reason: "not evaluated (an earlier segment failed)".to_string(),
+                    }));
                     break;
                 }
             }
-            None => {
-                // Only after a failing index (see above); reported as an
-                // error rather than dropped, should that ever not hold.
-                out.push(Err(MillPlanError::InvalidConfig {
-                    name: format!("plan evaluation of segment {}", indices[j]),
-                    reason: "not evaluated (an earlier segment failed)".to_string(),
-                }));
-                break;
-            }
         }
+        out
     }
-    out
 }
 
 #[cfg(test)]
