@@ -67,9 +67,16 @@ pub(crate) fn evaluate_impl(
 }
 
 /// [`evaluate_impl`] with direct |μ|max (no cache), running `alongside` on
-/// its own thread while the |μ|max are evaluated (the planner's steps 6–7:
+/// its own thread while the |μ|max are evaluated (the planner's step 7:
 /// the executed trajectory and the re-evaluation of the segments it slows
 /// read the segments' Ω, f, g and cell states, never their |μ|max).
+///
+/// Threads (`threads`, at most [`MAX_EVAL_THREADS`]): with 1, the evaluation
+/// and then `alongside`, on the calling thread. With k ≥ 2, `alongside` runs
+/// on a thread of its own that then takes evaluations from the same queue
+/// as the calling thread and k − 2 helpers (the queue of
+/// [`spectral_radii`]: indices handed out in increasing order, no new one
+/// after an error), so that k threads stay busy until the last |μ|max.
 ///
 /// `known`: a [`Prefetch`] that evaluated |μ|max of states while the planner
 /// produced them; its values for the longest prefix of `states` it saw

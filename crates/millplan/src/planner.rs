@@ -79,6 +79,29 @@
 //! start, segment midpoints, path end, in the executor's trajectory type
 //! [`crate::trajectory::JointTrajectory`]); step 7 time-scales it
 //! ([`crate::executed`]).
+//!
+//! # Overlap
+//! With direct |μ|max (the default source, or the cache source when the
+//! cache does not apply) the steps share the [`MillPlanner::eval_threads`]
+//! threads instead of running one after the other; the answer is the
+//! sequential one bit for bit (every value is the same function of the same
+//! inputs; only when it is computed changes), and errors are reported in the
+//! order of the steps:
+//! * During a `ddpg`/`fixed_g` rollout (≥ 2 threads), a helper thread
+//!   evaluates |μ|max of each state as the policy reaches it
+//!   ([`crate::evaluation::Prefetch`]); step 5 keeps its values for the
+//!   longest prefix of the final states it saw unchanged.
+//! * Step 7 up to the executed plan's assembly (the time scaling and the
+//!   direct |μ|max of the segments it slows, [`crate::plan::Reevaluation`])
+//!   reads the segments' Ω, f, g and cell states, never their |μ|max: it runs
+//!   on its own thread as soon as step 5's cell states are known, and that
+//!   thread then joins step 5's remaining evaluations
+//!   ([`crate::evaluation::evaluate_direct_alongside`]). With 1 thread the
+//!   steps run in order.
+//!
+//! [`MillPlanOutput::phases`] then has: `evaluation`, the wall time from the
+//! start of step 5 until every |μ|max of the plan is known (step 7 ran
+//! inside it); `trajectory`, the rest until the executed plan is assembled.
 
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
