@@ -91,6 +91,11 @@ const MAX_ROUND_FACTOR: f64 = 4.0;
 /// the limit × (1 + 1e-9)).
 const MARGIN: f64 = 1e-4;
 
+/// Below this fraction of a limit, [`piece_need`] takes the bound Σ |c_i| h^i of a piece's
+/// polynomial for its largest value (a margin of 0.1 % over the rounding of the exact
+/// extremes, about 1e-15 relative, so that no ratio crosses 1 either way).
+const BOUND_FRACTION: f64 = 0.999;
+
 /// Shortest ramp time before the law is given up \[s\].
 const MIN_RAMP_TIME: f64 = 1e-3;
 
@@ -687,9 +692,11 @@ fn evaluate(
 /// r of step 6 for one joint's quintic `c` over [0, h].
 ///
 /// A polynomial's largest |value| on [0, h] is bounded by Σ |c_i| h^i; where that bound is
-/// already below half the limit, the exact extremes (roots of the next derivative) are not
-/// needed: the contribution is reported as that bound's ratio (≤ 0.5, so it never triggers a
-/// slowdown and never hides one).
+/// already below [`BOUND_FRACTION`] of the limit, the exact extremes (roots of the next
+/// derivative) are not needed: the contribution is reported as that bound's ratio (< 1, so it
+/// never triggers a slowdown and never hides one: the exact value is below it too). The ratios
+/// are only compared with 1 and, above 1, used as slowdown factors (step 6), and a ratio above
+/// 1 is always the exact one: the trajectory is the same as with every extreme computed.
 fn piece_need(c: &[f64; 6], h: f64, limit: &JointLimit) -> f64 {
     use kerf_executor::roots::extrema;
     let v = [c[1], 2.0 * c[2], 3.0 * c[3], 4.0 * c[4], 5.0 * c[5]];
@@ -703,7 +710,7 @@ fn piece_need(c: &[f64; 6], h: f64, limit: &JointLimit) -> f64 {
             bound += x.abs() * power;
             power *= h;
         }
-        if bound <= 0.5 * scale {
+        if bound <= BOUND_FRACTION * scale {
             return bound / scale;
         }
         let ((_, lo), (_, hi)) = extrema(p, 0.0, h);
