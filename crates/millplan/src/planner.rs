@@ -89,14 +89,14 @@
 //! order of the steps:
 //! * During a `ddpg`/`fixed_g` rollout (≥ 2 threads), a helper thread
 //!   evaluates |μ|max of each state as the policy reaches it
-//!   ([`crate::evaluation::Prefetch`]); step 5 keeps its values for the
+//!   (`evaluation::Prefetch`); step 5 keeps its values for the
 //!   longest prefix of the final states it saw unchanged.
 //! * Step 7 up to the executed plan's assembly (the time scaling and the
-//!   direct |μ|max of the segments it slows, [`crate::plan::Reevaluation`])
+//!   direct |μ|max of the segments it slows, `plan::Reevaluation`)
 //!   reads the segments' Ω, f, g and cell states, never their |μ|max: it runs
 //!   on its own thread as soon as step 5's cell states are known, and that
 //!   thread then joins step 5's remaining evaluations
-//!   ([`crate::evaluation::evaluate_direct_alongside`]). With 1 thread the
+//!   (`evaluation::evaluate_direct_alongside`). With 1 thread the
 //!   steps run in order.
 //!
 //! [`MillPlanOutput::phases`] then has: `evaluation`, the wall time from the
@@ -469,33 +469,27 @@ impl MillPlanner {
     /// their grid; chatter-model errors; see [`status_of`].
     ///
     /// # Performance
-    /// Dominated by the N direct indicator evaluations of step 5 and, for
-    /// `dp`, the DP (seconds on the full grid); [`MillPlanOutput::phases`]
-    /// has the wall time of each step. Measured in release
+    /// Dominated by the N direct indicator evaluations of step 5 (about
+    /// 0.5–0.65 ms of CPU each on the 2-core build machine) and, for `dp`,
+    /// the DP (seconds on the full grid); [`MillPlanOutput::phases`] has the
+    /// wall time of each step (with direct |μ|max and ≥ 2 threads the steps
+    /// overlap: module documentation, "Overlap"). Measured in release
     /// (`cargo bench -p kerf_millplan --bench plan_latency -- --warm-up-time 1
-    /// --measurement-time 4`, default 100-segment request, the shipped ddpg
-    /// policy, cache loaded, request cell kept from an earlier plan) on the
-    /// idle 2-core machine (load average 1.3–1.4), after the chatter
-    /// equilibrium speed-up; criterion's median wall time, and the mean of 5
-    /// plans split into steps with the process CPU time (all threads):
-    ///
-    /// | planner | source of the μ values | wall (criterion) | CPU | setup + planner + evaluation + trajectory (wall) |
-    /// |---|---|---:|---:|---|
-    /// | ddpg | direct, 1 thread | 96.6 ms | 97 ms | 1.5 + 2.8 + 92.9 + 0.04 ms |
-    /// | ddpg | direct, 2 threads | 49.5 ms | 93 ms | 1.4 + 2.7 + 45.6 + 0.04 ms |
-    /// | ddpg | cache (bound ±0.163) | 6.3 ms | 5.9 ms | 1.3 + 2.5 + 2.0 + 0.03 ms |
-    /// | naive | direct, 2 threads | 181 ms | 228 ms | 1.7 + 138 + 45.4 + 0.05 ms |
-    /// | naive | cache (bound ±0.050) | 151 ms | 174 ms | 7.1 + 164 + 2.7 + 0.04 ms |
-    ///
-    /// The direct evaluation costs about 0.93 ms of CPU per segment (the
-    /// state-dependent chatter indicator; 1.2–1.6 ms before the equilibrium
-    /// speed-up); the evaluation step alone runs 1.8–1.9× faster on 2
-    /// threads than on 1 (alternating rounds), with the identical plan. The
-    /// issue's goal of ≤ 50 ms for ddpg is met with the direct |μ|max on the
-    /// 2 idle cores (49.5 ms), and with margin with
-    /// [`IndicatorSource::Cache`] (6 ms, the cache's stated bound in the
-    /// answer). The first plan of a new path pays 15–30 ms more for the
-    /// path's spline fit (then kept, step 2).
+    /// --measurement-time 5`, default 100-segment request, the shipped ddpg
+    /// policy, request cell kept from an earlier plan) on the shared 2-core
+    /// machine; the figures, the load they were measured under and where the
+    /// CPU time goes are in `BENCHMARKS.md`, "Planning one 100-segment path
+    /// (goal ≤ 50 ms)". For the default ddpg request with direct |μ|max on 2
+    /// threads the plan costs about 90–97 ms of CPU (setup 1.5, rollout 9,
+    /// 100 indicators about 60, step 7 about 20 of which the time scaling
+    /// 11 and the re-evaluation of the slowed segments 3–4), and takes about
+    /// half of it in wall time when both cores are free (49.5 ms criterion
+    /// median at load average 1.9, after the overlap of this issue's item 5);
+    /// on 1 thread the steps run in order (85–95 ms). With
+    /// [`IndicatorSource::Cache`] the evaluation takes 3 ms (about 27–30 ms
+    /// in all, the cache's stated bound in the answer). The first plan of a
+    /// new path pays 15–30 ms more for the path's spline fit (then kept,
+    /// step 2).
     pub fn plan(&self, request: &MillRequest) -> Result<MillPlanOutput, MillPlanError> {
         self.plan_within(request, &Budget::unlimited())
     }
