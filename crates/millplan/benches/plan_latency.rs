@@ -29,6 +29,7 @@
 //!
 //! Run (small sample counts, the machine is shared):
 //! `cargo bench -p kerf_millplan --bench plan_latency -- --warm-up-time 1 --measurement-time 5`
+//! (`KERF_BENCH_PLANNERS=ddpg` in the environment: that planner only).
 #![allow(clippy::unwrap_used, clippy::expect_used)] // tests report failures by panicking
 
 use std::path::PathBuf;
@@ -401,7 +402,15 @@ fn bench(c: &mut Criterion) {
             "cache source (|mu| interpolated, bound reported)".to_string(),
         ),
     ];
+    // KERF_BENCH_PLANNERS=ddpg runs only those (a short run for a quiet moment of the machine).
+    let only = std::env::var("KERF_BENCH_PLANNERS").ok();
     for (name, request) in &requests {
+        if only
+            .as_deref()
+            .is_some_and(|o| !o.split(',').any(|x| x == name))
+        {
+            continue;
+        }
         if !same_plan(&one, &many, request) {
             eprintln!("{name}: 1-thread and {threads}-thread plans differ or failed; skipped");
             continue;
