@@ -161,13 +161,23 @@ pub(crate) fn evaluate_direct_alongside<T: Send>(
                 spectral_radius(cell, &states[direct[j]], &cell_states[direct[j]])
             };
             let queue = Queue::new(&eval, direct.len());
+            // At least the time step 5's own work (cell states, prefetch) took.
+            let queued = start.elapsed().as_secs_f64();
             let task = std::sync::Mutex::new(Some(alongside));
             let run = || {
                 let f = task.lock().unwrap_or_else(|e| e.into_inner()).take();
                 f.map(|f| f(&inputs))
             };
-            // Each worker's results and when it found the queue empty.
-            let work = || (queue.work(), start.elapsed().as_secs_f64());
+            // Each worker's results and when its last evaluation ended (0 for none).
+            let work = || {
+                let done = queue.work();
+                let at = if done.is_empty() {
+                    0.0
+                } else {
+                    start.elapsed().as_secs_f64()
+                };
+                (done, at)
+            };
             std::thread::scope(|scope| {
                 let chain = std::thread::Builder::new()
                     .name("plan-trajectory".to_string())
@@ -184,7 +194,8 @@ pub(crate) fn evaluate_direct_alongside<T: Send>(
                             .ok()
                     })
                     .collect();
-                let (mut all, mut evaluated) = work();
+                let (mut all, at) = work();
+                let mut evaluated = at.max(queued);
                 for h in helpers {
                     match h.join() {
                         Ok((done, at)) => {
