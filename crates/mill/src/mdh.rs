@@ -52,7 +52,7 @@ impl MdhRow {
     /// # Performance
     /// O(1), no allocation.
     pub fn transform(&self, q: f64) -> Isometry3<f64> {
-        let rx = Rotation3::from_axis_angle(&Vector3::x_axis(), self.alpha);
+        let rx = twist(self.alpha);
         let rz = Rotation3::from_axis_angle(&Vector3::z_axis(), q + self.theta_offset);
         let rot = rx * rz;
         // TransX(a) then, in the rotated frame, TransZ(d).
@@ -62,6 +62,29 @@ impl MdhRow {
             UnitQuaternion::from_rotation_matrix(&rot),
         )
     }
+}
+
+/// RotX(α) (Craig eq. 3.6), for the twists of [`ArmGeometry::mdh_table`] (0, ±π/2) computed
+/// once: the rotation of `Rotation3::from_axis_angle` for that α, the same value bit for bit
+/// (any other α is computed on the spot).
+fn twist(alpha: f64) -> Rotation3<f64> {
+    use std::f64::consts::FRAC_PI_2;
+    static TWISTS: std::sync::OnceLock<[(u64, Rotation3<f64>); 3]> = std::sync::OnceLock::new();
+    let twists = TWISTS.get_or_init(|| {
+        [0.0, -FRAC_PI_2, FRAC_PI_2].map(|a: f64| {
+            (
+                a.to_bits(),
+                Rotation3::from_axis_angle(&Vector3::x_axis(), a),
+            )
+        })
+    });
+    twists
+        .iter()
+        .find(|(bits, _)| *bits == alpha.to_bits())
+        .map_or_else(
+            || Rotation3::from_axis_angle(&Vector3::x_axis(), alpha),
+            |(_, r)| *r,
+        )
 }
 
 /// The fixed transform from MDH frame 6 to the URDF `tool0` frame: the

@@ -53,6 +53,7 @@ fn main() {
                     out.planning_seconds * 1e3
                 );
                 breakdown(&planner, &out);
+                eprintln!("  {name}: answer fingerprint {:016x}", fingerprint(&out));
                 println!(
                     "| {name} | {} | {:.2} | {:.3} / {:.3} | {:.3} | {:.2} |",
                     t.points().len(),
@@ -107,4 +108,19 @@ fn breakdown(planner: &MillPlanner, out: &kerf_millplan::MillPlanOutput) {
         measure * 1e3,
         ms(measure_cpu)
     );
+}
+
+/// A hash of the answer's plan, executed plan, trajectories and measured deviation (their
+/// `Debug` text: every f64 printed to the digits that round-trip, so two answers with the
+/// same fingerprint are, but for hash collisions, the same bit for bit): for comparing
+/// builds.
+fn fingerprint(out: &kerf_millplan::MillPlanOutput) -> u64 {
+    use std::hash::{Hash, Hasher};
+    let mut h = std::collections::hash_map::DefaultHasher::new();
+    format!(
+        "{:?} {:?} {:?} {:?}",
+        out.plan, out.trajectory, out.executed, out.branch_jumps
+    )
+    .hash(&mut h);
+    h.finish()
 }

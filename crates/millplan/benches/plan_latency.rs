@@ -29,6 +29,7 @@
 //!
 //! Run (small sample counts, the machine is shared):
 //! `cargo bench -p kerf_millplan --bench plan_latency -- --warm-up-time 1 --measurement-time 5`
+//! (`KERF_BENCH_PLANNERS=ddpg` in the environment: that planner only).
 #![allow(clippy::unwrap_used, clippy::expect_used)] // tests report failures by panicking
 
 use std::path::PathBuf;
@@ -39,8 +40,8 @@ use kerf_millplan::cache::cell_fingerprint;
 use kerf_millplan::plan::{default_eval_threads, IndicatorSource, Plan};
 use kerf_millplan::planner::PlanningPhases;
 use kerf_millplan::{
-    default_policy_path, train, DdpgSettings, EnvConfig, MillEnv, MillPlanError, MillPlanOutput,
-    MillPlanner, MillRequest, PlannerKind, Policy,
+    default_policy_path, execute, train, DdpgSettings, EnvConfig, MillEnv, MillPlanError,
+    MillPlanOutput, MillPlanner, MillRequest, PlannerKind, Policy,
 };
 
 #[allow(dead_code)] // each bench uses some of the shared helpers
@@ -270,6 +271,47 @@ fn same_plan(one: &MillPlanner, many: &MillPlanner, request: &MillRequest) -> bo
     }
 }
 
+/// Whether the planner's answer (its steps 5–7 overlapped on threads) is the
+/// sequential route's, bit for bit: the plan of [`Plan::evaluate_with_threads`]
+/// on 1 thread from the same states, and what [`execute`] (time scaling, then
+/// the re-evaluation of the slowed segments, 1 thread) makes of it. Only for a
+/// direct |μ|max answer (the cache source takes other values).
+fn same_as_sequential(planner: &MillPlanner, request: &MillRequest) -> bool {
+    let out = match planner.plan(request) {
+        Ok(o) => o,
+        Err(e) => {
+            eprintln!("plan failed: {e}");
+            return false;
+        }
+    };
+    let cell = planner.cell();
+    let weights = planner.env_config().weights;
+    let states = out.plan.states();
+    let sequential = Plan::evaluate_with_threads(cell, &weights, &states, &out.plan.planner, 1)
+        .and_then(|plan| execute(cell, &plan, &weights, 1).map(|e| (plan, e)));
+    match sequential {
+        Ok((plan, executed)) => {
+            let bits = |p: &Plan| -> Vec<u64> {
+                p.segments
+                    .iter()
+                    .flat_map(|s| [s.spectral_radius, s.reward.total, s.time, s.feed])
+                    .map(f64::to_bits)
+                    .collect()
+            };
+            plan == out.plan
+                && bits(&plan) == bits(&out.plan)
+                && executed.plan == out.executed.plan
+                && bits(&executed.plan) == bits(&out.executed.plan)
+                && executed.scaling == out.executed.scaling
+                && executed.cached_segments == out.executed.cached_segments
+        }
+        Err(e) => {
+            eprintln!("sequential route failed: {e}");
+            false
+        }
+    }
+}
+
 /// Bit-for-bit equality of the plan and the trajectory (timings aside).
 fn identical(a: &MillPlanOutput, b: &MillPlanOutput) -> bool {
     let bits = |o: &MillPlanOutput| -> Vec<u64> {
@@ -360,11 +402,25 @@ fn bench(c: &mut Criterion) {
             "cache source (|mu| interpolated, bound reported)".to_string(),
         ),
     ];
+    // KERF_BENCH_PLANNERS=ddpg runs only those (a short run for a quiet moment of the machine).
+    let only = std::env::var("KERF_BENCH_PLANNERS").ok();
     for (name, request) in &requests {
+        if only
+            .as_deref()
+            .is_some_and(|o| !o.split(',').any(|x| x == name))
+        {
+            continue;
+        }
         if !same_plan(&one, &many, request) {
             eprintln!("{name}: 1-thread and {threads}-thread plans differ or failed; skipped");
             continue;
         }
+        let sequential = same_as_sequential(&many, request);
+        eprintln!(
+            "{name}: the {threads}-thread plan and executed plan {} the sequential route's (bit \
+             for bit)",
+            if sequential { "are" } else { "are NOT" }
+        );
         if let Ok(out) = many.plan(request) {
             evaluation_ab(&many, &out, threads, 10);
         }

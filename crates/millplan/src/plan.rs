@@ -21,7 +21,7 @@
 //!   the plan is bit for bit the sequential one (`tests/plan_eval.rs`).
 
 use kerf_budget::Budget;
-use kerf_mill::MillCell;
+use kerf_mill::{CellState, MillCell};
 
 use crate::cache::IndicatorCache;
 use crate::env::PhysicalState;
@@ -55,6 +55,134 @@ pub struct SegmentPlan {
     pub time: f64,
     /// Reward and its parts (eq. 12).
     pub reward: RewardParts,
+}
+
+impl SegmentPlan {
+    /// What the trajectory and the re-evaluation of a plan read of this
+    /// segment (neither reads |μ|max nor the reward).
+    pub(crate) fn input(&self) -> SegmentInput {
+        SegmentInput {
+            segment: self.segment,
+            rpm: self.rpm,
+            feed: self.feed,
+            g: self.g,
+            joints: self.joints,
+        }
+    }
+}
+
+/// A planned segment before its |μ|max is known: what the executed
+/// trajectory ([`crate::timing::time_scale`]) and the re-evaluation of
+/// the segments it slows ([`Reevaluation`]) read, so that both can run
+/// while the plan's |μ|max are being evaluated
+/// ([`crate::evaluation::evaluate_direct_alongside`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct SegmentInput {
+    /// Segment index.
+    pub segment: usize,
+    /// Spindle speed \[rpm\].
+    pub rpm: f64,
+    /// Feed \[m/s\].
+    pub feed: f64,
+    /// Redundancy angle \[rad\].
+    pub g: f64,
+    /// Joint vector of the segment's cell state \[rad\].
+    pub joints: [f64; 6],
+}
+
+/// The first half of [`Plan::as_executed_with`]: the segments whose
+/// executed feed differs from the planned one (bit for bit), their cell
+/// states (IK nearest the previous segment's planned joints, as
+/// [`Plan::evaluate`]: the same inputs, so the same cell states) and
+/// their |μ|max at the executed feed (the cache's where it applies, the
+/// others direct). It reads no |μ|max of the plan, so it can run before
+/// they are known.
+#[derive(Debug)]
+pub(crate) struct Reevaluation {
+    changed: Vec<usize>,
+    cell_states: Vec<CellState>,
+    cached_now: Vec<Option<(f64, f64)>>,
+    direct_mus: Vec<Result<f64, MillPlanError>>,
+}
+
+impl Reevaluation {
+    /// The re-evaluation of the segments `inputs` (the plan's, in order)
+    /// at `feeds`, `times` (one per segment, finite and > 0).
+    ///
+    /// # Errors
+    /// As [`Plan::as_executed_with`] before its assembly: wrong lengths,
+    /// bad feeds or times, 0 threads, cell-model errors, the cache's
+    /// errors. |μ|max errors are kept, per segment, for the assembly.
+    #[allow(clippy::too_many_arguments)]
+    pub(crate) fn new(
+        cell: &MillCell,
+        planner: &str,
+        inputs: &[SegmentInput],
+        feeds: &[f64],
+        times: &[f64],
+        threads: usize,
+        cache: Option<&IndicatorCache>,
+        budget: &Budget,
+    ) -> Result<Self, MillPlanError> {
+        let n = inputs.len();
+        if feeds.len() != n || times.len() != n {
+            return Err(MillPlanError::InvalidConfig {
+                name: format!("executed plan `{planner}`"),
+                reason: format!(
+                    "{} feeds and {} times for {n} segments",
+                    feeds.len(),
+                    times.len()
+                ),
+            });
+        }
+        for (i, (f, t)) in feeds.iter().zip(times).enumerate() {
+            for (name, v) in [("feed [m/s]", f), ("time [s]", t)] {
+                if !(v.is_finite() && *v > 0.0) {
+                    return Err(MillPlanError::InvalidParameter {
+                        name: format!("executed {name} at segment {i}"),
+                        value: *v,
+                        reason: "must be finite and > 0".to_string(),
+                    });
+                }
+            }
+        }
+        if threads == 0 {
+            return Err(MillPlanError::InvalidParameter {
+                name: "evaluation threads".to_string(),
+                value: 0.0,
+                reason: "must be >= 1".to_string(),
+            });
+        }
+        let changed: Vec<usize> = (0..n).filter(|&i| feeds[i] != inputs[i].feed).collect();
+        let mut states = Vec::with_capacity(changed.len());
+        let mut cell_states = Vec::with_capacity(changed.len());
+        for &i in &changed {
+            budget.check("the executed plan's cell states")?;
+            let s = &inputs[i];
+            let reference = i.checked_sub(1).map(|p| inputs[p].joints);
+            cell_states.push(cell.evaluate(i, s.g, reference.as_ref())?);
+            states.push(PhysicalState {
+                segment: i,
+                rpm: s.rpm,
+                feed: feeds[i],
+                g: s.g,
+            });
+        }
+        let cached_now = match cache {
+            Some(c) => cached_values(cell, &states, &cell_states, c)?,
+            None => vec![None; changed.len()],
+        };
+        let direct: Vec<usize> = (0..changed.len())
+            .filter(|j| cached_now[*j].is_none())
+            .collect();
+        let direct_mus = spectral_radii(cell, &states, &cell_states, &direct, threads, budget);
+        Ok(Self {
+            changed,
+            cell_states,
+            cached_now,
+            direct_mus,
+        })
+    }
 }
 
 /// A whole plan and its totals.
@@ -309,61 +437,53 @@ impl Plan {
         cache: Option<&IndicatorCache>,
         budget: &Budget,
     ) -> Result<(Self, Vec<usize>), MillPlanError> {
+        let inputs: Vec<SegmentInput> = self.segments.iter().map(SegmentPlan::input).collect();
+        let reevaluation = Reevaluation::new(
+            cell,
+            &self.planner,
+            &inputs,
+            feeds,
+            times,
+            threads,
+            cache,
+            budget,
+        )?;
+        self.with_reevaluation(cell, weights, feeds, times, cached, reevaluation)
+    }
+
+    /// The second half of [`Plan::as_executed_with`]: the executed plan from
+    /// this plan (same segments, Ω, f, g and joints as the `inputs` the
+    /// `reevaluation` was made for) and the re-evaluated |μ|max of its
+    /// changed segments, in segment order (the first error in segment order
+    /// wins, as in the sequential evaluation).
+    pub(crate) fn with_reevaluation(
+        &self,
+        cell: &MillCell,
+        weights: &RewardWeights,
+        feeds: &[f64],
+        times: &[f64],
+        cached: &IndicatorProvenance,
+        reevaluation: Reevaluation,
+    ) -> Result<(Self, Vec<usize>), MillPlanError> {
         let n = self.segments.len();
-        if feeds.len() != n || times.len() != n {
+        let Reevaluation {
+            changed,
+            cell_states,
+            cached_now,
+            direct_mus,
+        } = reevaluation;
+        if feeds.len() != n
+            || times.len() != n
+            || changed
+                .iter()
+                .any(|&i| i >= n || feeds[i] == self.segments[i].feed)
+        {
             return Err(MillPlanError::InvalidConfig {
                 name: format!("executed plan `{}`", self.planner),
-                reason: format!(
-                    "{} feeds and {} times for {n} segments",
-                    feeds.len(),
-                    times.len()
-                ),
+                reason: "the re-evaluation was made for another plan or other feeds".to_string(),
             });
         }
-        for (i, (f, t)) in feeds.iter().zip(times).enumerate() {
-            for (name, v) in [("feed [m/s]", f), ("time [s]", t)] {
-                if !(v.is_finite() && *v > 0.0) {
-                    return Err(MillPlanError::InvalidParameter {
-                        name: format!("executed {name} at segment {i}"),
-                        value: *v,
-                        reason: "must be finite and > 0".to_string(),
-                    });
-                }
-            }
-        }
-        if threads == 0 {
-            return Err(MillPlanError::InvalidParameter {
-                name: "evaluation threads".to_string(),
-                value: 0.0,
-                reason: "must be >= 1".to_string(),
-            });
-        }
-        let changed: Vec<usize> = (0..n)
-            .filter(|&i| feeds[i] != self.segments[i].feed)
-            .collect();
-        let mut states = Vec::with_capacity(changed.len());
-        let mut cell_states = Vec::with_capacity(changed.len());
-        for &i in &changed {
-            budget.check("the executed plan's cell states")?;
-            let s = &self.segments[i];
-            let reference = i.checked_sub(1).map(|p| self.segments[p].joints);
-            cell_states.push(cell.evaluate(i, s.g, reference.as_ref())?);
-            states.push(PhysicalState {
-                segment: i,
-                rpm: s.rpm,
-                feed: feeds[i],
-                g: s.g,
-            });
-        }
-        let cached_now = match cache {
-            Some(c) => cached_values(cell, &states, &cell_states, c)?,
-            None => vec![None; changed.len()],
-        };
-        let direct: Vec<usize> = (0..changed.len())
-            .filter(|j| cached_now[*j].is_none())
-            .collect();
-        let mut direct_mus =
-            spectral_radii(cell, &states, &cell_states, &direct, threads, budget).into_iter();
+        let mut direct_mus = direct_mus.into_iter();
         let max_feed = cell.state_limits().feed[1];
         let mut segments = self.segments.clone();
         let mut margins = vec![0.0; n];

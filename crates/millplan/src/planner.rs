@@ -90,6 +90,29 @@
 //! start, segment midpoints, path end, in the executor's trajectory type
 //! [`crate::trajectory::JointTrajectory`]); step 7 time-scales it
 //! ([`crate::executed`]).
+//!
+//! # Overlap
+//! With direct |μ|max (the default source, or the cache source when the
+//! cache does not apply) the steps share the [`MillPlanner::eval_threads`]
+//! threads instead of running one after the other; the answer is the
+//! sequential one bit for bit (every value is the same function of the same
+//! inputs; only when it is computed changes), and errors are reported in the
+//! order of the steps:
+//! * During a `ddpg`/`fixed_g` rollout (≥ 2 threads), a helper thread
+//!   evaluates |μ|max of each state as the policy reaches it
+//!   (`evaluation::Prefetch`); step 5 keeps its values for the
+//!   longest prefix of the final states it saw unchanged.
+//! * Step 7 up to the executed plan's assembly (the time scaling and the
+//!   direct |μ|max of the segments it slows, `plan::Reevaluation`)
+//!   reads the segments' Ω, f, g and cell states, never their |μ|max: it runs
+//!   on its own thread as soon as step 5's cell states are known, and that
+//!   thread then joins step 5's remaining evaluations
+//!   (`evaluation::evaluate_direct_alongside`). With 1 thread the
+//!   steps run in order.
+//!
+//! [`MillPlanOutput::phases`] then has: `evaluation`, the wall time from the
+//! start of step 5 until every |μ|max of the plan is known (step 7 ran
+//! inside it); `trajectory`, the rest until the executed plan is assembled.
 
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
@@ -103,18 +126,20 @@ use crate::cache::{cell_fingerprint, is_infeasible, IndicatorCache};
 use crate::dp::{self, DpSpec};
 use crate::env::{EnvConfig, MillEnv, PhysicalState};
 use crate::error::MillPlanError;
-use crate::evaluation::evaluate_impl;
+use crate::evaluation::{evaluate_direct_alongside, Prefetch};
 use crate::executed::executed;
 use crate::greedy;
 use crate::naive;
 use crate::observation::OBSERVATION_LAYOUT;
 use crate::path_cache::{path_grid, PathCacheKey, PathCaches};
-use crate::plan::{default_eval_threads, IndicatorProvenance, IndicatorSource, Plan};
+use crate::plan::{
+    default_eval_threads, IndicatorProvenance, IndicatorSource, Plan, Reevaluation, SegmentInput,
+};
 use crate::planned::planned_trajectory;
 use crate::policy::Policy;
 use crate::request::{MillRequest, PlannerKind, RequestProcess};
 use crate::rl::Environment;
-use crate::timing::TrajectorySettings;
+use crate::timing::{joint_limits, time_scale_inputs, TrajectorySettings};
 
 pub use crate::executed::{execute, Executed};
 pub use crate::output::{MillPlanOutput, PlanningPhases};
@@ -570,33 +595,27 @@ impl MillPlanner {
     /// their grid; chatter-model errors; see [`status_of`].
     ///
     /// # Performance
-    /// Dominated by the N direct indicator evaluations of step 5 and, for
-    /// `dp`, the DP (seconds on the full grid); [`MillPlanOutput::phases`]
-    /// has the wall time of each step. Measured in release
+    /// Dominated by the N direct indicator evaluations of step 5 (about
+    /// 0.5–0.65 ms of CPU each on the 2-core build machine) and, for `dp`,
+    /// the DP (seconds on the full grid); [`MillPlanOutput::phases`] has the
+    /// wall time of each step (with direct |μ|max and ≥ 2 threads the steps
+    /// overlap: module documentation, "Overlap"). Measured in release
     /// (`cargo bench -p kerf_millplan --bench plan_latency -- --warm-up-time 1
-    /// --measurement-time 4`, default 100-segment request, the shipped ddpg
-    /// policy, cache loaded, request cell kept from an earlier plan) on the
-    /// idle 2-core machine (load average 1.3–1.4), after the chatter
-    /// equilibrium speed-up; criterion's median wall time, and the mean of 5
-    /// plans split into steps with the process CPU time (all threads):
-    ///
-    /// | planner | source of the μ values | wall (criterion) | CPU | setup + planner + evaluation + trajectory (wall) |
-    /// |---|---|---:|---:|---|
-    /// | ddpg | direct, 1 thread | 96.6 ms | 97 ms | 1.5 + 2.8 + 92.9 + 0.04 ms |
-    /// | ddpg | direct, 2 threads | 49.5 ms | 93 ms | 1.4 + 2.7 + 45.6 + 0.04 ms |
-    /// | ddpg | cache (bound ±0.163) | 6.3 ms | 5.9 ms | 1.3 + 2.5 + 2.0 + 0.03 ms |
-    /// | naive | direct, 2 threads | 181 ms | 228 ms | 1.7 + 138 + 45.4 + 0.05 ms |
-    /// | naive | cache (bound ±0.050) | 151 ms | 174 ms | 7.1 + 164 + 2.7 + 0.04 ms |
-    ///
-    /// The direct evaluation costs about 0.93 ms of CPU per segment (the
-    /// state-dependent chatter indicator; 1.2–1.6 ms before the equilibrium
-    /// speed-up); the evaluation step alone runs 1.8–1.9× faster on 2
-    /// threads than on 1 (alternating rounds), with the identical plan. The
-    /// issue's goal of ≤ 50 ms for ddpg is met with the direct |μ|max on the
-    /// 2 idle cores (49.5 ms), and with margin with
-    /// [`IndicatorSource::Cache`] (6 ms, the cache's stated bound in the
-    /// answer). The first plan of a new path pays 15–30 ms more for the
-    /// path's spline fit (then kept, step 2).
+    /// --measurement-time 5`, default 100-segment request, the shipped ddpg
+    /// policy, request cell kept from an earlier plan) on the shared 2-core
+    /// machine; the figures, the load they were measured under and where the
+    /// CPU time goes are in `BENCHMARKS.md`, "Planning one 100-segment path
+    /// (goal ≤ 50 ms)". For the default ddpg request with direct |μ|max on 2
+    /// threads the plan costs about 90–97 ms of CPU (setup 1.5, rollout 9,
+    /// 100 indicators about 60, step 7 about 20 of which the time scaling
+    /// 11 and the re-evaluation of the slowed segments 3–4), and takes about
+    /// half of it in wall time when both cores are free (49.5 ms criterion
+    /// median at load average 1.9, after the overlap of this issue's item 5);
+    /// on 1 thread the steps run in order (85–95 ms). With
+    /// [`IndicatorSource::Cache`] the evaluation takes 3 ms (about 27–30 ms
+    /// in all, the cache's stated bound in the answer). The first plan of a
+    /// new path pays 15–30 ms more for the path's spline fit (then kept,
+    /// step 2).
     pub fn plan(&self, request: &MillRequest) -> Result<MillPlanOutput, MillPlanError> {
         self.plan_within(request, &Budget::unlimited())
     }
@@ -695,6 +714,7 @@ impl MillPlanner {
             None
         };
         let mut policy_file = None;
+        let mut prefetch: Option<Prefetch> = None;
         let states: Vec<PhysicalState> = match kind {
             PlannerKind::Ddpg | PlannerKind::FixedG => {
                 let path = match &request.policy_file {
@@ -734,6 +754,13 @@ impl MillPlanner {
                     ..self.env_config
                 };
                 let policy = self.policy(&path)?;
+                // Step 5 evaluates |μ|max directly: a helper thread starts on the
+                // states as the rollout makes them ("Overlap" in the module
+                // documentation), when there is a second evaluation thread.
+                let direct = !(self.indicator_source == IndicatorSource::Cache && cache.is_some());
+                if direct && self.eval_threads > 1 {
+                    prefetch = Prefetch::start(cell.clone());
+                }
                 let run = |config: EnvConfig| -> Result<crate::env::Rollout, MillPlanError> {
                     let mut env = MillEnv::new(cell.clone(), cache.clone(), config)?;
                     if let Some(c) = &shield.slowdown {
@@ -743,8 +770,11 @@ impl MillPlanner {
                         env = env.with_held_g(h.clone())?;
                     }
                     policy.check_observation(&OBSERVATION_LAYOUT, env.action_dim())?;
-                    env.rollout(|obs, _| {
+                    env.rollout(|obs, state| {
                         budget.check("the policy rollout")?;
+                        if let Some(p) = &prefetch {
+                            p.send(state);
+                        }
                         policy.act(obs)
                     })
                 };
@@ -771,7 +801,13 @@ impl MillPlanner {
                     });
                 }
                 policy_file = Some(path);
-                rollout.states()
+                let states = rollout.states();
+                // The last state is not handed to the policy: send it here.
+                if let (Some(p), Some(last)) = (&mut prefetch, states.last()) {
+                    p.send(last);
+                    p.close();
+                }
+                states
             }
             PlannerKind::Dp | PlannerKind::Naive => {
                 let cache = match &cache {
@@ -806,60 +842,119 @@ impl MillPlanner {
         let step = Instant::now();
         let weights = &self.env_config.weights;
         let segments = states.len();
-        let (plan, indicator) = match (self.indicator_source, &cache) {
-            (IndicatorSource::Cache, Some(c)) => Plan::evaluate_cached(
-                &cell,
-                weights,
-                &states,
-                kind.name(),
-                self.eval_threads,
-                c,
-                budget,
-            )?,
-            (source, _) => {
-                let (plan, _) = evaluate_impl(
-                    &cell,
-                    weights,
-                    &states,
-                    kind.name(),
-                    self.eval_threads,
-                    None,
-                    budget,
-                )?;
-                let reason = if source == IndicatorSource::Cache {
-                    if self.cache.is_none() {
-                        format!("cache requested, but {}", self.cache_note)
-                    } else {
-                        "cache requested, but this request changes the path/process".to_string()
-                    }
-                } else {
-                    String::new()
-                };
-                (plan, IndicatorProvenance::direct(source, segments, &reason))
-            }
-        };
-        phases.evaluation = step.elapsed().as_secs_f64();
-        let step = Instant::now();
-        budget.check("the planned trajectory")?;
-        let (trajectory, branch_jumps) = planned_trajectory(&cell, &plan)?;
         let mut settings = self.trajectory_settings.with_threads(self.eval_threads);
         if let Some(tolerance) = request.path_tolerance() {
             settings.path_tolerance = tolerance;
         }
-        let executed = executed(
-            &cell,
-            &plan,
-            &settings,
-            weights,
-            self.eval_threads,
-            &indicator,
-            match self.indicator_source {
-                IndicatorSource::Cache => cache.as_deref(),
-                IndicatorSource::Direct => None,
-            },
-            budget,
-        )?;
-        phases.trajectory = step.elapsed().as_secs_f64();
+        let (plan, indicator, trajectory, branch_jumps, executed) =
+            match (self.indicator_source, &cache) {
+                (IndicatorSource::Cache, Some(c)) => {
+                    let (plan, indicator) = Plan::evaluate_cached(
+                        &cell,
+                        weights,
+                        &states,
+                        kind.name(),
+                        self.eval_threads,
+                        c,
+                        budget,
+                    )?;
+                    phases.evaluation = step.elapsed().as_secs_f64();
+                    let step = Instant::now();
+                    budget.check("the planned trajectory")?;
+                    let (trajectory, branch_jumps) = planned_trajectory(&cell, &plan)?;
+                    let executed = executed(
+                        &cell,
+                        &plan,
+                        &settings,
+                        weights,
+                        self.eval_threads,
+                        &indicator,
+                        Some(c),
+                        budget,
+                    )?;
+                    phases.trajectory = step.elapsed().as_secs_f64();
+                    (plan, indicator, trajectory, branch_jumps, executed)
+                }
+                (source, _) => {
+                    let reason = if source == IndicatorSource::Cache {
+                        if self.cache.is_none() {
+                            format!("cache requested, but {}", self.cache_note)
+                        } else {
+                            "cache requested, but this request changes the path/process".to_string()
+                        }
+                    } else {
+                        String::new()
+                    };
+                    let indicator = IndicatorProvenance::direct(source, segments, &reason);
+                    // Step 7 up to the executed plan's assembly, on its own thread while
+                    // the |μ|max of step 5 are evaluated: it reads Ω, f, g and the cell
+                    // states of the segments, never their |μ|max (module documentation,
+                    // "Overlap").
+                    let beside = |inputs: &[SegmentInput]| {
+                        let limits = joint_limits(&cell)?;
+                        budget.check("the executed trajectory")?;
+                        let scaling = time_scale_inputs(&cell, inputs, &limits, &settings, budget)?;
+                        let reevaluation = Reevaluation::new(
+                            &cell,
+                            kind.name(),
+                            inputs,
+                            &scaling.segment_feeds,
+                            &scaling.segment_times,
+                            self.eval_threads,
+                            None,
+                            budget,
+                        )?;
+                        Ok::<_, MillPlanError>((scaling, reevaluation))
+                    };
+                    let (plan, _, beside, evaluated) = evaluate_direct_alongside(
+                        &cell,
+                        weights,
+                        &states,
+                        kind.name(),
+                        self.eval_threads,
+                        budget,
+                        prefetch.take(),
+                        beside,
+                    )?;
+                    phases.evaluation = evaluated;
+                    // In the order of the sequential steps: the planned trajectory's
+                    // errors before the executed trajectory's.
+                    budget.check("the planned trajectory")?;
+                    let (trajectory, branch_jumps) = planned_trajectory(&cell, &plan)?;
+                    let executed = match beside {
+                        Some(result) => {
+                            let (scaling, reevaluation) = result?;
+                            let (executed_plan, cached_segments) = plan.with_reevaluation(
+                                &cell,
+                                weights,
+                                &scaling.segment_feeds,
+                                &scaling.segment_times,
+                                &indicator,
+                                reevaluation,
+                            )?;
+                            Executed {
+                                scaling,
+                                plan: executed_plan,
+                                cached_segments,
+                                settings,
+                            }
+                        }
+                        // Not run (only when the evaluation failed, which returned above).
+                        None => executed(
+                            &cell,
+                            &plan,
+                            &settings,
+                            weights,
+                            self.eval_threads,
+                            &indicator,
+                            None,
+                            budget,
+                        )?,
+                    };
+                    phases.trajectory = (step.elapsed().as_secs_f64() - evaluated).max(0.0);
+                    (plan, indicator, trajectory, branch_jumps, executed)
+                }
+            };
         if let Some(minimum) = request.min_condition_indicator() {
             let (value, arc_length) = executed.scaling.min_condition_indicator;
             if value < minimum {

@@ -243,7 +243,27 @@ impl StepProfile {
 
     /// y, y', y'' at `t` (constant outside [x_0, x_n]).
     pub fn eval(&self, t: f64) -> Derivatives {
-        let i = interval(&self.x, t);
+        self.eval_in(interval(&self.x, t), t)
+    }
+
+    /// [`StepProfile::eval`] for abscissae that move little from call to
+    /// call (an integration along the path): the interval of the previous
+    /// call (`hint`) is tried first, and `hint` is set to this call's. The
+    /// same interval as [`StepProfile::eval`]'s binary search (both order by
+    /// `f64::total_cmp`), so the same value, bit for bit.
+    pub fn eval_near(&self, t: f64, hint: &mut usize) -> Derivatives {
+        let n = self.x.len() - 1;
+        let i = *hint;
+        let inside = i < n
+            && self.x[i].total_cmp(&t) != std::cmp::Ordering::Greater
+            && t.total_cmp(&self.x[i + 1]) == std::cmp::Ordering::Less;
+        let i = if inside { i } else { interval(&self.x, t) };
+        *hint = i;
+        self.eval_in(i, t)
+    }
+
+    /// The profile on interval `i` at `t`.
+    fn eval_in(&self, i: usize, t: f64) -> Derivatives {
         let h = self.x[i + 1] - self.x[i];
         let dy = self.y[i + 1] - self.y[i];
         let (s, s1, s2) = smootherstep((t - self.x[i]) / h);

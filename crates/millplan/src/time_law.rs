@@ -88,9 +88,25 @@ impl TimeLaw {
             return None;
         }
         let join = 0.5 * length;
-        let rate = |s: f64| feed.eval(s).value / slowdown.eval(s).0;
-        let forward = half(&rate, 0.0, join, ramp_time, step, 1.0)?;
-        let backward = half(&rate, length, join, ramp_time, step, -1.0)?;
+        // f/c along each half, the feed's interval kept from one call to the next.
+        let rate = |hint: &mut usize, s: f64| feed.eval_near(s, hint).value / slowdown.eval(s).0;
+        let (mut ahead, mut behind) = (0, 0);
+        let forward = half(
+            &mut |s| rate(&mut ahead, s),
+            0.0,
+            join,
+            ramp_time,
+            step,
+            1.0,
+        )?;
+        let backward = half(
+            &mut |s| rate(&mut behind, s),
+            length,
+            join,
+            ramp_time,
+            step,
+            -1.0,
+        )?;
         let (tf, sf, vf) = forward;
         let (tb, sb, vb) = backward;
         let (Some(&t_join), Some(&sigma_join)) = (tf.last(), tb.last()) else {
@@ -219,14 +235,14 @@ impl TimeLaw {
 type Half = (Vec<f64>, Vec<f64>, Vec<f64>);
 
 fn half(
-    rate: &dyn Fn(f64) -> f64,
+    rate: &mut dyn FnMut(f64) -> f64,
     from: f64,
     join: f64,
     ramp_time: f64,
     step: f64,
     dir: f64,
 ) -> Option<Half> {
-    let rhs = |t: f64, s: f64| dir * rate(s) * smootherstep(t / ramp_time).0;
+    let mut rhs = |t: f64, s: f64| dir * rate(s) * smootherstep(t / ramp_time).0;
     let (mut t, mut s) = (0.0, from);
     let (mut ts, mut ss, mut vs) = (vec![t], vec![s], vec![0.0]);
     for _ in 0..MAX_STEPS {

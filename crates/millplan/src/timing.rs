@@ -65,7 +65,7 @@ use kerf_mill::{condition_number, MillCell};
 
 use crate::deviation::{distance_to_path, measure, PathDeviation};
 use crate::error::MillPlanError;
-use crate::plan::Plan;
+use crate::plan::{Plan, SegmentInput};
 use crate::slowdown::SlowdownField;
 use crate::spline1d::{CubicSpline, Profile, StepProfile};
 use crate::time_law::TimeLaw;
@@ -90,6 +90,11 @@ const MAX_ROUND_FACTOR: f64 = 4.0;
 /// Relative margin kept below each limit (the executor accepts values up to
 /// the limit × (1 + 1e-9)).
 const MARGIN: f64 = 1e-4;
+
+/// Below this fraction of a limit, [`piece_need`] takes the bound Σ |c_i| h^i of a piece's
+/// polynomial for its largest value (a margin of 0.1 % over the rounding of the exact
+/// extremes, about 1e-15 relative, so that no ratio crosses 1 either way).
+const BOUND_FRACTION: f64 = 0.999;
 
 /// Shortest ramp time before the law is given up \[s\].
 const MIN_RAMP_TIME: f64 = 1e-3;
@@ -343,13 +348,27 @@ pub fn time_scale(
     settings: &TrajectorySettings,
     budget: &Budget,
 ) -> Result<TimeScaling, MillPlanError> {
+    let inputs: Vec<SegmentInput> = plan.segments.iter().map(|s| s.input()).collect();
+    time_scale_inputs(cell, &inputs, limits, settings, budget)
+}
+
+/// [`time_scale`] of the plan's segments as [`SegmentInput`]s (Ω, f, g,
+/// joints; the trajectory reads no |μ|max, so it can be built while they are
+/// evaluated: [`crate::evaluation::evaluate_direct_alongside`]).
+pub(crate) fn time_scale_inputs(
+    cell: &MillCell,
+    segments: &[SegmentInput],
+    limits: &[JointLimit],
+    settings: &TrajectorySettings,
+    budget: &Budget,
+) -> Result<TimeScaling, MillPlanError> {
     settings.validate()?;
     let bad = |reason: String| MillPlanError::InvalidConfig {
         name: "executed trajectory".to_string(),
         reason,
     };
     let path = cell.path();
-    let n = plan.segments.len();
+    let n = segments.len();
     if n == 0 || n != path.segments().len() {
         return Err(bad(format!(
             "{n} plan segments for a path of {} segments",
@@ -374,7 +393,7 @@ pub fn time_scale(
     let length = path.total_length();
     let mut boundaries = vec![0.0];
     let mut x = vec![0.0];
-    for (i, seg) in plan.segments.iter().enumerate() {
+    for (i, seg) in segments.iter().enumerate() {
         if seg.segment != i {
             return Err(bad(format!("plan entry {i} is segment {}", seg.segment)));
         }
@@ -396,7 +415,7 @@ pub fn time_scale(
         out.push(v(n - 1));
         out
     };
-    let g_values = ends(&|i| plan.segments[i].g);
+    let g_values = ends(&|i| segments[i].g);
     let cubic = CubicSpline::new("g(s)", &x, &g_values, Some((0.0, 0.0)))?;
     let [g_lo, g_hi] = cell.state_limits().redundancy_angle;
     let (lo, hi) = cubic.range();
@@ -409,13 +428,13 @@ pub fn time_scale(
     };
     let profiles = ExecutedProfiles {
         g: g_profile,
-        feed: StepProfile::new("f(s)", &x, &ends(&|i| plan.segments[i].feed))?,
-        rpm: StepProfile::new("spindle speed(s)", &x, &ends(&|i| plan.segments[i].rpm))?,
+        feed: StepProfile::new("f(s)", &x, &ends(&|i| segments[i].feed))?,
+        rpm: StepProfile::new("spindle speed(s)", &x, &ends(&|i| segments[i].rpm))?,
     };
     let (g, feed) = (&profiles.g, &profiles.feed);
     // Step 2: initial knots at every segment's ends and midpoint.
     let mut knots: Vec<GeoKnot> = Vec::with_capacity(2 * n + 1);
-    let mut reference = plan.segments[0].joints;
+    let mut reference = segments[0].joints;
     for k in 0..=2 * n {
         let s = if k % 2 == 0 {
             boundaries[k / 2]
@@ -465,7 +484,7 @@ pub fn time_scale(
             // Step 7: the executor's own interpolation at every control period.
             let mut scaling = finish(
                 cell,
-                plan,
+                segments,
                 &knots,
                 &boundaries,
                 &x,
@@ -673,9 +692,11 @@ fn evaluate(
 /// r of step 6 for one joint's quintic `c` over [0, h].
 ///
 /// A polynomial's largest |value| on [0, h] is bounded by Σ |c_i| h^i; where that bound is
-/// already below half the limit, the exact extremes (roots of the next derivative) are not
-/// needed: the contribution is reported as that bound's ratio (≤ 0.5, so it never triggers a
-/// slowdown and never hides one).
+/// already below [`BOUND_FRACTION`] of the limit, the exact extremes (roots of the next
+/// derivative) are not needed: the contribution is reported as that bound's ratio (< 1, so it
+/// never triggers a slowdown and never hides one: the exact value is below it too). The ratios
+/// are only compared with 1 and, above 1, used as slowdown factors (step 6), and a ratio above
+/// 1 is always the exact one: the trajectory is the same as with every extreme computed.
 fn piece_need(c: &[f64; 6], h: f64, limit: &JointLimit) -> f64 {
     use kerf_executor::roots::extrema;
     let v = [c[1], 2.0 * c[2], 3.0 * c[3], 4.0 * c[4], 5.0 * c[5]];
@@ -689,7 +710,7 @@ fn piece_need(c: &[f64; 6], h: f64, limit: &JointLimit) -> f64 {
             bound += x.abs() * power;
             power *= h;
         }
-        if bound <= 0.5 * scale {
+        if bound <= BOUND_FRACTION * scale {
             return bound / scale;
         }
         let ((_, lo), (_, hi)) = extrema(p, 0.0, h);
@@ -713,7 +734,7 @@ fn piece_need(c: &[f64; 6], h: f64, limit: &JointLimit) -> f64 {
 #[allow(clippy::too_many_arguments)]
 fn finish(
     cell: &MillCell,
-    plan: &Plan,
+    segments: &[SegmentInput],
     knots: &[GeoKnot],
     boundaries: &[f64],
     midpoints: &[f64],
@@ -724,7 +745,7 @@ fn finish(
     rounds: usize,
     uniform: bool,
 ) -> Result<TimeScaling, MillPlanError> {
-    let n = plan.segments.len();
+    let n = segments.len();
     let names: Vec<String> = cell
         .kinematics()
         .joints()
@@ -759,8 +780,7 @@ fn finish(
         .collect();
     let segment_times = at.windows(2).map(|w| w[1] - w[0]).collect();
     let segment_slowdown: Vec<f64> = (0..n).map(|i| slowdown.eval(midpoints[i + 1]).0).collect();
-    let segment_feeds = plan
-        .segments
+    let segment_feeds = segments
         .iter()
         .zip(&segment_slowdown)
         .map(|(s, c)| s.feed / c)
