@@ -1,0 +1,332 @@
+//! kerf's corner transition: a symmetric quintic Bézier curve replacing a
+//! corner of a G01 polyline, curvature-continuous (G2) with the two lines,
+//! whose largest distance from the polyline is known exactly.
+//!
+//! # Shape
+//! At a vertex V with incoming unit direction t₁, outgoing t₂ and turning
+//! angle θ = ∠(t₁, t₂) ∈ (0, π), the control points are (the symmetric
+//! quintic corner of Sencer, Ishizaki and Shamoto, "A curvature optimal
+//! sharp corner smoothing algorithm for high-speed feed motion generation of
+//! NC systems along linear tool paths", IJAMT 76, 2015, section 2):
+//!
+//! P₀ = V − (a+b+c) s t₁, P₁ = V − (a+b) s t₁, P₂ = V − a s t₁,
+//! P₃ = V + a s t₂, P₄ = V + (a+b) s t₂, P₅ = V + (a+b+c) s t₂,
+//!
+//! with the shape (a = 1, b, c) > 0 and the scale s > 0. P₀, P₁, P₂ lie on
+//! the incoming line, so the curve leaves it tangentially with zero
+//! curvature (Farin eq. 10.5 at u = 0: κ(0) = (4/5) |Δb₀ × Δb₁| / |Δb₀|³ =
+//! 0), and likewise joins the outgoing line: G2 continuity with both lines.
+//!
+//! # Deviation (proof)
+//! The signed distance to the incoming line is affine, so along the curve it
+//! is the Bernstein polynomial of the control points' distances (0, 0, 0,
+//! a s sin θ, (a+b) s sin θ, (a+b+c) s sin θ): non-decreasing coefficients,
+//! hence non-decreasing in u (Farin eq. 5.3 with Δ ≥ 0). For u ≤ ½ the
+//! curve's foot on the incoming line lies on the segment before V (its
+//! coordinate along −t₁ is the Bernstein polynomial of ((a+b+c)s, (a+b)s,
+//! a s, −a s cos θ, −(a+b)s cos θ, −(a+b+c)s cos θ): non-increasing for
+//! θ ≤ π/2, positive for θ > π/2, and ((16a + 6b + c)/32) s (1 − cos θ) ≥
+//! 0 at u = ½), so the distance to the polyline is at most the distance to
+//! the incoming line, at most its value at u = ½; the second half is the
+//! mirror image. Hence, exactly (attained at u = ½):
+//!
+//! e = max_u dist(b(u), polyline) = sin θ · s (16a + 6b + c) / 32,
+//!
+//! provided P₀ and P₅ lie on their segments ((a+b+c) s ≤ the available
+//! length on each side).
+//!
+//! # Choice of a, b, c and s
+//! s is the largest with e ≤ δ and (a+b+c) s ≤ the available length. The
+//! shape minimizes the curve's largest curvature for the binding
+//! constraint: [`SHAPES`] holds, per turning angle, the shape of least
+//! κ_max · δ (tolerance binding) and of least κ_max · L (length binding),
+//! found by the grid search of [`search_shape`] (`cargo run -p kerf_toolpath
+//! --example corner_shapes` prints the table; a test checks it against the
+//! search). Any positive shape satisfies the bound above: the table only
+//! makes the corner flatter.
+
+use crate::bezier::QuinticBezier;
+use crate::error::ToolpathError;
+use crate::vec3::{add, dot, norm, scale, sub};
+
+/// Turning angles below this are straight \[rad\]: no transition.
+pub const MIN_TURN: f64 = 1e-9;
+
+/// Turning angles above π − this are reversals \[rad\]: no G2 transition
+/// exists inside a tolerance (the path must stop at the vertex).
+pub const REVERSAL_MARGIN: f64 = 1e-6;
+
+/// Samples of the half curve for its largest curvature (then refined).
+pub const CURVATURE_SAMPLES: usize = 64;
+
+/// A corner shape: b/a and c/a (a = 1).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct CornerShape {
+    /// b / a.
+    pub b: f64,
+    /// c / a.
+    pub c: f64,
+}
+
+impl CornerShape {
+    /// 16a + 6b + c (a = 1): the deviation per unit scale is sin θ times
+    /// this over 32.
+    pub fn deviation_weight(&self) -> f64 {
+        16.0 + 6.0 * self.b + self.c
+    }
+
+    /// a + b + c (a = 1): the tangent length per unit scale.
+    pub fn length_weight(&self) -> f64 {
+        1.0 + self.b + self.c
+    }
+}
+
+/// Which constraint fixes a corner's scale.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Binding {
+    /// The tolerance δ.
+    Tolerance,
+    /// The length available on the shorter side.
+    Length,
+}
+
+/// A corner's transition.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct CornerTransition {
+    /// The curve, from P₀ on the incoming segment to P₅ on the outgoing.
+    pub curve: QuinticBezier,
+    /// The vertex it replaces.
+    pub vertex: [f64; 3],
+    /// Turning angle θ \[rad\].
+    pub turn: f64,
+    /// The shape and the scale s \[m\].
+    pub shape: CornerShape,
+    /// Scale s \[m\].
+    pub scale: f64,
+    /// |P₀ − V| = |P₅ − V| \[m\].
+    pub tangent_length: f64,
+    /// The exact largest distance from the polyline \[m\] (module
+    /// documentation).
+    pub deviation: f64,
+    /// The largest curvature \[1/m\] (sampled, then refined).
+    pub max_curvature: f64,
+    /// The constraint that fixed the scale.
+    pub binding: Binding,
+}
+
+/// The curve of a shape at a scale.
+fn curve(v: [f64; 3], t1: [f64; 3], t2: [f64; 3], shape: CornerShape, s: f64) -> QuinticBezier {
+    let (a, b, c) = (s, shape.b * s, shape.c * s);
+    QuinticBezier {
+        control: [
+            sub(v, scale(t1, a + b + c)),
+            sub(v, scale(t1, a + b)),
+            sub(v, scale(t1, a)),
+            add(v, scale(t2, a)),
+            add(v, scale(t2, a + b)),
+            add(v, scale(t2, a + b + c)),
+        ],
+    }
+}
+
+/// The largest curvature of a symmetric corner curve: the first half
+/// sampled at [`CURVATURE_SAMPLES`] + 1 points, the best refined by golden
+/// section on its neighbouring interval.
+fn max_curvature(curve: &QuinticBezier) -> f64 {
+    let n = CURVATURE_SAMPLES;
+    let mut best = (0.0, 0usize);
+    for k in 0..=n {
+        let kappa = curve.curvature(0.5 * k as f64 / n as f64);
+        if kappa > best.0 {
+            best = (kappa, k);
+        }
+    }
+    let h = 0.5 / n as f64;
+    let (mut lo, mut hi) = (
+        (best.1 as f64 * h - h).max(0.0),
+        (best.1 as f64 * h + h).min(0.5),
+    );
+    let g = 0.5 * (5f64.sqrt() - 1.0);
+    for _ in 0..24 {
+        let m1 = hi - g * (hi - lo);
+        let m2 = lo + g * (hi - lo);
+        if curve.curvature(m1) < curve.curvature(m2) {
+            lo = m1;
+        } else {
+            hi = m2;
+        }
+    }
+    best.0.max(curve.curvature(0.5 * (lo + hi)))
+}
+
+/// The unit direction from `a` to `b` and the distance.
+fn direction(a: [f64; 3], b: [f64; 3]) -> ([f64; 3], f64) {
+    let d = sub(b, a);
+    let l = norm(d);
+    (scale(d, 1.0 / l), l)
+}
+
+/// The transition at the corner `prev` → `vertex` → `next`.
+///
+/// # Arguments
+/// * `tolerance` — δ \[m\], > 0: the transition stays within δ of the
+///   polyline.
+/// * `available` — the longest tangent length allowed on each side \[m\]
+///   (at most the shorter adjacent segment's length; the caller shares
+///   segments between neighbouring corners).
+///
+/// # Returns
+/// `None` for a straight corner (θ < [`MIN_TURN`]); the transition
+/// otherwise, of the table shape ([`SHAPES`]) with the smaller largest
+/// curvature of the two bindings.
+///
+/// # Errors
+/// [`ToolpathError::InvalidParameter`] for δ or `available` not finite
+/// and positive, or a reversal (θ > π − [`REVERSAL_MARGIN`]);
+/// [`ToolpathError::BadPoint`] for coincident points.
+///
+/// # Performance
+/// Two curvature searches of about 100 curve evaluations each.
+pub fn corner_transition(
+    prev: [f64; 3],
+    vertex: [f64; 3],
+    next: [f64; 3],
+    tolerance: f64,
+    available: f64,
+) -> Result<Option<CornerTransition>, ToolpathError> {
+    for (name, v) in [
+        ("tolerance [m]", tolerance),
+        ("available length [m]", available),
+    ] {
+        if !(v.is_finite() && v > 0.0) {
+            return Err(ToolpathError::InvalidParameter {
+                name: name.to_string(),
+                value: v,
+                reason: "must be finite and > 0".to_string(),
+            });
+        }
+    }
+    let (t1, l1) = direction(prev, vertex);
+    let (t2, l2) = direction(vertex, next);
+    if !(l1 > 0.0 && l2 > 0.0 && l1.is_finite() && l2.is_finite()) {
+        return Err(ToolpathError::BadPoint {
+            index: usize::from(l1 > 0.0),
+            reason: "coincides with its neighbour (or is not finite)".to_string(),
+        });
+    }
+    let turn = dot(t1, t2).clamp(-1.0, 1.0).acos();
+    if turn < MIN_TURN {
+        return Ok(None);
+    }
+    if turn > std::f64::consts::PI - REVERSAL_MARGIN {
+        return Err(ToolpathError::InvalidParameter {
+            name: "turning angle [rad]".to_string(),
+            value: turn,
+            reason: "a reversal: no curvature-continuous transition fits a tolerance (stop at \
+                     the vertex)"
+                .to_string(),
+        });
+    }
+    let mut best: Option<CornerTransition> = None;
+    for binding in [Binding::Tolerance, Binding::Length] {
+        let shape = table_shape(turn, binding);
+        let by_tolerance = 32.0 * tolerance / (turn.sin() * shape.deviation_weight());
+        let by_length = available / shape.length_weight();
+        let (s, bound) = if by_tolerance <= by_length {
+            (by_tolerance, Binding::Tolerance)
+        } else {
+            (by_length, Binding::Length)
+        };
+        let c = curve(vertex, t1, t2, shape, s);
+        let t = CornerTransition {
+            curve: c,
+            vertex,
+            turn,
+            shape,
+            scale: s,
+            tangent_length: s * shape.length_weight(),
+            deviation: turn.sin() * s * shape.deviation_weight() / 32.0,
+            max_curvature: max_curvature(&c),
+            binding: bound,
+        };
+        if best.is_none_or(|b| t.max_curvature < b.max_curvature) {
+            best = Some(t);
+        }
+    }
+    Ok(best)
+}
+
+/// The largest curvature per unit of the binding constraint of a shape at a
+/// turning angle: κ_max · δ (tolerance) or κ_max · L (length).
+pub fn normalized_curvature(turn: f64, shape: CornerShape, binding: Binding) -> f64 {
+    let s = match binding {
+        Binding::Tolerance => 32.0 / (turn.sin() * shape.deviation_weight()),
+        Binding::Length => 1.0 / shape.length_weight(),
+    };
+    let c = curve(
+        [0.0; 3],
+        [1.0, 0.0, 0.0],
+        [turn.cos(), turn.sin(), 0.0],
+        shape,
+        s,
+    );
+    max_curvature(&c)
+}
+
+/// The grid search behind [`SHAPES`]: b and c on `steps` × `steps` points
+/// of (0, 4] × (0, 2], the shape of least [`normalized_curvature`], then a
+/// local grid of a tenth of the step around it.
+pub fn search_shape(turn: f64, binding: Binding, steps: usize) -> CornerShape {
+    let mut best = (f64::INFINITY, CornerShape { b: 1.0, c: 0.5 });
+    let scan = |b_lo: f64, b_hi: f64, c_lo: f64, c_hi: f64, best: &mut (f64, CornerShape)| {
+        for i in 0..=steps {
+            for j in 0..=steps {
+                let shape = CornerShape {
+                    b: b_lo + (b_hi - b_lo) * i as f64 / steps as f64,
+                    c: c_lo + (c_hi - c_lo) * j as f64 / steps as f64,
+                };
+                if shape.b <= 0.0 || shape.c <= 0.0 {
+                    continue;
+                }
+                let k = normalized_curvature(turn, shape, binding);
+                if k < best.0 {
+                    *best = (k, shape);
+                }
+            }
+        }
+    };
+    scan(0.0, 4.0, 0.0, 2.0, &mut best);
+    let (db, dc) = (4.0 / steps as f64, 2.0 / steps as f64);
+    let centre = best.1;
+    scan(
+        centre.b - db,
+        centre.b + db,
+        centre.c - dc,
+        centre.c + dc,
+        &mut best,
+    );
+    best.1
+}
+
+/// The table shape at a turning angle: linear interpolation in [`SHAPES`]
+/// (which holds θ = 5°, 10°, …, 175°; clamped outside).
+pub fn table_shape(turn: f64, binding: Binding) -> CornerShape {
+    let deg = turn.to_degrees().clamp(5.0, 175.0);
+    let k = ((deg - 5.0) / 5.0).floor().min((SHAPES.len() - 2) as f64) as usize;
+    let f = (deg - 5.0) / 5.0 - k as f64;
+    let pick = |row: &[f64; 5]| match binding {
+        Binding::Tolerance => (row[1], row[2]),
+        Binding::Length => (row[3], row[4]),
+    };
+    let (b0, c0) = pick(&SHAPES[k]);
+    let (b1, c1) = pick(&SHAPES[k + 1]);
+    CornerShape {
+        b: b0 + f * (b1 - b0),
+        c: c0 + f * (c1 - c0),
+    }
+}
+
+/// Per turning angle (degrees): the shape (b, c) of least κ_max · δ and of
+/// least κ_max · L ([`search_shape`] with 40 steps; generated by `cargo run
+/// -p kerf_toolpath --example corner_shapes`).
+pub const SHAPES: [[f64; 5]; 35] = include!("corner_shapes.in");

@@ -1,0 +1,196 @@
+//! A G01 polyline smoothed corner by corner ([`crate::corner`]): straight
+//! pieces and curvature-continuous corner transitions, within a tolerance
+//! of the polyline everywhere.
+
+use crate::corner::{corner_transition, CornerTransition};
+use crate::error::ToolpathError;
+use crate::vec3::{distance_to_segment, norm, sub};
+
+/// One piece of a smoothed path.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Piece {
+    /// A straight piece.
+    Line {
+        /// Start \[m\].
+        start: [f64; 3],
+        /// End \[m\].
+        end: [f64; 3],
+    },
+    /// A corner transition.
+    Corner(CornerTransition),
+}
+
+/// A smoothed polyline.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SmoothedPath {
+    /// The polyline it smooths.
+    pub polyline: Vec<[f64; 3]>,
+    /// The tolerance \[m\].
+    pub tolerance: f64,
+    /// Lines and corners in order, each starting where the previous ends.
+    pub pieces: Vec<Piece>,
+}
+
+impl SmoothedPath {
+    /// The largest distance from the polyline, exact per corner (module
+    /// [`crate::corner`]); 0 without corners \[m\].
+    pub fn max_deviation(&self) -> f64 {
+        self.corners().map(|c| c.deviation).fold(0.0, f64::max)
+    }
+
+    /// The largest curvature \[1/m\].
+    pub fn max_curvature(&self) -> f64 {
+        self.corners().map(|c| c.max_curvature).fold(0.0, f64::max)
+    }
+
+    /// The corner transitions.
+    pub fn corners(&self) -> impl Iterator<Item = &CornerTransition> {
+        self.pieces.iter().filter_map(|p| match p {
+            Piece::Corner(c) => Some(c),
+            Piece::Line { .. } => None,
+        })
+    }
+
+    /// Points along the path: each piece at `per_piece` + 1 equally spaced
+    /// parameters (lines by length, corners by their Bézier parameter).
+    pub fn sample(&self, per_piece: usize) -> Vec<[f64; 3]> {
+        let n = per_piece.max(1);
+        let mut out = Vec::with_capacity(self.pieces.len() * (n + 1));
+        for p in &self.pieces {
+            for k in 0..=n {
+                let u = k as f64 / n as f64;
+                out.push(match p {
+                    Piece::Line { start, end } => {
+                        std::array::from_fn(|d| start[d] + u * (end[d] - start[d]))
+                    }
+                    Piece::Corner(c) => c.curve.point(u),
+                });
+            }
+        }
+        out
+    }
+
+    /// The largest distance of `points` from the polyline \[m\] (brute force
+    /// over its segments: for checks).
+    pub fn distance_from_polyline(&self, points: &[[f64; 3]]) -> f64 {
+        points
+            .iter()
+            .map(|p| {
+                self.polyline
+                    .windows(2)
+                    .map(|w| distance_to_segment(*p, w[0], w[1]))
+                    .fold(f64::INFINITY, f64::min)
+            })
+            .fold(0.0, f64::max)
+    }
+}
+
+/// Smooths every corner of a polyline.
+///
+/// # Arguments
+/// * `polyline` — at least two points, finite, no two consecutive equal.
+/// * `tolerance` — δ \[m\].
+///
+/// # Returns
+/// The path: a transition at every corner that turns (each within δ of the
+/// polyline, using at most half of each segment it shares with another
+/// corner and all of a first or last segment), lines between them.
+///
+/// # Errors
+/// [`ToolpathError::BadPoint`] for a non-finite point or two equal
+/// consecutive points; [`ToolpathError::InvalidParameter`] for δ not finite
+/// and > 0, fewer than two points, or a reversal (the path must stop there:
+/// not smoothed).
+pub fn smooth_polyline(
+    polyline: &[[f64; 3]],
+    tolerance: f64,
+) -> Result<SmoothedPath, ToolpathError> {
+    if polyline.len() < 2 {
+        return Err(ToolpathError::InvalidParameter {
+            name: "points".to_string(),
+            value: polyline.len() as f64,
+            reason: "a path needs at least two".to_string(),
+        });
+    }
+    if !(tolerance.is_finite() && tolerance > 0.0) {
+        return Err(ToolpathError::InvalidParameter {
+            name: "tolerance [m]".to_string(),
+            value: tolerance,
+            reason: "must be finite and > 0".to_string(),
+        });
+    }
+    for (index, p) in polyline.iter().enumerate() {
+        if p.iter().any(|v| !v.is_finite()) {
+            return Err(ToolpathError::BadPoint {
+                index,
+                reason: "not finite".to_string(),
+            });
+        }
+        if index > 0 && norm(sub(*p, polyline[index - 1])) == 0.0 {
+            return Err(ToolpathError::BadPoint {
+                index,
+                reason: "equals the point before it".to_string(),
+            });
+        }
+    }
+    let n = polyline.len();
+    let length = |i: usize| norm(sub(polyline[i + 1], polyline[i]));
+    // The share of segment i (from point i to i + 1) a corner at either end
+    // may use: all of it next to a path end, else half.
+    let share = |i: usize| {
+        if i == 0 || i == n - 2 {
+            length(i)
+        } else {
+            0.5 * length(i)
+        }
+    };
+    let mut pieces = Vec::new();
+    let mut cursor = polyline[0];
+    for v in 1..n - 1 {
+        let available = share(v - 1).min(share(v));
+        match corner_transition(
+            polyline[v - 1],
+            polyline[v],
+            polyline[v + 1],
+            tolerance,
+            available,
+        )
+        .map_err(|e| match e {
+            ToolpathError::InvalidParameter {
+                name,
+                value,
+                reason,
+            } => ToolpathError::InvalidParameter {
+                name: format!("corner at point {v}: {name}"),
+                value,
+                reason,
+            },
+            other => other,
+        })? {
+            None => {}
+            Some(c) => {
+                let start = c.curve.control[0];
+                if norm(sub(start, cursor)) > 0.0 {
+                    pieces.push(Piece::Line {
+                        start: cursor,
+                        end: start,
+                    });
+                }
+                cursor = c.curve.control[5];
+                pieces.push(Piece::Corner(c));
+            }
+        }
+    }
+    let last = polyline[n - 1];
+    if norm(sub(last, cursor)) > 0.0 {
+        pieces.push(Piece::Line {
+            start: cursor,
+            end: last,
+        });
+    }
+    Ok(SmoothedPath {
+        polyline: polyline.to_vec(),
+        tolerance,
+        pieces,
+    })
+}
