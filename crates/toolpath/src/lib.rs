@@ -1,14 +1,20 @@
-//! Tool path geometry of kerf's G-code front end (issue 14, item 2): corner
-//! smoothing of G01 polylines under a tolerance with curvature-continuous
-//! transitions ([`corner`]).
+//! Tool path geometry of kerf's G-code front end (issue 14, items 2 and 3):
+//! corner smoothing of G01 polylines under a tolerance with
+//! curvature-continuous transitions ([`corner`], [`smooth`]), arc-length
+//! samples ([`samples`]) and the bang-bang time bound T_lb
+//! ([`lower_bound`]).
 
 pub mod bezier;
 pub mod corner;
 pub mod error;
+pub mod lower_bound;
+pub mod samples;
 pub mod smooth;
 pub mod vec3;
 
 pub use bezier::QuinticBezier;
 pub use corner::{corner_transition, Binding, CornerShape, CornerTransition};
 pub use error::ToolpathError;
+pub use lower_bound::{bang_bang, BangBang, BangBangLimits};
+pub use samples::{sample_path, PathSample};
 pub use smooth::{smooth_polyline, Piece, SmoothedPath};

@@ -1,0 +1,141 @@
+//! T_lb: the time of the second-order bang-bang optimum along a path (issue
+//! 14, item 3), the bound a jerk-limited feed plan is compared with.
+//!
+//! The path is sampled by arc length ([`crate::samples`]). The speed may not
+//! exceed the velocity-limit curve v_lim(s) = min(F, √(A_n / κ(s))) (the
+//! programmed feed and the normal acceleration v²κ ≤ A_n); the tangential
+//! acceleration is bounded by A_t. The optimum accelerates at A_t, follows
+//! v_lim or decelerates at A_t, switching where these meet (Bobrow, Dubowsky
+//! and Gibson, "Time-optimal control of robotic manipulators along specified
+//! paths", IJRR 4(3), 1985, section 4): a forward pass
+//! v_{i+1} = min(v_lim,i+1, √(v_i² + 2 A_t Δs)) from rest and a backward pass
+//! v_i = min(v_i, √(v_{i+1}² + 2 A_t Δs)) to rest. Between samples v² is
+//! linear in s (constant tangential acceleration), so an interval takes
+//! exactly 2 Δs / (v_i + v_{i+1}).
+//!
+//! On a grid the bound converges as the spacing falls (where the speed
+//! reaches F inside an interval, that interval is timed as if it accelerated
+//! all along it: slower by at most O(Δs / F)); `tests/lower_bound.rs`
+//! measures it against the exact trapezoid of a straight line.
+
+use crate::error::ToolpathError;
+use crate::samples::PathSample;
+
+/// The limits of the bang-bang bound.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct BangBangLimits {
+    /// Largest speed F \[m/s\] (the programmed feed, at most the machine's).
+    pub feed: f64,
+    /// Largest tangential acceleration A_t \[m/s²\].
+    pub tangential_acceleration: f64,
+    /// Largest normal acceleration A_n \[m/s²\].
+    pub normal_acceleration: f64,
+}
+
+impl BangBangLimits {
+    /// Checks that every limit is finite and > 0.
+    ///
+    /// # Errors
+    /// [`ToolpathError::InvalidParameter`] naming the limit.
+    pub fn validate(&self) -> Result<(), ToolpathError> {
+        for (name, v) in [
+            ("feed [m/s]", self.feed),
+            (
+                "tangential acceleration [m/s^2]",
+                self.tangential_acceleration,
+            ),
+            ("normal acceleration [m/s^2]", self.normal_acceleration),
+        ] {
+            if !(v.is_finite() && v > 0.0) {
+                return Err(ToolpathError::InvalidParameter {
+                    name: name.to_string(),
+                    value: v,
+                    reason: "must be finite and > 0".to_string(),
+                });
+            }
+        }
+        Ok(())
+    }
+}
+
+/// The bound and its speed profile.
+#[derive(Debug, Clone, PartialEq)]
+pub struct BangBang {
+    /// T_lb \[s\].
+    pub time: f64,
+    /// The optimal speed at every sample \[m/s\] (0 at both ends).
+    pub speed: Vec<f64>,
+    /// The velocity-limit curve at every sample \[m/s\].
+    pub limit: Vec<f64>,
+}
+
+/// The bang-bang bound along `samples` (module documentation).
+///
+/// # Arguments
+/// * `samples` — at least two, arc length strictly increasing.
+/// * `limits` — F, A_t, A_n.
+///
+/// # Errors
+/// [`ToolpathError::InvalidParameter`] for bad limits, fewer than two
+/// samples, an arc length that does not increase, or a curvature that is
+/// not finite and ≥ 0.
+pub fn bang_bang(
+    samples: &[PathSample],
+    limits: &BangBangLimits,
+) -> Result<BangBang, ToolpathError> {
+    limits.validate()?;
+    if samples.len() < 2 {
+        return Err(ToolpathError::InvalidParameter {
+            name: "samples".to_string(),
+            value: samples.len() as f64,
+            reason: "a path needs at least two".to_string(),
+        });
+    }
+    for (k, w) in samples.windows(2).enumerate() {
+        if w[1].s.partial_cmp(&w[0].s) != Some(std::cmp::Ordering::Greater) {
+            return Err(ToolpathError::InvalidParameter {
+                name: format!("arc length of sample {}", k + 1),
+                value: w[1].s,
+                reason: format!("must exceed the previous one ({})", w[0].s),
+            });
+        }
+    }
+    let limit: Vec<f64> = samples
+        .iter()
+        .map(|p| {
+            if !(p.curvature.is_finite() && p.curvature >= 0.0) {
+                return Err(ToolpathError::InvalidParameter {
+                    name: "curvature [1/m]".to_string(),
+                    value: p.curvature,
+                    reason: "must be finite and >= 0".to_string(),
+                });
+            }
+            Ok(if p.curvature > 0.0 {
+                limits
+                    .feed
+                    .min((limits.normal_acceleration / p.curvature).sqrt())
+            } else {
+                limits.feed
+            })
+        })
+        .collect::<Result<_, _>>()?;
+    let a = limits.tangential_acceleration;
+    let n = samples.len();
+    let mut speed = limit.clone();
+    speed[0] = 0.0;
+    for i in 0..n - 1 {
+        let ds = samples[i + 1].s - samples[i].s;
+        speed[i + 1] = speed[i + 1].min((speed[i] * speed[i] + 2.0 * a * ds).sqrt());
+    }
+    speed[n - 1] = 0.0;
+    for i in (0..n - 1).rev() {
+        let ds = samples[i + 1].s - samples[i].s;
+        speed[i] = speed[i].min((speed[i + 1] * speed[i + 1] + 2.0 * a * ds).sqrt());
+    }
+    let time = samples
+        .windows(2)
+        .zip(speed.windows(2))
+        .map(|(p, v)| 2.0 * (p[1].s - p[0].s) / (v[0] + v[1]))
+        .sum();
+    Ok(BangBang { time, speed, limit })
+}

@@ -1,0 +1,94 @@
+//! T_lb (the bang-bang bound) against exact answers on straight lines, its limits obeyed on a
+//! smoothed zig-zag, and the arc-length samples against the pieces' lengths.
+#![allow(clippy::unwrap_used, clippy::expect_used)] // tests report failures by panicking
+
+use kerf_toolpath::{bang_bang, sample_path, smooth_polyline, BangBangLimits, Piece};
+
+fn limits(feed: f64, at: f64, an: f64) -> BangBangLimits {
+    BangBangLimits {
+        feed,
+        tangential_acceleration: at,
+        normal_acceleration: an,
+    }
+}
+
+#[test]
+fn straight_lines_give_the_trapezoid_and_the_triangle() {
+    // 0.1 m at F = 0.05 m/s, A = 1 m/s²: L/F + F/A = 2.05 s.
+    let path = smooth_polyline(&[[0.0; 3], [0.1, 0.0, 0.0]], 1e-4).unwrap();
+    let lim = limits(0.05, 1.0, 1.0);
+    let mut errors = Vec::new();
+    for step in [1e-3, 1e-4, 1e-5] {
+        let t = bang_bang(&sample_path(&path, step), &lim).unwrap().time;
+        errors.push((t - 2.05).abs());
+        assert!(t >= 2.05 - 1e-12, "never below the exact optimum: {t}");
+    }
+    assert!(errors[2] < 2e-4 && errors[2] < errors[0], "{errors:?}");
+    // 1 mm never reaches F: 2 √(L/A).
+    let short = smooth_polyline(&[[0.0; 3], [0.0, 0.001, 0.0]], 1e-4).unwrap();
+    let t = bang_bang(&sample_path(&short, 1e-6), &lim).unwrap().time;
+    assert!((t - 2.0 * (0.001f64).sqrt()).abs() < 1e-7, "{t}");
+}
+
+#[test]
+fn a_smoothed_zig_zag_obeys_every_limit_and_slows_in_its_corners() {
+    let poly = [
+        [0.0, 0.0, 0.0],
+        [0.02, 0.0, 0.0],
+        [0.03, 0.01, 0.0],
+        [0.05, 0.01, 0.0],
+        [0.05, 0.03, 0.0],
+    ];
+    let path = smooth_polyline(&poly, 1e-4).unwrap();
+    let samples = sample_path(&path, 2e-5);
+    // The samples' arc length matches the pieces' lengths.
+    let total: f64 = path
+        .pieces
+        .iter()
+        .map(|p| match p {
+            Piece::Line { start, end } => {
+                kerf_toolpath::vec3::norm(kerf_toolpath::vec3::sub(*end, *start))
+            }
+            Piece::Corner(c) => c.curve.length(64),
+        })
+        .sum();
+    let last = samples.last().unwrap().s;
+    assert!((last - total).abs() < 1e-12, "{last} vs {total}");
+    let lim = limits(0.1, 2.0, 0.5);
+    let b = bang_bang(&samples, &lim).unwrap();
+    for (i, w) in samples.windows(2).enumerate() {
+        let (v0, v1) = (b.speed[i], b.speed[i + 1]);
+        let a = (v1 * v1 - v0 * v0) / (2.0 * (w[1].s - w[0].s));
+        assert!(a.abs() <= 2.0 * (1.0 + 1e-9), "sample {i}: {a}");
+        assert!(v1 <= 0.1 + 1e-15);
+        assert!(v1 * v1 * w[1].curvature <= 0.5 * (1.0 + 1e-9));
+    }
+    // The corners bind: the speed falls below F somewhere inside, and tighter limits take longer.
+    assert!(b
+        .speed
+        .iter()
+        .zip(&b.limit)
+        .any(|(v, l)| *v < 0.1 && (v - l).abs() < 1e-15));
+    let slower = bang_bang(&samples, &limits(0.1, 2.0, 0.1)).unwrap();
+    assert!(slower.time > b.time);
+    let faster = bang_bang(&samples, &limits(0.1, 2.0, 5.0)).unwrap();
+    assert!(faster.time < b.time);
+}
+
+#[test]
+fn bad_limits_and_samples_are_refused() {
+    let path = smooth_polyline(&[[0.0; 3], [0.1, 0.0, 0.0]], 1e-4).unwrap();
+    let samples = sample_path(&path, 1e-3);
+    for bad in [
+        limits(0.0, 1.0, 1.0),
+        limits(0.1, -1.0, 1.0),
+        limits(0.1, 1.0, f64::NAN),
+    ] {
+        assert!(bang_bang(&samples, &bad).is_err());
+    }
+    assert!(bang_bang(&samples[..1], &limits(0.1, 1.0, 1.0)).is_err());
+    let mut reversed = samples.clone();
+    reversed.swap(1, 2);
+    let e = bang_bang(&reversed, &limits(0.1, 1.0, 1.0)).unwrap_err();
+    assert!(e.to_string().contains("arc length"), "{e}");
+}
