@@ -10,11 +10,13 @@ pub mod error;
 pub mod lower_bound;
 pub mod samples;
 pub mod smooth;
+pub mod speed_limit;
 pub mod vec3;
 
 pub use bezier::QuinticBezier;
 pub use corner::{corner_transition, Binding, CornerShape, CornerTransition};
 pub use error::ToolpathError;
-pub use lower_bound::{bang_bang, BangBang, BangBangLimits};
+pub use lower_bound::{bang_bang, bang_bang_under, BangBang, BangBangLimits};
 pub use samples::{sample_path, PathSample};
 pub use smooth::{smooth_polyline, Piece, SmoothedPath};
+pub use speed_limit::{CurvatureLimits, Servo};

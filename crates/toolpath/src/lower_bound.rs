@@ -84,22 +84,7 @@ pub fn bang_bang(
     limits: &BangBangLimits,
 ) -> Result<BangBang, ToolpathError> {
     limits.validate()?;
-    if samples.len() < 2 {
-        return Err(ToolpathError::InvalidParameter {
-            name: "samples".to_string(),
-            value: samples.len() as f64,
-            reason: "a path needs at least two".to_string(),
-        });
-    }
-    for (k, w) in samples.windows(2).enumerate() {
-        if w[1].s.partial_cmp(&w[0].s) != Some(std::cmp::Ordering::Greater) {
-            return Err(ToolpathError::InvalidParameter {
-                name: format!("arc length of sample {}", k + 1),
-                value: w[1].s,
-                reason: format!("must exceed the previous one ({})", w[0].s),
-            });
-        }
-    }
+    check_samples(samples)?;
     let limit: Vec<f64> = samples
         .iter()
         .map(|p| {
@@ -119,7 +104,53 @@ pub fn bang_bang(
             })
         })
         .collect::<Result<_, _>>()?;
-    let a = limits.tangential_acceleration;
+    bang_bang_on(samples, limit, limits.tangential_acceleration)
+}
+
+/// The bang-bang bound under a given velocity-limit curve (one speed per
+/// sample, e.g. [`crate::CurvatureLimits::speed`] of each sample's
+/// curvature: seed 003 eq. 22) and the tangential acceleration A_t.
+///
+/// # Errors
+/// [`ToolpathError::InvalidParameter`] for A_t not finite and > 0, a limit
+/// that is not finite and > 0, another count of limits than samples, fewer
+/// than two samples or an arc length that does not increase.
+pub fn bang_bang_under(
+    samples: &[PathSample],
+    limit: Vec<f64>,
+    tangential_acceleration: f64,
+) -> Result<BangBang, ToolpathError> {
+    check_samples(samples)?;
+    if !(tangential_acceleration.is_finite() && tangential_acceleration > 0.0) {
+        return Err(ToolpathError::InvalidParameter {
+            name: "tangential acceleration [m/s^2]".to_string(),
+            value: tangential_acceleration,
+            reason: "must be finite and > 0".to_string(),
+        });
+    }
+    if limit.len() != samples.len() {
+        return Err(ToolpathError::InvalidParameter {
+            name: "velocity limits".to_string(),
+            value: limit.len() as f64,
+            reason: format!("one per sample ({})", samples.len()),
+        });
+    }
+    if let Some(v) = limit.iter().find(|v| !(v.is_finite() && **v > 0.0)) {
+        return Err(ToolpathError::InvalidParameter {
+            name: "velocity limit [m/s]".to_string(),
+            value: *v,
+            reason: "must be finite and > 0".to_string(),
+        });
+    }
+    bang_bang_on(samples, limit, tangential_acceleration)
+}
+
+/// The passes of the module documentation on checked input.
+fn bang_bang_on(
+    samples: &[PathSample],
+    limit: Vec<f64>,
+    a: f64,
+) -> Result<BangBang, ToolpathError> {
     let n = samples.len();
     let mut speed = limit.clone();
     speed[0] = 0.0;
@@ -138,4 +169,25 @@ pub fn bang_bang(
         .map(|(p, v)| 2.0 * (p[1].s - p[0].s) / (v[0] + v[1]))
         .sum();
     Ok(BangBang { time, speed, limit })
+}
+
+/// At least two samples with increasing arc length.
+fn check_samples(samples: &[PathSample]) -> Result<(), ToolpathError> {
+    if samples.len() < 2 {
+        return Err(ToolpathError::InvalidParameter {
+            name: "samples".to_string(),
+            value: samples.len() as f64,
+            reason: "a path needs at least two".to_string(),
+        });
+    }
+    for (k, w) in samples.windows(2).enumerate() {
+        if w[1].s.partial_cmp(&w[0].s) != Some(std::cmp::Ordering::Greater) {
+            return Err(ToolpathError::InvalidParameter {
+                name: format!("arc length of sample {}", k + 1),
+                value: w[1].s,
+                reason: format!("must exceed the previous one ({})", w[0].s),
+            });
+        }
+    }
+    Ok(())
 }
