@@ -18,17 +18,15 @@ use crate::plan::{Plan, SegmentInput, SegmentPlan};
 use crate::provenance::{IndicatorProvenance, IndicatorSource};
 use crate::reward::{step_reward, RewardWeights};
 
-/// The evaluation of [`Plan::evaluate_with_threads`] and, with a cache,
-/// [`Plan::evaluate_cached`].
-pub(crate) fn evaluate_impl(
+/// The checks every evaluation starts with: at least one thread, valid
+/// weights, one state per segment. Returns the segment count.
+fn check_inputs(
     cell: &MillCell,
     weights: &RewardWeights,
     states: &[PhysicalState],
     planner: &str,
     threads: usize,
-    cache: Option<&IndicatorCache>,
-    budget: &Budget,
-) -> Result<(Plan, IndicatorProvenance), MillPlanError> {
+) -> Result<usize, MillPlanError> {
     if threads == 0 {
         return Err(MillPlanError::InvalidParameter {
             name: "evaluation threads".to_string(),
@@ -44,6 +42,21 @@ pub(crate) fn evaluate_impl(
             reason: format!("{} states for {n} segments", states.len()),
         });
     }
+    Ok(n)
+}
+
+/// The evaluation of [`Plan::evaluate_with_threads`] and, with a cache,
+/// [`Plan::evaluate_cached`].
+pub(crate) fn evaluate_impl(
+    cell: &MillCell,
+    weights: &RewardWeights,
+    states: &[PhysicalState],
+    planner: &str,
+    threads: usize,
+    cache: Option<&IndicatorCache>,
+    budget: &Budget,
+) -> Result<(Plan, IndicatorProvenance), MillPlanError> {
+    check_inputs(cell, weights, states, planner, threads)?;
     let (cell_states, first_error) = cell_states_in_order(cell, states, planner, budget)?;
     // Step 2: cached values where the cache applies, the rest directly.
     let k = cell_states.len();
@@ -111,21 +124,7 @@ pub(crate) fn evaluate_direct_alongside<T: Send>(
     alongside: impl FnOnce(&[SegmentInput]) -> T + Send,
 ) -> Result<(Plan, IndicatorProvenance, Option<T>, f64), MillPlanError> {
     let start = std::time::Instant::now();
-    if threads == 0 {
-        return Err(MillPlanError::InvalidParameter {
-            name: "evaluation threads".to_string(),
-            value: 0.0,
-            reason: "must be >= 1".to_string(),
-        });
-    }
-    weights.validate()?;
-    let n = cell.path().segments().len();
-    if states.len() != n {
-        return Err(MillPlanError::InvalidConfig {
-            name: format!("plan `{planner}`"),
-            reason: format!("{} states for {n} segments", states.len()),
-        });
-    }
+    let n = check_inputs(cell, weights, states, planner, threads)?;
     let (cell_states, first_error) = cell_states_in_order(cell, states, planner, budget)?;
     let k = cell_states.len();
     let cached = vec![None; k];
