@@ -7,8 +7,10 @@
 pub mod bezier;
 pub mod corner;
 pub mod error;
+pub mod feed;
 pub mod lower_bound;
 pub mod samples;
+pub mod scurve;
 pub mod smooth;
 pub mod speed_limit;
 pub mod vec3;
@@ -16,6 +18,7 @@ pub mod vec3;
 pub use bezier::QuinticBezier;
 pub use corner::{corner_transition, Binding, CornerShape, CornerTransition};
 pub use error::ToolpathError;
+pub use feed::{plan_feed, FeedLimits, FeedPlan, FeedSample};
 pub use lower_bound::{bang_bang, bang_bang_under, BangBang, BangBangLimits};
 pub use samples::{sample_path, PathSample};
 pub use smooth::{smooth_polyline, Piece, SmoothedPath};
