@@ -17,12 +17,15 @@
 //!   servo, ρ (1 − |G(j v/ρ)|), at every interpolated point (its own
 //!   speed and the path's radius there): an estimate, not a simulation.
 //!
-//! Positions between path samples are interpolated linearly in arc length;
-//! with samples 10 µm apart that adds at most the sagitta of a 10 µm chord
-//! (12.5 nm at a 1 mm radius).
+//! Positions are on the path's geometry at the plan's arc length
+//! ([`crate::samples::point_at`]), not interpolated between samples: a
+//! linear interpolation put kinks every sample into the third differences
+//! (j_rms several times its true value when the period's step is shorter
+//! than the sample spacing).
 
 use crate::feed::FeedPlan;
-use crate::samples::PathSample;
+use crate::samples::{point_at, PathSample};
+use crate::smooth::SmoothedPath;
 use crate::speed_limit::Servo;
 use crate::vec3::{add, cross, dot, norm, scale, sub};
 
@@ -47,30 +50,17 @@ pub struct Metrics {
     pub points: usize,
 }
 
-/// The position at arc length `s` (linear between samples).
-pub fn position_at(samples: &[PathSample], s: f64) -> [f64; 3] {
-    let k = samples.partition_point(|p| p.s < s);
-    if k == 0 {
-        return samples[0].point;
-    }
-    if k >= samples.len() {
-        return samples[samples.len() - 1].point;
-    }
-    let (a, b) = (&samples[k - 1], &samples[k]);
-    let u = (s - a.s) / (b.s - a.s);
-    add(a.point, scale(sub(b.point, a.point), u))
-}
-
 /// The metrics of `plan` along `samples` at `period` (module
-/// documentation).
+/// documentation), `samples` being [`crate::sample_path`] of `path`.
 pub fn metrics(
     plan: &FeedPlan,
+    path: &SmoothedPath,
     samples: &[PathSample],
     period: f64,
     servo: Option<&Servo>,
 ) -> Metrics {
     let timed = plan.sample(period);
-    let points: Vec<[f64; 3]> = timed.iter().map(|p| position_at(samples, p.s)).collect();
+    let points: Vec<[f64; 3]> = timed.iter().map(|p| point_at(path, samples, p.s)).collect();
     let n = points.len();
     let max_curvature = samples.iter().map(|p| p.curvature).fold(0.0, f64::max);
     let mut max_turning_angle: f64 = 0.0;

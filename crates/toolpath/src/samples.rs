@@ -15,6 +15,11 @@ pub struct PathSample {
     pub tangent: [f64; 3],
     /// Curvature \[1/m\].
     pub curvature: f64,
+    /// Index of its piece in [`SmoothedPath::pieces`].
+    pub piece: usize,
+    /// Its parameter in the piece (a line's fraction of its length, a
+    /// corner's Bézier parameter).
+    pub u: f64,
 }
 
 /// Samples a smoothed path: lines at both ends and every `max_step` or
@@ -27,7 +32,7 @@ pub struct PathSample {
 pub fn sample_path(path: &SmoothedPath, max_step: f64) -> Vec<PathSample> {
     let mut out: Vec<PathSample> = Vec::new();
     let mut s0 = 0.0;
-    for piece in &path.pieces {
+    for (index, piece) in path.pieces.iter().enumerate() {
         let (length, steps) = match piece {
             Piece::Line { start, end } => {
                 let l = norm(sub(*end, *start));
@@ -52,6 +57,8 @@ pub fn sample_path(path: &SmoothedPath, max_step: f64) -> Vec<PathSample> {
                         point: std::array::from_fn(|i| start[i] + u * d[i]),
                         tangent: scale(d, 1.0 / length),
                         curvature: 0.0,
+                        piece: index,
+                        u,
                     }
                 }
                 Piece::Corner(c) => {
@@ -64,6 +71,8 @@ pub fn sample_path(path: &SmoothedPath, max_step: f64) -> Vec<PathSample> {
                         point: c.curve.point(u),
                         tangent: scale(d1, 1.0 / norm(d1)),
                         curvature: c.curve.curvature(u),
+                        piece: index,
+                        u,
                     }
                 }
             };
@@ -77,4 +86,41 @@ pub fn sample_path(path: &SmoothedPath, max_step: f64) -> Vec<PathSample> {
         }
     }
     out
+}
+
+/// The point of `path` at arc length `s`, exactly on its geometry: on a
+/// line by proportion, on a corner by Newton's method on the arc length
+/// from the sample before it (3 steps from the linear guess, each with
+/// [`crate::QuinticBezier::length_between`]), clamped to the path's ends.
+///
+/// # Arguments
+/// * `samples` — [`sample_path`] of `path`.
+pub fn point_at(path: &SmoothedPath, samples: &[PathSample], s: f64) -> [f64; 3] {
+    let k = samples.partition_point(|p| p.s < s);
+    if k == 0 {
+        return samples[0].point;
+    }
+    if k >= samples.len() {
+        return samples[samples.len() - 1].point;
+    }
+    let (a, b) = (&samples[k - 1], &samples[k]);
+    let ua = if a.piece == b.piece { a.u } else { 0.0 };
+    let guess = ua + (s - a.s) / (b.s - a.s) * (b.u - ua);
+    match path.pieces.get(b.piece) {
+        Some(Piece::Line { start, end }) => {
+            std::array::from_fn(|d| start[d] + guess * (end[d] - start[d]))
+        }
+        Some(Piece::Corner(c)) => {
+            let mut u = guess;
+            for _ in 0..3 {
+                let f = c.curve.length_between(ua, u) - (s - a.s);
+                let speed = norm(c.curve.d1(u));
+                if speed > 0.0 {
+                    u = (u - f / speed).clamp(ua, b.u);
+                }
+            }
+            c.curve.point(u)
+        }
+        None => b.point,
+    }
 }

@@ -6,6 +6,12 @@ use crate::corner::{corner_transition, CornerTransition};
 use crate::error::ToolpathError;
 use crate::vec3::{distance_to_segment, norm, sub};
 
+/// Gaps between two pieces up to this are rounding, not a line \[m\]: two
+/// corners that use all of the segment between them meet where the rounding
+/// of their end points leaves a line of 1e-17 m, which would give the path a
+/// step of zero length.
+pub const JOIN_GAP: f64 = 1e-12;
+
 /// One piece of a smoothed path.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum Piece {
@@ -170,7 +176,7 @@ pub fn smooth_polyline(
             None => {}
             Some(c) => {
                 let start = c.curve.control[0];
-                if norm(sub(start, cursor)) > 0.0 {
+                if norm(sub(start, cursor)) > JOIN_GAP {
                     pieces.push(Piece::Line {
                         start: cursor,
                         end: start,
@@ -182,7 +188,7 @@ pub fn smooth_polyline(
         }
     }
     let last = polyline[n - 1];
-    if norm(sub(last, cursor)) > 0.0 {
+    if norm(sub(last, cursor)) > JOIN_GAP {
         pieces.push(Piece::Line {
             start: cursor,
             end: last,

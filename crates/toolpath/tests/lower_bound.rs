@@ -92,3 +92,39 @@ fn bad_limits_and_samples_are_refused() {
     let e = bang_bang(&reversed, &limits(0.1, 1.0, 1.0)).unwrap_err();
     assert!(e.to_string().contains("arc length"), "{e}");
 }
+
+/// `point_at` puts a point on the geometry at its arc length: at the samples it is the sample,
+/// between samples of a corner its arc length from the sample before is the requested one.
+#[test]
+fn points_at_arc_lengths_are_on_the_geometry() {
+    let poly = [[0.0, 0.0, 0.0], [0.02, 0.0, 0.0], [0.03, 0.01, 0.0]];
+    let path = smooth_polyline(&poly, 1e-4).unwrap();
+    let samples = sample_path(&path, 2e-4);
+    let mut checked = 0;
+    for w in samples.windows(2) {
+        let at = kerf_toolpath::point_at(&path, &samples, w[1].s);
+        let off = kerf_toolpath::vec3::norm(kerf_toolpath::vec3::sub(at, w[1].point));
+        assert!(off < 1e-12, "{off}");
+        if w[0].piece == w[1].piece {
+            if let Piece::Corner(c) = &path.pieces[w[1].piece] {
+                let s = 0.5 * (w[0].s + w[1].s);
+                let p = kerf_toolpath::point_at(&path, &samples, s);
+                // Find its parameter by bisection on the distance along the chord direction.
+                let (mut lo, mut hi) = (w[0].u, w[1].u);
+                for _ in 0..200 {
+                    let mid = 0.5 * (lo + hi);
+                    if c.curve.length_between(w[0].u, mid) < s - w[0].s {
+                        lo = mid;
+                    } else {
+                        hi = mid;
+                    }
+                }
+                let exact = c.curve.point(0.5 * (lo + hi));
+                let err = kerf_toolpath::vec3::norm(kerf_toolpath::vec3::sub(p, exact));
+                assert!(err < 1e-12, "{err}");
+                checked += 1;
+            }
+        }
+    }
+    assert!(checked > 3);
+}

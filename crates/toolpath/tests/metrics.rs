@@ -21,7 +21,7 @@ fn a_straight_line() {
     let samples = sample_path(&path, 1e-4);
     let l = limits();
     let plan = plan_feed(&samples, &l).unwrap();
-    let m = metrics(&plan, &samples, 0.002, l.curvature.servo.as_ref());
+    let m = metrics(&plan, &path, &samples, 0.002, l.curvature.servo.as_ref());
     assert_eq!(m.time, plan.time);
     assert_eq!(m.max_curvature, 0.0);
     assert!(m.max_turning_angle < 1e-6, "{}", m.max_turning_angle);
@@ -53,6 +53,7 @@ fn a_smoothed_zig_zag_keeps_the_chord_and_contour_limits() {
     let plan = plan_feed(&samples, &l).unwrap();
     let m = metrics(
         &plan,
+        &path,
         &samples,
         l.curvature.interpolation_period,
         l.curvature.servo.as_ref(),

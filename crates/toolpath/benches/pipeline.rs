@@ -1,0 +1,116 @@
+//! The G-code front end's deterministic pipeline on the shipped outlines (issue 14, items 2–4, first
+//! figures: kerf's corner transition and the jerk-limited feed plan; the baselines come later):
+//! read the point list (`kerf_gcode::read_points`), smooth every corner within δ
+//! (`smooth_polyline`), sample by arc length, plan the feed (`plan_feed`), T_lb
+//! (`bang_bang_under`) and the metrics at the interpolation period (`metrics`). Two limit sets:
+//!
+//! * seed 000's (its appendix C, units not stated; read as mm and s: v 10 mm/s, a 100 mm/s²,
+//!   j 10 000 mm/s³, δ 0.5 mm, T 0.5 ms; normal acceleration and jerk taken equal to the
+//!   tangential ones, the chord error of the period not limited beyond δ);
+//! * seed 003's Table 1 (`CurvatureLimits::seed_003_table_1`, A_t 800 mm/s², J_t 20 000 mm/s³,
+//!   δ 0.1 mm).
+//!
+//! Timing: the whole pipeline from the text in memory to the plan and T_lb, best of 20 runs, on
+//! one thread.
+//!
+//! ```sh
+//! cargo bench -p kerf_toolpath --bench pipeline
+//! ```
+#![allow(clippy::unwrap_used, clippy::expect_used)] // a bench binary reports failures by panicking
+
+use std::time::Instant;
+
+use kerf_gcode::{read_points, PointUnit};
+use kerf_toolpath::{
+    bang_bang_under, metrics, plan_feed, sample_path, smooth_polyline, CurvatureLimits, FeedLimits,
+};
+
+/// Arc length between samples for planning \[m\].
+const STEP: f64 = 1e-5;
+
+fn main() {
+    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("data/outlines");
+    let mut names: Vec<_> = std::fs::read_dir(&dir)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|e| e == "txt"))
+        .collect();
+    names.sort();
+    let seed000 = (
+        "seed 000",
+        5e-4,
+        FeedLimits {
+            curvature: CurvatureLimits {
+                feed: 0.010,
+                interpolation_period: 5e-4,
+                chord_error: 5e-4,
+                normal_acceleration: 0.1,
+                normal_jerk: 10.0,
+                servo: None,
+            },
+            tangential_acceleration: 0.1,
+            tangential_jerk: 10.0,
+        },
+    );
+    let seed003 = (
+        "seed 003",
+        1e-4,
+        FeedLimits {
+            curvature: CurvatureLimits::seed_003_table_1(),
+            tangential_acceleration: 0.8,
+            tangential_jerk: 20.0,
+        },
+    );
+    println!(
+        "| outline | limits | corners | T_m (s) | T_lb (s) | T_m/T_lb | κ_max (1/mm) | θ_max (°) | a_rms (mm/s²) | j_rms (mm/s³) | max chord error (µm) | max deviation (mm) | pipeline (ms) |"
+    );
+    println!("|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|");
+    for path in &names {
+        let text = std::fs::read_to_string(path).unwrap();
+        let name = path.file_stem().unwrap().to_string_lossy().to_string();
+        for (limits_name, delta, limits) in [&seed000, &seed003] {
+            let run = || {
+                let points = read_points(text.as_bytes(), PointUnit::Millimetre).unwrap();
+                let smoothed = smooth_polyline(&points, *delta).unwrap();
+                let samples = sample_path(&smoothed, STEP);
+                let plan = plan_feed(&samples, limits).unwrap();
+                let curve: Vec<f64> = samples
+                    .iter()
+                    .map(|p| limits.curvature.speed(p.curvature))
+                    .collect();
+                let lb = bang_bang_under(&samples, curve, limits.tangential_acceleration).unwrap();
+                (smoothed, samples, plan, lb)
+            };
+            let mut best = f64::INFINITY;
+            let mut result = None;
+            for _ in 0..20 {
+                let start = Instant::now();
+                let r = run();
+                best = best.min(start.elapsed().as_secs_f64());
+                result = Some(r);
+            }
+            let (smoothed, samples, plan, lb) = result.unwrap();
+            let m = metrics(
+                &plan,
+                &smoothed,
+                &samples,
+                limits.curvature.interpolation_period,
+                limits.curvature.servo.as_ref(),
+            );
+            println!(
+                "| {name} | {limits_name} | {} | {:.3} | {:.3} | {:.3} | {:.3} | {:.2} | {:.1} | {:.0} | {:.3} | {:.4} | {:.1} |",
+                smoothed.corners().count(),
+                m.time,
+                lb.time,
+                m.time / lb.time,
+                m.max_curvature * 1e-3,
+                m.max_turning_angle.to_degrees(),
+                m.rms_acceleration * 1e3,
+                m.rms_jerk * 1e3,
+                m.max_chord_error * 1e6,
+                smoothed.max_deviation() * 1e3,
+                best * 1e3
+            );
+        }
+    }
+}
