@@ -9,14 +9,14 @@
 //! and Gibson, "Time-optimal control of robotic manipulators along specified
 //! paths", IJRR 4(3), 1985, section 4): a forward pass
 //! v_{i+1} = min(v_lim,i+1, √(v_i² + 2 A_t Δs)) from rest and a backward pass
-//! v_i = min(v_i, √(v_{i+1}² + 2 A_t Δs)) to rest. Between samples v² is
-//! linear in s (constant tangential acceleration), so an interval takes
-//! exactly 2 Δs / (v_i + v_{i+1}).
-//!
-//! On a grid the bound converges as the spacing falls (where the speed
-//! reaches F inside an interval, that interval is timed as if it accelerated
-//! all along it: slower by at most O(Δs / F)); `tests/lower_bound.rs`
-//! measures it against the exact trapezoid of a straight line.
+//! v_i = min(v_i, √(v_{i+1}² + 2 A_t Δs)) to rest. Within an interval the
+//! fastest motion between the two speeds accelerates at A_t up to the
+//! interval's cap (the larger limit of its two samples), cruises there and
+//! decelerates at A_t: its time is exact, so a straight line (limit F all
+//! along) is timed exactly from its two end samples alone (the trapezoid or
+//! the triangle), and [`crate::sample_path`] samples lines at their ends
+//! only. Within a curved interval the limit between the samples is taken as
+//! the larger of the two: the bound converges as the samples get closer.
 
 use crate::error::ToolpathError;
 use crate::samples::PathSample;
@@ -166,7 +166,8 @@ fn bang_bang_on(
     let time = samples
         .windows(2)
         .zip(speed.windows(2))
-        .map(|(p, v)| 2.0 * (p[1].s - p[0].s) / (v[0] + v[1]))
+        .zip(limit.windows(2))
+        .map(|((p, v), l)| interval_time(p[1].s - p[0].s, v[0], v[1], l[0].max(l[1]), a))
         .sum();
     Ok(BangBang { time, speed, limit })
 }
@@ -190,4 +191,19 @@ fn check_samples(samples: &[PathSample]) -> Result<(), ToolpathError> {
         }
     }
     Ok(())
+}
+
+/// The least time over `ds` from speed `v0` to `v1` with |acceleration| ≤
+/// `a` and speed ≤ `cap` (the ends reachable from each other: |v1² − v0²| ≤
+/// 2 a ds): accelerate at a, cruise at the cap if it is reached, decelerate
+/// at a. The peak without a cap is √((v0² + v1²)/2 + a ds).
+fn interval_time(ds: f64, v0: f64, v1: f64, cap: f64, a: f64) -> f64 {
+    let peak = (0.5 * (v0 * v0 + v1 * v1) + a * ds).sqrt();
+    if peak <= cap {
+        (2.0 * peak - v0 - v1) / a
+    } else {
+        let accelerate = (cap * cap - v0 * v0) / (2.0 * a);
+        let decelerate = (cap * cap - v1 * v1) / (2.0 * a);
+        (2.0 * cap - v0 - v1) / a + (ds - accelerate - decelerate).max(0.0) / cap
+    }
 }

@@ -22,22 +22,21 @@ pub struct PathSample {
     pub u: f64,
 }
 
-/// Samples a smoothed path: lines at both ends and every `max_step` or
-/// less, corners at equal parameter steps fine enough that no step is
-/// longer than `max_step` (arc length by [`crate::QuinticBezier::length_between`]).
+/// Samples a smoothed path: lines at their two ends, corners at equal
+/// parameter steps fine enough that no step is longer than `max_step` (arc length by [`crate::QuinticBezier::length_between`]).
 /// Consecutive pieces share their joining sample (kept once).
 ///
 /// # Arguments
-/// * `max_step` — largest arc length between samples \[m\], > 0.
+/// * `max_step` — largest arc length between samples of a corner \[m\],
+///   > 0.
 pub fn sample_path(path: &SmoothedPath, max_step: f64) -> Vec<PathSample> {
     let mut out: Vec<PathSample> = Vec::new();
     let mut s0 = 0.0;
     for (index, piece) in path.pieces.iter().enumerate() {
         let (length, steps) = match piece {
-            Piece::Line { start, end } => {
-                let l = norm(sub(*end, *start));
-                (l, (l / max_step).ceil().max(1.0) as usize)
-            }
+            // A line at its two ends: its curvature is 0, positions on it are exact
+            // by proportion, and T_lb times a whole line exactly.
+            Piece::Line { start, end } => (norm(sub(*end, *start)), 1),
             Piece::Corner(c) => {
                 let l = c.curve.length(8);
                 (l, (l / max_step).ceil().max(1.0) as usize)
