@@ -46,7 +46,7 @@
 //! makes the corner flatter.
 
 use crate::bezier::QuinticBezier;
-use crate::error::ToolpathError;
+use crate::error::{check_positive, ToolpathError};
 use crate::vec3::{add, dot, norm, scale, sub};
 
 /// Turning angles below this are straight \[rad\]: no transition.
@@ -194,18 +194,10 @@ pub fn corner_transition(
     tolerance: f64,
     available: f64,
 ) -> Result<Option<CornerTransition>, ToolpathError> {
-    for (name, v) in [
+    check_positive(&[
         ("tolerance [m]", tolerance),
         ("available length [m]", available),
-    ] {
-        if !(v.is_finite() && v > 0.0) {
-            return Err(ToolpathError::InvalidParameter {
-                name: name.to_string(),
-                value: v,
-                reason: "must be finite and > 0".to_string(),
-            });
-        }
-    }
+    ])?;
     let (t1, l1) = direction(prev, vertex);
     let (t2, l2) = direction(vertex, next);
     if !(l1 > 0.0 && l2 > 0.0 && l1.is_finite() && l2.is_finite()) {

@@ -25,3 +25,18 @@ pub enum ToolpathError {
         reason: String,
     },
 }
+
+/// Checks that each named value is finite and > 0.
+///
+/// # Errors
+/// [`ToolpathError::InvalidParameter`] naming the first that is not.
+pub(crate) fn check_positive(values: &[(&str, f64)]) -> Result<(), ToolpathError> {
+    match values.iter().find(|(_, v)| !(v.is_finite() && *v > 0.0)) {
+        Some((name, v)) => Err(ToolpathError::InvalidParameter {
+            name: (*name).to_string(),
+            value: *v,
+            reason: "must be finite and > 0".to_string(),
+        }),
+        None => Ok(()),
+    }
+}

@@ -19,8 +19,8 @@
 //! evaluates it at the interpolation period, where its limits are checked
 //! (`tests/feed.rs`).
 
-use crate::error::ToolpathError;
-use crate::samples::PathSample;
+use crate::error::{check_positive, ToolpathError};
+use crate::samples::{check_samples, PathSample};
 use crate::scurve::{reachable, scurve_distance, scurve_phases, Phase};
 use crate::speed_limit::CurvatureLimits;
 
@@ -42,22 +42,13 @@ impl FeedLimits {
     /// [`ToolpathError::InvalidParameter`] naming the limit.
     pub fn validate(&self) -> Result<(), ToolpathError> {
         self.curvature.validate()?;
-        for (name, v) in [
+        check_positive(&[
             (
                 "tangential acceleration [m/s^2]",
                 self.tangential_acceleration,
             ),
             ("tangential jerk [m/s^3]", self.tangential_jerk),
-        ] {
-            if !(v.is_finite() && v > 0.0) {
-                return Err(ToolpathError::InvalidParameter {
-                    name: name.to_string(),
-                    value: v,
-                    reason: "must be finite and > 0".to_string(),
-                });
-            }
-        }
-        Ok(())
+        ])
     }
 }
 
@@ -152,24 +143,7 @@ impl FeedPlan {
 /// samples, or an arc length that does not increase.
 pub fn plan_feed(samples: &[PathSample], limits: &FeedLimits) -> Result<FeedPlan, ToolpathError> {
     limits.validate()?;
-    if samples.len() < 2 {
-        return Err(ToolpathError::InvalidParameter {
-            name: "samples".to_string(),
-            value: samples.len() as f64,
-            reason: "a path needs at least two".to_string(),
-        });
-    }
-    if let Some((k, w)) = samples
-        .windows(2)
-        .enumerate()
-        .find(|(_, w)| w[1].s.partial_cmp(&w[0].s) != Some(std::cmp::Ordering::Greater))
-    {
-        return Err(ToolpathError::InvalidParameter {
-            name: format!("arc length of sample {}", k + 1),
-            value: w[1].s,
-            reason: "must increase".to_string(),
-        });
-    }
+    check_samples(samples)?;
     let f = limits.curvature.feed;
     let (a, j) = (limits.tangential_acceleration, limits.tangential_jerk);
     // Step 1: sensitive intervals [s_start, s_end] at their lowest limit.

@@ -18,8 +18,8 @@
 //! only. Within a curved interval the limit between the samples is taken as
 //! the larger of the two: the bound converges as the samples get closer.
 
-use crate::error::ToolpathError;
-use crate::samples::PathSample;
+use crate::error::{check_positive, ToolpathError};
+use crate::samples::{check_samples, PathSample};
 
 /// The limits of the bang-bang bound.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -38,23 +38,14 @@ impl BangBangLimits {
     /// # Errors
     /// [`ToolpathError::InvalidParameter`] naming the limit.
     pub fn validate(&self) -> Result<(), ToolpathError> {
-        for (name, v) in [
+        check_positive(&[
             ("feed [m/s]", self.feed),
             (
                 "tangential acceleration [m/s^2]",
                 self.tangential_acceleration,
             ),
             ("normal acceleration [m/s^2]", self.normal_acceleration),
-        ] {
-            if !(v.is_finite() && v > 0.0) {
-                return Err(ToolpathError::InvalidParameter {
-                    name: name.to_string(),
-                    value: v,
-                    reason: "must be finite and > 0".to_string(),
-                });
-            }
-        }
-        Ok(())
+        ])
     }
 }
 
@@ -121,13 +112,7 @@ pub fn bang_bang_under(
     tangential_acceleration: f64,
 ) -> Result<BangBang, ToolpathError> {
     check_samples(samples)?;
-    if !(tangential_acceleration.is_finite() && tangential_acceleration > 0.0) {
-        return Err(ToolpathError::InvalidParameter {
-            name: "tangential acceleration [m/s^2]".to_string(),
-            value: tangential_acceleration,
-            reason: "must be finite and > 0".to_string(),
-        });
-    }
+    check_positive(&[("tangential acceleration [m/s^2]", tangential_acceleration)])?;
     if limit.len() != samples.len() {
         return Err(ToolpathError::InvalidParameter {
             name: "velocity limits".to_string(),
@@ -170,27 +155,6 @@ fn bang_bang_on(
         .map(|((p, v), l)| interval_time(p[1].s - p[0].s, v[0], v[1], l[0].max(l[1]), a))
         .sum();
     Ok(BangBang { time, speed, limit })
-}
-
-/// At least two samples with increasing arc length.
-fn check_samples(samples: &[PathSample]) -> Result<(), ToolpathError> {
-    if samples.len() < 2 {
-        return Err(ToolpathError::InvalidParameter {
-            name: "samples".to_string(),
-            value: samples.len() as f64,
-            reason: "a path needs at least two".to_string(),
-        });
-    }
-    for (k, w) in samples.windows(2).enumerate() {
-        if w[1].s.partial_cmp(&w[0].s) != Some(std::cmp::Ordering::Greater) {
-            return Err(ToolpathError::InvalidParameter {
-                name: format!("arc length of sample {}", k + 1),
-                value: w[1].s,
-                reason: format!("must exceed the previous one ({})", w[0].s),
-            });
-        }
-    }
-    Ok(())
 }
 
 /// The least time over `ds` from speed `v0` to `v1` with |acceleration| ≤

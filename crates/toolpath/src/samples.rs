@@ -1,6 +1,7 @@
 //! A smoothed path sampled by arc length: positions, unit tangents and
 //! curvature at every sample, for feed planning ([`crate::lower_bound`]).
 
+use crate::error::ToolpathError;
 use crate::smooth::{Piece, SmoothedPath};
 use crate::vec3::{norm, scale, sub};
 
@@ -122,4 +123,25 @@ pub fn point_at(path: &SmoothedPath, samples: &[PathSample], s: f64) -> [f64; 3]
         }
         None => b.point,
     }
+}
+
+/// At least two samples with increasing arc length.
+pub(crate) fn check_samples(samples: &[PathSample]) -> Result<(), ToolpathError> {
+    if samples.len() < 2 {
+        return Err(ToolpathError::InvalidParameter {
+            name: "samples".to_string(),
+            value: samples.len() as f64,
+            reason: "a path needs at least two".to_string(),
+        });
+    }
+    for (k, w) in samples.windows(2).enumerate() {
+        if w[1].s.partial_cmp(&w[0].s) != Some(std::cmp::Ordering::Greater) {
+            return Err(ToolpathError::InvalidParameter {
+                name: format!("arc length of sample {}", k + 1),
+                value: w[1].s,
+                reason: format!("must exceed the previous one ({})", w[0].s),
+            });
+        }
+    }
+    Ok(())
 }

@@ -3,7 +3,7 @@
 //! of the polyline everywhere.
 
 use crate::corner::{corner_transition, CornerTransition};
-use crate::error::ToolpathError;
+use crate::error::{check_positive, ToolpathError};
 use crate::vec3::{distance_to_segment, norm, sub};
 
 /// Gaps between two pieces up to this are rounding, not a line \[m\]: two
@@ -118,13 +118,7 @@ pub fn smooth_polyline(
             reason: "a path needs at least two".to_string(),
         });
     }
-    if !(tolerance.is_finite() && tolerance > 0.0) {
-        return Err(ToolpathError::InvalidParameter {
-            name: "tolerance [m]".to_string(),
-            value: tolerance,
-            reason: "must be finite and > 0".to_string(),
-        });
-    }
+    check_positive(&[("tolerance [m]", tolerance)])?;
     for (index, p) in polyline.iter().enumerate() {
         if p.iter().any(|v| !v.is_finite()) {
             return Err(ToolpathError::BadPoint {

@@ -3,7 +3,7 @@
 //! interpolation period, the contour error of a second-order servo, and the
 //! normal acceleration and jerk, together with the programmed feed.
 
-use crate::error::ToolpathError;
+use crate::error::{check_positive, ToolpathError};
 
 /// A second-order position loop G(s) = ω_n² / (s² + 2ζω_n s + ω_n²) (seed
 /// 003 eq. 17's model: ω_n = √(K_p/J), ζ = B / (2√(J K_p))).
@@ -71,15 +71,7 @@ impl CurvatureLimits {
             checks.push(("servo damping ratio [-]", s.damping));
             checks.push(("contour error [m]", s.contour_error));
         }
-        for (name, v) in checks {
-            if !(v.is_finite() && v > 0.0) {
-                return Err(ToolpathError::InvalidParameter {
-                    name: name.to_string(),
-                    value: v,
-                    reason: "must be finite and > 0".to_string(),
-                });
-            }
-        }
+        check_positive(&checks)?;
         if let Some(s) = &self.servo {
             if s.damping < std::f64::consts::FRAC_1_SQRT_2 {
                 return Err(ToolpathError::InvalidParameter {

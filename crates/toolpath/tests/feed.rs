@@ -4,18 +4,11 @@
 //! and close corners lower their speeds so that the gaps between them can be run.
 #![allow(clippy::unwrap_used, clippy::expect_used)] // tests report failures by panicking
 
-use kerf_toolpath::{
-    bang_bang_under, plan_feed, sample_path, smooth_polyline, CurvatureLimits, FeedLimits,
-    PathSample,
-};
+#[allow(dead_code)] // each test file uses some of the shared data
+mod common;
+use common::{feed_limits, ZIG_ZAG};
 
-fn limits() -> FeedLimits {
-    FeedLimits {
-        curvature: CurvatureLimits::seed_003_table_1(),
-        tangential_acceleration: 0.8,
-        tangential_jerk: 20.0,
-    }
-}
+use kerf_toolpath::{bang_bang_under, plan_feed, sample_path, smooth_polyline, PathSample};
 
 /// The curvature at arc length `s` (the larger of the two samples around it).
 fn curvature_at(samples: &[PathSample], s: f64) -> f64 {
@@ -29,7 +22,7 @@ fn curvature_at(samples: &[PathSample], s: f64) -> f64 {
 fn a_straight_line_is_the_s_curve_trapezoid() {
     let path = smooth_polyline(&[[0.0; 3], [0.1, 0.0, 0.0]], 1e-4).unwrap();
     let samples = sample_path(&path, 1e-3);
-    let l = limits();
+    let l = feed_limits();
     let plan = plan_feed(&samples, &l).unwrap();
     let (f, a, j) = (0.070, 0.8, 20.0);
     // F ≥ A²/J: the acceleration reaches A; t_acc = F/A + A/J, d_acc = F/2 t_acc.
@@ -50,17 +43,10 @@ fn a_straight_line_is_the_s_curve_trapezoid() {
 
 #[test]
 fn every_limit_holds_at_the_interpolation_period_and_t_is_at_least_t_lb() {
-    let poly = [
-        [0.0, 0.0, 0.0],
-        [0.02, 0.0, 0.0],
-        [0.03, 0.01, 0.0],
-        [0.05, 0.01, 0.0],
-        [0.05, 0.03, 0.0],
-        [0.045, 0.031, 0.0],
-    ];
+    let poly = ZIG_ZAG;
     let path = smooth_polyline(&poly, 1e-4).unwrap();
     let samples = sample_path(&path, 1e-5);
-    let l = limits();
+    let l = feed_limits();
     let plan = plan_feed(&samples, &l).unwrap();
     let curve: Vec<f64> = samples
         .iter()
@@ -109,7 +95,7 @@ fn close_corners_lower_their_speeds_until_the_gap_can_be_run() {
     ];
     let path = smooth_polyline(&poly, 1e-4).unwrap();
     let samples = sample_path(&path, 1e-5);
-    let l = limits();
+    let l = feed_limits();
     let plan = plan_feed(&samples, &l).unwrap();
     assert!(!plan.intervals.is_empty());
     // Between every two intervals the S-curve from one speed to the next fits.
@@ -129,11 +115,11 @@ fn close_corners_lower_their_speeds_until_the_gap_can_be_run() {
 fn bad_limits_are_refused() {
     let path = smooth_polyline(&[[0.0; 3], [0.1, 0.0, 0.0]], 1e-4).unwrap();
     let samples = sample_path(&path, 1e-3);
-    let mut l = limits();
+    let mut l = feed_limits();
     l.tangential_jerk = 0.0;
     assert!(plan_feed(&samples, &l).is_err());
-    let mut l = limits();
+    let mut l = feed_limits();
     l.curvature.feed = f64::NAN;
     assert!(plan_feed(&samples, &l).is_err());
-    assert!(plan_feed(&samples[..1], &limits()).is_err());
+    assert!(plan_feed(&samples[..1], &feed_limits()).is_err());
 }

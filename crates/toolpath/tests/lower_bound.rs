@@ -2,6 +2,10 @@
 //! smoothed zig-zag, and the arc-length samples against the pieces' lengths.
 #![allow(clippy::unwrap_used, clippy::expect_used)] // tests report failures by panicking
 
+#[allow(dead_code)] // each test file uses some of the shared data
+mod common;
+use common::ZIG_ZAG;
+
 use kerf_toolpath::{bang_bang, sample_path, smooth_polyline, BangBangLimits, Piece};
 
 fn limits(feed: f64, at: f64, an: f64) -> BangBangLimits {
@@ -27,13 +31,7 @@ fn straight_lines_give_the_trapezoid_and_the_triangle() {
 
 #[test]
 fn a_smoothed_zig_zag_obeys_every_limit_and_slows_in_its_corners() {
-    let poly = [
-        [0.0, 0.0, 0.0],
-        [0.02, 0.0, 0.0],
-        [0.03, 0.01, 0.0],
-        [0.05, 0.01, 0.0],
-        [0.05, 0.03, 0.0],
-    ];
+    let poly = ZIG_ZAG;
     let path = smooth_polyline(&poly, 1e-4).unwrap();
     let samples = sample_path(&path, 2e-5);
     // The samples' arc length matches the pieces' lengths.

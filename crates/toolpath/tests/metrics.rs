@@ -3,23 +3,17 @@
 //! and its contour-error estimate within seed 003's limits (which the feed plan was built for).
 #![allow(clippy::unwrap_used, clippy::expect_used)] // tests report failures by panicking
 
-use kerf_toolpath::{
-    metrics, plan_feed, sample_path, smooth_polyline, CurvatureLimits, FeedLimits,
-};
+#[allow(dead_code)] // each test file uses some of the shared data
+mod common;
+use common::{feed_limits, ZIG_ZAG};
 
-fn limits() -> FeedLimits {
-    FeedLimits {
-        curvature: CurvatureLimits::seed_003_table_1(),
-        tangential_acceleration: 0.8,
-        tangential_jerk: 20.0,
-    }
-}
+use kerf_toolpath::{metrics, plan_feed, sample_path, smooth_polyline};
 
 #[test]
 fn a_straight_line() {
     let path = smooth_polyline(&[[0.0; 3], [0.1, 0.02, 0.0]], 1e-4).unwrap();
     let samples = sample_path(&path, 1e-4);
-    let l = limits();
+    let l = feed_limits();
     let plan = plan_feed(&samples, &l).unwrap();
     let m = metrics(&plan, &path, &samples, 0.002, l.curvature.servo.as_ref());
     assert_eq!(m.time, plan.time);
@@ -39,17 +33,11 @@ fn a_straight_line() {
 }
 
 #[test]
-fn a_smoothed_zig_zag_keeps_the_chord_and_contour_limits() {
-    let poly = [
-        [0.0, 0.0, 0.0],
-        [0.02, 0.0, 0.0],
-        [0.03, 0.01, 0.0],
-        [0.05, 0.01, 0.0],
-        [0.05, 0.03, 0.0],
-    ];
+fn a_smoothed_zig_zag_keeps_the_chord_and_contour_feed_limits() {
+    let poly = ZIG_ZAG;
     let path = smooth_polyline(&poly, 1e-4).unwrap();
     let samples = sample_path(&path, 1e-5);
-    let l = limits();
+    let l = feed_limits();
     let plan = plan_feed(&samples, &l).unwrap();
     let m = metrics(
         &plan,
