@@ -17,6 +17,16 @@ use crate::{Worker, WorkerError};
 /// How long the node loop sleeps when there is nothing to do.
 const POLL: Duration = Duration::from_millis(2);
 
+/// How long a stopping node keeps its writers after answering requests at
+/// shutdown. Why: ros2-client 0.12's `Publisher` offers no wait for
+/// acknowledgements, and dropping a reliable writer right after a write lost
+/// the answer about one time in four over loopback (`tests/deadline_e2e.rs`,
+/// `stopping_mid_plan_cancels_and_answers_it`). The linger covers the write
+/// itself and one repair: RustDDS's reliable writers announce their samples
+/// every second (`HEARTBEAT_PERIOD_SLOW`), and a reader asks for a lost one
+/// in reply.
+pub const SHUTDOWN_LINGER: Duration = Duration::from_millis(1500);
+
 /// Work for the planner thread. Failed requests travel through it too, so that every answer
 /// leaves in arrival order.
 pub enum Job<R, A> {
@@ -239,6 +249,7 @@ impl<S: PlanningService> PlannerNode<S> {
                 self.pending.len()
             ));
         }
+        let answered_at_shutdown = !self.pending.is_empty();
         while !self.pending.is_empty() {
             match self.worker.recv_timeout(Duration::from_secs(1)) {
                 Some(done) => self.answer(done),
@@ -246,6 +257,10 @@ impl<S: PlanningService> PlannerNode<S> {
                     .log
                     .warn("shutting down: the plan in progress has not reached a budget check yet"),
             }
+        }
+        if answered_at_shutdown {
+            // Let the reliable writers deliver (and repair) the answers just written.
+            std::thread::sleep(SHUTDOWN_LINGER);
         }
         self.log.info("shutting down");
     }
