@@ -39,7 +39,7 @@ mod text;
 
 pub use error::NodeError;
 pub use executable::{check_trajectory_msg, trajectory_msg, trajectory_request};
-pub use harness::{answer_text, run, work, Job, MAX_REQUEST_ID_BYTES};
+pub use harness::{answer_text, run, work, Job, MAX_REQUEST_ID_BYTES, SHUTDOWN_LINGER};
 pub use main::node_main;
 pub use service::{AnswerKey, Failure, PlanAnswer, PlanningService, Topics, TRAJECTORY_TOPIC};
 pub use size::{
