@@ -644,15 +644,16 @@ impl MillPlanner {
         // segment also at the feed the executed trajectory ran it at, then
         // with a lower limit.
         let mut round = ShieldRound::first(shield);
-        let mut last = out.executed.clone();
-        let mut last_states = out.plan.states();
+        // The round before, when it was not answered (else it is `out`).
+        let mut last: Option<MillPlanOutput> = None;
         for _ in 1..SHIELD_ROUNDS {
-            if last.plan.chatter_free
+            let previous = last.as_ref().unwrap_or(&out);
+            if previous.executed.plan.chatter_free
                 || !matches!(out.planner, PlannerKind::Ddpg | PlannerKind::FixedG)
             {
                 break;
             }
-            let Some(next) = round.next(&last) else {
+            let Some(next) = round.next(&previous.executed) else {
                 break;
             };
             round = next;
@@ -660,12 +661,13 @@ impl MillPlanner {
                 Ok(again) => {
                     // The same plan again: a lower limit will not change it
                     // (no safe move within a step is left to the shield).
-                    let states = again.plan.states();
-                    let same = states == last_states;
-                    last_states = states;
-                    last = again.executed.clone();
+                    let previous = last.as_ref().unwrap_or(&out);
+                    let same = again.plan.states() == previous.plan.states();
                     if shield_prefers(&again, &out) {
                         out = again;
+                        last = None;
+                    } else {
+                        last = Some(again);
                     }
                     if same {
                         break;
