@@ -109,23 +109,10 @@ fn main() {
     println!("|---|---:|---|---:|---|---|---:|---:|");
     for r in &rows {
         match &r.out {
-            Ok(o) => {
-                let e = &o.executed.plan;
-                let d = &o.executed.scaling.deviation;
-                println!(
-                    "| {} | {:.2} | {} | {:.4} | {:.3} / {:.3} | {:.3} / {:.3} | {:.3} | {:.1} |",
-                    r.name,
-                    e.total_time,
-                    if e.chatter_free { "yes" } else { "no" },
-                    e.max_spectral_radius,
-                    e.min_condition_indicator,
-                    o.executed.scaling.min_condition_indicator.0,
-                    d.max_off_path * 1e3,
-                    d.max_off_plane * 1e3,
-                    e.total_reward,
-                    r.seconds
-                );
-            }
+            Ok(o) => println!(
+                "{}",
+                row(&r.name, &o.executed, &format!("{:.1}", r.seconds))
+            ),
             Err(e) => println!("| {} | failed: {e} | | | | | | {:.1} |", r.name, r.seconds),
         }
     }
@@ -219,8 +206,6 @@ fn dp_with_accelerations(planner: &MillPlanner) {
         let seconds = start.elapsed().as_secs_f64();
         let plan = Plan::evaluate(cell, &weights, &r.states, name).unwrap();
         let out = kerf_millplan::execute(cell, &plan, &weights, default_eval_threads()).unwrap();
-        let e = &out.plan;
-        let d = &out.scaling.deviation;
         let g: Vec<f64> = plan.segments.iter().map(|s| s.g).collect();
         eprintln!(
             "{name}: DP {seconds:.1} s; planned {:.3} s (chatter-free {}, max |mu| {:.4}); \
@@ -232,17 +217,7 @@ fn dp_with_accelerations(planner: &MillPlanner) {
             g.iter().copied().fold(f64::NEG_INFINITY, f64::max),
             out.scaling.slowed_segments()
         );
-        println!(
-            "| {name} | {:.2} | {} | {:.4} | {:.3} / {:.3} | {:.3} / {:.3} | {:.3} | {seconds:.1} (DP) |",
-            e.total_time,
-            if e.chatter_free { "yes" } else { "no" },
-            e.max_spectral_radius,
-            e.min_condition_indicator,
-            out.scaling.min_condition_indicator.0,
-            d.max_off_path * 1e3,
-            d.max_off_plane * 1e3,
-            e.total_reward
-        );
+        println!("{}", row(name, &out, &format!("{seconds:.1} (DP)")));
     }
 }
 
@@ -294,21 +269,33 @@ fn dp_executed(planner: &MillPlanner) {
             );
         }
         let best = r.best().unwrap();
-        let e = &best.executed.plan;
-        let d = &best.executed.scaling.deviation;
-        println!(
-            "| {name} (round {} of {}; {:.2} s as planned) | {:.2} | {} | {:.4} | {:.3} / {:.3} | {:.3} / {:.3} | {:.3} | {seconds:.1} (all rounds) |",
+        let name = format!(
+            "{name} (round {} of {}; {:.2} s as planned)",
             r.best,
             r.rounds.len(),
-            best.plan.total_time,
-            e.total_time,
-            if e.chatter_free { "yes" } else { "no" },
-            e.max_spectral_radius,
-            e.min_condition_indicator,
-            best.executed.scaling.min_condition_indicator.0,
-            d.max_off_path * 1e3,
-            d.max_off_plane * 1e3,
-            e.total_reward
+            best.plan.total_time
+        );
+        println!(
+            "{}",
+            row(&name, &best.executed, &format!("{seconds:.1} (all rounds)"))
         );
     }
+}
+
+/// One row of the as-executed table: the plan the robot runs (`Executed`), its name and its
+/// planning time as text.
+fn row(name: &str, executed: &kerf_millplan::Executed, planning: &str) -> String {
+    let e = &executed.plan;
+    let d = &executed.scaling.deviation;
+    format!(
+        "| {name} | {:.2} | {} | {:.4} | {:.3} / {:.3} | {:.3} / {:.3} | {:.3} | {planning} |",
+        e.total_time,
+        if e.chatter_free { "yes" } else { "no" },
+        e.max_spectral_radius,
+        e.min_condition_indicator,
+        executed.scaling.min_condition_indicator.0,
+        d.max_off_path * 1e3,
+        d.max_off_plane * 1e3,
+        e.total_reward
+    )
 }
