@@ -3,6 +3,9 @@
 //! and its chatter constraint.
 #![allow(clippy::unwrap_used, clippy::expect_used)] // tests report failures by panicking
 
+mod support;
+use support::reduced_dp_spec;
+
 use kerf_mill::MillCell;
 use kerf_millplan::cache::{IndicatorCache, SplitMix64};
 use kerf_millplan::dp::{self, solve_grid, DpSpec};
@@ -131,20 +134,11 @@ fn cache_value_with(
     Some(total)
 }
 
-fn reduced_spec(cell: &MillCell) -> DpSpec {
-    DpSpec {
-        rpm_range: [2000.0, 2400.0],
-        feed_range: [0.03, 0.06],
-        g_range: [-1.0, 1.0],
-        ..DpSpec::full(cell, RewardWeights::default(), false)
-    }
-}
-
 #[test]
 fn cell_dp_beats_every_feasible_plan_it_is_compared_with() {
     let cell = MillCell::default_cell().unwrap();
     let cache = IndicatorCache::load(&IndicatorCache::default_path(), &cell).unwrap();
-    let spec = reduced_spec(&cell);
+    let spec = reduced_dp_spec(&cell);
     let r = dp::solve(&cell, &cache, &spec).unwrap();
     assert_eq!(r.dims, [21, 31, 11]);
     assert_eq!(r.states.len(), 100);
@@ -215,10 +209,10 @@ fn cell_dp_beats_every_feasible_plan_it_is_compared_with() {
 fn chatter_constrained_dp_is_chatter_free_per_the_cache() {
     let cell = MillCell::default_cell().unwrap();
     let cache = IndicatorCache::load(&IndicatorCache::default_path(), &cell).unwrap();
-    let free = dp::solve(&cell, &cache, &reduced_spec(&cell)).unwrap();
+    let free = dp::solve(&cell, &cache, &reduced_dp_spec(&cell)).unwrap();
     let spec = DpSpec {
         chatter_limit: Some((0.99, 1)),
-        ..reduced_spec(&cell)
+        ..reduced_dp_spec(&cell)
     };
     let r = dp::solve(&cell, &cache, &spec).unwrap();
     for s in r.states.iter().skip(1) {
@@ -233,7 +227,7 @@ fn chatter_constrained_dp_is_chatter_free_per_the_cache() {
         &cache,
         &DpSpec {
             g_range: [0.0, 0.0],
-            ..reduced_spec(&cell)
+            ..reduced_dp_spec(&cell)
         },
     )
     .unwrap();
@@ -251,7 +245,7 @@ fn dp_plan_replayed_in_the_unfiltered_environment_gives_its_value() {
     use kerf_millplan::env::{EnvConfig, MillEnv};
     let cell = MillCell::default_cell().unwrap();
     let cache = IndicatorCache::load(&IndicatorCache::default_path(), &cell).unwrap();
-    let r = dp::solve(&cell, &cache, &reduced_spec(&cell)).unwrap();
+    let r = dp::solve(&cell, &cache, &reduced_dp_spec(&cell)).unwrap();
     let actions: Vec<Vec<f32>> = r
         .states
         .windows(2)
@@ -300,7 +294,7 @@ fn dp_plans_respect_the_joint_speed_limits() {
     let cache = IndicatorCache::load(&IndicatorCache::default_path(), &cell).unwrap();
     let spec = DpSpec {
         g_range: [-1.2, 1.6],
-        ..reduced_spec(&cell)
+        ..reduced_dp_spec(&cell)
     };
     let r = dp::solve(&cell, &cache, &spec).unwrap();
     let plan = Plan::evaluate(&cell, &RewardWeights::default(), &r.states, "dp").unwrap();

@@ -4,11 +4,14 @@
 //! acceleration limits at the planned feeds (recomputed here).
 #![allow(clippy::unwrap_used, clippy::expect_used)] // tests report failures by panicking
 
+mod support;
+use support::reduced_dp_spec;
+
 use kerf_budget::Budget;
 use kerf_mill::MillCell;
 use kerf_millplan::dp::{self, solve_grid_with_history, solve_grid_with_moves, DpSpec};
 use kerf_millplan::joint_speed::{midpoint_interval, smallest_motion};
-use kerf_millplan::{IndicatorCache, RewardWeights};
+use kerf_millplan::IndicatorCache;
 
 /// A synthetic stage reward on a small grid: prefers k high, with a stage-dependent twist.
 fn reward(t: usize, x: [usize; 3]) -> Option<f64> {
@@ -69,11 +72,8 @@ fn acceleration_dp_moves_within_the_joint_acceleration_limits() {
     let cell = MillCell::default_cell().unwrap();
     let cache = IndicatorCache::load(&IndicatorCache::default_path(), &cell).unwrap();
     let spec = DpSpec {
-        rpm_range: [2000.0, 2400.0],
-        feed_range: [0.03, 0.06],
-        g_range: [-1.0, 1.0],
         joint_acceleration_limits: true,
-        ..DpSpec::full(&cell, RewardWeights::default(), false)
+        ..reduced_dp_spec(&cell)
     };
     let r = dp::solve(&cell, &cache, &spec).unwrap();
     let free = dp::solve(

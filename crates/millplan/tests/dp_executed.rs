@@ -4,27 +4,20 @@
 //! executed, and holding every move is the fixed-g DP.
 #![allow(clippy::unwrap_used, clippy::expect_used)] // tests report failures by panicking
 
+mod support;
+use support::reduced_dp_spec;
+
 use kerf_budget::Budget;
 use kerf_mill::MillCell;
 use kerf_millplan::cache::IndicatorCache;
 use kerf_millplan::dp::{self, DpSpec};
 use kerf_millplan::dp_executed::{solve_executed, DP_EXECUTED_ROUNDS};
-use kerf_millplan::reward::RewardWeights;
-
-fn spec(cell: &MillCell) -> DpSpec {
-    DpSpec {
-        rpm_range: [2000.0, 2400.0],
-        feed_range: [0.03, 0.06],
-        g_range: [-1.0, 1.0],
-        ..DpSpec::full(cell, RewardWeights::default(), false)
-    }
-}
 
 #[test]
 fn holding_every_move_is_the_fixed_g_dp() {
     let cell = MillCell::default_cell().unwrap();
     let cache = IndicatorCache::load(&IndicatorCache::default_path(), &cell).unwrap();
-    let spec = spec(&cell);
+    let spec = reduced_dp_spec(&cell);
     let n = cell.path().segments().len();
     let held =
         dp::solve_holding(&cell, &cache, &spec, &vec![true; n], &Budget::unlimited()).unwrap();
@@ -47,7 +40,14 @@ fn holding_every_move_is_the_fixed_g_dp() {
 fn rounds_obey_and_grow_their_holds_and_answer_the_best_as_executed() {
     let cell = MillCell::default_cell().unwrap();
     let cache = IndicatorCache::load(&IndicatorCache::default_path(), &cell).unwrap();
-    let r = solve_executed(&cell, &cache, &spec(&cell), 2, &Budget::unlimited()).unwrap();
+    let r = solve_executed(
+        &cell,
+        &cache,
+        &reduced_dp_spec(&cell),
+        2,
+        &Budget::unlimited(),
+    )
+    .unwrap();
     assert!(!r.rounds.is_empty() && r.rounds.len() <= DP_EXECUTED_ROUNDS);
     assert!(
         r.rounds[0].held.iter().all(|h| !h),

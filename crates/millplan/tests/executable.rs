@@ -6,14 +6,15 @@
 //! executor node would receive them.
 #![allow(clippy::unwrap_used, clippy::expect_used)] // tests report failures by panicking
 
+mod support;
+use support::reduced_dp_spec;
+
 use std::sync::OnceLock;
 
 use kerf_executor::{ExecutorConfig, JointLimits, JointSample};
 use kerf_mill::MillCell;
 use kerf_millplan::request::RequestLimits;
-use kerf_millplan::{
-    dp, execute, DpSpec, JointTrajectory, MillPlanner, MillRequest, Plan, RewardWeights,
-};
+use kerf_millplan::{dp, execute, JointTrajectory, MillPlanner, MillRequest, Plan, RewardWeights};
 
 fn planner() -> &'static MillPlanner {
     static P: OnceLock<MillPlanner> = OnceLock::new();
@@ -92,12 +93,7 @@ fn an_executed_dp_plan_passes_the_executors_validation() {
     let cell = MillCell::default_cell().expect("cell");
     let cache = planner().cache().expect("the default cell's cache");
     let weights = RewardWeights::default();
-    let spec = DpSpec {
-        rpm_range: [2000.0, 2400.0],
-        feed_range: [0.03, 0.06],
-        g_range: [-1.0, 1.0],
-        ..DpSpec::full(&cell, weights, false)
-    };
+    let spec = reduced_dp_spec(&cell);
     let r = dp::solve(&cell, cache, &spec).expect("dp");
     let plan = Plan::evaluate(&cell, &weights, &r.states, "dp").expect("plan");
     let executed = execute(&cell, &plan, &weights, 2).expect("executed");

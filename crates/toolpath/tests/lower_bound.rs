@@ -3,8 +3,8 @@
 #![allow(clippy::unwrap_used, clippy::expect_used)] // tests report failures by panicking
 
 #[allow(dead_code)] // each test file uses some of the shared data
-mod common;
-use common::ZIG_ZAG;
+mod support;
+use support::ZIG_ZAG;
 
 use kerf_toolpath::{bang_bang, sample_path, smooth_polyline, BangBangLimits, Piece};
 

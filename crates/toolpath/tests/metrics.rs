@@ -4,8 +4,8 @@
 #![allow(clippy::unwrap_used, clippy::expect_used)] // tests report failures by panicking
 
 #[allow(dead_code)] // each test file uses some of the shared data
-mod common;
-use common::{feed_limits, ZIG_ZAG};
+mod support;
+use support::{feed_limits, ZIG_ZAG};
 
 use kerf_toolpath::{metrics, plan_feed, sample_path, smooth_polyline};
 
