@@ -23,13 +23,14 @@ pub struct PathSample {
     pub u: f64,
 }
 
-/// Samples a smoothed path: lines at their two ends, corners at equal
-/// parameter steps fine enough that no step is longer than `max_step` (arc length by [`crate::QuinticBezier::length_between`]).
-/// Consecutive pieces share their joining sample (kept once).
+/// Samples a smoothed path: lines at their two ends, corners at
+/// ⌈length / `max_step`⌉ equal parameter steps (their arc lengths by
+/// [`crate::QuinticBezier::length_between`]; a step is `max_step` long on
+/// average, longer where the curve's speed in its parameter is above its
+/// mean). Consecutive pieces share their joining sample (kept once).
 ///
 /// # Arguments
-/// * `max_step` — largest arc length between samples of a corner \[m\],
-///   > 0.
+/// * `max_step` — mean arc length between samples of a corner \[m\], > 0.
 pub fn sample_path(path: &SmoothedPath, max_step: f64) -> Vec<PathSample> {
     let mut out: Vec<PathSample> = Vec::new();
     let mut s0 = 0.0;
@@ -78,12 +79,9 @@ pub fn sample_path(path: &SmoothedPath, max_step: f64) -> Vec<PathSample> {
             };
             out.push(sample);
         }
-        s0 += length;
-        if let (Piece::Corner(_), Some(last)) = (piece, out.last_mut()) {
-            // The corner's summed sub-lengths and its total differ by
-            // rounding only; the next piece starts at the summed end.
-            s0 = last.s;
-        }
+        // The next piece starts where this one's last sample is (a corner's
+        // summed sub-lengths, not its separately computed total).
+        s0 = out.last().map_or(s0, |p| p.s);
     }
     out
 }
