@@ -24,6 +24,6 @@ pub use feed::{plan_feed, FeedLimits, FeedPlan, FeedSample};
 pub use lower_bound::{bang_bang, bang_bang_under, BangBang, BangBangLimits};
 pub use merge::merge_collinear;
 pub use metrics::{metrics, Metrics};
-pub use samples::{point_at, sample_path, PathSample};
+pub use samples::{derivatives_at, point_at, sample_path, PathSample};
 pub use smooth::{smooth_polyline, Piece, SmoothedPath};
 pub use speed_limit::{CurvatureLimits, Servo};

@@ -3,7 +3,7 @@
 
 use crate::error::ToolpathError;
 use crate::smooth::{Piece, SmoothedPath};
-use crate::vec3::{norm, scale, sub};
+use crate::vec3::{dot, norm, scale, sub};
 
 /// One sample of a path.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -94,20 +94,61 @@ pub fn sample_path(path: &SmoothedPath, max_step: f64) -> Vec<PathSample> {
 /// # Arguments
 /// * `samples` — [`sample_path`] of `path`.
 pub fn point_at(path: &SmoothedPath, samples: &[PathSample], s: f64) -> [f64; 3] {
+    derivatives_at(path, samples, s).0
+}
+
+/// The point of `path` at arc length `s` with its first and second
+/// derivatives in arc length: (p, dp/ds, d²p/ds²). dp/ds is the unit
+/// tangent; d²p/ds² = κ n, from the curve's parameter derivatives C′, C″ by
+/// the chain rule: (C″ − (C″·t) t) / |C′|² (a line's is zero).
+///
+/// # Arguments
+/// * `samples` — [`sample_path`] of `path`; `s` is clamped to its ends.
+///
+/// # Performance
+/// As [`point_at`]: a binary search and, on a corner, 3 Newton steps.
+pub fn derivatives_at(
+    path: &SmoothedPath,
+    samples: &[PathSample],
+    s: f64,
+) -> ([f64; 3], [f64; 3], [f64; 3]) {
+    let (piece, u) = parameter_at(path, samples, s);
+    match path.pieces.get(piece) {
+        Some(Piece::Line { start, end }) => {
+            let d = sub(*end, *start);
+            let t = scale(d, 1.0 / norm(d));
+            (std::array::from_fn(|k| start[k] + u * d[k]), t, [0.0; 3])
+        }
+        Some(Piece::Corner(c)) => {
+            let d1 = c.curve.d1(u);
+            let d2 = c.curve.d2(u);
+            let speed = norm(d1);
+            let t = scale(d1, 1.0 / speed);
+            let along = dot(d2, t);
+            let n: [f64; 3] = std::array::from_fn(|k| (d2[k] - along * t[k]) / (speed * speed));
+            (c.curve.point(u), t, n)
+        }
+        None => {
+            let last = &samples[samples.len() - 1];
+            (last.point, last.tangent, [0.0; 3])
+        }
+    }
+}
+
+/// The piece and its parameter at arc length `s`, as [`point_at`] finds them.
+fn parameter_at(path: &SmoothedPath, samples: &[PathSample], s: f64) -> (usize, f64) {
     let k = samples.partition_point(|p| p.s < s);
     if k == 0 {
-        return samples[0].point;
+        return (samples[0].piece, samples[0].u);
     }
     if k >= samples.len() {
-        return samples[samples.len() - 1].point;
+        let last = &samples[samples.len() - 1];
+        return (last.piece, last.u);
     }
     let (a, b) = (&samples[k - 1], &samples[k]);
     let ua = if a.piece == b.piece { a.u } else { 0.0 };
     let guess = ua + (s - a.s) / (b.s - a.s) * (b.u - ua);
     match path.pieces.get(b.piece) {
-        Some(Piece::Line { start, end }) => {
-            std::array::from_fn(|d| start[d] + guess * (end[d] - start[d]))
-        }
         Some(Piece::Corner(c)) => {
             let mut u = guess;
             for _ in 0..3 {
@@ -117,9 +158,9 @@ pub fn point_at(path: &SmoothedPath, samples: &[PathSample], s: f64) -> [f64; 3]
                     u = (u - f / speed).clamp(ua, b.u);
                 }
             }
-            c.curve.point(u)
+            (b.piece, u)
         }
-        None => b.point,
+        _ => (b.piece, guess),
     }
 }
 
