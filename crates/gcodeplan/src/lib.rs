@@ -10,6 +10,7 @@ pub mod error;
 pub mod knots;
 pub mod machine;
 pub mod plan;
+pub mod request;
 pub mod runs;
 pub mod settings;
 pub mod timed;
@@ -17,6 +18,9 @@ pub mod timed;
 pub use error::GcodePlanError;
 pub use machine::{JointBounds, LaserSheet, Machine, MillingPlane, DOF};
 pub use plan::{plan_program, GcodePlan, RunReport, ToolEvent};
+pub use request::{
+    plan_request, GcodeRequest, LimitOverrides, MachineBase, MachineKind, ProgramSource, METHODS,
+};
 pub use runs::{read_steps, Reading, Run, RunKind, Step};
 pub use settings::PlanSettings;
 pub use timed::{PathMotion, TimedRun};

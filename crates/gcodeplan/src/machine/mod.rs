@@ -7,8 +7,8 @@
 //! | [`LaserSheet`] | the laser cutter of seed 001 over a flat sheet: q1, q2 trace the path, q3 at the cutting height, q4 = q5 = 0 (vertical beam), q6 fixed |
 //! | [`MillingPlane`] | the IRB 6660 of seed 004 on a milling plane: the tool pose at the point with a fixed redundancy angle g, through kerf_mill's closed-form IK |
 
-mod irb;
-mod laser;
+pub mod irb;
+pub mod laser;
 
 pub use irb::MillingPlane;
 pub use laser::LaserSheet;
