@@ -294,7 +294,7 @@ fn set(field: &mut f64, value: Option<f64>) {
 #[derive(Debug, Clone)]
 pub enum MachineBase {
     /// The laser cutter.
-    Laser(kerf_mjto::LaserMachine),
+    Laser(Box<kerf_mjto::LaserMachine>),
     /// The IRB 6660 milling cell.
     Irb(Box<kerf_mill::MillCell>),
 }
@@ -312,7 +312,7 @@ impl MachineBase {
         };
         match kind {
             MachineKind::LaserCutter => kerf_mjto::LaserMachine::default_machine()
-                .map(MachineBase::Laser)
+                .map(|m| MachineBase::Laser(Box::new(m)))
                 .map_err(|e| bad(e.to_string())),
             MachineKind::Irb6660 => kerf_mill::MillCell::default_cell()
                 .map(|c| MachineBase::Irb(Box::new(c)))
@@ -356,7 +356,7 @@ impl MachineBase {
         }
         match self {
             MachineBase::Laser(m) => Ok(Box::new(crate::LaserSheet::new(
-                m.clone(),
+                (**m).clone(),
                 request
                     .origin
                     .unwrap_or(crate::machine::laser::DEFAULT_SHEET_ORIGIN),
