@@ -68,13 +68,13 @@ fn g01_program(title: &str, about: &[&str], points: &[Fixed], preamble: &str) ->
 }
 
 /// The W-shape (seed 003 Fig. 11's kind): an open path of four lines, three corners of
-/// different angles (a, b, c as in its Table 2), 60 × 40 mm.
+/// different angles (a, b, c as in its Table 2: 132°, 159°, 140° of turning), 60 × 40 mm.
 fn w_shape() -> Vec<Fixed> {
     [
-        [0.0, 40.0],
-        [15.0, 0.0],
-        [30.0, 28.0],
-        [42.0, 0.0],
+        [0.0, 30.0],
+        [22.0, 0.0],
+        [30.0, 38.0],
+        [36.0, 0.0],
         [60.0, 40.0],
     ]
     .map(fixed)

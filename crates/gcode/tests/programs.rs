@@ -126,7 +126,7 @@ fn the_w_shape_in_millimetres_and_in_inches() {
         "{lo:?} {hi:?}"
     );
     let mm = line_points(&m);
-    assert!(near(mm[2], [0.030, 0.028, 0.0], 1e-12), "corner b");
+    assert!(near(mm[2], [0.030, 0.038, 0.0], 1e-12), "corner b");
     let (inch, _) = read("w_shape_inch.ngc");
     let inch = line_points(&inch);
     assert_eq!(inch.len(), mm.len());
