@@ -98,6 +98,7 @@ fn bezier(a: [f64; 2], c: [f64; 2], b: [f64; 2], n: usize) -> Vec<[f64; 2]> {
 /// The dress (seed 003 Fig. 13's "dress"/"clothes" kind): a closed outline symmetric about
 /// x = 0, 80 × 100 mm: a gently curved hem (small curvature, short segments), long sides,
 /// sharp corners at the waist, armpits, shoulders and the V neck, curved armholes and neckline.
+/// It starts and ends in the middle of its right side.
 fn dress() -> Vec<Fixed> {
     let mut right = vec![[0.0, 0.0]];
     // Hem: y = 4 (x/40)², 8 segments.
@@ -115,7 +116,14 @@ fn dress() -> Vec<Fixed> {
     // The left half: the mirror image, back down to the hem's middle (closed).
     let mirrored: Vec<Fixed> = out.iter().rev().skip(1).map(|p| [-p[0], p[1]]).collect();
     out.extend(mirrored);
-    out
+    // Start and end in the middle of the right side (index 8 to 9), not at the hem's middle:
+    // a closed contour entered and left on a straight line, not at a corner.
+    let middle = [(out[8][0] + out[9][0]) / 2, (out[8][1] + out[9][1]) / 2];
+    let mut rotated = vec![middle];
+    rotated.extend_from_slice(&out[9..out.len() - 1]);
+    rotated.extend_from_slice(&out[..=8]);
+    rotated.push(middle);
+    rotated
 }
 
 /// The torch (seed 003 Fig. 14's kind): an open path starting and ending with long lines (the

@@ -9,13 +9,17 @@ use super::ticks::{tick_label, Axis};
 use crate::error::ToolpathError;
 
 /// Width of the document \[px\].
-pub const WIDTH: f64 = 760.0;
+pub const WIDTH: f64 = 900.0;
 /// Height of the document \[px\].
 pub const HEIGHT: f64 = 460.0;
 /// Left margin (tick labels and the y label) \[px\].
 pub const LEFT: f64 = 90.0;
-/// Right margin \[px\].
-pub const RIGHT: f64 = 20.0;
+/// Right margin (the legend) \[px\].
+pub const RIGHT: f64 = 210.0;
+/// The y range is widened by this fraction of its span on each side (not
+/// below 0 when no value is negative), so that limit lines at the data's
+/// extremes stay inside the frame.
+pub const Y_PADDING: f64 = 0.05;
 /// Top margin (the title) \[px\].
 pub const TOP: f64 = 40.0;
 /// Bottom margin (tick labels and the x label) \[px\].
@@ -189,8 +193,14 @@ impl Chart {
             lo[1] = lo[1].min(l.y);
             hi[1] = hi[1].max(l.y);
         }
+        let pad = Y_PADDING * (hi[1] - lo[1]);
+        let y_lo = if lo[1] >= 0.0 {
+            (lo[1] - pad).max(0.0)
+        } else {
+            lo[1] - pad
+        };
         let mut x = Axis::covering(lo[0], hi[0], 8);
-        let mut y = Axis::covering(lo[1], hi[1], 6);
+        let mut y = Axis::covering(y_lo, hi[1] + pad, 6);
         if self.equal_aspect {
             let (w, h) = plot_size();
             let scale = (w / (x.hi - x.lo)).min(h / (y.hi - y.lo));
@@ -355,15 +365,19 @@ impl Chart {
         Ok(out)
     }
 
-    /// The colour of series `k`.
+    /// The colour of series `k`: its own, or the palette's next one (series
+    /// with their own colour take none from the palette).
     fn colour(&self, k: usize) -> String {
-        self.series[k]
-            .colour
-            .clone()
-            .unwrap_or_else(|| PALETTE[k % PALETTE.len()].to_string())
+        self.series[k].colour.clone().unwrap_or_else(|| {
+            let n = self.series[..k]
+                .iter()
+                .filter(|s| s.colour.is_none())
+                .count();
+            PALETTE[n % PALETTE.len()].to_string()
+        })
     }
 
-    /// The legend, in the plot area's top right corner.
+    /// The legend, right of the plot area.
     fn legend(&self, out: &mut String, w: f64) {
         let entries: Vec<(String, String, &str)> = self
             .series
@@ -391,7 +405,7 @@ impl Chart {
             40.0 + 7.0 * longest as f64,
             8.0 + 18.0 * entries.len() as f64,
         );
-        let (x0, y0) = (LEFT + w - bw - 8.0, TOP + 8.0);
+        let (x0, y0) = (LEFT + w + 10.0, TOP);
         let _ = writeln!(
             out,
             r##"<g class="legend"><rect x="{}" y="{}" width="{}" height="{}" fill="white" fill-opacity="0.85" stroke="#999999"/>"##,

@@ -113,7 +113,7 @@ pub fn pipeline_plots(
     let chart = Chart::new("Feed along the path", x_label, "feed v [mm/s]")
         .line("planned feed v", at(&|p| p.v * MM))
         .line(
-            "limit v_f = min(F, eqs. 16, 17, 19, 21)",
+            "limit v_f (eq. 22)",
             samples
                 .iter()
                 .map(|q| [q.s * MM, c.speed(q.curvature) * MM])
@@ -128,16 +128,8 @@ pub fn pipeline_plots(
     for w in feed.windows(2) {
         let (s0, s1) = (w[0].s, w[1].s);
         measured.push([s0 * MM, chord_error(path, samples, s0, s1) * UM]);
-        // Eq. 15: Δ = ρ − √(ρ² − (vT/2)²), the chord of length v T on a
-        // circle of radius ρ (the sagitta); at most ρ.
-        let k = curvature(0.5 * (s0 + s1));
-        let half = 0.5 * (s1 - s0);
-        let sag = if k > 0.0 {
-            let rho = 1.0 / k;
-            rho - (rho * rho - half * half).max(0.0).sqrt()
-        } else {
-            0.0
-        };
+        // Eq. 15 with the period's chord (about v T) at the middle's curvature.
+        let sag = sagitta(0.5 * (s1 - s0), curvature(0.5 * (s0 + s1)));
         estimate.push([s0 * MM, sag * UM]);
     }
     let chart = Chart::new(
@@ -177,8 +169,8 @@ pub fn pipeline_plots(
         full.push([p.s * MM, turning.hypot(growing) * MM]);
     }
     let chart = Chart::new("Normal jerk", x_label, "j_n [mm/s³]")
+        .line("|d(a_n n)/dt|", full)
         .line("j_n = v³ κ² (eq. 20)", eq20)
-        .line("|d(a_n n)/dt| with v³ dκ/ds and 2vaκ", full)
         .limit("limit j_n,lim", c.normal_jerk * MM);
     out.push(("normal_jerk.svg".to_string(), chart.render()?));
 
@@ -240,15 +232,28 @@ pub fn chord_error(path: &SmoothedPath, samples: &[PathSample], s0: f64, s1: f64
 
 /// Seed 003 eq. 17's quantity: the steady-state radius error ρ (1 − |G(jω)|)
 /// of the servo G(s) = ω_n² / (s² + 2ζω_n s + ω_n²) on a circle of radius
-/// ρ = 1/κ at speed v (ω = v/ρ); 0 on a line \[m\].
+/// ρ = 1/κ at speed v (ω = v/ρ = vκ); 0 on a line \[m\].
+///
+/// Written without the cancellation of 1 − |G| near 1 (which, times a
+/// radius of 10¹³ m at a numerically straight joint, gives millimetres):
+/// with |D| = √((ω_n² − ω²)² + (2ζω_nω)²), 1 − |G| = (|D|² − ω_n⁴) /
+/// (|D| (|D| + ω_n²)) = ω² (ω² + (4ζ² − 2) ω_n²) / (|D| (|D| + ω_n²)),
+/// so ρ (1 − |G|) = v² κ (ω² + (4ζ² − 2) ω_n²) / (|D| (|D| + ω_n²)).
 pub fn contour_error(servo: &Servo, v: f64, kappa: f64) -> f64 {
-    // Not `!(κ > 0 && v > 0)`: a NaN must reach the chart's check.
-    if kappa == 0.0 || v == 0.0 {
-        return 0.0;
+    let (wn, z) = (servo.natural_frequency, servo.damping);
+    let w = v * kappa;
+    let d = (wn * wn - w * w).hypot(2.0 * z * wn * w);
+    (v * v * kappa * (w * w + (4.0 * z * z - 2.0) * wn * wn) / (d * (d + wn * wn))).abs()
+}
+
+/// Seed 003 eq. 15's chord error Δ = ρ − √(ρ² − h²) of a chord of half
+/// length h on a circle of curvature κ = 1/ρ, as h² κ / (1 + √(1 − (hκ)²))
+/// (no cancellation for large ρ); ρ where the chord would exceed the
+/// diameter \[m\].
+pub fn sagitta(half: f64, kappa: f64) -> f64 {
+    let x = half * kappa;
+    if x >= 1.0 {
+        return 1.0 / kappa;
     }
-    let rho = 1.0 / kappa;
-    let (wn, w) = (servo.natural_frequency, v / rho);
-    let gain =
-        wn * wn / ((wn * wn - w * w).powi(2) + (2.0 * servo.damping * wn * w).powi(2)).sqrt();
-    rho * (1.0 - gain).abs()
+    half * half * kappa / (1.0 + (1.0 - x * x).sqrt())
 }
