@@ -42,7 +42,11 @@ impl Generated {
         } else {
             let row = (k - 1) / 1000;
             let col = (k - 1) % 1000;
-            let col = if row.is_multiple_of(2) { col } else { 999 - col };
+            let col = if row.is_multiple_of(2) {
+                col
+            } else {
+                999 - col
+            };
             // In 0.0001 mm, written as integers (float formatting would cost as much as
             // the reading being measured).
             let x = col * 1000 + k % 7;
