@@ -12,9 +12,9 @@
 use std::path::PathBuf;
 
 use kerf_gcode::{read_program, Motion, ReaderSettings};
+use kerf_toolpath::plot::pipeline_charts;
 use kerf_toolpath::{
-    corner_metrics, pipeline_plots, plan_feed, sample_path, smooth_polyline, CurvatureLimits,
-    FeedLimits,
+    corner_metrics, plan_feed, sample_path, smooth_polyline, CurvatureLimits, FeedLimits,
 };
 
 /// Curvatures below this are straight \[1/m\] (the workaround in `main`).
@@ -57,7 +57,11 @@ fn main() {
         let plan = plan_feed(&samples, &limits).unwrap();
         let feed = plan.sample(period);
         let start = std::time::Instant::now();
-        let plots = pipeline_plots(&path, &samples, &feed, &limits, period).unwrap();
+        let charts = pipeline_charts(&path, &samples, &feed, &limits, period).unwrap();
+        let plots: Vec<(String, String)> = charts
+            .iter()
+            .map(|(file, chart)| (file.clone(), chart.render().unwrap()))
+            .collect();
         let took = start.elapsed().as_secs_f64();
         let dir = out_dir.join(name);
         std::fs::create_dir_all(&dir).unwrap();
@@ -75,6 +79,28 @@ fn main() {
             dir.display(),
             took * 1e3
         );
+        // The largest |y| of every plotted series against its chart's limits.
+        for (file, chart) in charts.iter().skip(1) {
+            let series: Vec<String> = chart
+                .series
+                .iter()
+                .map(|x| {
+                    let max = x.points.iter().map(|p| p[1].abs()).fold(0.0, f64::max);
+                    format!("{} {max:.3}", x.name)
+                })
+                .collect();
+            let limits: Vec<String> = chart
+                .limits
+                .iter()
+                .map(|l| format!("{} {}", l.name, l.y))
+                .collect();
+            println!(
+                "  {file}: max |y|: {}; limits: {} ({})",
+                series.join(", "),
+                limits.join(", "),
+                chart.y_label
+            );
+        }
         println!(
             "| corner | vertex (mm) | θ (°) | approximation error (mm) | κ_max (1/mm) | bound by |"
         );

@@ -11,5 +11,5 @@ pub mod svg;
 pub mod ticks;
 
 pub use chart::{Chart, LimitLine, Series, Style};
-pub use pipeline::pipeline_plots;
+pub use pipeline::{pipeline_charts, pipeline_plots};
 pub use ticks::{nice_step, tick_label, Axis};

@@ -51,6 +51,25 @@ pub fn pipeline_plots(
     limits: &FeedLimits,
     period: f64,
 ) -> Result<Vec<(String, String)>, ToolpathError> {
+    pipeline_charts(path, samples, feed, limits, period)?
+        .into_iter()
+        .map(|(name, chart)| Ok((name, chart.render()?)))
+        .collect()
+}
+
+/// The charts of [`pipeline_plots`] before rendering, with their data (for
+/// tables of the plotted maxima, or other renderings).
+///
+/// # Errors
+/// As [`pipeline_plots`], except that non-finite plotted values are found
+/// when a chart is rendered or validated ([`Chart::validate`]).
+pub fn pipeline_charts(
+    path: &SmoothedPath,
+    samples: &[PathSample],
+    feed: &[FeedSample],
+    limits: &FeedLimits,
+    period: f64,
+) -> Result<Vec<(String, Chart)>, ToolpathError> {
     limits.validate()?;
     check_positive(&[("period [s]", period)])?;
     check_samples(samples)?;
@@ -106,7 +125,7 @@ pub fn pipeline_plots(
             Some("#d62728"),
         )
         .with_equal_aspect();
-    out.push(("path_xy.svg".to_string(), chart.render()?));
+    out.push(("path_xy.svg".to_string(), chart));
 
     // Seed 003 Figs. 12b–14b: the feed, F and the velocity-limit curve of
     // eq. 22 at the path's samples (exact curvature there).
@@ -120,7 +139,7 @@ pub fn pipeline_plots(
                 .collect(),
         )
         .limit("programmed feed F", c.feed * MM);
-    out.push(("feed.svg".to_string(), chart.render()?));
+    out.push(("feed.svg".to_string(), chart));
 
     // Chord error of each period: measured, and seed 003 eq. 15's estimate.
     let mut measured = Vec::with_capacity(feed.len());
@@ -137,10 +156,10 @@ pub fn pipeline_plots(
         x_label,
         "chord error [µm]",
     )
-    .line("measured (path vs chord)", measured)
-    .line("eq. 15 with the period's chord", estimate)
+    .line("measured", measured)
+    .line("eq. 15 estimate", estimate)
     .limit("limit Δ_lim", c.chord_error * UM);
-    out.push(("chord_error.svg".to_string(), chart.render()?));
+    out.push(("chord_error.svg".to_string(), chart));
 
     // Eq. 18: a_n = v² / ρ = v² κ.
     let normal: Vec<[f64; 2]> = feed
@@ -151,7 +170,7 @@ pub fn pipeline_plots(
     let chart = Chart::new("Normal acceleration", x_label, "a_n [mm/s²]")
         .line("a_n = v² κ (eq. 18)", normal)
         .limit("limit a_n,lim", c.normal_acceleration * MM);
-    out.push(("normal_acceleration.svg".to_string(), chart.render()?));
+    out.push(("normal_acceleration.svg".to_string(), chart));
 
     // Eq. 20: j_n = v³ / ρ² (the normal acceleration turning at constant
     // speed and curvature); and the whole rate of change of the normal
@@ -172,7 +191,7 @@ pub fn pipeline_plots(
         .line("|d(a_n n)/dt|", full)
         .line("j_n = v³ κ² (eq. 20)", eq20)
         .limit("limit j_n,lim", c.normal_jerk * MM);
-    out.push(("normal_jerk.svg".to_string(), chart.render()?));
+    out.push(("normal_jerk.svg".to_string(), chart));
 
     if let Some(servo) = &c.servo {
         let contour: Vec<[f64; 2]> = feed
@@ -185,9 +204,9 @@ pub fn pipeline_plots(
             x_label,
             "contour error [µm]",
         )
-        .line("ρ (1 − |G(j v/ρ)|) (eq. 17's servo)", contour)
+        .line("ρ (1 − |G(jv/ρ)|), eq. 17", contour)
         .limit("limit ε_lim", servo.contour_error * UM);
-        out.push(("contour_error.svg".to_string(), chart.render()?));
+        out.push(("contour_error.svg".to_string(), chart));
     }
 
     let (a, j) = (limits.tangential_acceleration, limits.tangential_jerk);
@@ -195,12 +214,12 @@ pub fn pipeline_plots(
         .line("a_t = dv/dt", at(&|p| p.a * MM))
         .limit("+A_t", a * MM)
         .limit("−A_t", -a * MM);
-    out.push(("tangential_acceleration.svg".to_string(), chart.render()?));
+    out.push(("tangential_acceleration.svg".to_string(), chart));
     let chart = Chart::new("Tangential jerk", x_label, "j_t [mm/s³]")
         .line("j_t = da/dt", at(&|p| p.j * MM))
         .limit("+J_t", j * MM)
         .limit("−J_t", -j * MM);
-    out.push(("tangential_jerk.svg".to_string(), chart.render()?));
+    out.push(("tangential_jerk.svg".to_string(), chart));
     Ok(out)
 }
 
