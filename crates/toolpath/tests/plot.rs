@@ -321,3 +321,72 @@ fn bad_pipeline_input_is_refused() {
         "{e:?}"
     );
 }
+
+#[test]
+fn dense_series_are_thinned_within_a_quarter_pixel() {
+    let n = 100_000;
+    let points: Vec<[f64; 2]> = (0..n)
+        .map(|k| {
+            let x = k as f64 / n as f64 * 10.0;
+            [x, (3.0 * x).sin() + 0.2 * (40.0 * x).sin()]
+        })
+        .collect();
+    let chart = Chart::new("dense", "x [m]", "y [m]").line("wave", points.clone());
+    let (xa, ya) = chart.axes().unwrap();
+    let svg = chart.render().unwrap();
+    let t = check_structure(&svg);
+    let frame = &t
+        .iter()
+        .find(|x| attr(&x.3, "class") == Some("frame"))
+        .unwrap()
+        .3;
+    let f = |k: &str| attr(frame, k).unwrap().parse::<f64>().unwrap();
+    let (fx, fy, fw, fh) = (f("x"), f("y"), f("width"), f("height"));
+    let poly = &t
+        .iter()
+        .find(|x| attr(&x.3, "class") == Some("series"))
+        .unwrap()
+        .3;
+    let drawn: Vec<(f64, f64)> = attr(poly, "points")
+        .unwrap()
+        .split(' ')
+        .map(|p| {
+            let (x, y) = p.split_once(',').unwrap();
+            (x.parse().unwrap(), y.parse().unwrap())
+        })
+        .collect();
+    assert!(drawn.len() < n / 4, "{} points drawn", drawn.len());
+    // Every point of the data is within a quarter pixel (plus rounding) of a drawn one, in
+    // order: a walk along the drawn points finds each; the last point is drawn exactly.
+    let mut j = 0;
+    for p in &points {
+        let px = fx + (p[0] - xa.lo) / (xa.hi - xa.lo) * fw;
+        let py = fy + (1.0 - (p[1] - ya.lo) / (ya.hi - ya.lo)) * fh;
+        let near = |q: (f64, f64)| (q.0 - px).abs() < 0.26 && (q.1 - py).abs() < 0.26;
+        while !near(drawn[j]) {
+            j += 1;
+            assert!(j < drawn.len(), "({px}, {py}) is not drawn");
+        }
+    }
+    let last = points[n - 1];
+    let end = drawn[drawn.len() - 1];
+    assert!((end.0 - (fx + (last[0] - xa.lo) / (xa.hi - xa.lo) * fw)).abs() < 0.006);
+    assert!((end.1 - (fy + (1.0 - (last[1] - ya.lo) / (ya.hi - ya.lo)) * fh)).abs() < 0.006);
+}
+
+#[test]
+fn geometry_is_drawn_at_equal_scales() {
+    let chart = Chart::new("xy", "x [mm]", "y [mm]")
+        .line("tall", vec![[0.0, 0.0], [1.0, 30.0], [2.0, 0.0]])
+        .with_equal_aspect();
+    let (x, y) = chart.axes().unwrap();
+    let (w, h) = kerf_toolpath::plot::chart::plot_size();
+    assert!(
+        ((x.hi - x.lo) / w - (y.hi - y.lo) / h).abs() < 1e-12,
+        "units per pixel: x {} y {}",
+        (x.hi - x.lo) / w,
+        (y.hi - y.lo) / h
+    );
+    assert!(x.lo <= 0.0 && x.hi >= 2.0 && y.lo <= 0.0 && y.hi >= 30.0);
+    assert!(x.ticks().len() >= 3 && y.ticks().len() >= 3);
+}
