@@ -7,7 +7,25 @@
 //! Every quantity is plotted against the arc length s of the plan's
 //! samples at the interpolation period, in millimetres (speeds in mm/s,
 //! errors in µm), with the path's geometry at s from
-//! [`crate::derivatives_at`] (κ = |d²p/ds²|).
+//! [`crate::derivatives_at`] (κ = |d²p/ds²|). The formulas and their
+//! sources:
+//!
+//! * feed limit curve: v_f = min(v_p, v_Δ, v_a, v_j, v_c), seed 003 eq. 22
+//!   ([`crate::CurvatureLimits::speed`]) at the path's samples;
+//! * chord error of a period: measured, the largest distance of the path
+//!   between two consecutive positions from the chord joining them
+//!   ([`chord_error`]); and seed 003 eq. 15, Δ = ρ − √(ρ² − (L/2)²) with
+//!   the period's arc length L ([`sagitta`]);
+//! * normal acceleration a_n = v²/ρ, seed 003 eq. 18;
+//! * normal jerk j_n = v³/ρ², seed 003 eq. 20 (the normal acceleration
+//!   turning at constant speed and curvature); and the whole rate of change
+//!   of the normal acceleration vector on a plane curve (Frenet–Serret,
+//!   dn/ds = −κ t): d(v²κ n)/dt = (2 v a κ + v³ dκ/ds) n − v³ κ² t, with
+//!   dκ/ds by a central difference of ±1 µm;
+//! * contour error: the steady-state radius error of seed 003 eq. 17's
+//!   servo, ρ (1 − |G(j v/ρ)|) ([`contour_error`]);
+//! * tangential acceleration and jerk: the plan's own a and j (exact,
+//!   piecewise constant jerk), against ±A_t and ±J_t.
 
 use super::chart::{Chart, Style};
 use crate::error::{check_positive, ToolpathError};
