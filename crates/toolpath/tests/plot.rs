@@ -390,3 +390,45 @@ fn geometry_is_drawn_at_equal_scales() {
     assert!(x.lo <= 0.0 && x.hi >= 2.0 && y.lo <= 0.0 && y.hi >= 30.0);
     assert!(x.ticks().len() >= 3 && y.ticks().len() >= 3);
 }
+
+#[test]
+fn the_whole_normal_jerk_matches_a_difference_of_the_normal_acceleration() {
+    // The plan at 20 µs: d(a_n n)/dt by central differences in time of v² d²p/ds² against the
+    // chart's |d(a_n n)/dt| (2 v a κ + v³ dκ/ds along n, v³ κ² along t).
+    let (path, samples, _) = zig_zag();
+    let limits = feed_limits();
+    let dt = 2e-5;
+    let feed = plan_feed(&samples, &limits).unwrap().sample(dt);
+    let charts = kerf_toolpath::plot::pipeline_charts(&path, &samples, &feed, &limits, dt).unwrap();
+    let jerk = &charts.iter().find(|c| c.0 == "normal_jerk.svg").unwrap().1;
+    let whole = &jerk
+        .series
+        .iter()
+        .find(|s| s.name == "|d(a_n n)/dt|")
+        .unwrap()
+        .points;
+    let an: Vec<[f64; 3]> = feed
+        .iter()
+        .map(|p| {
+            let n = kerf_toolpath::derivatives_at(&path, &samples, p.s).2;
+            [p.v * p.v * n[0], p.v * p.v * n[1], p.v * p.v * n[2]]
+        })
+        .collect();
+    let mut errors = Vec::new();
+    for k in 1..feed.len() - 1 {
+        let d: Vec<f64> = (0..3)
+            .map(|i| (an[k + 1][i] - an[k - 1][i]) / (2.0 * dt))
+            .collect();
+        let fd = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt() * 1e3; // mm/s³
+        let plotted = whole[k][1];
+        if plotted > 1e4 {
+            errors.push((fd - plotted).abs() / plotted);
+        }
+    }
+    errors.sort_by(f64::total_cmp);
+    assert!(errors.len() > 100, "{} points on corners", errors.len());
+    let median = errors[errors.len() / 2];
+    let p90 = errors[errors.len() * 9 / 10];
+    println!("relative difference: median {median:.2e}, 90th percentile {p90:.2e}");
+    assert!(median < 1e-3 && p90 < 1e-2, "median {median}, p90 {p90}");
+}
