@@ -320,7 +320,7 @@ fn main() {
                 "Dense G01 program under G64 P0.01: a closed rosette r = 30 + 5 cos 7t mm, 2000 segments",
                 &[
                     "CAM-style micro-segments (0.1 mm on average) with a blending tolerance of 0.01 mm.",
-                    "Units: millimetres (G21), absolute (G90); centre (40, 40), 70 x 70 mm.",
+                    "Units: millimetres (G21), absolute (G90); centre (40, 40), within a 70 mm square.",
                     feed,
                 ],
                 &rosette(),

@@ -1,8 +1,9 @@
 //! Writes the figures of `kerf_toolpath::pipeline_plots` (seed 000 Fig. 5, seed 003 Figs. 12–14)
-//! for the W-shape, dress and torch programs of `crates/gcode/data/programs/`: each G01 program
-//! smoothed within δ = 0.1 mm, sampled every 10 µm, its feed planned under seed 003's Table 1
+//! for the W-shape, dress, torch and dense rosette programs of `crates/gcode/data/programs/`: each
+//! G01 program smoothed within δ = 0.1 mm, sampled every 10 µm, its feed planned under seed 003's Table 1
 //! (A_t 800 mm/s², J_t 20 000 mm/s³) and sampled at T = 2 ms. Prints each path's per-corner
-//! figures (seed 003 Table 2's kind) and where the SVG files went.
+//! figures (seed 003 Table 2's kind; their extremes for more than 60 corners), the largest value
+//! of each plotted quantity, and where the SVG files went.
 //!
 //! ```sh
 //! cargo run --release -p kerf_toolpath --example plots [-- OUTPUT_DIR]   # default target/plots
@@ -31,7 +32,7 @@ fn main() {
         tangential_jerk: 20.0,
     };
     let period = limits.curvature.interpolation_period;
-    for name in ["w_shape", "dress", "torch"] {
+    for name in ["w_shape", "dress", "torch", "rosette_dense_g64"] {
         let file = root.join(format!("crates/gcode/data/programs/{name}.ngc"));
         let text = std::fs::read_to_string(&file).unwrap();
         let mut polyline = Vec::new();
@@ -101,11 +102,25 @@ fn main() {
                 chart.y_label
             );
         }
+        let corners = corner_metrics(&path);
+        if corners.len() > 60 {
+            let error = corners
+                .iter()
+                .map(|c| c.approximation_error)
+                .fold(0.0, f64::max);
+            let kappa = corners.iter().map(|c| c.max_curvature).fold(0.0, f64::max);
+            println!(
+                "  corners: largest approximation error {:.4} mm, largest curvature {:.3} 1/mm",
+                error * 1e3,
+                kappa * 1e-3
+            );
+            continue;
+        }
         println!(
             "| corner | vertex (mm) | θ (°) | approximation error (mm) | κ_max (1/mm) | bound by |"
         );
         println!("|---:|---|---:|---:|---:|---|");
-        for (k, c) in corner_metrics(&path).iter().enumerate() {
+        for (k, c) in corners.iter().enumerate() {
             println!(
                 "| {k} | ({:.3}, {:.3}) | {:.2} | {:.4} | {:.3} | {:?} |",
                 c.vertex[0] * 1e3,
