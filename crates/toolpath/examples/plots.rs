@@ -18,9 +18,6 @@ use kerf_toolpath::{
     corner_metrics, plan_feed, sample_path, smooth_polyline, CurvatureLimits, FeedLimits,
 };
 
-/// Curvatures below this are straight \[1/m\] (the workaround in `main`).
-const STRAIGHT: f64 = 1e-9;
-
 fn main() {
     let root = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../..");
     let out_dir = std::env::args()
@@ -45,16 +42,7 @@ fn main() {
             }
         }
         let path = smooth_polyline(&polyline, 1e-4).unwrap();
-        let mut samples = sample_path(&path, 1e-5);
-        // Workaround: where two corners meet, the curvature is 0 up to rounding (3e-14 1/m on
-        // the dress's hem), and `CurvatureLimits::contour_speed` (eq. 17) cancels to a speed
-        // of 0 at such radii (1 − 2ζ² + √(…) ≈ 0), which `plan_feed` cannot reach. A radius
-        // over 10⁹ m is straight.
-        for q in &mut samples {
-            if q.curvature < STRAIGHT {
-                q.curvature = 0.0;
-            }
-        }
+        let samples = sample_path(&path, 1e-5);
         let plan = plan_feed(&samples, &limits).unwrap();
         let feed = plan.sample(period);
         let start = std::time::Instant::now();
