@@ -1,6 +1,6 @@
 //! `kerf launch`: every node in one process, each with its own Context and thread: the
-//! trajectory executor, and with `--with-planner` the robot's planner (laser cutter: the MJTO
-//! planner; IRB 6660: the milling planner).
+//! trajectory executor, and with `--with-planner` the robot's planners (laser cutter: the MJTO
+//! planner; IRB 6660: the milling planner; both: the G-code planner for that machine).
 
 use std::path::PathBuf;
 
@@ -34,8 +34,9 @@ pub struct LaunchArgs {
     /// shipped descriptions; `-p` arguments after `--ros-args` override them).
     #[arg(long, value_enum, default_value = "laser_cutter")]
     robot: Robot,
-    /// Also start the robot's planner: the MJTO laser-cutting planner (`mjto_planner`) for
-    /// the laser cutter, the milling planner (`milling_planner`) for the IRB 6660. Its
+    /// Also start the robot's planners: the MJTO laser-cutting planner (`mjto_planner`) for
+    /// the laser cutter, the milling planner (`milling_planner`) for the IRB 6660, and the
+    /// G-code planner (`gcode_planner`, its `machine` parameter set to the robot). Their
     /// `~/joint_trajectory` reaches the executor only when remapped (README).
     #[arg(long)]
     with_planner: bool,
@@ -113,6 +114,23 @@ fn planner_node(robot: Robot) -> LaunchNode {
     }
 }
 
+/// The G-code planner of `--with-planner`, for any robot (its `machine` parameter names it).
+fn gcode_node() -> LaunchNode {
+    (
+        kerf_gcode_planner::DEFAULT_NAME,
+        kerf_gcode_planner::KNOWN_PARAMS,
+        |a, e, s| kerf_gcode_planner::run(a, e, s).map_err(|e| e.to_string()),
+    )
+}
+
+/// The G-code planner's `machine` parameter for `robot`.
+fn gcode_machine(robot: Robot) -> &'static str {
+    match robot {
+        Robot::LaserCutter => "laser-cutter",
+        Robot::Irb6660 => "irb6660",
+    }
+}
+
 /// Runs `kerf launch` until Ctrl-C or until a node fails.
 pub fn run(a: LaunchArgs) -> Result<(), String> {
     let mut args = RosArgs::parse(a.ros_args.iter().cloned()).map_err(|e| e.to_string())?;
@@ -125,13 +143,22 @@ pub fn run(a: LaunchArgs) -> Result<(), String> {
     let stem = a.robot.stem();
     // Defaults first: later sources (the user's -p and --params-file) override them.
     let defaults = [
-        ("urdf_file", dir.join(format!("{stem}.urdf"))),
-        ("joint_limits_file", dir.join(format!("{stem}_limits.yaml"))),
+        (
+            "urdf_file",
+            dir.join(format!("{stem}.urdf")).display().to_string(),
+        ),
+        (
+            "joint_limits_file",
+            dir.join(format!("{stem}_limits.yaml"))
+                .display()
+                .to_string(),
+        ),
+        ("machine", gcode_machine(a.robot).to_string()),
     ];
-    for (i, (name, path)) in defaults.into_iter().enumerate() {
+    for (i, (name, value)) in defaults.into_iter().enumerate() {
         args.params.insert(
             i,
-            ParamSource::Inline(name.into(), ParamValue::String(path.display().to_string())),
+            ParamSource::Inline(name.into(), ParamValue::String(value)),
         );
     }
     let env = RosEnv::from_env().map_err(|e| e.to_string())?;
@@ -145,6 +172,7 @@ pub fn run(a: LaunchArgs) -> Result<(), String> {
     )];
     if a.with_planner {
         nodes.push(planner_node(a.robot));
+        nodes.push(gcode_node());
     }
     let all_known: Vec<&[&str]> = nodes.iter().map(|(_, known, _)| *known).collect();
     let mut handles = Vec::new();
@@ -261,5 +289,13 @@ mod tests {
         assert_eq!(planner_node(Robot::LaserCutter).0, "mjto_planner");
         assert_eq!(planner_node(Robot::Irb6660).0, "milling_planner");
         assert!(planner_node(Robot::Irb6660).1.contains(&"cell_file"));
+        assert_eq!(gcode_node().0, "gcode_planner");
+        // Its machine follows the robot, and only it reads `machine`.
+        assert_eq!(gcode_machine(Robot::Irb6660), "irb6660");
+        assert_eq!(gcode_machine(Robot::LaserCutter), "laser-cutter");
+        let exec = kerf_trajectory_executor::KNOWN_PARAMS;
+        let all = [exec, kerf_mjto_planner::KNOWN_PARAMS, gcode_node().1];
+        assert!(!all[..2].iter().any(|k| knows(k, "machine")));
+        assert!(knows(gcode_node().1, "machine"));
     }
 }

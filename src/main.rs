@@ -21,6 +21,7 @@ mod launch;
 mod lobes;
 mod output_paths;
 mod plan_cut;
+mod plan_gcode;
 mod plan_mill;
 mod plots;
 mod publish;

@@ -35,6 +35,8 @@ enum PlanCommand {
     Cut(CutArgs),
     /// Plan a milling path (DDPG, fixed g, DP or naive; seed 004) from a request file.
     Mill(crate::plan_mill::MillArgs),
+    /// Plan a G-code program for the laser cutter or the IRB 6660.
+    Gcode(crate::plan_gcode::GcodeArgs),
 }
 
 /// Arguments of `kerf plan cut`.
@@ -66,6 +68,7 @@ pub fn run(a: PlanArgs) -> Result<(), String> {
     match a.command {
         PlanCommand::Cut(c) => cut(c),
         PlanCommand::Mill(m) => crate::plan_mill::run(m),
+        PlanCommand::Gcode(g) => crate::plan_gcode::run(g),
     }
 }
 

@@ -4,7 +4,8 @@
 //! joint limits.
 //!
 //! # Steps of [`run_knots`]
-//! 1. **Points** every `knot_spacing` (at least two per run). At each: the
+//! 1. **Points** at every start of a phase of the feed plan and between them every
+//!    `knot_spacing` at most ([`initial_times`]). At each: the
 //!    planned (s, v, a) and p, p′, p″ ([`TimedRun::motion`]); the joints
 //!    q = IK(p) nearest the previous point's; q′ and q″ in arc length by
 //!    central differences of the IK at the second-order Taylor points
@@ -37,6 +38,10 @@ pub const SPLIT_FRACTION: f64 = 0.8;
 
 /// Rounds of splitting before the run is given up.
 pub const MAX_SPLIT_ROUNDS: usize = 40;
+
+/// The largest uniform slowdown of a run: a run that needs more cannot be followed (an IK
+/// branch change or a singularity on the path), and is refused rather than crawled.
+pub const MAX_SLOWDOWN: f64 = 100.0;
 
 /// The largest step h of the IK's central differences \[m\].
 pub const DIFF_STEP: f64 = 1e-4;
@@ -196,6 +201,36 @@ pub fn piece_peaks(machine: &dyn Machine, a: &JointKnot, b: &JointKnot) -> [[f64
     })
 }
 
+/// The first times of a run's points: every start of a constant-jerk phase of its feed plan
+/// (so that no piece straddles a jump of the path jerk, which a quintic would overshoot; on a
+/// line a phase's motion is a cubic in time, which the quintic Hermite reproduces exactly),
+/// and between them a grid of at most `spacing`.
+fn initial_times(run: &TimedRun, spacing: f64, shortest: f64) -> Vec<f64> {
+    let duration = run.duration();
+    let mut bounds: Vec<f64> = vec![0.0];
+    for t in run.plan.phases.iter().map(|p| p.t0) {
+        // A phase shorter than `shortest` is straddled: a piece that short has enormous
+        // quintic coefficients (1/Δt⁵) for the rounding in its end states.
+        if t - bounds[bounds.len() - 1] >= shortest && duration - t >= shortest {
+            bounds.push(t);
+        }
+    }
+    bounds.push(duration);
+    let mut times = Vec::with_capacity(bounds.len() + (duration / spacing) as usize + 1);
+    for w in bounds.windows(2) {
+        let span = w[1] - w[0];
+        if span <= 0.0 {
+            continue;
+        }
+        let n = ((span / spacing).ceil() as usize).max(1);
+        for k in 0..n {
+            times.push(w[0] + span * k as f64 / n as f64);
+        }
+    }
+    times.push(duration);
+    times
+}
+
 /// The points of a run (module documentation).
 ///
 /// # Arguments
@@ -222,7 +257,6 @@ pub fn run_knots(
     max_points: usize,
     budget: &Budget,
 ) -> Result<RunKnots, GcodePlanError> {
-    let duration = run.duration();
     let unreachable = |t: f64, reason: String| {
         let p = run.motion(t).point;
         GcodePlanError::Unreachable {
@@ -233,14 +267,14 @@ pub fn run_knots(
             reason,
         }
     };
-    let n = ((duration / knot_spacing).ceil() as usize).max(1);
-    if n + 1 > max_points {
+    let times = initial_times(run, knot_spacing, 0.25 * control_period);
+    if times.len() > max_points {
         return Err(GcodePlanError::TooManyPoints { max: max_points });
     }
+    let n = times.len() - 1;
     let mut knots: Vec<JointKnot> = Vec::with_capacity(n + 1);
     let mut previous = reference.copied();
-    for k in 0..=n {
-        let t = duration * k as f64 / n as f64;
+    for (k, &t) in times.iter().enumerate() {
         let mut knot =
             knot_at(machine, run, t, previous.as_ref()).map_err(|e| unreachable(t, e))?;
         if k == 0 || k == n {
@@ -310,6 +344,15 @@ pub fn run_knots(
                 }
             }
         }
+    }
+    if !(ratio.is_finite() && ratio <= MAX_SLOWDOWN) {
+        return Err(GcodePlanError::NotExecutable {
+            reason: format!(
+                "line {line}: the {} of {} would need a slowdown of {ratio:.3e} \
+                 (more than {MAX_SLOWDOWN}): the joints cannot follow this path",
+                peak.what, peak.joint
+            ),
+        });
     }
     // 1e-9 above r: the scaled peaks land just inside the limits despite rounding.
     let slowdown = if ratio > 1.0 {

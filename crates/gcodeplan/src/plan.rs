@@ -123,6 +123,8 @@ pub struct GcodePlan {
     pub skipped_blocks: usize,
     /// What the user should know (a feed capped, a run slowed).
     pub warnings: Vec<String>,
+    /// Each run's smoothed path and feed plan (aligned with `runs`), for plots and checks.
+    pub timed: Vec<TimedRun>,
 }
 
 impl GcodePlan {
@@ -298,6 +300,7 @@ pub fn plan_program<R: BufRead>(
         refine(machine, &mut placed, &bad)?;
     };
     let peak_ratios = joint_peaks(machine, &placed);
+    let timed: Vec<TimedRun> = placed.into_iter().map(|p| p.timed).collect();
     let duration = trajectory.points.last().map_or(0.0, |p| p.time_from_start);
     Ok(GcodePlan {
         machine: machine.name().to_string(),
@@ -320,6 +323,7 @@ pub fn plan_program<R: BufRead>(
         zero_length_moves: reading.zero_length_moves,
         skipped_blocks: reading.skipped_blocks,
         warnings,
+        timed,
     })
 }
 

@@ -4,7 +4,7 @@
 use kerf_toolpath::{derivatives_at, FeedPlan, PathSample, SmoothedPath};
 
 /// A run smoothed, sampled and timed.
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, PartialEq)]
 pub struct TimedRun {
     /// The smoothed path, program frame.
     pub path: SmoothedPath,

@@ -2,7 +2,7 @@
 //! live in other crates than the planner nodes).
 
 use kerf_msgs::{
-    msg::{CutPlan, MillPlan},
+    msg::{CutPlan, GcodePlan, MillPlan},
     trajectory_msgs::JointTrajectory,
 };
 
@@ -44,3 +44,4 @@ macro_rules! plan_answer {
 
 plan_answer!(CutPlan, |_m| String::new());
 plan_answer!(MillPlan, |m| m.planner.clone());
+plan_answer!(GcodePlan, |m| m.method.clone());

@@ -1,0 +1,200 @@
+//! Messages to requests and plans to messages.
+
+use kerf_gcodeplan::{GcodePlan, GcodePlanError, GcodeRequest, LimitOverrides, RunKind};
+use kerf_msgs::msg;
+
+/// The status of a planner error.
+///
+/// | error | status |
+/// |---|---|
+/// | reader error, a path that cannot be smoothed, an empty program | PROGRAM_ERROR |
+/// | a point out of reach | UNREACHABLE |
+/// | a bad setting, too many points | INVALID_REQUEST |
+/// | the time budget ran out | TIMEOUT |
+/// | cancelled, not executable | INTERNAL_ERROR |
+pub fn status_of(e: &GcodePlanError) -> u8 {
+    match e {
+        GcodePlanError::Program(_) | GcodePlanError::Path { .. } | GcodePlanError::Empty { .. } => {
+            msg::GcodePlan::PROGRAM_ERROR
+        }
+        GcodePlanError::Unreachable { .. } => msg::GcodePlan::UNREACHABLE,
+        GcodePlanError::InvalidSetting { .. } | GcodePlanError::TooManyPoints { .. } => {
+            msg::GcodePlan::INVALID_REQUEST
+        }
+        GcodePlanError::Interrupted(kerf_budget::Interrupt::TimedOut { .. }) => {
+            msg::GcodePlan::TIMEOUT
+        }
+        GcodePlanError::Interrupted(_) | GcodePlanError::NotExecutable { .. } => {
+            msg::GcodePlan::INTERNAL_ERROR
+        }
+    }
+}
+
+/// The program line an error names (0 when none).
+pub fn error_line(e: &GcodePlanError) -> u32 {
+    let line = match e {
+        GcodePlanError::Program(g) => g.line(),
+        GcodePlanError::Path { line, .. } | GcodePlanError::Unreachable { line, .. } => *line,
+        _ => 0,
+    };
+    u32::try_from(line).unwrap_or(u32::MAX)
+}
+
+/// A request message as a [`GcodeRequest`]: empty strings and zeros are "not given" where
+/// the message says so; groups are read when their `has_*` flag is set.
+///
+/// # Errors
+/// [`GcodePlanError::InvalidSetting`] for both or neither of `program` and `program_uri`
+/// (checked again by the planner, named here for the message's field names).
+pub fn request_from_msg(m: &msg::GcodeRequest) -> Result<GcodeRequest, GcodePlanError> {
+    let given = |v: f64| if v == 0.0 { None } else { Some(v) };
+    let program = (!m.program.is_empty()).then(|| m.program.clone());
+    let program_file = (!m.program_uri.is_empty()).then(|| m.program_uri.clone());
+    if program.is_some() == program_file.is_some() {
+        return Err(GcodePlanError::InvalidSetting {
+            name: "program / program_uri".to_string(),
+            value: f64::NAN,
+            reason: "exactly one must be non-empty".to_string(),
+        });
+    }
+    Ok(GcodeRequest {
+        request_id: m.request_id.clone(),
+        machine: m.machine.clone(),
+        program,
+        program_file,
+        tolerance: given(m.tolerance),
+        method: (!m.method.is_empty()).then(|| m.method.clone()),
+        limits: m.has_limits.then_some(LimitOverrides {
+            max_feed: Some(m.max_feed),
+            tangential_acceleration: Some(m.tangential_acceleration),
+            tangential_jerk: Some(m.tangential_jerk),
+            normal_acceleration: Some(m.normal_acceleration),
+            normal_jerk: Some(m.normal_jerk),
+            chord_error: Some(m.chord_error),
+            contour_error: Some(m.contour_error),
+        }),
+        rapid_feed: given(m.rapid_feed),
+        origin: m
+            .has_placement
+            .then_some([m.origin.x, m.origin.y, m.origin.z]),
+        redundancy_angle: (m.has_placement && m.machine == msg::GcodeRequest::MACHINE_IRB6660)
+            .then_some(m.redundancy_angle),
+        standoff_axis: (m.has_placement && m.machine != msg::GcodeRequest::MACHINE_IRB6660)
+            .then_some(m.standoff_axis),
+        time_budget: given(m.time_budget),
+    })
+}
+
+/// The method named in an answer.
+pub fn method_name(request: &GcodeRequest) -> String {
+    request
+        .method
+        .clone()
+        .filter(|m| !m.is_empty())
+        .unwrap_or_else(|| msg::GcodeRequest::METHOD_KERF.to_string())
+}
+
+/// A `GcodePlan` that carries only the request id, machine, method, status and message.
+pub fn failure_msg(
+    request_id: &str,
+    machine: &str,
+    method: &str,
+    status: u8,
+    message: impl Into<String>,
+) -> msg::GcodePlan {
+    msg::GcodePlan {
+        request_id: request_id.to_string(),
+        status,
+        message: message.into(),
+        machine: machine.to_string(),
+        method: method.to_string(),
+        ..msg::GcodePlan::default()
+    }
+}
+
+/// The `GcodePlan` of a planner error.
+pub fn error_to_msg(request: &GcodeRequest, machine: &str, e: &GcodePlanError) -> msg::GcodePlan {
+    msg::GcodePlan {
+        error_line: error_line(e),
+        ..failure_msg(
+            &request.request_id,
+            machine,
+            &method_name(request),
+            status_of(e),
+            e.to_string(),
+        )
+    }
+}
+
+/// The one-line summary of a plan.
+pub fn success_message(plan: &GcodePlan) -> String {
+    let cuts = plan.runs.iter().filter(|r| r.kind == RunKind::Cut).count();
+    let mut text = format!(
+        "{} lines, {} runs ({cuts} cutting), {} points: {:.3} s ({:.3} s along the path, \
+         T_lb {:.3} s, ratio {:.3}), corners within {:.1} um, executed tip within {:.2} um of \
+         the plan (tolerance {:.1} um)",
+        plan.lines,
+        plan.runs.len(),
+        plan.trajectory.points.len(),
+        plan.duration,
+        plan.feed_time,
+        plan.lower_bound,
+        plan.lower_bound_ratio(),
+        plan.max_corner_deviation * 1e6,
+        plan.max_interpolation_deviation * 1e6,
+        plan.tolerance * 1e6,
+    );
+    if !plan.warnings.is_empty() {
+        text.push_str(&format!("; {} warnings", plan.warnings.len()));
+    }
+    text
+}
+
+/// The `GcodePlan` of a successful plan.
+///
+/// # Errors
+/// A sentence when the trajectory cannot be put in a message (a non-finite value).
+pub fn plan_to_msg(request: &GcodeRequest, plan: &GcodePlan) -> Result<msg::GcodePlan, String> {
+    let trajectory = kerf_ros::planner::trajectory_msg(&plan.trajectory)?;
+    let m = plan.cut_metrics();
+    let count = |n: usize| u32::try_from(n).unwrap_or(u32::MAX);
+    Ok(msg::GcodePlan {
+        request_id: request.request_id.clone(),
+        status: msg::GcodePlan::SUCCESS,
+        message: success_message(plan),
+        machine: plan.machine.clone(),
+        method: method_name(request),
+        trajectory,
+        error_line: 0,
+        machining_time: plan.duration,
+        feed_time: plan.feed_time,
+        lower_bound_time: plan.lower_bound,
+        lower_bound_ratio: plan.lower_bound_ratio(),
+        dwell_time: plan.dwell_time,
+        tolerance: plan.tolerance,
+        max_corner_deviation: plan.max_corner_deviation,
+        max_interpolation_deviation: plan.max_interpolation_deviation,
+        max_curvature: m.max_curvature,
+        max_turning_angle: m.max_turning_angle,
+        rms_acceleration: m.rms_acceleration,
+        rms_jerk: m.rms_jerk,
+        max_chord_error: m.max_chord_error,
+        max_contour_error: m.max_contour_error,
+        max_slowdown: plan.runs.iter().map(|r| r.slowdown).fold(1.0, f64::max),
+        lines: count(plan.lines),
+        runs: count(plan.runs.len()),
+        cut_runs: count(plan.runs.iter().filter(|r| r.kind == RunKind::Cut).count()),
+        corners: count(plan.runs.iter().map(|r| r.corners).sum()),
+        arcs: count(plan.arcs),
+        tool_events: plan
+            .events
+            .iter()
+            .map(|e| msg::GcodeToolEvent {
+                time: e.time,
+                on: e.on,
+                line: count(e.line),
+            })
+            .collect(),
+        warnings: plan.warnings.clone(),
+    })
+}

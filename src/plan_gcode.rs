@@ -1,0 +1,219 @@
+//! `kerf plan gcode`: plans one G-code program offline, without ROS (issue 14, item 6).
+//!
+//! ```sh
+//! kerf plan gcode FILE [--machine laser-cutter|irb6660] [--tolerance M] [--method kerf]
+//!                      [--g RAD] [--origin X,Y,Z] [--plots DIR] [--out plan.json]
+//! ```
+//!
+//! Reads the program as a stream (`-` reads standard input), plans it with
+//! [`kerf_gcodeplan::plan_request`] (the shipped machine) and prints the totals (time, T_lb
+//! and T/T_lb, tolerance use, seeds 000/003 metrics), a table of the runs, the tool switches
+//! and the warnings. `--out` writes the answer the `gcode_planner` node would publish
+//! (`kerf_msgs/msg/GcodePlan`, with its trajectory) as JSON. `--plots DIR` writes, per cutting
+//! run k, `run<k>_*.svg`: the path before and after smoothing, the feed along the path with its
+//! limit curve, chord error, normal acceleration and jerk, contour error, tangential
+//! acceleration and jerk (seed 000 Fig. 5, seed 003 Figs. 12-14).
+//!
+//! Exit code 0 on success; 2 on any failure (its status, line and message are printed).
+
+use std::io::Read;
+use std::path::PathBuf;
+
+use clap::{Args, ValueEnum};
+use kerf_budget::Budget;
+use kerf_gcodeplan::{plan_request, GcodePlan, GcodeRequest, MachineBase, MachineKind, RunKind};
+use kerf_msgs::msg::GcodePlan as GcodePlanMsg;
+
+/// The machines, as named in requests.
+#[derive(Debug, Clone, Copy, ValueEnum)]
+pub enum MachineArg {
+    /// The laser cutter of seed 001 over a flat sheet.
+    #[value(name = "laser-cutter", alias = "laser_cutter")]
+    LaserCutter,
+    /// The IRB 6660 milling cell of seed 004.
+    Irb6660,
+}
+
+/// Arguments of `kerf plan gcode`.
+#[derive(Args, Debug)]
+pub struct GcodeArgs {
+    /// The program (G-code); `-` reads standard input.
+    file: PathBuf,
+    /// The machine.
+    #[arg(long, value_enum, default_value = "laser-cutter")]
+    machine: MachineArg,
+    /// Largest distance of the executed tool tip from the programmed path (m).
+    #[arg(long)]
+    tolerance: Option<f64>,
+    /// Corner smoothing method.
+    #[arg(long)]
+    method: Option<String>,
+    /// IRB 6660: the redundancy angle g about the tool axis (rad).
+    #[arg(long, allow_hyphen_values = true)]
+    g: Option<f64>,
+    /// The program's zero in the machine's base frame, `x,y,z` (m).
+    #[arg(long, value_delimiter = ',', num_args = 3, allow_hyphen_values = true)]
+    origin: Option<Vec<f64>>,
+    /// Write the plots here.
+    #[arg(long)]
+    plots: Option<PathBuf>,
+    /// Write the answer (kerf_msgs/msg/GcodePlan) as JSON here.
+    #[arg(long)]
+    out: Option<PathBuf>,
+}
+
+/// Runs `kerf plan gcode`.
+///
+/// # Errors
+/// The message to print; the caller exits with [`crate::EXIT_FAILURE`].
+pub fn run(a: GcodeArgs) -> Result<(), String> {
+    if let Some(out) = &a.out {
+        crate::output_paths::check_writable("--out", out)?;
+    }
+    if let Some(dir) = &a.plots {
+        crate::output_paths::check_dir_writable("--plots", dir)?;
+    }
+    let kind = match a.machine {
+        MachineArg::LaserCutter => MachineKind::LaserCutter,
+        MachineArg::Irb6660 => MachineKind::Irb6660,
+    };
+    let (program, program_file) = if a.file.as_os_str() == "-" {
+        let mut text = String::new();
+        std::io::stdin()
+            .read_to_string(&mut text)
+            .map_err(|e| format!("cannot read standard input: {e}"))?;
+        (Some(text), None)
+    } else {
+        (None, Some(a.file.display().to_string()))
+    };
+    let request = GcodeRequest {
+        request_id: a.file.display().to_string(),
+        machine: kind.name().to_string(),
+        program,
+        program_file,
+        tolerance: a.tolerance,
+        method: a.method.clone(),
+        origin: a.origin.as_ref().map(|o| [o[0], o[1], o[2]]),
+        redundancy_angle: a.g,
+        ..GcodeRequest::default()
+    };
+    let base = MachineBase::load(kind).map_err(|e| e.to_string())?;
+    let started = std::time::Instant::now();
+    let plan = plan_request(&request, &base, &Budget::unlimited()).map_err(|e| {
+        let status = kerf_gcode_planner::convert::status_of(&e);
+        let name = GcodePlanMsg::status_name(status).unwrap_or("?");
+        format!("{name} ({status}): {e}")
+    })?;
+    let took = started.elapsed().as_secs_f64();
+    print!("{}", summary(&plan, took));
+    if let Some(out) = &a.out {
+        let m = kerf_gcode_planner::convert::plan_to_msg(&request, &plan)?;
+        let json = serde_json::to_string_pretty(&m)
+            .map_err(|e| format!("cannot serialize the plan: {e}"))?;
+        std::fs::write(out, json).map_err(|e| format!("cannot write {}: {e}", out.display()))?;
+        println!("plan written to {}", out.display());
+    }
+    if let Some(dir) = &a.plots {
+        let settings = request.settings().map_err(|e| e.to_string())?;
+        let mut files = 0;
+        for (k, (report, timed)) in plan.runs.iter().zip(&plan.timed).enumerate() {
+            if report.kind != RunKind::Cut {
+                continue;
+            }
+            let mut limits = settings.limits;
+            limits.curvature.feed = report.feed;
+            let period = limits.curvature.interpolation_period;
+            let feed = timed.plan.sample(period);
+            let plots =
+                kerf_toolpath::pipeline_plots(&timed.path, &timed.samples, &feed, &limits, period)
+                    .map_err(|e| format!("run {k}: plots: {e}"))?;
+            for (name, svg) in plots {
+                let path = dir.join(format!("run{k}_{name}"));
+                std::fs::write(&path, svg)
+                    .map_err(|e| format!("cannot write {}: {e}", path.display()))?;
+                files += 1;
+            }
+        }
+        println!("{files} plots written to {}", dir.display());
+    }
+    Ok(())
+}
+
+/// The printed summary.
+fn summary(plan: &GcodePlan, took: f64) -> String {
+    use std::fmt::Write;
+    let mut s = String::new();
+    let m = plan.cut_metrics();
+    let _ = writeln!(
+        s,
+        "{}: {} lines, {} arcs, {} runs, {} trajectory points, planned in {:.3} s",
+        plan.machine,
+        plan.lines,
+        plan.arcs,
+        plan.runs.len(),
+        plan.trajectory.points.len(),
+        took
+    );
+    let _ = writeln!(
+        s,
+        "time {:.3} s: along the path T_m {:.3} s, T_lb {:.3} s, T_m/T_lb {:.3}; dwell {:.3} s",
+        plan.duration,
+        plan.feed_time,
+        plan.lower_bound,
+        plan.lower_bound_ratio(),
+        plan.dwell_time
+    );
+    let _ = writeln!(
+        s,
+        "tolerance {:.1} um: corners within {:.2} um, executed tip within {:.3} um of the plan",
+        plan.tolerance * 1e6,
+        plan.max_corner_deviation * 1e6,
+        plan.max_interpolation_deviation * 1e6
+    );
+    let _ = writeln!(
+        s,
+        "cutting: kappa_max {:.1} 1/m, theta_max {:.4} rad, a_rms {:.4} m/s^2, j_rms {:.2} m/s^3, \
+         chord error {:.3} um, contour error {:.3} um",
+        m.max_curvature,
+        m.max_turning_angle,
+        m.rms_acceleration,
+        m.rms_jerk,
+        m.max_chord_error * 1e6,
+        m.max_contour_error * 1e6
+    );
+    let _ = writeln!(
+        s,
+        "{:>4} {:>7} {:>13} {:>8} {:>10} {:>9} {:>9} {:>9} {:>8}  binding",
+        "run", "kind", "lines", "corners", "length [m]", "F [m/s]", "T_m [s]", "T_lb [s]", "slowed"
+    );
+    for (k, r) in plan.runs.iter().enumerate() {
+        let _ = writeln!(
+            s,
+            "{k:>4} {:>7} {:>13} {:>8} {:>10.4} {:>9.4} {:>9.3} {:>9.3} {:>8.3}  {} {} at {:.2}",
+            r.kind.name(),
+            format!("{}-{}", r.lines.0, r.lines.1),
+            r.corners,
+            r.length,
+            r.feed,
+            r.feed_time,
+            r.lower_bound,
+            r.slowdown,
+            r.peak.joint,
+            r.peak.what,
+            r.peak.ratio
+        );
+    }
+    for e in &plan.events {
+        let _ = writeln!(
+            s,
+            "line {}: tool {} at {:.3} s",
+            e.line,
+            if e.on { "on" } else { "off" },
+            e.time
+        );
+    }
+    for w in &plan.warnings {
+        let _ = writeln!(s, "warning: {w}");
+    }
+    s
+}
