@@ -171,6 +171,17 @@ fn direction(a: [f64; 3], b: [f64; 3]) -> ([f64; 3], f64) {
     (scale(d, 1.0 / l), l)
 }
 
+/// A corner's incoming and outgoing unit directions and turning angle.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct CornerFrame {
+    /// t₁.
+    pub t1: [f64; 3],
+    /// t₂.
+    pub t2: [f64; 3],
+    /// θ \[rad\].
+    pub turn: f64,
+}
+
 /// The checks every corner method shares, and the corner's directions.
 ///
 /// # Returns
@@ -185,7 +196,7 @@ pub(crate) fn corner_frame(
     next: [f64; 3],
     tolerance: f64,
     available: f64,
-) -> Result<Option<([f64; 3], [f64; 3], f64)>, ToolpathError> {
+) -> Result<Option<CornerFrame>, ToolpathError> {
     check_positive(&[
         ("tolerance [m]", tolerance),
         ("available length [m]", available),
@@ -211,7 +222,7 @@ pub(crate) fn corner_frame(
                 .to_string(),
         });
     }
-    Ok(Some((t1, t2, turn)))
+    Ok(Some(CornerFrame { t1, t2, turn }))
 }
 
 /// The transition at the corner `prev` → `vertex` → `next`.
@@ -242,7 +253,9 @@ pub fn corner_transition(
     tolerance: f64,
     available: f64,
 ) -> Result<Option<CornerTransition>, ToolpathError> {
-    let Some((t1, t2, turn)) = corner_frame(prev, vertex, next, tolerance, available)? else {
+    let Some(CornerFrame { t1, t2, turn }) =
+        corner_frame(prev, vertex, next, tolerance, available)?
+    else {
         return Ok(None);
     };
     let mut best: Option<CornerTransition> = None;

@@ -7,6 +7,9 @@ use crate::spline::CubicSpline;
 
 /// The curve of a corner transition.
 #[derive(Debug, Clone, Copy, PartialEq)]
+// A spline is 400 bytes, a quintic 144: boxing would cost an allocation per
+// corner and the pieces' Copy, for one value per corner.
+#[allow(clippy::large_enum_variant)]
 pub enum CornerCurve {
     /// kerf's symmetric quintic ([`crate::corner`]).
     Quintic(QuinticBezier),

@@ -15,6 +15,9 @@ pub const JOIN_GAP: f64 = 1e-12;
 
 /// One piece of a smoothed path.
 #[derive(Debug, Clone, Copy, PartialEq)]
+// A corner is about 500 bytes with a baseline's spline, a line 48: boxing
+// would cost an allocation per corner and the pieces' Copy.
+#[allow(clippy::large_enum_variant)]
 pub enum Piece {
     /// A straight piece.
     Line {
@@ -183,18 +186,18 @@ pub fn smooth_polyline_with(
                 available,
                 v,
             )
-        .map_err(|e| match e {
-            ToolpathError::InvalidParameter {
-                name,
-                value,
-                reason,
-            } => ToolpathError::InvalidParameter {
-                name: format!("corner at point {v}: {name}"),
-                value,
-                reason,
-            },
-            other => other,
-        })? {
+            .map_err(|e| match e {
+                ToolpathError::InvalidParameter {
+                    name,
+                    value,
+                    reason,
+                } => ToolpathError::InvalidParameter {
+                    name: format!("corner at point {v}: {name}"),
+                    value,
+                    reason,
+                },
+                other => other,
+            })? {
             None => {}
             Some(c) => {
                 let start = c.curve.start();

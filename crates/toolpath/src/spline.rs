@@ -19,10 +19,16 @@
 
 use crate::error::ToolpathError;
 use crate::quadrature::gauss_legendre_8;
-use crate::vec3::{cross, norm, scale};
+use crate::vec3::{add, cross, norm, scale, sub};
 
 /// The most control points of a [`CubicSpline`].
 pub const MAX_CONTROL: usize = 9;
+
+/// Below this sine of the angle between C′ and C″ the curvature is
+/// rounding, reported as 0 (a genuine corner with θ ≥
+/// [`crate::corner::MIN_TURN`] stays far above it except within ~1e-10 of
+/// its ends).
+pub const ROUNDING_SINE: f64 = 1e-10;
 
 /// The degree.
 const P: usize = 3;
@@ -60,7 +66,11 @@ impl CubicSpline {
         };
         let n = control.len();
         if !(P + 1..=MAX_CONTROL).contains(&n) {
-            return Err(bad("control points", n as f64, "a cubic spline needs 4 to 9"));
+            return Err(bad(
+                "control points",
+                n as f64,
+                "a cubic spline needs 4 to 9",
+            ));
         }
         if weights.len() != n || knots.len() != n + P + 1 {
             return Err(bad(
@@ -78,8 +88,8 @@ impl CubicSpline {
         let clamped = knots[..=P].iter().all(|k| *k == 0.0) && knots[n..].iter().all(|k| *k == 1.0);
         let increasing = knots.windows(2).all(|w| w[0] <= w[1]);
         let inner = &knots[P + 1..n];
-        let inner_ok = inner.iter().all(|k| *k > 0.0 && *k < 1.0)
-            && inner.windows(P + 1).all(|w| w[0] < w[P]);
+        let inner_ok =
+            inner.iter().all(|k| *k > 0.0 && *k < 1.0) && inner.windows(P + 1).all(|w| w[0] < w[P]);
         if !(clamped && increasing && inner_ok) {
             return Err(bad(
                 "knot vector",
@@ -161,27 +171,30 @@ impl CubicSpline {
         for (j, d) in d1_q2.iter_mut().enumerate().take(3) {
             *d = d_lower(2, &table[1], j);
         }
-        let mut out = [[0.0; P + 1]; 3];
-        out[0] = table[P];
-        for j in 0..=P {
-            out[1][j] = d_lower(P, &table[P - 1], j);
-            // N″_{i,3} from N′_{·,2} (seed 003 eq. 4).
-            out[2][j] = d_lower(P, &d1_q2, j);
-        }
-        (k - P, out)
+        let first: [f64; P + 1] = std::array::from_fn(|j| d_lower(P, &table[P - 1], j));
+        // N″_{i,3} from N′_{·,2} (seed 003 eq. 4).
+        let second: [f64; P + 1] = std::array::from_fn(|j| d_lower(P, &d1_q2, j));
+        (k - P, [table[P], first, second])
     }
 
     /// C, C′ and C″ at u.
     fn derivatives(&self, u: f64) -> [[f64; 3]; 3] {
         let (first, b) = self.basis(u);
+        // Relative to the span's first control point: smaller coordinates,
+        // less rounding in the derivatives.
+        let origin = self.control[first];
         let mut a = [[0.0; 3]; 3];
         let mut w = [0.0; 3];
-        for j in 0..=P {
-            let (p, wi) = (self.control[first + j], self.weights[first + j]);
-            for d in 0..3 {
-                w[d] += b[d][j] * wi;
-                for x in 0..3 {
-                    a[d][x] += b[d][j] * wi * p[x];
+        for (j, (p, wi)) in self.control[first..=first + P]
+            .iter()
+            .zip(&self.weights[first..=first + P])
+            .enumerate()
+        {
+            let p = sub(*p, origin);
+            for ((ad, wd), bd) in a.iter_mut().zip(w.iter_mut()).zip(&b) {
+                *wd += bd[j] * wi;
+                for (ax, px) in ad.iter_mut().zip(p) {
+                    *ax += bd[j] * wi * px;
                 }
             }
         }
@@ -189,7 +202,7 @@ impl CubicSpline {
         let c1: [f64; 3] = std::array::from_fn(|x| (a[1][x] - w[1] * c[x]) / w[0]);
         let c2: [f64; 3] =
             std::array::from_fn(|x| (a[2][x] - 2.0 * w[1] * c1[x] - w[2] * c[x]) / w[0]);
-        [c, c1, c2]
+        [add(c, origin), c1, c2]
     }
 
     /// The point at u ∈ [0, 1].
@@ -207,14 +220,17 @@ impl CubicSpline {
         self.derivatives(u)[2]
     }
 
-    /// The curvature at u; 0 where C′ = 0.
+    /// The curvature at u; 0 where C′ = 0, and 0 where |C′ × C″| is below
+    /// [`ROUNDING_SINE`] |C′| |C″| (at a G2 end, where three control points
+    /// lie on the line, rounding leaves ~1e-14 1/m instead of 0).
     pub fn curvature(&self, u: f64) -> f64 {
         let [_, d1, d2] = self.derivatives(u);
         let speed = norm(d1);
-        if speed == 0.0 {
+        let area = norm(cross(d1, d2));
+        if speed == 0.0 || area <= ROUNDING_SINE * speed * norm(d2) {
             return 0.0;
         }
-        norm(cross(d1, d2)) / (speed * speed * speed)
+        area / (speed * speed * speed)
     }
 
     /// The arc length between `u0` and `u1` \[m\]: 8-point Gauss–Legendre

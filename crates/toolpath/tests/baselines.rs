@@ -7,8 +7,8 @@ use kerf_gcode::{read_points, PointUnit};
 use kerf_toolpath::baseline::{ccr, icr, nurbs};
 use kerf_toolpath::vec3::{cross, distance_to_segment, dot, norm, sub};
 use kerf_toolpath::{
-    smooth_polyline, smooth_polyline_with, CornerMethod, CubicSpline, NurbsSettings,
-    Piece, SmoothedPath, ToolpathError,
+    smooth_polyline, smooth_polyline_with, CornerMethod, CubicSpline, NurbsSettings, Piece,
+    SmoothedPath, ToolpathError,
 };
 
 /// A smaller swarm than the default, to keep the outline tests short.
@@ -68,16 +68,20 @@ fn the_basis_constants_of_the_deviation_formulas_are_the_splines() {
         let s = CubicSpline::new(&vec![[0.0; 3]; n], &vec![1.0; n], knots).unwrap();
         let (first, b) = s.basis(0.5);
         let mut full = vec![0.0; n];
-        for j in 0..4 {
-            full[first + j] = b[0][j];
-        }
+        full[first..first + 4].copy_from_slice(&b[0]);
         full
     };
     let icr_half = at_half(&icr::KNOTS);
-    assert!((icr_half[3] - icr::MID_WEIGHT).abs() < 1e-15, "{icr_half:?}");
+    assert!(
+        (icr_half[3] - icr::MID_WEIGHT).abs() < 1e-15,
+        "{icr_half:?}"
+    );
     assert!((icr_half[2] - 0.5).abs() < 1e-15 && (icr_half[1] - 0.25).abs() < 1e-15);
     let nurbs_half = at_half(&nurbs::KNOTS);
-    assert!((nurbs_half[2] - nurbs::SIDE_WEIGHT).abs() < 1e-15, "{nurbs_half:?}");
+    assert!(
+        (nurbs_half[2] - nurbs::SIDE_WEIGHT).abs() < 1e-15,
+        "{nurbs_half:?}"
+    );
     assert!((nurbs_half[3] - nurbs::CENTRE_WEIGHT).abs() < 1e-15);
     assert!((nurbs_half[4] - nurbs::SIDE_WEIGHT).abs() < 1e-15);
     // CCR's PEAK: the largest N₃ on ICR's knots, by dense sampling.
@@ -236,7 +240,10 @@ fn curvature_is_finite_and_matches_finite_differences() {
                     "{name} {deg} u {u}: {fd} vs {kappa}"
                 );
                 let exact = curve.d1(u);
-                assert!(norm(sub(exact, d1)) <= 1e-6 * norm(exact), "{name} {deg} u {u}");
+                assert!(
+                    norm(sub(exact, d1)) <= 1e-6 * norm(exact),
+                    "{name} {deg} u {u}"
+                );
                 sampled = sampled.max(kappa);
             }
             // The stated largest curvature is the curve's (sampled, refined).
@@ -265,11 +272,7 @@ fn the_swarm_is_deterministic_and_optimizes() {
     let a = smooth_polyline_with(points, 1e-4, &method).unwrap();
     let b = smooth_polyline_with(points, 1e-4, &method).unwrap();
     let bits = |p: &SmoothedPath| -> Vec<u64> {
-        p.sample(16)
-            .iter()
-            .flatten()
-            .map(|x| x.to_bits())
-            .collect()
+        p.sample(16).iter().flatten().map(|x| x.to_bits()).collect()
     };
     assert_eq!(bits(&a), bits(&b));
     assert_eq!(a, b);
@@ -278,7 +281,10 @@ fn the_swarm_is_deterministic_and_optimizes() {
         seed: 7,
         ..quick_swarm()
     });
-    assert_ne!(bits(&a), bits(&smooth_polyline_with(points, 1e-4, &other).unwrap()));
+    assert_ne!(
+        bits(&a),
+        bits(&smooth_polyline_with(points, 1e-4, &other).unwrap())
+    );
     // More iterations of the same stream can only lower the optimum, and do.
     let [p, v, n] = corner_points(90.0);
     let kappa = |iterations| {
@@ -299,7 +305,11 @@ fn the_swarm_is_deterministic_and_optimizes() {
         short.max_curvature
     );
     // The weight solves eq. 7's last line: the deviation is δ where the tolerance binds.
-    assert!((long.deviation - 1e-4).abs() <= 1e-12 * 1e-4, "{}", long.deviation);
+    assert!(
+        (long.deviation - 1e-4).abs() <= 1e-12 * 1e-4,
+        "{}",
+        long.deviation
+    );
 }
 
 #[test]
@@ -334,15 +344,64 @@ fn bad_input_is_refused_by_name() {
     }
     let base = NurbsSettings::default();
     let bad = [
-        ("particles", NurbsSettings { particles: 1, ..base }),
-        ("iterations", NurbsSettings { iterations: 0, ..base }),
-        ("inertia", NurbsSettings { inertia: 1.0, ..base }),
-        ("inertia", NurbsSettings { inertia: f64::NAN, ..base }),
-        ("c1", NurbsSettings { c1: f64::INFINITY, ..base }),
+        (
+            "particles",
+            NurbsSettings {
+                particles: 1,
+                ..base
+            },
+        ),
+        (
+            "iterations",
+            NurbsSettings {
+                iterations: 0,
+                ..base
+            },
+        ),
+        (
+            "inertia",
+            NurbsSettings {
+                inertia: 1.0,
+                ..base
+            },
+        ),
+        (
+            "inertia",
+            NurbsSettings {
+                inertia: f64::NAN,
+                ..base
+            },
+        ),
+        (
+            "c1",
+            NurbsSettings {
+                c1: f64::INFINITY,
+                ..base
+            },
+        ),
         ("c3", NurbsSettings { c3: -0.1, ..base }),
-        ("c1 + c2", NurbsSettings { c1: 0.0, c2: 0.0, ..base }),
-        ("min_weight", NurbsSettings { min_weight: 0.0, ..base }),
-        ("max_weight", NurbsSettings { max_weight: 0.005, ..base }),
+        (
+            "c1 + c2",
+            NurbsSettings {
+                c1: 0.0,
+                c2: 0.0,
+                ..base
+            },
+        ),
+        (
+            "min_weight",
+            NurbsSettings {
+                min_weight: 0.0,
+                ..base
+            },
+        ),
+        (
+            "max_weight",
+            NurbsSettings {
+                max_weight: 0.005,
+                ..base
+            },
+        ),
     ];
     for (name, settings) in bad {
         // Refused even on a path without a corner.

@@ -86,20 +86,21 @@ impl CornerMethod {
         index: usize,
     ) -> Result<Option<CornerTransition>, ToolpathError> {
         self.check()?;
-        let framed = |build: &dyn Fn([f64; 3], [f64; 3], f64) -> Result<CornerTransition, ToolpathError>| {
-            match corner_frame(prev, vertex, next, tolerance, available)? {
-                None => Ok(None),
-                Some((t1, t2, turn)) => build(t1, t2, turn).map(Some),
-            }
-        };
+        let framed =
+            |build: &dyn Fn([f64; 3], [f64; 3], f64) -> Result<CornerTransition, ToolpathError>| {
+                match corner_frame(prev, vertex, next, tolerance, available)? {
+                    None => Ok(None),
+                    Some(f) => build(f.t1, f.t2, f.turn).map(Some),
+                }
+            };
         match self {
             CornerMethod::Kerf => corner_transition(prev, vertex, next, tolerance, available),
-            CornerMethod::Icr => framed(&|t1, t2, turn| {
-                icr::transition(vertex, t1, t2, turn, tolerance, available)
-            }),
-            CornerMethod::Ccr => framed(&|t1, t2, turn| {
-                ccr::transition(vertex, t1, t2, turn, tolerance, available)
-            }),
+            CornerMethod::Icr => {
+                framed(&|t1, t2, turn| icr::transition(vertex, t1, t2, turn, tolerance, available))
+            }
+            CornerMethod::Ccr => {
+                framed(&|t1, t2, turn| ccr::transition(vertex, t1, t2, turn, tolerance, available))
+            }
             CornerMethod::Nurbs(s) => framed(&|t1, t2, turn| {
                 nurbs::transition(vertex, t1, t2, turn, tolerance, available, s, index)
             }),

@@ -138,31 +138,51 @@ impl NurbsSettings {
             }
         }
         if self.c1 + self.c2 <= 0.0 {
-            return bad("c1 + c2", self.c1 + self.c2, "must be > 0 (else nothing moves)");
+            return bad(
+                "c1 + c2",
+                self.c1 + self.c2,
+                "must be > 0 (else nothing moves)",
+            );
         }
         if !(self.min_weight.is_finite() && self.min_weight > 0.0) {
             return bad("min_weight", self.min_weight, "must be finite and > 0");
         }
         if !(self.max_weight.is_finite() && self.max_weight > self.min_weight) {
-            return bad("max_weight", self.max_weight, "must be finite and > min_weight");
+            return bad(
+                "max_weight",
+                self.max_weight,
+                "must be finite and > min_weight",
+            );
         }
         Ok(())
     }
 }
 
-/// The corner's geometry for the swarm's variables x = (ℓ / available, α,
-/// β): the curve, its weight and its deviation, or `None` if infeasible
-/// (the weight needed for δ exceeds `max_weight`).
-fn candidate(
+/// One corner's data for the swarm.
+#[derive(Clone, Copy)]
+struct Corner<'a> {
     v: [f64; 3],
     t1: [f64; 3],
     t2: [f64; 3],
     sin_turn: f64,
     tolerance: f64,
     available: f64,
-    settings: &NurbsSettings,
-    x: &[f64; 3],
-) -> Option<(CubicSpline, f64, f64, f64)> {
+    settings: &'a NurbsSettings,
+}
+
+/// The corner's geometry for the swarm's variables x = (ℓ / available, α,
+/// β): the curve, its weight and its deviation, or `None` if infeasible
+/// (the weight needed for δ exceeds `max_weight`).
+fn candidate(corner: &Corner, x: &[f64; 3]) -> Option<(CubicSpline, f64, f64, f64)> {
+    let Corner {
+        v,
+        t1,
+        t2,
+        sin_turn,
+        tolerance,
+        available,
+        settings,
+    } = *corner;
     let l = x[0] * available;
     let (outer, inner) = (x[1] * l, x[2] * x[1] * l);
     let needed = SIDE_WEIGHT * (inner * sin_turn / tolerance - 2.0) / CENTRE_WEIGHT;
@@ -205,17 +225,23 @@ pub fn transition(
     settings: &NurbsSettings,
     index: usize,
 ) -> Result<CornerTransition, ToolpathError> {
-    let sin_turn = turn.sin();
-    let objective = |x: &[f64; 3]| {
-        match candidate(v, t1, t2, sin_turn, tolerance, available, settings, x) {
-            Some((c, ..)) => {
-                let c = CornerCurve::Spline(c);
-                (0..=OBJECTIVE_SAMPLES)
-                    .map(|k| c.curvature(0.5 * k as f64 / OBJECTIVE_SAMPLES as f64))
-                    .fold(0.0, f64::max)
-            }
-            None => f64::INFINITY,
+    let corner = Corner {
+        v,
+        t1,
+        t2,
+        sin_turn: turn.sin(),
+        tolerance,
+        available,
+        settings,
+    };
+    let objective = |x: &[f64; 3]| match candidate(&corner, x) {
+        Some((c, ..)) => {
+            let c = CornerCurve::Spline(c);
+            (0..=OBJECTIVE_SAMPLES)
+                .map(|k| c.curvature(0.5 * k as f64 / OBJECTIVE_SAMPLES as f64))
+                .fold(0.0, f64::max)
         }
+        None => f64::INFINITY,
     };
     let swarm = Swarm {
         particles: settings.particles,
@@ -227,7 +253,7 @@ pub fn transition(
     };
     let seed = settings.seed ^ (index as u64).wrapping_mul(0x9e37_79b9_7f4a_7c15);
     let (x, value) = minimize(objective, LOWER, UPPER, &swarm, seed);
-    let found = candidate(v, t1, t2, sin_turn, tolerance, available, settings, &x);
+    let found = candidate(&corner, &x);
     let (curve, w, deviation, l) = match found {
         Some(f) if value.is_finite() => f,
         _ => {
