@@ -2,18 +2,14 @@
 //! [`MAX_CONTROL`] control points: the curves of the corner baselines
 //! ([`crate::baseline`]).
 //!
-//! Formulas (Piegl and Tiller, "The NURBS Book", 2nd ed., 1997, and seed
-//! 003 which restates them):
-//! * the curve C(u) = Σ Nᵢ,₃(u) wᵢ Pᵢ / Σ Nᵢ,₃(u) wᵢ (seed 003 eq. 1; Piegl
-//!   and Tiller eq. 4.2);
-//! * the basis by the Cox–de Boor recursion with 0/0 = 0 (seed 003 eq. 2;
-//!   Piegl and Tiller eq. 2.5);
-//! * its first and second derivatives (seed 003 eqs. 3–4; Piegl and Tiller
-//!   eq. 2.7);
+//! Formulas (seed 003's equation numbers; the same in Piegl and Tiller,
+//! "The NURBS Book", 2nd ed., 1997, sections 2.2–2.3 and 4.2–4.3):
+//! * the curve C(u) = Σ Nᵢ,₃(u) wᵢ Pᵢ / Σ Nᵢ,₃(u) wᵢ (eq. 1);
+//! * the basis by the Cox–de Boor recursion with 0/0 = 0 (eq. 2);
+//! * its first and second derivatives (eqs. 3–4);
 //! * the curve's derivatives from those of A(u) = Σ Nᵢ wᵢ Pᵢ and
 //!   W(u) = Σ Nᵢ wᵢ: C′ = (A′ − W′ C) / W and C″ = (A″ − 2 W′ C′ − W″ C) /
-//!   W (seed 003 eq. 5 and the unnumbered one after it; Piegl and Tiller
-//!   eq. 4.8);
+//!   W (eq. 5 and the unnumbered one after it);
 //! * the curvature κ = |C′ × C″| / |C′|³ (the inverse of seed 003 eq. 6,
 //!   which gives the radius).
 

@@ -6,9 +6,10 @@
 //! # Reading
 //! Seed 000 only names the method ("inserting transition curves using
 //! double cubic B-splines at junctions"). Our reading of Xu and Sun's
-//! construction (written from its known description, not from their
-//! text): the transition passes through the vertex V ("circumscribed": it
-//! runs outside the corner), made of two cubic B-splines mirror-symmetric
+//! construction (written from its published description, not from their
+//! text, which we could not consult; no equation of theirs is cited): the
+//! transition passes through the vertex V ("circumscribed": it runs
+//! outside the corner), made of two cubic B-splines mirror-symmetric
 //! about the corner's bisector, each with five control points and knots
 //! {0, 0, 0, 0, ½, 1, 1, 1, 1}. With m = (t₁ + t₂)/|t₁ + t₂| the tangent at
 //! V and spacing d, the first is

@@ -5,8 +5,9 @@
 //!
 //! # Reading
 //! Seed 000 only names the method ("curvature-continuous B-splines with G2
-//! continuity"). This is our reading of Zhao et al.'s transition (their
-//! section 3, written from its known description, not from their text): a
+//! continuity"). This is our reading of Zhao et al.'s transition
+//! (written from its published description, not from their text, which we
+//! could not consult; equation numbers of theirs are therefore not cited): a
 //! cubic B-spline with five control points and knots {0, 0, 0, 0, ½, 1, 1,
 //! 1, 1}, the vertex V the middle one, two on each segment at equal
 //! spacing d:
@@ -24,7 +25,7 @@
 //! distance to the incoming line is the B-spline of the control points'
 //! distances (0, 0, 0, d sin θ, 2d sin θ), non-decreasing, hence
 //! non-decreasing in u (variation diminishing, Piegl and Tiller section
-//! 2.3); the foot's coordinate along −t₁ from V is the spline of (2d, d,
+//! 3.2); the foot's coordinate along −t₁ from V is the spline of (2d, d,
 //! 0, −d cos θ, −2d cos θ): at u ≤ ½ it is ≥ (d/4)(1 − cos θ) ≥ 0 and ≤ 2d,
 //! so the foot lies on the incoming segment. As for kerf's corner, the
 //! distance from the polyline is then largest at u = ½:

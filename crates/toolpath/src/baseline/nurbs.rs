@@ -17,6 +17,16 @@
 //! Pᵢ₊₄, fits a cubic with a simple knot at ½ and we take the inner knots
 //! uniform.
 //!
+//! What the extraction gets wrong, checked: eq. 7 lists
+//! `Pᵢ,ₓ < Pᵢ₊₄,ₓ < Pᵢ₊₁,ₓ` twice (the second must be the y bound); its
+//! prose asks the angles at Pᵢ₋₁ and Pᵢ₊₃ to be "smaller than" the angle
+//! at Pᵢ where eq. 7 writes ">" (as interior angles ">" is the one that
+//! puts the largest turn at the vertex, which we follow); eq. 6 is the
+//! radius, not the curvature. Table 2's "92.7 %" for corner b is
+//! (27.06 − 14.04) / 14.04, relative to the optimized value: the reduction
+//! is 48.1 %, and case 1's "maximum reduction of up to 92.7 %" should
+//! read 48.1 %.
+//!
 //! Departures from the paper, each stated:
 //! * eq. 7 lets Pᵢ₊₃ anywhere in the box between Pᵢ₋₁ and Pᵢ; off the
 //!   incoming line the curve's curvature at its start is not zero (κ(0) ∝
