@@ -3,12 +3,14 @@
 //! pieces that chain, curvature against finite differences, determinism of the swarm, bad input.
 #![allow(clippy::unwrap_used, clippy::expect_used)] // tests report failures by panicking
 
+mod support;
+
 use kerf_gcode::{read_points, PointUnit};
 use kerf_toolpath::baseline::{ccr, icr, nurbs};
 use kerf_toolpath::vec3::{cross, distance_to_segment, dot, norm, sub};
 use kerf_toolpath::{
-    smooth_polyline, smooth_polyline_with, CornerMethod, CubicSpline, NurbsSettings, Piece,
-    SmoothedPath, ToolpathError,
+    derivatives_at, plan_feed, point_at, sample_path, smooth_polyline, smooth_polyline_with,
+    CornerMethod, CubicSpline, NurbsSettings, Piece, SmoothedPath, ToolpathError,
 };
 
 /// A smaller swarm than the default, to keep the outline tests short.
@@ -421,4 +423,75 @@ fn bad_input_is_refused_by_name() {
     assert!(CubicSpline::new(&[[0.0; 3]; 5], &[1.0, 1.0, 0.0, 1.0, 1.0], &icr::KNOTS).is_err());
     let unclamped = [0.0, 0.0, 0.0, 0.1, 0.5, 1.0, 1.0, 1.0, 1.0];
     assert!(CubicSpline::new(&[[0.0; 3]; 5], &[1.0; 5], &unclamped).is_err());
+}
+
+#[test]
+fn every_method_runs_through_sampling_and_the_feed_plan() {
+    // The butterfly's hairpins with seed 003's limits: every corner's samples must give the
+    // planner a positive speed (a CCR end sample once had κ ~ 1e-14 1/m from rounding, where
+    // the contour-error speed of seed 003 eq. 17 cancels to 0).
+    let points = &outlines()[0].1;
+    for method in &methods() {
+        let path = smooth_polyline_with(points, 1e-4, method).unwrap();
+        let samples = sample_path(&path, 1e-5);
+        let plan = plan_feed(&samples, &support::feed_limits()).unwrap();
+        assert!(
+            plan.time.is_finite() && plan.time > 0.0,
+            "{}",
+            method.name()
+        );
+    }
+}
+
+#[test]
+fn arc_length_derivatives_match_central_differences_on_baseline_corners() {
+    let polyline = [
+        [0.0, 0.0, 0.0],
+        [0.01, 0.0, 0.0],
+        [0.01, 0.01, 0.0],
+        [0.0, 0.012, 0.001],
+    ];
+    for method in &methods()[1..] {
+        let name = method.name();
+        let path = smooth_polyline_with(&polyline, 1e-4, method).unwrap();
+        let samples = sample_path(&path, 1e-5);
+        let length = samples.last().unwrap().s;
+        let (h1, h2) = (1e-7, 2e-6);
+        // G2 joins, not G3: dκ/ds jumps at a corner's end (ICR's κ grows linearly from it), so a
+        // second difference straddling a join is off by about dκ/ds · h; those points are skipped.
+        let joins: Vec<f64> = samples
+            .windows(2)
+            .filter(|w| w[0].piece != w[1].piece)
+            .map(|w| w[0].s)
+            .collect();
+        assert!(joins.len() >= 3, "{name}: {joins:?}");
+        let mut on_corners = 0;
+        for k in 1..400 {
+            let s = length * k as f64 / 400.0;
+            if joins.iter().any(|j| (s - j).abs() < 3.0 * h2) {
+                continue;
+            }
+            let (p, d1, d2) = derivatives_at(&path, &samples, s);
+            let at = |x: f64| point_at(&path, &samples, x);
+            let (pm1, pp1, pm2, pp2) = (at(s - h1), at(s + h1), at(s - h2), at(s + h2));
+            for d in 0..3 {
+                let first = (pp1[d] - pm1[d]) / (2.0 * h1);
+                let second = (pp2[d] - 2.0 * p[d] + pm2[d]) / (h2 * h2);
+                assert!(
+                    (first - d1[d]).abs() < 1e-5,
+                    "{name} s {s}: {first} vs {}",
+                    d1[d]
+                );
+                assert!(
+                    (second - d2[d]).abs() < 2e-2 * (1.0 + d2[d].abs()),
+                    "{name} s {s}: {second} vs {}",
+                    d2[d]
+                );
+            }
+            if d2.iter().any(|v| *v != 0.0) {
+                on_corners += 1;
+            }
+        }
+        assert!(on_corners > 10, "{name}: the corners were sampled");
+    }
 }
