@@ -440,6 +440,11 @@ fn every_method_runs_through_sampling_and_the_feed_plan() {
             "{}",
             method.name()
         );
+        // And the shared zig-zag of short and long segments, within δ by brute force.
+        let zig = smooth_polyline_with(&support::ZIG_ZAG, 5e-5, method).unwrap();
+        assert!(zig.distance_from_polyline(&zig.sample(400)) <= 5e-5 * (1.0 + 1e-9));
+        let plan = plan_feed(&sample_path(&zig, 1e-5), &support::feed_limits()).unwrap();
+        assert!(plan.time > 0.0, "{}", method.name());
     }
 }
 
