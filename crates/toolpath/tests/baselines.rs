@@ -429,7 +429,7 @@ fn bad_input_is_refused_by_name() {
 fn every_method_runs_through_sampling_and_the_feed_plan() {
     // The butterfly's hairpins with seed 003's limits: every corner's samples must give the
     // planner a positive speed (a CCR end sample once had κ ~ 1e-14 1/m from rounding, where
-    // the contour-error speed of seed 003 eq. 17 cancels to 0).
+    // the contour-error speed of seed 003 eq. 17 cancelled to 0 before main's 7462289).
     let points = &outlines()[0].1;
     for method in &methods() {
         let path = smooth_polyline_with(points, 1e-4, method).unwrap();
