@@ -4,6 +4,7 @@
 //! eq. 5.3: d/du b(u) = n Σ Δb_i B_i^{n−1}(u); curvature κ = |b' × b''| /
 //! |b'|³, eq. 10.5).
 
+use crate::quadrature::gauss_legendre_8;
 use crate::vec3::{cross, norm, sub};
 
 /// A quintic Bézier curve.
@@ -68,26 +69,7 @@ impl QuinticBezier {
     /// as (u1 − u0)^16). Nodes and weights: Abramowitz and Stegun, Handbook
     /// of Mathematical Functions, Table 25.4, n = 8.
     pub fn length_between(&self, u0: f64, u1: f64) -> f64 {
-        const X: [f64; 4] = [
-            0.183_434_642_495_649_8,
-            0.525_532_409_916_329,
-            0.796_666_477_413_626_7,
-            0.960_289_856_497_536_3,
-        ];
-        const W: [f64; 4] = [
-            0.362_683_783_378_362,
-            0.313_706_645_877_887_3,
-            0.222_381_034_453_374_5,
-            0.101_228_536_290_376_3,
-        ];
-        let (mid, half) = (0.5 * (u0 + u1), 0.5 * (u1 - u0));
-        let mut total = 0.0;
-        for (x, w) in X.iter().zip(W) {
-            for s in [-1.0, 1.0] {
-                total += w * half * norm(self.d1(mid + s * x * half));
-            }
-        }
-        total
+        gauss_legendre_8(u0, u1, |u| norm(self.d1(u)))
     }
 
     /// The arc length by 8-point Gauss–Legendre quadrature on each of

@@ -46,6 +46,7 @@
 //! makes the corner flatter.
 
 use crate::bezier::QuinticBezier;
+use crate::corner_curve::CornerCurve;
 use crate::error::{check_positive, ToolpathError};
 use crate::vec3::{add, dot, norm, scale, sub};
 
@@ -90,23 +91,27 @@ pub enum Binding {
     Length,
 }
 
-/// A corner's transition.
+/// A corner's transition: kerf's ([`corner_transition`]) or a baseline's
+/// ([`crate::baseline`]).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct CornerTransition {
-    /// The curve, from P₀ on the incoming segment to P₅ on the outgoing.
-    pub curve: QuinticBezier,
+    /// The curve, from its first point on the incoming segment to its last
+    /// on the outgoing one.
+    pub curve: CornerCurve,
     /// The vertex it replaces.
     pub vertex: [f64; 3],
     /// Turning angle θ \[rad\].
     pub turn: f64,
-    /// The shape and the scale s \[m\].
-    pub shape: CornerShape,
-    /// Scale s \[m\].
+    /// kerf's shape (a = 1, b, c); `None` for a baseline.
+    pub shape: Option<CornerShape>,
+    /// The construction's scale \[m\]: kerf's s, ICR's and CCR's control
+    /// point spacing d, the NURBS corner's tangent length ℓ.
     pub scale: f64,
-    /// |P₀ − V| = |P₅ − V| \[m\].
+    /// |first point − V| = |last point − V| \[m\].
     pub tangent_length: f64,
-    /// The exact largest distance from the polyline \[m\] (module
-    /// documentation).
+    /// The largest distance from the polyline \[m\]: exact for kerf's
+    /// corner (module documentation), exact or an upper bound for a
+    /// baseline (its module says which).
     pub deviation: f64,
     /// The largest curvature \[1/m\] (sampled, then refined).
     pub max_curvature: f64,
@@ -166,6 +171,60 @@ fn direction(a: [f64; 3], b: [f64; 3]) -> ([f64; 3], f64) {
     (scale(d, 1.0 / l), l)
 }
 
+/// A corner's incoming and outgoing unit directions and turning angle.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct CornerFrame {
+    /// t₁.
+    pub t1: [f64; 3],
+    /// t₂.
+    pub t2: [f64; 3],
+    /// θ \[rad\].
+    pub turn: f64,
+}
+
+/// The checks every corner method shares, and the corner's directions.
+///
+/// # Returns
+/// `None` for a straight corner (θ < [`MIN_TURN`]), else the incoming and
+/// outgoing unit directions t₁, t₂ and the turning angle θ.
+///
+/// # Errors
+/// As [`corner_transition`].
+pub(crate) fn corner_frame(
+    prev: [f64; 3],
+    vertex: [f64; 3],
+    next: [f64; 3],
+    tolerance: f64,
+    available: f64,
+) -> Result<Option<CornerFrame>, ToolpathError> {
+    check_positive(&[
+        ("tolerance [m]", tolerance),
+        ("available length [m]", available),
+    ])?;
+    let (t1, l1) = direction(prev, vertex);
+    let (t2, l2) = direction(vertex, next);
+    if !(l1 > 0.0 && l2 > 0.0 && l1.is_finite() && l2.is_finite()) {
+        return Err(ToolpathError::BadPoint {
+            index: usize::from(l1 > 0.0),
+            reason: "coincides with its neighbour (or is not finite)".to_string(),
+        });
+    }
+    let turn = dot(t1, t2).clamp(-1.0, 1.0).acos();
+    if turn < MIN_TURN {
+        return Ok(None);
+    }
+    if turn > std::f64::consts::PI - REVERSAL_MARGIN {
+        return Err(ToolpathError::InvalidParameter {
+            name: "turning angle [rad]".to_string(),
+            value: turn,
+            reason: "a reversal: no curvature-continuous transition fits a tolerance (stop at \
+                     the vertex)"
+                .to_string(),
+        });
+    }
+    Ok(Some(CornerFrame { t1, t2, turn }))
+}
+
 /// The transition at the corner `prev` → `vertex` → `next`.
 ///
 /// # Arguments
@@ -194,31 +253,11 @@ pub fn corner_transition(
     tolerance: f64,
     available: f64,
 ) -> Result<Option<CornerTransition>, ToolpathError> {
-    check_positive(&[
-        ("tolerance [m]", tolerance),
-        ("available length [m]", available),
-    ])?;
-    let (t1, l1) = direction(prev, vertex);
-    let (t2, l2) = direction(vertex, next);
-    if !(l1 > 0.0 && l2 > 0.0 && l1.is_finite() && l2.is_finite()) {
-        return Err(ToolpathError::BadPoint {
-            index: usize::from(l1 > 0.0),
-            reason: "coincides with its neighbour (or is not finite)".to_string(),
-        });
-    }
-    let turn = dot(t1, t2).clamp(-1.0, 1.0).acos();
-    if turn < MIN_TURN {
+    let Some(CornerFrame { t1, t2, turn }) =
+        corner_frame(prev, vertex, next, tolerance, available)?
+    else {
         return Ok(None);
-    }
-    if turn > std::f64::consts::PI - REVERSAL_MARGIN {
-        return Err(ToolpathError::InvalidParameter {
-            name: "turning angle [rad]".to_string(),
-            value: turn,
-            reason: "a reversal: no curvature-continuous transition fits a tolerance (stop at \
-                     the vertex)"
-                .to_string(),
-        });
-    }
+    };
     let mut best: Option<CornerTransition> = None;
     for binding in [Binding::Tolerance, Binding::Length] {
         let shape = table_shape(turn, binding);
@@ -231,10 +270,10 @@ pub fn corner_transition(
         };
         let c = curve(vertex, t1, t2, shape, s);
         let t = CornerTransition {
-            curve: c,
+            curve: CornerCurve::Quintic(c),
             vertex,
             turn,
-            shape,
+            shape: Some(shape),
             scale: s,
             tangent_length: s * shape.length_weight(),
             deviation: turn.sin() * s * shape.deviation_weight() / 32.0,

@@ -4,29 +4,37 @@
 //! samples ([`samples`]) and the bang-bang time bound T_lb
 //! ([`lower_bound`]).
 
+pub mod baseline;
 pub mod bezier;
 pub mod corner;
+pub mod corner_curve;
 pub mod error;
 pub mod feed;
 pub mod lower_bound;
 pub mod merge;
 pub mod metrics;
+mod quadrature;
 pub mod samples;
 pub mod scurve;
 pub mod smooth;
 pub mod speed_limit;
+pub mod spline;
 pub mod vec3;
 
+pub use baseline::{CornerMethod, NurbsSettings};
 pub use bezier::QuinticBezier;
 pub use corner::{corner_transition, Binding, CornerShape, CornerTransition};
+pub use corner_curve::CornerCurve;
 pub use error::ToolpathError;
 pub use feed::{plan_feed, FeedLimits, FeedPlan, FeedSample};
 pub use lower_bound::{bang_bang, bang_bang_under, BangBang, BangBangLimits};
 pub use merge::merge_collinear;
 pub use metrics::{metrics, Metrics};
 pub use samples::{derivatives_at, point_at, sample_path, PathSample};
+pub use smooth::smooth_polyline_with;
 pub use smooth::{smooth_polyline, Piece, SmoothedPath};
 pub use speed_limit::{CurvatureLimits, Servo};
+pub use spline::CubicSpline;
 pub mod plot;
 pub use plot::{pipeline_plots, Chart};
 pub mod corner_metrics;

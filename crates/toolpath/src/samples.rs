@@ -19,13 +19,13 @@ pub struct PathSample {
     /// Index of its piece in [`SmoothedPath::pieces`].
     pub piece: usize,
     /// Its parameter in the piece (a line's fraction of its length, a
-    /// corner's Bézier parameter).
+    /// corner curve's parameter).
     pub u: f64,
 }
 
 /// Samples a smoothed path: lines at their two ends, corners at
 /// ⌈length / `max_step`⌉ equal parameter steps (their arc lengths by
-/// [`crate::QuinticBezier::length_between`]; a step is `max_step` long on
+/// [`crate::CornerCurve::length_between`]; a step is `max_step` long on
 /// average, longer where the curve's speed in its parameter is above its
 /// mean). Consecutive pieces share their joining sample (kept once).
 ///
@@ -89,7 +89,7 @@ pub fn sample_path(path: &SmoothedPath, max_step: f64) -> Vec<PathSample> {
 /// The point of `path` at arc length `s`, exactly on its geometry: on a
 /// line by proportion, on a corner by Newton's method on the arc length
 /// from the sample before it (3 steps from the linear guess, each with
-/// [`crate::QuinticBezier::length_between`]), clamped to the path's ends.
+/// [`crate::CornerCurve::length_between`]), clamped to the path's ends.
 ///
 /// # Arguments
 /// * `samples` — [`sample_path`] of `path`.

@@ -2,7 +2,8 @@
 //! pieces and curvature-continuous corner transitions, within a tolerance
 //! of the polyline everywhere.
 
-use crate::corner::{corner_transition, CornerTransition};
+use crate::baseline::CornerMethod;
+use crate::corner::CornerTransition;
 use crate::error::{check_positive, ToolpathError};
 use crate::vec3::{distance_to_segment, norm, sub};
 
@@ -14,6 +15,9 @@ pub const JOIN_GAP: f64 = 1e-12;
 
 /// One piece of a smoothed path.
 #[derive(Debug, Clone, Copy, PartialEq)]
+// A corner is about 500 bytes with a baseline's spline, a line 48: boxing
+// would cost an allocation per corner and the pieces' Copy.
+#[allow(clippy::large_enum_variant)]
 pub enum Piece {
     /// A straight piece.
     Line {
@@ -38,8 +42,9 @@ pub struct SmoothedPath {
 }
 
 impl SmoothedPath {
-    /// The largest distance from the polyline, exact per corner (module
-    /// [`crate::corner`]); 0 without corners \[m\].
+    /// The largest distance from the polyline, exact per kerf corner (module
+    /// [`crate::corner`]), exact or bounded per baseline corner (module
+    /// [`crate::baseline`]); 0 without corners \[m\].
     pub fn max_deviation(&self) -> f64 {
         self.corners().map(|c| c.deviation).fold(0.0, f64::max)
     }
@@ -58,7 +63,7 @@ impl SmoothedPath {
     }
 
     /// Points along the path: each piece at `per_piece` + 1 equally spaced
-    /// parameters (lines by length, corners by their Bézier parameter).
+    /// parameters (lines by length, corners by their curve's parameter).
     pub fn sample(&self, per_piece: usize) -> Vec<[f64; 3]> {
         let n = per_piece.max(1);
         let mut out = Vec::with_capacity(self.pieces.len() * (n + 1));
@@ -111,6 +116,30 @@ pub fn smooth_polyline(
     polyline: &[[f64; 3]],
     tolerance: f64,
 ) -> Result<SmoothedPath, ToolpathError> {
+    smooth_polyline_with(polyline, tolerance, &CornerMethod::Kerf)
+}
+
+/// Smooths every corner of a polyline by a chosen method: kerf's corner or
+/// a baseline ([`crate::baseline`]).
+///
+/// # Arguments
+/// * `polyline`, `tolerance` — as [`smooth_polyline`].
+/// * `method` — the corner construction; [`CornerMethod::Kerf`] gives
+///   exactly [`smooth_polyline`]'s path.
+///
+/// # Returns
+/// As [`smooth_polyline`], every corner built by `method`.
+///
+/// # Errors
+/// As [`smooth_polyline`], and [`ToolpathError::InvalidParameter`] for bad
+/// swarm settings ([`crate::baseline::NurbsSettings::check`]) or a NURBS
+/// corner the swarm found no feasible point for.
+pub fn smooth_polyline_with(
+    polyline: &[[f64; 3]],
+    tolerance: f64,
+    method: &CornerMethod,
+) -> Result<SmoothedPath, ToolpathError> {
+    method.check()?;
     if polyline.len() < 2 {
         return Err(ToolpathError::InvalidParameter {
             name: "points".to_string(),
@@ -148,35 +177,37 @@ pub fn smooth_polyline(
     let mut cursor = polyline[0];
     for v in 1..n - 1 {
         let available = share(v - 1).min(share(v));
-        match corner_transition(
-            polyline[v - 1],
-            polyline[v],
-            polyline[v + 1],
-            tolerance,
-            available,
-        )
-        .map_err(|e| match e {
-            ToolpathError::InvalidParameter {
-                name,
-                value,
-                reason,
-            } => ToolpathError::InvalidParameter {
-                name: format!("corner at point {v}: {name}"),
-                value,
-                reason,
-            },
-            other => other,
-        })? {
+        match method
+            .transition(
+                polyline[v - 1],
+                polyline[v],
+                polyline[v + 1],
+                tolerance,
+                available,
+                v,
+            )
+            .map_err(|e| match e {
+                ToolpathError::InvalidParameter {
+                    name,
+                    value,
+                    reason,
+                } => ToolpathError::InvalidParameter {
+                    name: format!("corner at point {v}: {name}"),
+                    value,
+                    reason,
+                },
+                other => other,
+            })? {
             None => {}
             Some(c) => {
-                let start = c.curve.control[0];
+                let start = c.curve.start();
                 if norm(sub(start, cursor)) > JOIN_GAP {
                     pieces.push(Piece::Line {
                         start: cursor,
                         end: start,
                     });
                 }
-                cursor = c.curve.control[5];
+                cursor = c.curve.end();
                 pieces.push(Piece::Corner(c));
             }
         }

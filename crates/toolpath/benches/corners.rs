@@ -1,0 +1,121 @@
+//! Corner smoothing methods compared on the shipped outlines (issue 14, the baselines): kerf's
+//! quintic corner against ICR (Zhao, Zhu and Ding 2013), CCR (Xu and Sun 2018) and seed 003's
+//! NURBS corner chosen by a particle swarm (`kerf_toolpath::baseline`), each through the same
+//! pipeline as `benches/pipeline.rs`: smooth within δ (`smooth_polyline_with`), sample by arc
+//! length, plan the feed (`plan_feed`), T_lb (`bang_bang_under`) and seed 000's Table 1 metrics at
+//! the interpolation period (`metrics`). The two limit sets are the pipeline bench's (seed 000's
+//! appendix C read as mm and s, δ 0.5 mm; seed 003's Table 1, δ 0.1 mm).
+//!
+//! Smoothing time: `smooth_polyline_with` alone on the point list in memory, best of 20 runs (3
+//! for the swarm), on one thread.
+//!
+//! ```sh
+//! cargo bench -p kerf_toolpath --bench corners
+//! ```
+#![allow(clippy::unwrap_used, clippy::expect_used)] // a bench binary reports failures by panicking
+
+use std::time::Instant;
+
+use kerf_gcode::{read_points, PointUnit};
+use kerf_toolpath::{
+    bang_bang_under, metrics, plan_feed, sample_path, smooth_polyline_with, CornerMethod,
+    CurvatureLimits, FeedLimits, NurbsSettings,
+};
+
+/// Arc length between samples for planning \[m\] (as the pipeline bench).
+const STEP: f64 = 1e-5;
+
+fn main() {
+    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("data/outlines");
+    let mut names: Vec<_> = std::fs::read_dir(&dir)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|e| e == "txt"))
+        .collect();
+    names.sort();
+    let seed000 = (
+        "seed 000",
+        5e-4,
+        FeedLimits {
+            curvature: CurvatureLimits {
+                feed: 0.010,
+                interpolation_period: 5e-4,
+                chord_error: 5e-4,
+                normal_acceleration: 0.1,
+                normal_jerk: 10.0,
+                servo: None,
+            },
+            tangential_acceleration: 0.1,
+            tangential_jerk: 10.0,
+        },
+    );
+    let seed003 = (
+        "seed 003",
+        1e-4,
+        FeedLimits {
+            curvature: CurvatureLimits::seed_003_table_1(),
+            tangential_acceleration: 0.8,
+            tangential_jerk: 20.0,
+        },
+    );
+    let methods = [
+        CornerMethod::Kerf,
+        CornerMethod::Icr,
+        CornerMethod::Ccr,
+        CornerMethod::Nurbs(NurbsSettings::default()),
+    ];
+    println!(
+        "| outline | limits | method | T_m (s) | T_lb (s) | κ_max (1/mm) | θ_max (°) | a_rms (mm/s²) | j_rms (mm/s³) | max chord error (µm) | max deviation (mm) | smoothing (ms) |"
+    );
+    println!("|---|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|");
+    for path in &names {
+        let text = std::fs::read_to_string(path).unwrap();
+        let name = path.file_stem().unwrap().to_string_lossy().to_string();
+        let points = read_points(text.as_bytes(), PointUnit::Millimetre).unwrap();
+        for (limits_name, delta, limits) in [&seed000, &seed003] {
+            for method in &methods {
+                let runs = if matches!(method, CornerMethod::Nurbs(_)) {
+                    3
+                } else {
+                    20
+                };
+                let mut best = f64::INFINITY;
+                let mut smoothed = None;
+                for _ in 0..runs {
+                    let start = Instant::now();
+                    let s = smooth_polyline_with(&points, *delta, method).unwrap();
+                    best = best.min(start.elapsed().as_secs_f64());
+                    smoothed = Some(s);
+                }
+                let smoothed = smoothed.unwrap();
+                let samples = sample_path(&smoothed, STEP);
+                let plan = plan_feed(&samples, limits).unwrap();
+                let curve: Vec<f64> = samples
+                    .iter()
+                    .map(|p| limits.curvature.speed(p.curvature))
+                    .collect();
+                let lb = bang_bang_under(&samples, curve, limits.tangential_acceleration).unwrap();
+                let m = metrics(
+                    &plan,
+                    &smoothed,
+                    &samples,
+                    limits.curvature.interpolation_period,
+                    limits.curvature.servo.as_ref(),
+                );
+                println!(
+                    "| {name} | {limits_name} | {} | {:.3} | {:.3} | {:.3} | {:.2} | {:.1} | {:.0} | {:.3} | {:.4} | {:.2} |",
+                    method.name(),
+                    m.time,
+                    lb.time,
+                    m.max_curvature * 1e-3,
+                    m.max_turning_angle.to_degrees(),
+                    m.rms_acceleration * 1e3,
+                    m.rms_jerk * 1e3,
+                    m.max_chord_error * 1e6,
+                    smoothed.max_deviation() * 1e3,
+                    best * 1e3
+                );
+            }
+        }
+    }
+}
