@@ -4,13 +4,19 @@
 //! samples ([`samples`]) and the bang-bang time bound T_lb
 //! ([`lower_bound`]).
 
+pub mod axis;
 pub mod bezier;
+pub mod constraints;
 pub mod corner;
 pub mod error;
 pub mod feed;
+pub mod feed_method;
+pub mod feed_optimal;
+pub mod limit_curve;
 pub mod lower_bound;
 pub mod merge;
 pub mod metrics;
+pub mod plan_check;
 pub mod samples;
 pub mod scurve;
 pub mod smooth;
@@ -27,3 +33,9 @@ pub use metrics::{metrics, Metrics};
 pub use samples::{derivatives_at, point_at, sample_path, PathSample};
 pub use smooth::{smooth_polyline, Piece, SmoothedPath};
 pub use speed_limit::{CurvatureLimits, Servo};
+pub use axis::AxisLimits;
+pub use constraints::FeedConstraints;
+pub use feed_method::FeedMethod;
+pub use feed_optimal::plan_feed_optimal;
+pub use limit_curve::{limit_curve, LimitCurve};
+pub use plan_check::{check_plan, PlanCheck, Worst};

@@ -1,0 +1,399 @@
+//! A near time-optimal, jerk-limited, bidirectional feed plan (issue 14,
+//! item 3) that tracks the velocity-limit curve ([`crate::limit_curve`])
+//! instead of holding whole feed-sensitive intervals at their lowest limit
+//! ([`crate::plan_feed`]).
+//!
+//! **Structure of the optimum.** Between two local minima of the speed the
+//! speed rises and falls once, and at every local minimum and maximum the
+//! tangential acceleration is zero. With |a| ≤ A and |j| ≤ J, the fastest
+//! motion over a distance d from v₀ to v₁ (zero acceleration at both) under
+//! a cap is an S-curve up to the highest peak that fits, a cruise there and
+//! an S-curve down (the S-curves of [`crate::scurve`], Lin, Tsai and Yau,
+//! "Development of a dynamics-based NURBS interpolator with real-time
+//! look-ahead algorithm", IJMTM 47(15), 2007, the jerk-limited S-shape
+//! profile with bidirectional look-ahead). The second-order analogue is the
+//! bang-bang switching structure of Bobrow, Dubowsky and Gibson, IJRR 4(3),
+//! 1985, section 4, whose speed touches the limit curve at its critical
+//! points. The planner:
+//!
+//! 1. **Critical points** (knots): the start and end at rest and every
+//!    local minimum of the limit curve (both ends of a flat minimum), each
+//!    at its limit with zero acceleration.
+//! 2. **Bidirectional scan**: a knot's speed is lowered to what one S-curve
+//!    from its predecessor reaches in their gap (forward) and to what lets
+//!    one S-curve reach its successor (backward), until nothing changes
+//!    ([`crate::scurve::reachable`]).
+//! 3. **Each gap** is run as up–cruise–down with the highest peak that fits,
+//!    at most the gap's cap (initially the largest limit in the gap).
+//! 4. **Exact check under the limit curve**: the gap's speed is evaluated at
+//!    every node inside it and at every phase boundary (the arc length
+//!    solved by safeguarded Newton on the cubic s(t)). The speed is
+//!    monotone within a constant-jerk phase of an S-curve, so these points
+//!    bound it over every interval against that interval's limit. Where it
+//!    exceeds the limit, the gap's cap is lowered to the lowest exceeded
+//!    limit if that is above both knot speeds (a cruise under a lower
+//!    plateau), else a knot is added at the lowest exceeded node. Then back
+//!    to 2; caps only fall and knots only get added, so this ends.
+//!
+//! The speed is never above the limit curve, and |a| ≤ A, |j| ≤ J exactly
+//! (the tangential budget of [`crate::FeedConstraints::tangential`]); the
+//! remaining losses against the time optimum are the zero acceleration at
+//! knots added in 4 and a critical point whose speed the scan lowered (the
+//! speed then stops rising there).
+
+use crate::constraints::FeedConstraints;
+use crate::feed::{FeedPlan, PlacedPhase};
+use crate::limit_curve::{limit_curve, LimitCurve};
+use crate::samples::PathSample;
+use crate::scurve::{reachable, scurve_distance, scurve_phases, Phase};
+use crate::ToolpathError;
+
+/// Relative tolerance of the check under the limit curve.
+const TOLERANCE: f64 = 1e-12;
+
+/// A critical point.
+#[derive(Debug, Clone, Copy)]
+struct Knot {
+    /// Its node in the limit curve.
+    node: usize,
+    /// Its speed \[m/s\].
+    v: f64,
+    /// The cap of the gap from it to the next knot \[m/s\].
+    cap: f64,
+    /// (v, next v, cap) when the gap last passed the check.
+    passed: Option<(f64, f64, f64)>,
+}
+
+/// Plans a near time-optimal feed along `samples` under `constraints`
+/// (module documentation).
+///
+/// # Errors
+/// [`ToolpathError::InvalidParameter`] for bad constraints
+/// ([`FeedConstraints::validate`]), or if the repair of step 4 does not end
+/// (not expected: reported rather than looping).
+pub fn plan_feed_optimal(
+    samples: &[PathSample],
+    constraints: &FeedConstraints<'_>,
+) -> Result<FeedPlan, ToolpathError> {
+    constraints.validate(samples)?;
+    let curve = limit_curve(samples, constraints);
+    let (a, j) = constraints.tangential();
+    let mut knots = critical_points(&curve);
+    let budget = 4 * curve.s.len() + 100;
+    let mut rounds = 0usize;
+    loop {
+        rounds += 1;
+        if rounds > budget {
+            return Err(ToolpathError::InvalidParameter {
+                name: "feed plan rounds".to_string(),
+                value: rounds as f64,
+                reason: "the check under the limit curve did not settle".to_string(),
+            });
+        }
+        scan(&mut knots, &curve, a, j);
+        let mut changed = false;
+        let mut inserts: Vec<(usize, Knot)> = Vec::new();
+        for k in 0..knots.len() - 1 {
+            let (p, q) = (knots[k], knots[k + 1]);
+            if p.passed == Some((p.v, q.v, p.cap)) {
+                continue;
+            }
+            let d = curve.s[q.node] - curve.s[p.node];
+            let phases = gap_phases(p.v, q.v, d, p.cap, a, j);
+            match excess(&curve, &p, &q, &phases) {
+                None => knots[k].passed = Some((p.v, q.v, p.cap)),
+                Some(e) => {
+                    changed = true;
+                    let high = p.v.max(q.v);
+                    let node = e.node;
+                    let inside = node > p.node && node < q.node;
+                    let cap = match e.lowest_at_peak {
+                        Some(l) if l > high * (1.0 + TOLERANCE) => Some(l),
+                        _ if !inside => Some(e.lowest),
+                        _ => None,
+                    };
+                    if std::env::var("KERF_DEBUG").is_ok() {
+                        eprintln!("gap {} {:.5}-{:.5} v {:.5} {:.5} cap {:.5}: {:?} node s {:.5} -> {:?}", k, curve.s[p.node], curve.s[q.node], p.v, q.v, p.cap, e, curve.s[node], cap);
+                    }
+                    if let Some(cap) = cap {
+                        knots[k].cap = cap.max(high).min(p.cap * (1.0 - TOLERANCE));
+                    } else {
+                        inserts.push((
+                            k + 1,
+                            Knot {
+                                node,
+                                v: curve.node[node],
+                                cap: p.cap,
+                                passed: None,
+                            },
+                        ));
+                    }
+                }
+            }
+        }
+        for (at, knot) in inserts.into_iter().rev() {
+            knots[at - 1].passed = None;
+            knots.insert(at, knot);
+        }
+        if !changed {
+            break;
+        }
+    }
+    Ok(place(&knots, &curve, a, j))
+}
+
+/// Step 1: the start, the end and every local minimum of the limit curve.
+fn critical_points(curve: &LimitCurve) -> Vec<Knot> {
+    let n = curve.s.len();
+    let lim = &curve.node;
+    let cap_max = curve.interval.iter().copied().fold(0.0, f64::max);
+    let knot = |node: usize, v: f64| Knot {
+        node,
+        v,
+        cap: cap_max,
+        passed: None,
+    };
+    let mut knots = vec![knot(0, 0.0)];
+    let mut k = 1;
+    while k + 1 < n {
+        let mut end = k;
+        while end + 2 < n && lim[end + 1] == lim[k] {
+            end += 1;
+        }
+        if lim[k - 1] > lim[k] && lim[end + 1] > lim[k] {
+            knots.push(knot(k, lim[k]));
+            if end > k {
+                knots.push(knot(end, lim[k]));
+            }
+        }
+        k = end + 1;
+    }
+    knots.push(knot(n - 1, 0.0));
+    // The gap caps: the largest limit in each gap.
+    for g in 0..knots.len() - 1 {
+        let (a, b) = (knots[g].node, knots[g + 1].node);
+        knots[g].cap = curve.interval[a..b].iter().copied().fold(0.0, f64::max);
+    }
+    knots
+}
+
+/// Step 2: the bidirectional scan of the knot speeds.
+fn scan(knots: &mut [Knot], curve: &LimitCurve, a: f64, j: f64) {
+    loop {
+        let mut changed = false;
+        for k in 0..knots.len() - 1 {
+            let d = curve.s[knots[k + 1].node] - curve.s[knots[k].node];
+            if knots[k + 1].v > knots[k].v {
+                let r = reachable(knots[k].v, d, knots[k + 1].v, a, j);
+                if r < knots[k + 1].v {
+                    knots[k + 1].v = r;
+                    changed = true;
+                }
+            }
+        }
+        for k in (0..knots.len() - 1).rev() {
+            let d = curve.s[knots[k + 1].node] - curve.s[knots[k].node];
+            if knots[k].v > knots[k + 1].v {
+                let r = reachable(knots[k + 1].v, d, knots[k].v, a, j);
+                if r < knots[k].v {
+                    knots[k].v = r;
+                    changed = true;
+                }
+            }
+        }
+        if !changed {
+            break;
+        }
+    }
+}
+
+/// Step 3: S-curve from `v0` up to the highest peak (at most `cap`) whose
+/// up and down S-curves fit in `d`, cruise, S-curve down to `v1`.
+fn gap_phases(v0: f64, v1: f64, d: f64, cap: f64, a: f64, j: f64) -> Vec<Phase> {
+    let fits = |vp: f64| scurve_distance(v0, vp, a, j) + scurve_distance(vp, v1, a, j) <= d;
+    let low = v0.max(v1);
+    let peak = if cap <= low || !fits(low) {
+        low
+    } else if fits(cap) {
+        cap
+    } else {
+        let (mut lo, mut hi) = (low, cap);
+        for _ in 0..64 {
+            let mid = 0.5 * (lo + hi);
+            if fits(mid) {
+                lo = mid;
+            } else {
+                hi = mid;
+            }
+        }
+        lo
+    };
+    let used = scurve_distance(v0, peak, a, j) + scurve_distance(peak, v1, a, j);
+    let mut phases = scurve_phases(v0, peak, a, j);
+    if peak > 0.0 && d > used {
+        phases.push(Phase {
+            duration: (d - used) / peak,
+            jerk: 0.0,
+        });
+    }
+    phases.extend(scurve_phases(peak, v1, a, j));
+    phases
+}
+
+/// Where a gap exceeds the limit curve.
+#[derive(Debug, Clone, Copy)]
+struct Excess {
+    /// The lowest exceeded limit \[m/s\].
+    lowest: f64,
+    /// Its node (inside the gap where possible).
+    node: usize,
+    /// The lowest limit exceeded at the gap's peak speed, if any.
+    lowest_at_peak: Option<f64>,
+}
+
+/// The highest speed of a gap starting at `v0` and run as `phases`.
+fn peak_speed(v0: f64, phases: &[Phase]) -> f64 {
+    let (mut v, mut a, mut peak) = (v0, 0.0f64, v0);
+    for ph in phases {
+        let t = ph.duration;
+        v += a * t + 0.5 * ph.jerk * t * t;
+        a += ph.jerk * t;
+        peak = peak.max(v);
+    }
+    peak
+}
+
+/// Step 4: where the gap from `p` to `q` run as `phases` exceeds the limit
+/// curve (`None` if nowhere).
+fn excess(curve: &LimitCurve, p: &Knot, q: &Knot, phases: &[Phase]) -> Option<Excess> {
+    let peak = peak_speed(p.v, phases);
+    let mut worst: Option<Excess> = None;
+    let mut note = |limit: f64, node: usize, v: f64| {
+        let at_peak = v >= peak * (1.0 - 1e-9);
+        if std::env::var("KERF_DEBUG2").is_ok() {
+            eprintln!("  node {node} limit {limit:.6} v {v:.6} peak {peak:.6}");
+        }
+        let w = worst.get_or_insert(Excess {
+            lowest: limit,
+            node,
+            lowest_at_peak: None,
+        });
+        if limit < w.lowest {
+            w.lowest = limit;
+            w.node = node;
+        }
+        if at_peak {
+            w.lowest_at_peak = Some(w.lowest_at_peak.map_or(limit, |l: f64| l.min(limit)));
+        }
+    };
+    let end_s = curve.s[q.node];
+    let mut ph = PlacedPhase {
+        t0: 0.0,
+        s0: curve.s[p.node],
+        v0: p.v,
+        a0: 0.0,
+        phase: Phase {
+            duration: 0.0,
+            jerk: 0.0,
+        },
+    };
+    let mut k = p.node + 1;
+    for phase in phases.iter().filter(|x| x.duration > 0.0) {
+        ph.phase = *phase;
+        let (s1, v1, a1) = ph.at(phase.duration);
+        let mut t_lo = 0.0;
+        while k < q.node && curve.s[k] <= s1 {
+            let t = time_at(&ph, curve.s[k], t_lo);
+            t_lo = t;
+            let v = ph.at(t).1;
+            if v > curve.node[k] * (1.0 + TOLERANCE) {
+                note(curve.node[k], k, v);
+            }
+            k += 1;
+        }
+        // The phase's end, inside interval k − 1 (nodes k − 1 and k).
+        if s1 < end_s && k > 0 && k < curve.s.len() {
+            let limit = curve.interval[k - 1];
+            if v1 > limit * (1.0 + TOLERANCE) {
+                let inside = |n: usize| n > p.node && n < q.node;
+                let node = match (inside(k - 1), inside(k)) {
+                    (true, true) if curve.node[k] < curve.node[k - 1] => k,
+                    (true, _) => k - 1,
+                    (false, true) => k,
+                    (false, false) => p.node,
+                };
+                note(limit, node, v1);
+            }
+        }
+        ph.s0 = s1;
+        ph.v0 = v1;
+        ph.a0 = a1;
+    }
+    worst
+}
+
+/// The time in `ph` (from `t_lo` on) at which its arc length is `s`:
+/// safeguarded Newton on the cubic s(t), increasing since v ≥ 0.
+fn time_at(ph: &PlacedPhase, s: f64, t_lo: f64) -> f64 {
+    let (mut lo, mut hi) = (t_lo, ph.phase.duration);
+    let mut t = 0.5 * (lo + hi);
+    if ph.v0 > 0.0 {
+        t = (t_lo + (s - ph.at(t_lo).0) / ph.v0).clamp(lo, hi);
+    }
+    for _ in 0..60 {
+        let (st, vt, _) = ph.at(t);
+        let f = st - s;
+        if f.abs() <= 1e-16 * s.abs().max(1e-3) {
+            return t;
+        }
+        if f > 0.0 {
+            hi = t;
+        } else {
+            lo = t;
+        }
+        let newton = if vt > 0.0 { t - f / vt } else { f64::NAN };
+        t = if newton > lo && newton < hi {
+            newton
+        } else {
+            0.5 * (lo + hi)
+        };
+        if hi - lo <= 1e-15 * ph.phase.duration {
+            break;
+        }
+    }
+    t
+}
+
+/// The plan: every gap's phases in order, placed by exact integration.
+fn place(knots: &[Knot], curve: &LimitCurve, a: f64, j: f64) -> FeedPlan {
+    let mut placed = Vec::new();
+    let (mut t, mut s, mut v, mut acc) = (0.0, curve.s[0], 0.0, 0.0);
+    for w in knots.windows(2) {
+        let d = curve.s[w[1].node] - curve.s[w[0].node];
+        for ph in gap_phases(w[0].v, w[1].v, d, w[0].cap, a, j) {
+            if ph.duration <= 0.0 {
+                continue;
+            }
+            let p = PlacedPhase {
+                t0: t,
+                s0: s,
+                v0: v,
+                a0: acc,
+                phase: ph,
+            };
+            let (s1, v1, a1) = p.at(ph.duration);
+            placed.push(p);
+            t += ph.duration;
+            (s, v, acc) = (s1, v1, a1);
+        }
+    }
+    FeedPlan {
+        phases: placed,
+        time: t,
+        length: curve.s[curve.s.len() - 1],
+        intervals: knots
+            .iter()
+            .map(|k| (curve.s[k.node], curve.s[k.node], k.v))
+            .collect(),
+    }
+}
