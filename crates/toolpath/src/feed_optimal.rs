@@ -45,7 +45,7 @@ use crate::constraints::FeedConstraints;
 use crate::feed::{FeedPlan, PlacedPhase};
 use crate::limit_curve::{limit_curve, LimitCurve};
 use crate::samples::PathSample;
-use crate::scurve::{reachable, scurve_distance, scurve_phases, Phase};
+use crate::scurve::{reachable_closed_form as reachable, scurve_distance, scurve_phases, Phase};
 use crate::ToolpathError;
 
 /// Relative tolerance of the check under the limit curve.
@@ -62,6 +62,9 @@ struct Knot {
     cap: f64,
     /// (v, next v, cap) when the gap last passed the check.
     passed: Option<(f64, f64, f64)>,
+    /// Kept even when the scan lowers it (the ends, and knots added where
+    /// a gap exceeded the limit curve).
+    permanent: bool,
 }
 
 /// Plans a near time-optimal feed along `samples` under `constraints`
@@ -90,7 +93,7 @@ pub fn plan_feed_optimal(
                 reason: "the check under the limit curve did not settle".to_string(),
             });
         }
-        scan(&mut knots, &curve, a, j);
+        settle(&mut knots, &curve, a, j);
         let mut changed = false;
         let mut inserts: Vec<(usize, Knot)> = Vec::new();
         for k in 0..knots.len() - 1 {
@@ -108,11 +111,11 @@ pub fn plan_feed_optimal(
                     let node = e.node;
                     let inside = node > p.node && node < q.node;
                     let cap = match e.lowest_at_peak {
-                        Some(l) if l > high * (1.0 + TOLERANCE) => Some(l),
+                        Some(l) if l > high * (1.0 + TOLERANCE) && std::env::var("CAPMODE").is_ok() => Some(l),
                         _ if !inside => Some(e.lowest),
                         _ => None,
                     };
-                    if std::env::var("KERF_DEBUG").is_ok() {
+                    if std::env::var("KERF_DEBUG").is_ok() && curve.s[p.node] > 1.769 && curve.s[p.node] < 1.771 {
                         eprintln!("gap {} {:.5}-{:.5} v {:.5} {:.5} cap {:.5}: {:?} node s {:.5} -> {:?}", k, curve.s[p.node], curve.s[q.node], p.v, q.v, p.cap, e, curve.s[node], cap);
                     }
                     if let Some(cap) = cap {
@@ -125,19 +128,34 @@ pub fn plan_feed_optimal(
                                 v: curve.node[node],
                                 cap: p.cap,
                                 passed: None,
+                                permanent: true,
                             },
                         ));
                     }
                 }
             }
         }
-        for (at, knot) in inserts.into_iter().rev() {
-            knots[at - 1].passed = None;
-            knots.insert(at, knot);
+        if !inserts.is_empty() {
+            let mut merged = Vec::with_capacity(knots.len() + inserts.len());
+            let mut next = inserts.into_iter().peekable();
+            for (i, knot) in knots.iter().enumerate() {
+                if next.peek().is_some_and(|(at, _)| *at == i) {
+                    if let (Some(prev), Some((_, new))) = (merged.last_mut(), next.next()) {
+                        let prev: &mut Knot = prev;
+                        prev.passed = None;
+                        merged.push(new);
+                    }
+                }
+                merged.push(*knot);
+            }
+            knots = merged;
         }
         if !changed {
             break;
         }
+    }
+    if std::env::var("KERF_ROUNDS").is_ok() {
+        eprintln!("rounds {rounds} knots {}", knots.len());
     }
     Ok(place(&knots, &curve, a, j))
 }
@@ -152,8 +170,10 @@ fn critical_points(curve: &LimitCurve) -> Vec<Knot> {
         v,
         cap: cap_max,
         passed: None,
+        permanent: false,
     };
     let mut knots = vec![knot(0, 0.0)];
+    knots[0].permanent = true;
     let mut k = 1;
     while k + 1 < n {
         let mut end = k;
@@ -168,13 +188,53 @@ fn critical_points(curve: &LimitCurve) -> Vec<Knot> {
         }
         k = end + 1;
     }
-    knots.push(knot(n - 1, 0.0));
-    // The gap caps: the largest limit in each gap.
+    let mut end = knot(n - 1, 0.0);
+    end.permanent = true;
+    knots.push(end);
     for g in 0..knots.len() - 1 {
-        let (a, b) = (knots[g].node, knots[g + 1].node);
-        knots[g].cap = curve.interval[a..b].iter().copied().fold(0.0, f64::max);
+        knots[g].cap = largest_limit(curve, knots[g].node, knots[g + 1].node);
     }
     knots
+}
+
+/// The largest limit between nodes `a` and `b` (a gap's first cap).
+fn largest_limit(curve: &LimitCurve, a: usize, b: usize) -> f64 {
+    curve.interval[a..b].iter().copied().fold(0.0, f64::max)
+}
+
+/// Step 2 with pruning: every knot back at its limit, the scan, and the
+/// knots it lowered (not binding: the speed passes below the limit there
+/// without stopping to rise or fall) removed, until none is; a removed
+/// knot comes back, for good, if its gap then exceeds the limit there.
+fn settle(knots: &mut Vec<Knot>, curve: &LimitCurve, a: f64, j: f64) {
+    loop {
+        let last = knots.len() - 1;
+        for k in 1..last {
+            knots[k].v = curve.node[knots[k].node];
+        }
+        scan(knots, curve, a, j);
+        let before = knots.len();
+        let mut kept: Vec<Knot> = Vec::with_capacity(before);
+        for (i, k) in knots.iter().enumerate() {
+            if i > 0 && i < last && !k.permanent && k.v < curve.node[k.node] * (1.0 - TOLERANCE) {
+                if let Some(prev) = kept.last_mut() {
+                    prev.cap = f64::NAN;
+                }
+                continue;
+            }
+            kept.push(*k);
+        }
+        if kept.len() == before {
+            return;
+        }
+        for g in 0..kept.len() - 1 {
+            if kept[g].cap.is_nan() {
+                kept[g].cap = largest_limit(curve, kept[g].node, kept[g + 1].node);
+                kept[g].passed = None;
+            }
+        }
+        *knots = kept;
+    }
 }
 
 /// Step 2: the bidirectional scan of the knot speeds.
@@ -270,9 +330,6 @@ fn excess(curve: &LimitCurve, p: &Knot, q: &Knot, phases: &[Phase]) -> Option<Ex
     let mut worst: Option<Excess> = None;
     let mut note = |limit: f64, node: usize, v: f64| {
         let at_peak = v >= peak * (1.0 - 1e-9);
-        if std::env::var("KERF_DEBUG2").is_ok() {
-            eprintln!("  node {node} limit {limit:.6} v {v:.6} peak {peak:.6}");
-        }
         let w = worst.get_or_insert(Excess {
             lowest: limit,
             node,
@@ -302,12 +359,17 @@ fn excess(curve: &LimitCurve, p: &Knot, q: &Knot, phases: &[Phase]) -> Option<Ex
         ph.phase = *phase;
         let (s1, v1, a1) = ph.at(phase.duration);
         let mut t_lo = 0.0;
+        // The speed is monotone in the phase: nodes whose limit is above
+        // both its ends cannot be exceeded.
+        let top = ph.v0.max(v1);
         while k < q.node && curve.s[k] <= s1 {
-            let t = time_at(&ph, curve.s[k], t_lo);
-            t_lo = t;
-            let v = ph.at(t).1;
-            if v > curve.node[k] * (1.0 + TOLERANCE) {
-                note(curve.node[k], k, v);
+            if curve.node[k] * (1.0 + TOLERANCE) < top {
+                let t = time_at(&ph, curve.s[k], t_lo);
+                t_lo = t;
+                let v = ph.at(t).1;
+                if v > curve.node[k] * (1.0 + TOLERANCE) {
+                    note(curve.node[k], k, v);
+                }
             }
             k += 1;
         }
