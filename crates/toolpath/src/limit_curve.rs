@@ -30,7 +30,8 @@
 
 use crate::constraints::FeedConstraints;
 use crate::samples::PathSample;
-use crate::vec3::dot;
+use crate::speed_limit::CurvatureLimits;
+use crate::vec3::{dot, norm, sub};
 
 /// Safety factor on the finite-difference estimate of |x‴|.
 const THIRD_DERIVATIVE_FACTOR: f64 = 1.5;
@@ -107,6 +108,7 @@ pub fn limit_curve(samples: &[PathSample], constraints: &FeedConstraints<'_>) ->
         third[k] = std::array::from_fn(|a| (m[k][a] - m[k - 1][a]).abs() / h);
     }
     let chord_kappa = window_max(&nodes, w);
+    let free = feed_curvature(lim);
     let (a_eff, j_eff) = constraints.tangential();
     let mut interval = Vec::with_capacity(n - 1);
     for k in 0..n - 1 {
@@ -118,11 +120,16 @@ pub fn limit_curve(samples: &[PathSample], constraints: &FeedConstraints<'_>) ->
         let change = (lo..=hi)
             .map(|r| (nodes[r + 1].kappa - nodes[r].kappa).abs())
             .fold(0.0, f64::max);
-        let turn = dot(p.tangent, q.tangent).clamp(-1.0, 1.0).acos();
+        // The chord of the tangents' turn, 2 sin(θ/2) ≤ θ: a lower bound of
+        // the mean curvature times ds.
+        let turn = norm(sub(q.tangent, p.tangent));
         let kappa = (p.kappa.max(q.kappa) + 0.5 * change).max(turn / ds);
-        let mut v = lim.feed.min(p.cap).min(q.cap).min(lim.speed(kappa));
+        let mut v = lim.feed.min(p.cap).min(q.cap);
+        if kappa > free {
+            v = v.min(lim.speed(kappa));
+        }
         let kc = chord_kappa[k].max(kappa);
-        if kc > 0.0 {
+        if kc > free {
             v = v.min(lim.chord_speed(1.0 / kc));
         }
         if let Some(axes) = &constraints.axes {
@@ -177,4 +184,23 @@ fn window_max(nodes: &[Node], w: f64) -> Vec<f64> {
         out.push(deque.front().map_or(0.0, |&f| nodes[f].kappa));
     }
     out
+}
+
+/// The largest curvature at which no curvature limit is below the feed
+/// (every law of [`CurvatureLimits::speed`] decreases with κ), by bisection
+/// on log κ, rounded down: below it the limit is F without evaluating them.
+fn feed_curvature(lim: &CurvatureLimits) -> f64 {
+    let (mut lo, mut hi) = (1e-12f64, 1e12f64);
+    if lim.speed(lo) < lim.feed {
+        return 0.0;
+    }
+    for _ in 0..100 {
+        let mid = (lo * hi).sqrt();
+        if lim.speed(mid) >= lim.feed {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    lo * (1.0 - 1e-9)
 }
