@@ -113,39 +113,45 @@ pub fn plan_feed_optimal(
             }
             let d = curve.s[q.node] - curve.s[p.node];
             let phases = gap_phases(p.v, q.v, d, p.cap, a, j);
-            match excess(&curve, &p, &q, &phases) {
-                None => knots[k].passed = Some((p.v, q.v, p.cap)),
-                Some(e) => {
-                    changed = true;
-                    let high = p.v.max(q.v);
-                    let node = e.node;
-                    // A knot where the gap exceeds the limit; a lower cap only
-                    // when no node inside the gap is exceeded (a gap of one
-                    // interval, whose limit then binds its peak).
-                    let inside = node > p.node && node < q.node;
-                    let cap = (!inside).then_some(e.lowest);
-                    if let Some(cap) = cap {
-                        knots[k].cap = cap.max(high).min(p.cap * (1.0 - TOLERANCE));
-                    } else {
-                        inserts.push((
-                            k + 1,
-                            Knot {
-                                node,
-                                v: curve.node[node],
-                                cap: p.cap,
-                                passed: None,
-                                permanent: true,
-                            },
-                        ));
-                    }
+            let found = excess(&curve, &p, &q, &phases);
+            if found.iter().all(Option::is_none) {
+                knots[k].passed = Some((p.v, q.v, p.cap));
+                continue;
+            }
+            changed = true;
+            // A knot where the gap exceeds the limit (one where it rises, one
+            // where it falls); a lower cap only when no node inside the gap
+            // is exceeded (a gap of one interval, whose limit then binds).
+            let mut nodes: Vec<usize> = Vec::with_capacity(2);
+            for e in found.iter().flatten() {
+                if e.node > p.node && e.node < q.node {
+                    nodes.push(e.node);
+                } else {
+                    let cap = e.lowest.max(p.v.max(q.v));
+                    knots[k].cap = cap.min(p.cap * (1.0 - TOLERANCE));
+                    knots[k].passed = None;
                 }
+            }
+            nodes.sort_unstable();
+            nodes.dedup();
+            for node in nodes {
+                inserts.push((
+                    k + 1,
+                    Knot {
+                        node,
+                        v: curve.node[node],
+                        cap: p.cap,
+                        passed: None,
+                        permanent: true,
+                    },
+                ));
             }
         }
         if !inserts.is_empty() {
             let mut merged = Vec::with_capacity(knots.len() + inserts.len());
             let mut next = inserts.into_iter().peekable();
             for (i, knot) in knots.iter().enumerate() {
-                if next.peek().is_some_and(|(at, _)| *at == i) {
+                while next.peek().is_some_and(|(at, _)| *at == i) {
                     if let (Some(prev), Some((_, new))) = (merged.last_mut(), next.next()) {
                         let prev: &mut Knot = prev;
                         prev.passed = None;
@@ -313,11 +319,12 @@ struct Excess {
 }
 
 /// Step 4: where the gap from `p` to `q` run as `phases` exceeds the limit
-/// curve (`None` if nowhere).
-fn excess(curve: &LimitCurve, p: &Knot, q: &Knot, phases: &[Phase]) -> Option<Excess> {
-    let mut worst: Option<Excess> = None;
-    let mut note = |limit: f64, node: usize| {
-        let w = worst.get_or_insert(Excess {
+/// curve, while its speed rises and while it falls (`None` where nowhere).
+fn excess(curve: &LimitCurve, p: &Knot, q: &Knot, phases: &[Phase]) -> [Option<Excess>; 2] {
+    // The lowest exceeded limit where the speed rises (or cruises), and where it falls.
+    let mut worst: [Option<Excess>; 2] = [None, None];
+    let mut note = |limit: f64, node: usize, falling: bool| {
+        let w = worst[usize::from(falling)].get_or_insert(Excess {
             lowest: limit,
             node,
         });
@@ -345,13 +352,14 @@ fn excess(curve: &LimitCurve, p: &Knot, q: &Knot, phases: &[Phase]) -> Option<Ex
         // The speed is monotone in the phase: nodes whose limit is above
         // both its ends cannot be exceeded.
         let top = ph.v0.max(v1);
+        let falling = v1 < ph.v0;
         while k < q.node && curve.s[k] <= s1 {
             if curve.node[k] * (1.0 + TOLERANCE) < top {
                 let t = time_at(&ph, curve.s[k], t_lo);
                 t_lo = t;
                 let v = ph.at(t).1;
                 if v > curve.node[k] * (1.0 + TOLERANCE) {
-                    note(curve.node[k], k);
+                    note(curve.node[k], k, falling);
                 }
             }
             k += 1;
@@ -367,7 +375,7 @@ fn excess(curve: &LimitCurve, p: &Knot, q: &Knot, phases: &[Phase]) -> Option<Ex
                     (false, true) => k,
                     (false, false) => p.node,
                 };
-                note(limit, node);
+                note(limit, node, falling);
             }
         }
         ph.s0 = s1;
