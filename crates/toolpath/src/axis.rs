@@ -73,7 +73,10 @@ impl AxisLimits {
     /// min(J_t, min_i J_i/2)) (module documentation).
     pub fn tangential(&self, a_t: f64, j_t: f64) -> (f64, f64) {
         let half_min = |v: &[f64; 3]| 0.5 * v.iter().copied().fold(f64::INFINITY, f64::min);
-        (a_t.min(half_min(&self.acceleration)), j_t.min(half_min(&self.jerk)))
+        (
+            a_t.min(half_min(&self.acceleration)),
+            j_t.min(half_min(&self.jerk)),
+        )
     }
 
     /// The largest speed on a stretch of path where, for every axis i,
@@ -133,11 +136,19 @@ mod tests {
 
     #[test]
     fn the_cubic_bound_is_the_root() {
-        for (g, p, q) in [(1.0, 0.0, 8.0), (2.0, 3.0, 7.0), (1e-6, 1.0, 0.5), (5.0, 1e3, 1e-3)] {
+        for (g, p, q) in [
+            (1.0, 0.0, 8.0),
+            (2.0, 3.0, 7.0),
+            (1e-6, 1.0, 0.5),
+            (5.0, 1e3, 1e-3),
+        ] {
             let v = cubic_root_bound(g, p, q);
             assert!(g * v * v * v + p * v <= q, "{g} {p} {q}: {v}");
             let w = v * (1.0 + 1e-8);
-            assert!(g * w * w * w + p * w > q, "{g} {p} {q}: {v} not the largest");
+            assert!(
+                g * w * w * w + p * w > q,
+                "{g} {p} {q}: {v} not the largest"
+            );
         }
         assert_eq!(cubic_root_bound(0.0, 0.0, 1.0), f64::INFINITY);
         assert!((cubic_root_bound(0.0, 2.0, 1.0) - 0.5).abs() < 1e-15);

@@ -218,8 +218,8 @@ fn largest_limit(curve: &LimitCurve, a: usize, b: usize) -> f64 {
 fn settle(knots: &mut Vec<Knot>, curve: &LimitCurve, a: f64, j: f64) {
     loop {
         let last = knots.len() - 1;
-        for k in 1..last {
-            knots[k].v = curve.node[knots[k].node];
+        for knot in &mut knots[1..last] {
+            knot.v = curve.node[knot.node];
         }
         scan(knots, curve, a, j);
         let before = knots.len();

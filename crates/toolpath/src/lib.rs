@@ -3,6 +3,12 @@
 //! curvature-continuous transitions ([`corner`], [`smooth`]), arc-length
 //! samples ([`samples`]) and the bang-bang time bound T_lb
 //! ([`lower_bound`]).
+//!
+//! Feed planning: seed 003's constant-interval planner ([`feed`]) and kerf's
+//! near time-optimal one ([`feed_optimal`]) over a velocity-limit curve
+//! ([`limit_curve`]) with per-sample feeds and axis limits ([`constraints`],
+//! [`axis`]), picked by [`FeedMethod`] and verified on their output by
+//! [`check_plan`] ([`plan_check`]).
 
 pub mod axis;
 pub mod bezier;
@@ -23,19 +29,19 @@ pub mod smooth;
 pub mod speed_limit;
 pub mod vec3;
 
+pub use axis::AxisLimits;
 pub use bezier::QuinticBezier;
+pub use constraints::FeedConstraints;
 pub use corner::{corner_transition, Binding, CornerShape, CornerTransition};
 pub use error::ToolpathError;
 pub use feed::{plan_feed, FeedLimits, FeedPlan, FeedSample};
-pub use lower_bound::{bang_bang, bang_bang_under, BangBang, BangBangLimits};
-pub use merge::merge_collinear;
-pub use metrics::{metrics, Metrics};
-pub use samples::{derivatives_at, point_at, sample_path, PathSample};
-pub use smooth::{smooth_polyline, Piece, SmoothedPath};
-pub use speed_limit::{CurvatureLimits, Servo};
-pub use axis::AxisLimits;
-pub use constraints::FeedConstraints;
 pub use feed_method::FeedMethod;
 pub use feed_optimal::plan_feed_optimal;
 pub use limit_curve::{limit_curve, LimitCurve};
+pub use lower_bound::{bang_bang, bang_bang_under, BangBang, BangBangLimits};
+pub use merge::merge_collinear;
+pub use metrics::{metrics, Metrics};
 pub use plan_check::{check_plan, PlanCheck, Worst};
+pub use samples::{derivatives_at, point_at, sample_path, PathSample};
+pub use smooth::{smooth_polyline, Piece, SmoothedPath};
+pub use speed_limit::{CurvatureLimits, Servo};

@@ -115,8 +115,16 @@ pub fn limit_curve(samples: &[PathSample], constraints: &FeedConstraints<'_>) ->
         let (p, q) = (&nodes[k], &nodes[k + 1]);
         let ds = q.s - p.s;
         // Intervals k − 1 ..= k + 1 of the same piece as interval k.
-        let lo = if k > 0 && nodes[k - 1].piece == p.piece { k - 1 } else { k };
-        let hi = if k + 2 < n && nodes[k + 1].piece == p.piece { k + 1 } else { k };
+        let lo = if k > 0 && nodes[k - 1].piece == p.piece {
+            k - 1
+        } else {
+            k
+        };
+        let hi = if k + 2 < n && nodes[k + 1].piece == p.piece {
+            k + 1
+        } else {
+            k
+        };
         let change = (lo..=hi)
             .map(|r| (nodes[r + 1].kappa - nodes[r].kappa).abs())
             .fold(0.0, f64::max);
@@ -148,7 +156,11 @@ pub fn limit_curve(samples: &[PathSample], constraints: &FeedConstraints<'_>) ->
     }
     let node = (0..n)
         .map(|k| {
-            let left = if k > 0 { interval[k - 1] } else { f64::INFINITY };
+            let left = if k > 0 {
+                interval[k - 1]
+            } else {
+                f64::INFINITY
+            };
             left.min(*interval.get(k).unwrap_or(&f64::INFINITY))
         })
         .collect();

@@ -93,7 +93,10 @@ impl PlanCheck {
             ("contour error", self.contour_error),
         ];
         for i in 0..3 {
-            out.push((["X velocity", "Y velocity", "Z velocity"][i], self.axis_velocity[i]));
+            out.push((
+                ["X velocity", "Y velocity", "Z velocity"][i],
+                self.axis_velocity[i],
+            ));
             out.push((
                 ["X acceleration", "Y acceleration", "Z acceleration"][i],
                 self.axis_acceleration[i],
@@ -164,8 +167,8 @@ pub fn check_plan(
             let rho = 1.0 / kappa;
             let wn = servo.natural_frequency;
             let w = v / rho;
-            let gain =
-                wn * wn / ((wn * wn - w * w).powi(2) + (2.0 * servo.damping * wn * w).powi(2)).sqrt();
+            let gain = wn * wn
+                / ((wn * wn - w * w).powi(2) + (2.0 * servo.damping * wn * w).powi(2)).sqrt();
             out.contour_error
                 .note(rho * (1.0 - gain).abs() / servo.contour_error, p.t);
         }
@@ -250,7 +253,9 @@ fn chord_error(
     }
     if s1 > s0 {
         for f in [0.25, 0.5, 0.75] {
-            e = e.max(distance(derivatives_at(path, samples, s0 + f * (s1 - s0)).0));
+            e = e.max(distance(
+                derivatives_at(path, samples, s0 + f * (s1 - s0)).0,
+            ));
         }
     }
     e

@@ -234,8 +234,14 @@ fn feed_caps_hold_across_a_change_without_stopping() {
             }
         }
         // The higher cap is used where it holds.
-        let before = ts.iter().filter(|p| p.s < s_change).fold(0.0, |m, p| p.v.max(m));
-        let after = ts.iter().filter(|p| p.s > s_change).fold(0.0, |m, p| p.v.max(m));
+        let before = ts
+            .iter()
+            .filter(|p| p.s < s_change)
+            .fold(0.0, |m, p| p.v.max(m));
+        let after = ts
+            .iter()
+            .filter(|p| p.s > s_change)
+            .fold(0.0, |m, p| p.v.max(m));
         assert!(before.max(after) > 0.0499, "{before} {after}");
     }
 }
@@ -273,8 +279,16 @@ fn axis_limits_bind_and_hold() {
     };
     let (plan, check) = plan_and_check(&path, &samples, &c);
     println!("axes: {check:?}");
-    assert!(plan.time > free.time * 1.05, "{} vs {}", plan.time, free.time);
-    let a = check.axis_acceleration.iter().fold(0.0f64, |m, w| m.max(w.ratio));
+    assert!(
+        plan.time > free.time * 1.05,
+        "{} vs {}",
+        plan.time,
+        free.time
+    );
+    let a = check
+        .axis_acceleration
+        .iter()
+        .fold(0.0f64, |m, w| m.max(w.ratio));
     let j = check.axis_jerk.iter().fold(0.0f64, |m, w| m.max(w.ratio));
     // The tangential budget takes half of each axis's acceleration and jerk (AxisLimits): on
     // a straight line along an axis the acceleration reaches exactly half, in the corners the
@@ -321,7 +335,14 @@ fn bad_input_is_refused() {
         };
         let e = plan_feed_optimal(&samples, &c).unwrap_err();
         assert!(e.to_string().contains("feed cap"), "{e}");
-        assert!(check_plan(&path, &samples, &plan_feed_optimal(&samples, &ok).unwrap(), &c, 0.002).is_err());
+        assert!(check_plan(
+            &path,
+            &samples,
+            &plan_feed_optimal(&samples, &ok).unwrap(),
+            &c,
+            0.002
+        )
+        .is_err());
     }
     for (field, value) in [(0, f64::NAN), (1, 0.0), (2, -1.0), (0, f64::INFINITY)] {
         let mut axes = AxisLimits::laser_cutter();
