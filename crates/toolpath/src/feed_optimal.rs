@@ -29,12 +29,14 @@
 //!    repeated, until every remaining knot is at its limit or permanent.
 //! 3. **Each gap** is run as up–cruise–down with the highest peak that fits,
 //!    at most the gap's cap (the largest limit in the gap).
-//! 4. **Exact check under the limit curve**: the gap's speed is evaluated at
-//!    every node inside it whose limit is below the speed at an end of the
-//!    phase there, and at every phase boundary (the node's time solved by
-//!    safeguarded Newton on the cubic s(t)). The speed is monotone within a
-//!    constant-jerk phase of an S-curve, so these points bound it over every
-//!    interval against that interval's limit. Where it exceeds the limit, a
+//! 4. **Exact check under the limit curve**: the gap's speed is compared
+//!    with the limit at every node inside it whose limit is below the speed
+//!    at an end of the phase there, and at every phase boundary. The speed
+//!    is monotone within a constant-jerk phase of an S-curve, so a node is
+//!    exceeded iff it lies beyond (rising) or before (falling) the arc
+//!    length where the speed crosses its limit: a quadratic in time, solved
+//!    in closed form. These points bound the speed over every interval
+//!    against that interval's limit. Where it exceeds the limit, a
 //!    permanent knot is added at the node with the lowest exceeded limit, at
 //!    that limit (a gap of one interval gets that interval's limit as its
 //!    cap instead). Then back to 2. Knots are removed at most once each and
@@ -348,17 +350,21 @@ fn excess(curve: &LimitCurve, p: &Knot, q: &Knot, phases: &[Phase]) -> [Option<E
     for phase in phases.iter().filter(|x| x.duration > 0.0) {
         ph.phase = *phase;
         let (s1, v1, a1) = ph.at(phase.duration);
-        let mut t_lo = 0.0;
         // The speed is monotone in the phase: nodes whose limit is above
         // both its ends cannot be exceeded.
         let top = ph.v0.max(v1);
         let falling = v1 < ph.v0;
         while k < q.node && curve.s[k] <= s1 {
-            if curve.node[k] * (1.0 + TOLERANCE) < top {
-                let t = time_at(&ph, curve.s[k], t_lo);
-                t_lo = t;
-                let v = ph.at(t).1;
-                if v > curve.node[k] * (1.0 + TOLERANCE) {
+            let limit = curve.node[k] * (1.0 + TOLERANCE);
+            if limit < top {
+                // Where the speed crosses the limit (v is monotone in the
+                // phase): exceeded after it when rising, before it when falling.
+                let exceeded = if falling {
+                    limit < v1 || curve.s[k] < ph.at(time_of_speed(&ph, limit)).0
+                } else {
+                    limit < ph.v0 || curve.s[k] > ph.at(time_of_speed(&ph, limit)).0
+                };
+                if exceeded {
                     note(curve.node[k], k, falling);
                 }
             }
@@ -385,36 +391,26 @@ fn excess(curve: &LimitCurve, p: &Knot, q: &Knot, phases: &[Phase]) -> [Option<E
     worst
 }
 
-/// The time in `ph` (from `t_lo` on) at which its arc length is `s`:
-/// safeguarded Newton on the cubic s(t), increasing since v ≥ 0.
-fn time_at(ph: &PlacedPhase, s: f64, t_lo: f64) -> f64 {
-    let (mut lo, mut hi) = (t_lo, ph.phase.duration);
-    let mut t = 0.5 * (lo + hi);
-    if ph.v0 > 0.0 {
-        t = (t_lo + (s - ph.at(t_lo).0) / ph.v0).clamp(lo, hi);
-    }
-    for _ in 0..60 {
-        let (st, vt, _) = ph.at(t);
-        let f = st - s;
-        if f.abs() <= 1e-16 * s.abs().max(1e-3) {
-            return t;
-        }
-        if f > 0.0 {
-            hi = t;
-        } else {
-            lo = t;
-        }
-        let newton = if vt > 0.0 { t - f / vt } else { f64::NAN };
-        t = if newton > lo && newton < hi {
-            newton
-        } else {
-            0.5 * (lo + hi)
-        };
-        if hi - lo <= 1e-15 * ph.phase.duration {
-            break;
-        }
-    }
-    t
+/// The time in `ph` at which its speed is `v` (between its end speeds; v
+/// is monotone in the phase): the root in the phase of
+/// j t²/2 + a₀ t − (v − v₀) = 0, written 2Δ/(a₀ + √(a₀² + 2jΔ)) (signs
+/// flipped when the speed falls) so that it does not cancel.
+fn time_of_speed(ph: &PlacedPhase, v: f64) -> f64 {
+    let (a0, j) = (ph.a0, ph.phase.jerk);
+    let dv = v - ph.v0;
+    let sign = if a0 > 0.0 || (a0 == 0.0 && j > 0.0) {
+        1.0
+    } else {
+        -1.0
+    };
+    let root = (a0 * a0 + 2.0 * j * dv).max(0.0).sqrt();
+    let den = sign * a0 + root;
+    let t = if den > 0.0 {
+        2.0 * sign * dv / den
+    } else {
+        0.0
+    };
+    t.clamp(0.0, ph.phase.duration)
 }
 
 /// The plan: every gap's phases in order, placed by exact integration.
