@@ -289,7 +289,7 @@ fn gap_phases(v0: f64, v1: f64, d: f64, cap: f64, a: f64, j: f64) -> Vec<Phase> 
         cap
     } else {
         let (mut lo, mut hi) = (low, cap);
-        for _ in 0..64 {
+        for _ in 0..40 {
             let mid = 0.5 * (lo + hi);
             if fits(mid) {
                 lo = mid;

@@ -94,19 +94,11 @@ pub fn limit_curve(samples: &[PathSample], constraints: &FeedConstraints<'_>) ->
         }
     }
     let n = nodes.len();
-    // Tangent differences: m_k ≈ κ n over interval k; third[k] ≈ |x‴| at node k.
-    let m: Vec<[f64; 3]> = nodes
-        .windows(2)
-        .map(|w| {
-            let ds = w[1].s - w[0].s;
-            std::array::from_fn(|a| (w[1].tangent[a] - w[0].tangent[a]) / ds)
-        })
-        .collect();
-    let mut third = vec![[0.0f64; 3]; n];
-    for k in 1..n - 1 {
-        let h = 0.5 * (nodes[k + 1].s - nodes[k - 1].s);
-        third[k] = std::array::from_fn(|a| (m[k][a] - m[k - 1][a]).abs() / h);
-    }
+    let third = if constraints.axes.is_some() {
+        third_derivatives(&nodes)
+    } else {
+        Vec::new()
+    };
     let chord_kappa = window_max(&nodes, w);
     let free = feed_curvature(lim);
     let (a_eff, j_eff) = constraints.tangential();
@@ -134,7 +126,7 @@ pub fn limit_curve(samples: &[PathSample], constraints: &FeedConstraints<'_>) ->
         let kappa = (p.kappa.max(q.kappa) + 0.5 * change).max(turn / ds);
         let mut v = lim.feed.min(p.cap).min(q.cap);
         if kappa > free {
-            v = v.min(lim.speed(kappa));
+            v = v.min(curvature_speed(lim, kappa, v));
         }
         let kc = chord_kappa[k].max(kappa);
         if kc > free {
@@ -215,4 +207,37 @@ fn feed_curvature(lim: &CurvatureLimits) -> f64 {
         }
     }
     lo * (1.0 - 1e-9)
+}
+
+/// min(`v`, eqs. 17, 19, 21 at κ) as [`CurvatureLimits::speed`] without its
+/// chord term (the chord is bounded separately), the cube root only where
+/// it is below `v` (ρ² j_n < v³).
+fn curvature_speed(lim: &CurvatureLimits, kappa: f64, v: f64) -> f64 {
+    let rho = 1.0 / kappa;
+    let mut v = v.min((rho * lim.normal_acceleration).sqrt());
+    let jerk = rho * rho * lim.normal_jerk;
+    if jerk < v * v * v {
+        v = jerk.cbrt();
+    }
+    v.min(lim.contour_speed(rho))
+}
+
+/// |x‴| at every node, per axis, from the tangents: m_k = Δt/Δs ≈ κ n over
+/// interval k, and |m_k − m_{k−1}| over the mean spacing at node k (0 at the
+/// ends).
+fn third_derivatives(nodes: &[Node]) -> Vec<[f64; 3]> {
+    let n = nodes.len();
+    let m: Vec<[f64; 3]> = nodes
+        .windows(2)
+        .map(|w| {
+            let ds = w[1].s - w[0].s;
+            std::array::from_fn(|a| (w[1].tangent[a] - w[0].tangent[a]) / ds)
+        })
+        .collect();
+    let mut third = vec![[0.0f64; 3]; n];
+    for k in 1..n - 1 {
+        let h = 0.5 * (nodes[k + 1].s - nodes[k - 1].s);
+        third[k] = std::array::from_fn(|a| (m[k][a] - m[k - 1][a]).abs() / h);
+    }
+    third
 }
