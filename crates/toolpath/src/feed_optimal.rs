@@ -281,20 +281,42 @@ fn scan(knots: &mut [Knot], curve: &LimitCurve, a: f64, j: f64) {
 /// Step 3: S-curve from `v0` up to the highest peak (at most `cap`) whose
 /// up and down S-curves fit in `d`, cruise, S-curve down to `v1`.
 fn gap_phases(v0: f64, v1: f64, d: f64, cap: f64, a: f64, j: f64) -> Vec<Phase> {
-    let fits = |vp: f64| scurve_distance(v0, vp, a, j) + scurve_distance(vp, v1, a, j) <= d;
+    let excess = |vp: f64| scurve_distance(v0, vp, a, j) + scurve_distance(vp, v1, a, j) - d;
     let low = v0.max(v1);
-    let peak = if cap <= low || !fits(low) {
+    let peak = if cap <= low || excess(low) > 0.0 {
         low
-    } else if fits(cap) {
+    } else if excess(cap) <= 0.0 {
         cap
     } else {
+        // The distance rises with the peak: the Illinois variant of regula
+        // falsi keeps a bracket [lo (fits), hi (does not)] and converges
+        // superlinearly; lo is returned, so the S-curves always fit.
         let (mut lo, mut hi) = (low, cap);
-        for _ in 0..40 {
-            let mid = 0.5 * (lo + hi);
-            if fits(mid) {
+        let (mut f_lo, mut f_hi) = (excess(lo), excess(hi));
+        let mut side = 0i8;
+        for _ in 0..100 {
+            if hi - lo <= 1e-13 * hi {
+                break;
+            }
+            let mut mid = (lo * f_hi - hi * f_lo) / (f_hi - f_lo);
+            if !(mid > lo && mid < hi) {
+                mid = 0.5 * (lo + hi);
+            }
+            let f = excess(mid);
+            if f <= 0.0 {
                 lo = mid;
+                f_lo = f;
+                if side == -1 {
+                    f_hi *= 0.5;
+                }
+                side = -1;
             } else {
                 hi = mid;
+                f_hi = f;
+                if side == 1 {
+                    f_lo *= 0.5;
+                }
+                side = 1;
             }
         }
         lo
