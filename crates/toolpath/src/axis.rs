@@ -24,7 +24,7 @@
 //! The right-hand sides are at least A_i / 2 and J_i / 2 (|x_i′| ≤ 1), and
 //! with |a| ≤ A, |j| ≤ J the triangle inequality on the chain rule gives
 //! |ẋ_i| ≤ V_i, |ẍ_i| ≤ A_i, |x⃛_i| ≤ J_i. The bounds |x_i′|, |x_i″|, |x_i‴|
-//! over each interval between samples come from [`crate::limit_curve`].
+//! over each interval between samples come from [`crate::limit_curve`](mod@crate::limit_curve).
 
 use crate::error::{check_positive, ToolpathError};
 

@@ -1,5 +1,5 @@
 //! A near time-optimal, jerk-limited, bidirectional feed plan (issue 14,
-//! item 3) that tracks the velocity-limit curve ([`crate::limit_curve`])
+//! item 3) that tracks the velocity-limit curve ([`crate::limit_curve`](mod@crate::limit_curve))
 //! instead of holding whole feed-sensitive intervals at their lowest limit
 //! ([`crate::plan_feed`]).
 //!
@@ -80,7 +80,8 @@ struct Knot {
 }
 
 /// Plans a near time-optimal feed along `samples` under `constraints`
-/// (module documentation).
+/// (module documentation). The plan's [`FeedPlan::intervals`] are its
+/// critical points, each as (s, s, v).
 ///
 /// # Errors
 /// [`ToolpathError::InvalidParameter`] for bad constraints

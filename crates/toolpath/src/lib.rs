@@ -6,7 +6,7 @@
 //!
 //! Feed planning: seed 003's constant-interval planner ([`feed`]) and kerf's
 //! near time-optimal one ([`feed_optimal`]) over a velocity-limit curve
-//! ([`limit_curve`]) with per-sample feeds and axis limits ([`constraints`],
+//! ([`limit_curve`](mod@limit_curve)) with per-sample feeds and axis limits ([`constraints`],
 //! [`axis`]), picked by [`FeedMethod`] and verified on their output by
 //! [`check_plan`] ([`plan_check`]).
 

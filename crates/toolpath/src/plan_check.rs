@@ -14,7 +14,7 @@
 //! * normal jerk κ² v³ / j_n,lim (seed 003 eq. 20: j_n = v³/ρ², the limit of
 //!   eq. 21);
 //! * contour error ρ |1 − |G(j v/ρ)|| / ε_lim, the steady-state radius error
-//!   of eq. 17's servo (as [`crate::metrics`]);
+//!   of eq. 17's servo (as [`crate::metrics()`]);
 //! * per axis i, by the chain rule of [`crate::axis`]: |t_i v| / V_i,
 //!   |(κn)_i v² + t_i a| / A_i, |x_i‴ v³ + 3 (κn)_i v a + t_i j| / J_i with
 //!   x‴ the central difference of κ n over ±1 µm of arc length.
