@@ -116,7 +116,10 @@ const LETTERS: &str = "XYZIJKRFPQS";
 impl Interpreter {
     /// A fresh interpreter: at `settings.start`, millimetres, absolute
     /// distances, incremental arc centres (G91.1), XY plane, no motion mode,
-    /// no feed, tool off (LinuxCNC's defaults).
+    /// no feed, tool off (LinuxCNC's defaults); path blending (G64) without
+    /// a P tolerance: kerf's choice, so that a program is smoothed within
+    /// the planner's tolerance unless it says G61 (exact path, a stop at
+    /// every vertex).
     ///
     /// # Errors
     /// [`ReaderSettings::validate`].
@@ -133,7 +136,10 @@ impl Interpreter {
             feed: None,
             spindle_speed: 0.0,
             tool_on: false,
-            path_control: PathControl::Exact,
+            path_control: PathControl::Blend {
+                tolerance: None,
+                naive_tolerance: None,
+            },
             ended: None,
         })
     }

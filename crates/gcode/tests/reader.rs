@@ -173,6 +173,14 @@ fn arcs_centre_format_radius_format_full_circles_helices_planes() {
 fn path_control_and_safe_state_codes() {
     let text = "G17 G21 G40 G49 G54 G80 G90 G94\nG64 P0.02 Q0.01\n";
     let mut p = Program::new(text.as_bytes(), ReaderSettings::default()).unwrap();
+    // Before any code: blending without a tolerance (the planner's applies).
+    assert_eq!(
+        p.interpreter().path_control(),
+        PathControl::Blend {
+            tolerance: None,
+            naive_tolerance: None
+        }
+    );
     assert_eq!(p.by_ref().count(), 0);
     assert_eq!(
         p.interpreter().path_control(),

@@ -45,3 +45,7 @@ pub use plan_check::{check_plan, PlanCheck, Worst};
 pub use samples::{derivatives_at, point_at, sample_path, PathSample};
 pub use smooth::{smooth_polyline, Piece, SmoothedPath};
 pub use speed_limit::{CurvatureLimits, Servo};
+pub mod plot;
+pub use plot::{pipeline_plots, Chart};
+pub mod corner_metrics;
+pub use corner_metrics::{corner_metrics, CornerMetrics};

@@ -124,8 +124,14 @@ impl CurvatureLimits {
         if e >= rho {
             return f64::INFINITY;
         }
-        let z2 = 2.0 * s.damping * s.damping;
-        let inner = (z2 - 1.0).powi(2) - (e * e - 2.0 * e * rho) / ((rho - e) * (rho - e));
-        rho * s.natural_frequency * (1.0 - z2 + inner.sqrt()).max(0.0).sqrt()
+        // With a = 2ζ² − 1 ≥ 0 (validated) and x = (2ερ − ε²)/(ρ − ε)² ≥ 0, the bracket
+        // 1 − 2ζ² + √(a² + x) = −a + √(a² + x) is computed as x / (√(a² + x) + a): the
+        // difference of two nearly equal numbers cancels to 0 for x ≪ a² (a numerically
+        // straight joint, κ ~ 1e-14 1/m), which made the speed 0 there.
+        let a = 2.0 * s.damping * s.damping - 1.0;
+        let x = (2.0 * e * rho - e * e) / ((rho - e) * (rho - e));
+        let root = (a * a + x).sqrt();
+        let bracket = if root + a > 0.0 { x / (root + a) } else { 0.0 };
+        rho * s.natural_frequency * bracket.max(0.0).sqrt()
     }
 }

@@ -92,3 +92,15 @@ fn the_bound_under_the_full_limit_curve_is_slower_than_under_a_n_alone() {
     assert!(bang_bang_under(&samples, vec![0.07; 3], 0.8).is_err());
     assert!(bang_bang_under(&samples, vec![0.0; samples.len()], 0.8).is_err());
 }
+
+#[test]
+fn contour_speed_does_not_cancel_on_nearly_straight_paths() {
+    // Where two corners meet, rounding leaves κ ~ 1e-14 1/m: the speed there
+    // must be huge, not 0 (the literal form of eq. 17 cancels to 0).
+    let l = CurvatureLimits::seed_003_table_1();
+    for kappa in [3e-14, 1e-10, 1e-6] {
+        let v = l.contour_speed(1.0 / kappa);
+        assert!(v > 1.0, "kappa {kappa}: v {v}");
+        assert!(l.speed(kappa) > 0.0);
+    }
+}

@@ -1,7 +1,8 @@
 //! kerf's own messages (`kerf_msgs/msg`, defined in `msgs/msg/`): the trajectory executor's
 //! [`TrajectoryStatus`], the MJTO planner's [`CutRequest`] / [`CutPlan`] (with [`CutRto`],
 //! [`CutMetrics`], [`CutCollision`]) and the milling planner's [`MillRequest`] / [`MillPlan`]
-//! (with [`MillSegment`]).
+//! (with [`MillSegment`]) and the G-code planner's [`GcodeRequest`] / [`GcodePlan`] (with
+//! [`GcodeToolEvent`]).
 
 use serde::{Deserialize, Serialize};
 
@@ -477,9 +478,190 @@ impl MillPlan {
     }
 }
 
+/// `kerf_msgs/msg/GcodeRequest`: a G-code program for the G-code planner node (issue 14), sent
+/// to its `~/gcode_request` topic; answered by a [`GcodePlan`] on `~/gcode_plan`.
+#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
+pub struct GcodeRequest {
+    /// Any text; echoed in the [`GcodePlan`].
+    pub request_id: String,
+    /// One of the `MACHINE_*` constants; empty = laser-cutter.
+    pub machine: String,
+    /// The program text (exactly one of `program` and `program_uri` non-empty).
+    pub program: String,
+    /// A program file: absolute path, `file://` or `package://kerf/` URI.
+    pub program_uri: String,
+    /// Tolerance of the executed tool tip (m), in (0, 0.01]; 0 = 1e-4.
+    pub tolerance: f64,
+    /// One of the `METHOD_*` constants; empty = kerf.
+    pub method: String,
+    /// Whether the path limits below are given; false = the machine's.
+    pub has_limits: bool,
+    /// Largest cutting feed (m/s).
+    pub max_feed: f64,
+    /// Tangential acceleration (m/s²).
+    pub tangential_acceleration: f64,
+    /// Tangential jerk (m/s³).
+    pub tangential_jerk: f64,
+    /// Normal acceleration (m/s²).
+    pub normal_acceleration: f64,
+    /// Normal jerk (m/s³).
+    pub normal_jerk: f64,
+    /// Chord error per interpolation period (m).
+    pub chord_error: f64,
+    /// Servo contour error (m).
+    pub contour_error: f64,
+    /// G0 speed (m/s); 0 = the machine's.
+    pub rapid_feed: f64,
+    /// Whether the placement below is given; false = the machine's.
+    pub has_placement: bool,
+    /// The program's zero in the machine's base frame (m).
+    pub origin: Point,
+    /// IRB 6660: redundancy angle g (rad).
+    pub redundancy_angle: f64,
+    /// Laser cutter: standoff axis q6 (m).
+    pub standoff_axis: f64,
+    /// Time budget of the plan (s): 0 = the node's `plan_timeout`.
+    pub time_budget: f64,
+}
+impl_ros_type!(GcodeRequest, "kerf_msgs", msg, "GcodeRequest");
+
+impl GcodeRequest {
+    /// The laser cutter of seed 001.
+    pub const MACHINE_LASER_CUTTER: &'static str = "laser-cutter";
+    /// The ABB IRB 6660 milling cell of seed 004.
+    pub const MACHINE_IRB6660: &'static str = "irb6660";
+    /// kerf's curvature-continuous quintic corner.
+    pub const METHOD_KERF: &'static str = "kerf";
+}
+
+/// `kerf_msgs/msg/GcodeToolEvent`: a beam or spindle switch of a planned program, at rest.
+#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
+pub struct GcodeToolEvent {
+    /// Time from the trajectory's start (s).
+    pub time: f64,
+    /// On after it.
+    pub on: bool,
+    /// Source line.
+    pub line: u32,
+}
+impl_ros_type!(GcodeToolEvent, "kerf_msgs", msg, "GcodeToolEvent");
+
+/// `kerf_msgs/msg/GcodePlan`: the G-code planner's answer to one [`GcodeRequest`], published on
+/// `~/gcode_plan`; failures carry their status and message.
+#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
+pub struct GcodePlan {
+    /// `request_id` of the request (empty when it could not be read).
+    pub request_id: String,
+    /// One of the status constants ([`SUCCESS`](Self::SUCCESS) …).
+    pub status: u8,
+    /// Human-readable result or reason.
+    pub message: String,
+    /// The machine planned for.
+    pub machine: String,
+    /// The corner method planned with.
+    pub method: String,
+    /// The joint trajectory from rest to rest; empty unless SUCCESS.
+    pub trajectory: JointTrajectory,
+    /// The program line at fault (0 when none).
+    pub error_line: u32,
+    /// The trajectory's duration (s).
+    pub machining_time: f64,
+    /// The feed plans' time T_m (s).
+    pub feed_time: f64,
+    /// T_lb (s).
+    pub lower_bound_time: f64,
+    /// T_m / T_lb.
+    pub lower_bound_ratio: f64,
+    /// Total dwell time (s).
+    pub dwell_time: f64,
+    /// The tolerance (m).
+    pub tolerance: f64,
+    /// Largest exact corner deviation (m).
+    pub max_corner_deviation: f64,
+    /// Largest distance of the executed tip from the planned point (m).
+    pub max_interpolation_deviation: f64,
+    /// Largest curvature (1/m).
+    pub max_curvature: f64,
+    /// Largest turning angle (rad).
+    pub max_turning_angle: f64,
+    /// RMS acceleration (m/s²).
+    pub rms_acceleration: f64,
+    /// RMS jerk (m/s³).
+    pub rms_jerk: f64,
+    /// Largest chord error (m).
+    pub max_chord_error: f64,
+    /// Largest servo contour error (m).
+    pub max_contour_error: f64,
+    /// Largest uniform slowdown of a run (1 = none).
+    pub max_slowdown: f64,
+    /// Lines read.
+    pub lines: u32,
+    /// Runs.
+    pub runs: u32,
+    /// Cutting runs.
+    pub cut_runs: u32,
+    /// Corners smoothed.
+    pub corners: u32,
+    /// Arcs read.
+    pub arcs: u32,
+    /// Beam or spindle switches.
+    pub tool_events: Vec<GcodeToolEvent>,
+    /// Warnings.
+    pub warnings: Vec<String>,
+}
+impl_ros_type!(GcodePlan, "kerf_msgs", msg, "GcodePlan");
+
+impl GcodePlan {
+    /// The plan succeeded.
+    pub const SUCCESS: u8 = 0;
+    /// A field of the request is bad, or the answer would be too large.
+    pub const INVALID_REQUEST: u8 = 1;
+    /// The program is not valid G-code, uses a refused code, or has no motion.
+    pub const PROGRAM_ERROR: u8 = 2;
+    /// A programmed point is out of reach.
+    pub const UNREACHABLE: u8 = 3;
+    /// The request queue is full.
+    pub const QUEUE_FULL: u8 = 4;
+    /// Another internal error.
+    pub const INTERNAL_ERROR: u8 = 5;
+    /// The time budget ran out.
+    pub const TIMEOUT: u8 = 6;
+
+    /// Name of a status value, or `None` for an unknown value.
+    pub fn status_name(status: u8) -> Option<&'static str> {
+        match status {
+            Self::SUCCESS => Some("SUCCESS"),
+            Self::INVALID_REQUEST => Some("INVALID_REQUEST"),
+            Self::PROGRAM_ERROR => Some("PROGRAM_ERROR"),
+            Self::UNREACHABLE => Some("UNREACHABLE"),
+            Self::QUEUE_FULL => Some("QUEUE_FULL"),
+            Self::INTERNAL_ERROR => Some("INTERNAL_ERROR"),
+            Self::TIMEOUT => Some("TIMEOUT"),
+            _ => None,
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn gcode_plan_status_names() {
+        let names: Vec<&str> = (0..=u8::MAX).filter_map(GcodePlan::status_name).collect();
+        assert_eq!(
+            names,
+            [
+                "SUCCESS",
+                "INVALID_REQUEST",
+                "PROGRAM_ERROR",
+                "UNREACHABLE",
+                "QUEUE_FULL",
+                "INTERNAL_ERROR",
+                "TIMEOUT"
+            ]
+        );
+    }
 
     #[test]
     fn status_names() {

@@ -1,0 +1,571 @@
+//! [`plan_program`]: a G-code program to a joint trajectory for a machine,
+//! checked as the executor will run it.
+//!
+//! 1. Read the program into runs and stops ([`crate::runs`]).
+//! 2. Per run: smooth its corners within δ_c
+//!    ([`kerf_toolpath::smooth_polyline`]), sample it, plan the feed
+//!    ([`kerf_toolpath::plan_feed`], the programmed F capped at the
+//!    machine's), and the bang-bang bound T_lb on the same path
+//!    ([`kerf_toolpath::bang_bang_under`] under seed 003 eq. 22's limit
+//!    curve).
+//! 3. Per run: the joint points ([`crate::knots::run_knots`]), slowed
+//!    uniformly where a joint limit needs it.
+//! 4. The runs in order, from rest to rest, with dwells held.
+//! 5. **The executor's check**: the trajectory through
+//!    `kerf_executor::check_executable` (what the executor accepts), then
+//!    its interpolation at every control period, the tool tip by forward
+//!    kinematics against the planned point at that time. A piece beyond δ_i
+//!    is split and steps 4–5 repeat.
+
+use std::io::BufRead;
+
+use kerf_budget::Budget;
+use kerf_executor::{
+    check_executable, ExecutorConfig, JointSample, TrajectoryPoint, TrajectoryRequest,
+};
+use kerf_toolpath::{
+    bang_bang_under, metrics, plan_feed, sample_path, smooth_polyline, FeedLimits, Metrics,
+};
+
+use crate::error::GcodePlanError;
+use crate::knots::{knot_at, run_knots, JointKnot, Peak, RunKnots};
+use crate::machine::{Machine, DOF};
+use crate::runs::{read_steps, Run, RunKind, Step};
+use crate::settings::PlanSettings;
+use crate::timed::TimedRun;
+
+/// Rounds of the executor's check (step 5) before the plan is given up.
+pub const MAX_CHECK_ROUNDS: usize = 8;
+
+/// What one run became.
+#[derive(Debug, Clone, PartialEq)]
+pub struct RunReport {
+    /// What it does.
+    pub kind: RunKind,
+    /// First and last source line.
+    pub lines: (usize, usize),
+    /// Vertices of its polyline (after merging).
+    pub vertices: usize,
+    /// Corners smoothed.
+    pub corners: usize,
+    /// Length of the smoothed path \[m\].
+    pub length: f64,
+    /// The feed it was planned at \[m/s\].
+    pub feed: f64,
+    /// The corner tolerance δ_c it was smoothed within \[m\].
+    pub corner_tolerance: f64,
+    /// The largest corner deviation from its polyline (exact) \[m\].
+    pub max_corner_deviation: f64,
+    /// Time of its feed plan \[s\].
+    pub feed_time: f64,
+    /// T_lb on the same path \[s\].
+    pub lower_bound: f64,
+    /// Uniform slowdown for the joint limits (1: none).
+    pub slowdown: f64,
+    /// The binding joint limit before the slowdown.
+    pub peak: Peak,
+    /// When it starts in the trajectory \[s\].
+    pub start_time: f64,
+    /// Seeds 000/003 metrics of its feed plan at the interpolation period.
+    pub metrics: Metrics,
+}
+
+/// A beam or spindle switch, at rest.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ToolEvent {
+    /// Time in the trajectory \[s\].
+    pub time: f64,
+    /// On after it.
+    pub on: bool,
+    /// Source line.
+    pub line: usize,
+}
+
+/// A planned program.
+#[derive(Debug, Clone, PartialEq)]
+pub struct GcodePlan {
+    /// The machine's name.
+    pub machine: String,
+    /// The joint trajectory, from rest at the program's start to rest at
+    /// its end.
+    pub trajectory: TrajectoryRequest,
+    /// Every run.
+    pub runs: Vec<RunReport>,
+    /// Every tool switch.
+    pub events: Vec<ToolEvent>,
+    /// The trajectory's duration \[s\].
+    pub duration: f64,
+    /// Σ feed-plan times of the runs: the machining time T_m before any
+    /// joint slowdown \[s\].
+    pub feed_time: f64,
+    /// Σ T_lb \[s\].
+    pub lower_bound: f64,
+    /// Σ dwell times \[s\].
+    pub dwell_time: f64,
+    /// The largest distance of the executed tip (the executor's
+    /// interpolation at each control period, by forward kinematics) from
+    /// the planned point at the same time: ≤ δ_i \[m\].
+    pub max_interpolation_deviation: f64,
+    /// The largest exact corner deviation: ≤ δ_c \[m\].
+    pub max_corner_deviation: f64,
+    /// δ \[m\].
+    pub tolerance: f64,
+    /// The largest peak ratio of each joint over the trajectory after the
+    /// slowdowns: (velocity, acceleration, jerk) / limit.
+    pub peak_ratios: [[f64; 3]; DOF],
+    /// Lines read.
+    pub lines: usize,
+    /// Arcs read.
+    pub arcs: usize,
+    /// Motions of zero length.
+    pub zero_length_moves: usize,
+    /// Blocks skipped by block delete.
+    pub skipped_blocks: usize,
+    /// What the user should know (a feed capped, a run slowed).
+    pub warnings: Vec<String>,
+}
+
+impl GcodePlan {
+    /// T_m / T_lb of the feed plans.
+    pub fn lower_bound_ratio(&self) -> f64 {
+        self.feed_time / self.lower_bound
+    }
+
+    /// Metrics over every cutting run: times summed, maxima of the maxima,
+    /// RMS values weighted by their point counts.
+    pub fn cut_metrics(&self) -> Metrics {
+        let mut out = Metrics {
+            time: 0.0,
+            max_curvature: 0.0,
+            max_turning_angle: 0.0,
+            rms_acceleration: 0.0,
+            rms_jerk: 0.0,
+            max_chord_error: 0.0,
+            max_contour_error: 0.0,
+            points: 0,
+        };
+        let (mut sa, mut sj) = (0.0, 0.0);
+        for r in self.runs.iter().filter(|r| r.kind == RunKind::Cut) {
+            let m = &r.metrics;
+            out.time += m.time;
+            out.max_curvature = out.max_curvature.max(m.max_curvature);
+            out.max_turning_angle = out.max_turning_angle.max(m.max_turning_angle);
+            out.max_chord_error = out.max_chord_error.max(m.max_chord_error);
+            out.max_contour_error = out.max_contour_error.max(m.max_contour_error);
+            sa += m.rms_acceleration.powi(2) * m.points as f64;
+            sj += m.rms_jerk.powi(2) * m.points as f64;
+            out.points += m.points;
+        }
+        if out.points > 0 {
+            out.rms_acceleration = (sa / out.points as f64).sqrt();
+            out.rms_jerk = (sj / out.points as f64).sqrt();
+        }
+        out
+    }
+}
+
+/// One run in the trajectory.
+struct Placed {
+    timed: TimedRun,
+    knots: RunKnots,
+    start: f64,
+    line: usize,
+}
+
+/// Plans `source` for `machine` (module documentation).
+///
+/// # Errors
+/// Every [`GcodePlanError`]: the reader's (line, column), a setting, a
+/// path (line), a point out of reach (line, point), too many points, an
+/// empty program, the budget.
+pub fn plan_program<R: BufRead>(
+    source: R,
+    machine: &dyn Machine,
+    settings: &PlanSettings,
+    budget: &Budget,
+) -> Result<GcodePlan, GcodePlanError> {
+    settings.validate()?;
+    let reading = read_steps(source, settings)?;
+    budget.check("reading")?;
+    let mut warnings = Vec::new();
+    let mut placed: Vec<Placed> = Vec::new();
+    let mut reports: Vec<RunReport> = Vec::new();
+    let mut events = Vec::new();
+    let mut time = 0.0;
+    let mut dwell_time = 0.0;
+    let mut holds: Vec<(f64, f64)> = Vec::new();
+    let mut reference: Option<[f64; DOF]> = None;
+    let mut points = 0usize;
+    for step in &reading.steps {
+        budget.check("planning runs")?;
+        match step {
+            Step::Dwell { seconds, .. } => {
+                if *seconds > 0.0 {
+                    holds.push((time, *seconds));
+                    time += seconds;
+                    dwell_time += seconds;
+                }
+            }
+            Step::Tool { on, line } => events.push(crate::plan::ToolEvent {
+                time,
+                on: *on,
+                line: *line,
+            }),
+            Step::Run(run) => {
+                reachable(machine, run, reference.as_ref())?;
+                let (timed, mut report) = time_run(run, settings, &mut warnings)?;
+                let line = run.lines[0];
+                let knots = run_knots(
+                    machine,
+                    &timed,
+                    line,
+                    reference.as_ref(),
+                    settings.knot_spacing,
+                    settings.control_period,
+                    settings.interpolation_tolerance(),
+                    settings.max_points.saturating_sub(points),
+                    budget,
+                )?;
+                points += knots.knots.len();
+                if knots.slowdown > 1.0 {
+                    warnings.push(format!(
+                        "lines {}-{}: {} run slowed {:.3}x for the {} limit of {}",
+                        report.lines.0,
+                        report.lines.1,
+                        run.kind.name(),
+                        knots.slowdown,
+                        knots.peak.what,
+                        knots.peak.joint
+                    ));
+                }
+                reference = knots.knots.last().map(|k| k.q);
+                report.slowdown = knots.slowdown;
+                report.peak = knots.peak.clone();
+                report.start_time = time;
+                let start = time;
+                time += timed.duration() * knots.slowdown;
+                reports.push(report);
+                placed.push(Placed {
+                    timed,
+                    knots,
+                    start,
+                    line,
+                });
+            }
+        }
+    }
+    if placed.is_empty() {
+        return Err(GcodePlanError::Empty {
+            reason: format!(
+                "{} lines read, no move of nonzero length (zero-length moves: {})",
+                reading.lines, reading.zero_length_moves
+            ),
+        });
+    }
+    let limits = machine.executor_limits()?;
+    let config = ExecutorConfig {
+        control_period: settings.control_period,
+        ..ExecutorConfig::default()
+    };
+    let mut round = 0;
+    let (trajectory, max_interpolation_deviation) = loop {
+        budget.check("executor check")?;
+        let request = assemble(machine, &placed, &holds);
+        if request.points.len() > settings.max_points {
+            return Err(GcodePlanError::TooManyPoints {
+                max: settings.max_points,
+            });
+        }
+        let prepared = check_executable(&limits, &config, &request).map_err(|e| {
+            GcodePlanError::NotExecutable {
+                reason: e.to_string(),
+            }
+        })?;
+        let (worst, bad) = executed_deviation(machine, &placed, &prepared, settings, budget)?;
+        if bad.is_empty() {
+            break (request, worst);
+        }
+        round += 1;
+        if round > MAX_CHECK_ROUNDS {
+            return Err(GcodePlanError::NotExecutable {
+                reason: format!(
+                    "the executed tool tip leaves the interpolation tolerance {:.3e} m by {worst:.3e} m \
+                     after {MAX_CHECK_ROUNDS} rounds of refinement",
+                    settings.interpolation_tolerance()
+                ),
+            });
+        }
+        refine(machine, &mut placed, &bad)?;
+    };
+    let peak_ratios = joint_peaks(machine, &placed);
+    let duration = trajectory.points.last().map_or(0.0, |p| p.time_from_start);
+    Ok(GcodePlan {
+        machine: machine.name().to_string(),
+        trajectory,
+        feed_time: reports.iter().map(|r| r.feed_time).sum(),
+        lower_bound: reports.iter().map(|r| r.lower_bound).sum(),
+        max_corner_deviation: reports
+            .iter()
+            .map(|r| r.max_corner_deviation)
+            .fold(0.0, f64::max),
+        runs: reports,
+        events,
+        duration,
+        dwell_time,
+        max_interpolation_deviation,
+        tolerance: settings.tolerance,
+        peak_ratios,
+        lines: reading.lines,
+        arcs: reading.arcs,
+        zero_length_moves: reading.zero_length_moves,
+        skipped_blocks: reading.skipped_blocks,
+        warnings,
+    })
+}
+
+/// Every vertex of a run within reach, each IK nearest the previous: an
+/// unreachable program point is reported with its own source line.
+fn reachable(
+    machine: &dyn Machine,
+    run: &Run,
+    reference: Option<&[f64; DOF]>,
+) -> Result<(), GcodePlanError> {
+    let mut previous = reference.copied();
+    for (p, line) in run.points.iter().zip(&run.lines) {
+        let q = machine.joints(*p, previous.as_ref()).map_err(|reason| {
+            GcodePlanError::Unreachable {
+                line: *line,
+                x: p[0],
+                y: p[1],
+                z: p[2],
+                reason,
+            }
+        })?;
+        previous = Some(q);
+    }
+    Ok(())
+}
+
+/// Step 2 for one run.
+fn time_run(
+    run: &Run,
+    settings: &PlanSettings,
+    warnings: &mut Vec<String>,
+) -> Result<(TimedRun, RunReport), GcodePlanError> {
+    let line = run.lines[0];
+    let last_line = run.lines.last().copied().unwrap_or(line);
+    let path_error = |error| GcodePlanError::Path { line, error };
+    let cap = match run.kind {
+        RunKind::Rapid => run.feed,
+        _ => settings.limits.curvature.feed,
+    };
+    let feed = run.feed.min(cap);
+    if run.feed > cap {
+        warnings.push(format!(
+            "lines {line}-{last_line}: F {:.4} m/s is above the machine's {:.4} m/s and is \
+             planned at {:.4} m/s",
+            run.feed, cap, feed
+        ));
+    }
+    let mut limits: FeedLimits = settings.limits;
+    limits.curvature.feed = feed;
+    let path = smooth_polyline(&run.points, run.corner_tolerance).map_err(path_error)?;
+    let samples = sample_path(&path, settings.sample_step);
+    let plan = plan_feed(&samples, &limits).map_err(path_error)?;
+    let curve: Vec<f64> = samples
+        .iter()
+        .map(|p| limits.curvature.speed(p.curvature))
+        .collect();
+    let lower =
+        bang_bang_under(&samples, curve, limits.tangential_acceleration).map_err(path_error)?;
+    let m = metrics(
+        &plan,
+        &path,
+        &samples,
+        limits.curvature.interpolation_period,
+        limits.curvature.servo.as_ref(),
+    );
+    let report = RunReport {
+        kind: run.kind,
+        lines: (line, last_line),
+        vertices: run.points.len(),
+        corners: path.corners().count(),
+        length: plan.length,
+        feed,
+        corner_tolerance: run.corner_tolerance,
+        max_corner_deviation: path.max_deviation(),
+        feed_time: plan.time,
+        lower_bound: lower.time,
+        slowdown: 1.0,
+        peak: Peak {
+            ratio: 0.0,
+            joint: String::new(),
+            what: "velocity",
+        },
+        start_time: 0.0,
+        metrics: m,
+    };
+    Ok((
+        TimedRun {
+            path,
+            samples,
+            plan,
+        },
+        report,
+    ))
+}
+
+/// Step 4: every run's points in scaled global time, dwells as a second
+/// point at rest; the first point of a run is the previous run's last
+/// (both at rest at the same place) and is kept once.
+fn assemble(machine: &dyn Machine, placed: &[Placed], holds: &[(f64, f64)]) -> TrajectoryRequest {
+    let names: Vec<String> = machine.bounds().iter().map(|b| b.name.clone()).collect();
+    let mut points: Vec<TrajectoryPoint> = Vec::new();
+    let mut hold = holds.iter().peekable();
+    let push = |points: &mut Vec<TrajectoryPoint>, k: &JointKnot| {
+        points.push(TrajectoryPoint {
+            positions: k.q.to_vec(),
+            velocities: k.qd.to_vec(),
+            accelerations: k.qdd.to_vec(),
+            effort: Vec::new(),
+            time_from_start: k.t,
+        });
+    };
+    for p in placed {
+        while let Some((at, seconds)) = hold.next_if(|(at, _)| *at <= p.start) {
+            if let Some(last) = points.last().cloned() {
+                points.push(TrajectoryPoint {
+                    time_from_start: at + seconds,
+                    velocities: vec![0.0; DOF],
+                    accelerations: vec![0.0; DOF],
+                    ..last
+                });
+            }
+        }
+        for (i, k) in p.knots.scaled(p.start).enumerate() {
+            if i == 0 && !points.is_empty() {
+                continue;
+            }
+            push(&mut points, &k);
+        }
+    }
+    for (at, seconds) in hold {
+        if let Some(last) = points.last().cloned() {
+            points.push(TrajectoryPoint {
+                time_from_start: at + seconds,
+                velocities: vec![0.0; DOF],
+                accelerations: vec![0.0; DOF],
+                ..last
+            });
+        }
+    }
+    TrajectoryRequest {
+        joint_names: names,
+        points,
+        start_time: None,
+    }
+}
+
+/// Step 5: the executor's interpolation at every control period against
+/// the planned point; returns the worst distance and, per run, the local
+/// (unscaled) times where it exceeds δ_i.
+fn executed_deviation(
+    machine: &dyn Machine,
+    placed: &[Placed],
+    prepared: &kerf_executor::ValidatedTrajectory,
+    settings: &PlanSettings,
+    budget: &Budget,
+) -> Result<(f64, Vec<(usize, f64)>), GcodePlanError> {
+    let period = settings.control_period;
+    let tolerance = settings.interpolation_tolerance();
+    let (t0, t1) = (prepared.start_time(), prepared.end_time());
+    let steps = ((t1 - t0) / period).ceil() as usize;
+    let mut sample = JointSample::default();
+    let mut worst: f64 = 0.0;
+    let mut bad = Vec::new();
+    let mut run = 0usize;
+    for k in 0..=steps {
+        if k % 4096 == 0 {
+            budget.check("executor check")?;
+        }
+        let t = (k as f64 * period).min(t1 - t0);
+        prepared.sample_into(t0 + t, &mut sample);
+        while run + 1 < placed.len() && placed[run + 1].start <= t {
+            run += 1;
+        }
+        let p = &placed[run];
+        let end = p.start + p.timed.duration() * p.knots.slowdown;
+        let local = ((t - p.start) / p.knots.slowdown).clamp(0.0, p.timed.duration());
+        // Beyond the run's end (a dwell), the tool stands at the run's end.
+        let planned = p
+            .timed
+            .motion(if t > end { p.timed.duration() } else { local })
+            .point;
+        let q: [f64; DOF] =
+            std::array::from_fn(|j| sample.positions.get(j).copied().unwrap_or(f64::NAN));
+        let tip = machine
+            .tip(&q)
+            .map_err(|reason| GcodePlanError::NotExecutable {
+                reason: format!("at {t:.4} s: {reason}"),
+            })?;
+        let d = (0..3)
+            .map(|i| (tip[i] - planned[i]).powi(2))
+            .sum::<f64>()
+            .sqrt();
+        worst = worst.max(d);
+        if d > tolerance {
+            bad.push((run, local));
+        }
+    }
+    Ok((worst, bad))
+}
+
+/// Splits the pieces holding the bad times (step 5's repeat).
+fn refine(
+    machine: &dyn Machine,
+    placed: &mut [Placed],
+    bad: &[(usize, f64)],
+) -> Result<(), GcodePlanError> {
+    for (run, t) in bad {
+        let p = &mut placed[*run];
+        let knots = &mut p.knots.knots;
+        let k = knots
+            .partition_point(|x| x.t <= *t)
+            .clamp(1, knots.len() - 1);
+        let (a, b) = (knots[k - 1], knots[k]);
+        let mid = 0.5 * (a.t + b.t);
+        if mid <= a.t || mid >= b.t {
+            continue;
+        }
+        let knot = knot_at(machine, &p.timed, mid, Some(&a.q)).map_err(|reason| {
+            let x = p.timed.motion(mid).point;
+            GcodePlanError::Unreachable {
+                line: p.line,
+                x: x[0],
+                y: x[1],
+                z: x[2],
+                reason,
+            }
+        })?;
+        knots.insert(k, knot);
+    }
+    Ok(())
+}
+
+/// The largest peak ratios of every joint over every piece, after the
+/// slowdowns (v/r, a/r², j/r³).
+fn joint_peaks(machine: &dyn Machine, placed: &[Placed]) -> [[f64; 3]; DOF] {
+    let mut out = [[0.0f64; 3]; DOF];
+    for p in placed {
+        let r = p.knots.slowdown;
+        for w in p.knots.knots.windows(2) {
+            let peaks = crate::knots::piece_peaks(machine, &w[0], &w[1]);
+            for j in 0..DOF {
+                out[j][0] = out[j][0].max(peaks[j][0] / r);
+                out[j][1] = out[j][1].max(peaks[j][1] / (r * r));
+                out[j][2] = out[j][2].max(peaks[j][2] / (r * r * r));
+            }
+        }
+    }
+    out
+}

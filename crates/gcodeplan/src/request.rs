@@ -1,0 +1,422 @@
+//! [`GcodeRequest`]: a G-code plan request as a document (the `gcode_planner` node's text
+//! topic, `kerf plan gcode`), checked and turned into the machine and settings to plan with.
+//!
+//! ```yaml
+//! request_id: job-1
+//! machine: laser-cutter        # or irb6660; default laser-cutter
+//! program: "G21 G90\nM3\nG1 X20 F3000\nG1 Y20\nM5\n"   # or program_file: /path/part.ngc
+//! tolerance: 1.0e-4            # m, default 1e-4
+//! ```
+//!
+//! Optional: `method` (`kerf`), `limits` (any of `max_feed`, `tangential_acceleration`,
+//! `tangential_jerk`, `normal_acceleration`, `normal_jerk`, `chord_error`, `contour_error`,
+//! each replacing the machine's default), `rapid_feed`, `origin` (the program's zero in the
+//! machine's base frame), `redundancy_angle` (IRB 6660 only), `standoff_axis` (laser cutter
+//! only), `time_budget`. Unknown fields are refused; every value used is checked.
+
+use std::path::PathBuf;
+
+use serde::{Deserialize, Serialize};
+
+use crate::error::GcodePlanError;
+use crate::settings::PlanSettings;
+
+/// The machines a program can be planned for.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum MachineKind {
+    /// The laser cutter of seed 001 over a flat sheet ([`crate::LaserSheet`]).
+    LaserCutter,
+    /// The IRB 6660 of seed 004 on its milling plane ([`crate::MillingPlane`]).
+    Irb6660,
+}
+
+impl MachineKind {
+    /// The name in requests (`laser-cutter`, `irb6660`).
+    pub fn name(self) -> &'static str {
+        match self {
+            MachineKind::LaserCutter => "laser-cutter",
+            MachineKind::Irb6660 => "irb6660",
+        }
+    }
+
+    /// Parses a name; empty is the laser cutter.
+    ///
+    /// # Errors
+    /// [`GcodePlanError::InvalidSetting`] naming `machine` and the names known.
+    pub fn parse(name: &str) -> Result<Self, GcodePlanError> {
+        match name {
+            "" | "laser-cutter" | "laser_cutter" => Ok(MachineKind::LaserCutter),
+            "irb6660" => Ok(MachineKind::Irb6660),
+            other => Err(GcodePlanError::InvalidSetting {
+                name: format!("machine '{other}'"),
+                value: f64::NAN,
+                reason: "unknown; use laser-cutter or irb6660".to_string(),
+            }),
+        }
+    }
+
+    /// The machine's default settings.
+    pub fn default_settings(self) -> PlanSettings {
+        match self {
+            MachineKind::LaserCutter => PlanSettings::laser_cutter(),
+            MachineKind::Irb6660 => PlanSettings::irb6660(),
+        }
+    }
+}
+
+/// The corner smoothing methods.
+pub const METHODS: &[&str] = &["kerf"];
+
+/// Path limits that replace the machine's defaults (SI units).
+#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct LimitOverrides {
+    /// Largest cutting feed \[m/s\].
+    pub max_feed: Option<f64>,
+    /// Tangential acceleration \[m/s²\].
+    pub tangential_acceleration: Option<f64>,
+    /// Tangential jerk \[m/s³\].
+    pub tangential_jerk: Option<f64>,
+    /// Normal acceleration \[m/s²\] (seed 003 eq. 19).
+    pub normal_acceleration: Option<f64>,
+    /// Normal jerk \[m/s³\] (seed 003 eq. 21).
+    pub normal_jerk: Option<f64>,
+    /// Chord error per interpolation period \[m\] (seed 003 eq. 15–16).
+    pub chord_error: Option<f64>,
+    /// Servo contour error \[m\] (seed 003 eq. 17).
+    pub contour_error: Option<f64>,
+}
+
+/// A request (module documentation).
+#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct GcodeRequest {
+    /// Any text; echoed in the answer.
+    #[serde(default)]
+    pub request_id: String,
+    /// `laser-cutter` (default) or `irb6660`.
+    #[serde(default)]
+    pub machine: String,
+    /// The program text (exactly one of `program` and `program_file`).
+    #[serde(default)]
+    pub program: Option<String>,
+    /// A program file: a path, `file://` or `package://kerf/` URI.
+    #[serde(default)]
+    pub program_file: Option<String>,
+    /// δ \[m\], default 1e-4.
+    #[serde(default)]
+    pub tolerance: Option<f64>,
+    /// Corner smoothing method ([`METHODS`]), default `kerf`.
+    #[serde(default)]
+    pub method: Option<String>,
+    /// Path limits.
+    #[serde(default)]
+    pub limits: Option<LimitOverrides>,
+    /// G0 speed \[m/s\].
+    #[serde(default)]
+    pub rapid_feed: Option<f64>,
+    /// The program's zero in the machine's base frame \[m\].
+    #[serde(default)]
+    pub origin: Option<[f64; 3]>,
+    /// The IRB 6660's redundancy angle g \[rad\] (default 0).
+    #[serde(default)]
+    pub redundancy_angle: Option<f64>,
+    /// The laser cutter's standoff axis q6 \[m\].
+    #[serde(default)]
+    pub standoff_axis: Option<f64>,
+    /// The plan's time budget \[s\]; none = the node's.
+    #[serde(default)]
+    pub time_budget: Option<f64>,
+}
+
+/// Where the program comes from.
+#[derive(Debug, Clone, PartialEq)]
+pub enum ProgramSource {
+    /// The text itself.
+    Text(String),
+    /// A file.
+    File(PathBuf),
+}
+
+impl GcodeRequest {
+    /// Parses YAML (or JSON) text.
+    ///
+    /// # Errors
+    /// [`GcodePlanError::InvalidSetting`] naming `request` with the parser's message.
+    pub fn from_yaml_str(text: &str) -> Result<Self, GcodePlanError> {
+        kerf_robot::document::from_yaml_or_json(text).map_err(|reason| {
+            GcodePlanError::InvalidSetting {
+                name: "request".to_string(),
+                value: f64::NAN,
+                reason,
+            }
+        })
+    }
+
+    /// The machine.
+    ///
+    /// # Errors
+    /// As [`MachineKind::parse`].
+    pub fn machine_kind(&self) -> Result<MachineKind, GcodePlanError> {
+        MachineKind::parse(&self.machine)
+    }
+
+    /// The program's source: a file resolves `package://kerf/` and `file://` URIs.
+    ///
+    /// # Errors
+    /// [`GcodePlanError::InvalidSetting`] for both or neither given, an empty one, or a URI
+    /// that does not resolve.
+    pub fn source(&self) -> Result<ProgramSource, GcodePlanError> {
+        let bad = |reason: String| GcodePlanError::InvalidSetting {
+            name: "program".to_string(),
+            value: f64::NAN,
+            reason,
+        };
+        match (&self.program, &self.program_file) {
+            (Some(_), Some(_)) => Err(bad("give program or program_file, not both".to_string())),
+            (None, None) => Err(bad("give program (text) or program_file".to_string())),
+            (Some(text), None) => {
+                if text.trim().is_empty() {
+                    Err(bad("the program text is empty".to_string()))
+                } else {
+                    Ok(ProgramSource::Text(text.clone()))
+                }
+            }
+            (None, Some(file)) => {
+                let file = file.trim();
+                if file.is_empty() {
+                    return Err(bad("program_file is empty".to_string()));
+                }
+                if file.starts_with("package://") {
+                    kerf_robot::data::resolve_package_uri(file)
+                        .map(ProgramSource::File)
+                        .map_err(|e| bad(e.to_string()))
+                } else if let Some(path) = file.strip_prefix("file://") {
+                    Ok(ProgramSource::File(PathBuf::from(path)))
+                } else if file.contains("://") {
+                    Err(bad(format!(
+                        "{file}: only file:// and package://kerf/ URIs are read"
+                    )))
+                } else {
+                    Ok(ProgramSource::File(PathBuf::from(file)))
+                }
+            }
+        }
+    }
+
+    /// The time budget, when the request asks for one.
+    ///
+    /// # Errors
+    /// [`GcodePlanError::InvalidSetting`] for a budget that is not finite and > 0.
+    pub fn time_limit(&self) -> Result<Option<std::time::Duration>, GcodePlanError> {
+        match self.time_budget {
+            None => Ok(None),
+            Some(s) => kerf_budget::limit_from_seconds(s).map_err(|reason| {
+                GcodePlanError::InvalidSetting {
+                    name: "time_budget [s]".to_string(),
+                    value: s,
+                    reason,
+                }
+            }),
+        }
+    }
+
+    /// The settings to plan with: the machine's defaults with the request's values, checked.
+    ///
+    /// # Errors
+    /// [`GcodePlanError::InvalidSetting`] naming the first bad field, an unknown method, or a
+    /// field of the other machine.
+    pub fn settings(&self) -> Result<PlanSettings, GcodePlanError> {
+        let kind = self.machine_kind()?;
+        let mut s = kind.default_settings();
+        if let Some(t) = self.tolerance {
+            s.tolerance = t;
+        }
+        if let Some(m) = &self.method {
+            if !METHODS.contains(&m.as_str()) && !m.is_empty() {
+                return Err(GcodePlanError::InvalidSetting {
+                    name: format!("method '{m}'"),
+                    value: f64::NAN,
+                    reason: format!("unknown; use one of {}", METHODS.join(", ")),
+                });
+            }
+        }
+        if let Some(l) = &self.limits {
+            let c = &mut s.limits.curvature;
+            set(&mut c.feed, l.max_feed);
+            set(
+                &mut s.limits.tangential_acceleration,
+                l.tangential_acceleration,
+            );
+            set(&mut s.limits.tangential_jerk, l.tangential_jerk);
+            let c = &mut s.limits.curvature;
+            set(&mut c.normal_acceleration, l.normal_acceleration);
+            set(&mut c.normal_jerk, l.normal_jerk);
+            set(&mut c.chord_error, l.chord_error);
+            if let (Some(e), Some(servo)) = (l.contour_error, c.servo.as_mut()) {
+                servo.contour_error = e;
+            }
+        }
+        if let Some(r) = self.rapid_feed {
+            s.rapid_feed = r;
+        }
+        let other =
+            |field: &str, value: f64, machine: MachineKind| GcodePlanError::InvalidSetting {
+                name: field.to_string(),
+                value,
+                reason: format!("applies to the other machine, not {}", machine.name()),
+            };
+        match kind {
+            MachineKind::LaserCutter => {
+                if let Some(g) = self.redundancy_angle {
+                    return Err(other("redundancy_angle [rad]", g, kind));
+                }
+            }
+            MachineKind::Irb6660 => {
+                if let Some(q6) = self.standoff_axis {
+                    return Err(other("standoff_axis [m]", q6, kind));
+                }
+            }
+        }
+        s.validate()?;
+        Ok(s)
+    }
+}
+
+fn set(field: &mut f64, value: Option<f64>) {
+    if let Some(v) = value {
+        *field = v;
+    }
+}
+
+/// A machine loaded once (its URDF, limits and cell), from which each request's machine is
+/// placed (its origin, g or standoff).
+#[derive(Debug, Clone)]
+pub enum MachineBase {
+    /// The laser cutter.
+    Laser(Box<kerf_mjto::LaserMachine>),
+    /// The IRB 6660 milling cell.
+    Irb(Box<kerf_mill::MillCell>),
+}
+
+impl MachineBase {
+    /// Loads the shipped machine of `kind`.
+    ///
+    /// # Errors
+    /// [`GcodePlanError::InvalidSetting`] naming `machine` when its files cannot be loaded.
+    pub fn load(kind: MachineKind) -> Result<Self, GcodePlanError> {
+        let bad = |reason: String| GcodePlanError::InvalidSetting {
+            name: "machine".to_string(),
+            value: f64::NAN,
+            reason,
+        };
+        match kind {
+            MachineKind::LaserCutter => kerf_mjto::LaserMachine::default_machine()
+                .map(|m| MachineBase::Laser(Box::new(m)))
+                .map_err(|e| bad(e.to_string())),
+            MachineKind::Irb6660 => kerf_mill::MillCell::default_cell()
+                .map(|c| MachineBase::Irb(Box::new(c)))
+                .map_err(|e| bad(e.to_string())),
+        }
+    }
+
+    /// Which machine it is.
+    pub fn kind(&self) -> MachineKind {
+        match self {
+            MachineBase::Laser(_) => MachineKind::LaserCutter,
+            MachineBase::Irb(_) => MachineKind::Irb6660,
+        }
+    }
+
+    /// The robot model.
+    pub fn robot(&self) -> &kerf_robot::RobotModel {
+        match self {
+            MachineBase::Laser(m) => m.robot(),
+            MachineBase::Irb(c) => c.robot(),
+        }
+    }
+
+    /// The machine placed as `request` asks.
+    ///
+    /// # Errors
+    /// [`GcodePlanError::InvalidSetting`] for a request naming another machine (a node
+    /// plans for one), or a bad origin, g or standoff.
+    pub fn place(&self, request: &GcodeRequest) -> Result<Box<dyn crate::Machine>, GcodePlanError> {
+        let asked = request.machine_kind()?;
+        if asked != self.kind() {
+            return Err(GcodePlanError::InvalidSetting {
+                name: format!("machine '{}'", request.machine),
+                value: f64::NAN,
+                reason: format!(
+                    "this planner plans for {} (start one with machine {} for the other)",
+                    self.kind().name(),
+                    asked.name()
+                ),
+            });
+        }
+        match self {
+            MachineBase::Laser(m) => Ok(Box::new(crate::LaserSheet::new(
+                (**m).clone(),
+                request
+                    .origin
+                    .unwrap_or(crate::machine::laser::DEFAULT_SHEET_ORIGIN),
+                request
+                    .standoff_axis
+                    .unwrap_or(crate::machine::laser::DEFAULT_STANDOFF_AXIS),
+            )?)),
+            MachineBase::Irb(cell) => {
+                let origin = match request.origin {
+                    Some(o) => o,
+                    None => {
+                        let p =
+                            cell.path()
+                                .point(0.0)
+                                .map_err(|e| GcodePlanError::InvalidSetting {
+                                    name: "machine".to_string(),
+                                    value: f64::NAN,
+                                    reason: e.to_string(),
+                                })?;
+                        [p.x, p.y, p.z]
+                    }
+                };
+                Ok(Box::new(crate::MillingPlane::new(
+                    (**cell).clone(),
+                    origin,
+                    request.redundancy_angle.unwrap_or(0.0),
+                )?))
+            }
+        }
+    }
+}
+
+/// Plans a request on `base` (the program read from its text or streamed from its file).
+///
+/// # Errors
+/// The request's own errors ([`GcodeRequest::settings`], [`GcodeRequest::source`],
+/// [`MachineBase::place`]), an unreadable file, and [`crate::plan_program`]'s.
+pub fn plan_request(
+    request: &GcodeRequest,
+    base: &MachineBase,
+    budget: &kerf_budget::Budget,
+) -> Result<crate::GcodePlan, GcodePlanError> {
+    let settings = request.settings()?;
+    let machine = base.place(request)?;
+    match request.source()? {
+        ProgramSource::Text(text) => {
+            crate::plan_program(text.as_bytes(), machine.as_ref(), &settings, budget)
+        }
+        ProgramSource::File(path) => {
+            let file = std::fs::File::open(&path).map_err(|e| GcodePlanError::InvalidSetting {
+                name: format!("program_file {}", path.display()),
+                value: f64::NAN,
+                reason: e.to_string(),
+            })?;
+            crate::plan_program(
+                std::io::BufReader::new(file),
+                machine.as_ref(),
+                &settings,
+                budget,
+            )
+        }
+    }
+}

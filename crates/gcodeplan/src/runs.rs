@@ -1,0 +1,339 @@
+//! A program split into runs: the stretches the machine moves through
+//! without stopping, each a polyline in the program's frame (arcs as
+//! chords), and the stops between them.
+//!
+//! A run ends (the machine comes to rest) where:
+//! * the kind of move changes: a cut (G1/G2/G3 with the beam or spindle on),
+//!   a feed move with it off, a rapid (G0);
+//! * the programmed feed or the path control mode (G61, G64 P) changes;
+//! * the tool is switched (M3/M4/M5), a dwell (G4) or the end (M2/M30);
+//! * the path reverses (turns by more than π − [`REVERSAL_MARGIN`]): no
+//!   curvature-continuous transition fits a tolerance there;
+//! * under G61 (exact path), at every programmed vertex.
+
+use std::io::BufRead;
+
+use kerf_gcode::{ArcMove, Motion, PathControl, Program};
+use kerf_toolpath::corner::REVERSAL_MARGIN;
+
+use crate::error::GcodePlanError;
+use crate::settings::PlanSettings;
+
+/// What a run does.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum RunKind {
+    /// Feed move with the beam or spindle on.
+    Cut,
+    /// Feed move (G1/G2/G3) with it off.
+    Travel,
+    /// G0.
+    Rapid,
+}
+
+impl RunKind {
+    /// Lower-case name for messages.
+    pub fn name(self) -> &'static str {
+        match self {
+            RunKind::Cut => "cut",
+            RunKind::Travel => "travel",
+            RunKind::Rapid => "rapid",
+        }
+    }
+}
+
+/// A stretch moved through without stopping.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Run {
+    /// What it does.
+    pub kind: RunKind,
+    /// The polyline \[m\], program frame; no two consecutive points equal.
+    pub points: Vec<[f64; 3]>,
+    /// Source line of each point (the motion that ends there; the first
+    /// point's is the run's first motion).
+    pub lines: Vec<usize>,
+    /// Programmed feed \[m/s\] (G0: the rapid speed).
+    pub feed: f64,
+    /// The corner tolerance δ_c of this run \[m\] (a G64 P below δ_c
+    /// replaces it).
+    pub corner_tolerance: f64,
+}
+
+/// One step of a program.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Step {
+    /// A run.
+    Run(Run),
+    /// G4: stand still.
+    Dwell {
+        /// Seconds.
+        seconds: f64,
+        /// Source line.
+        line: usize,
+    },
+    /// M3/M4 (on) or M5 (off), at rest.
+    Tool {
+        /// On after this.
+        on: bool,
+        /// Source line.
+        line: usize,
+    },
+}
+
+/// A program read into steps.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct Reading {
+    /// The steps in order.
+    pub steps: Vec<Step>,
+    /// Lines read.
+    pub lines: usize,
+    /// Motions of zero length (start = end), which move nothing and are
+    /// counted here.
+    pub zero_length_moves: usize,
+    /// Blocks skipped by the block delete switch.
+    pub skipped_blocks: usize,
+    /// Arcs read.
+    pub arcs: usize,
+    /// Where the program starts \[m\], program frame.
+    pub start: [f64; 3],
+}
+
+/// The run being built.
+struct Open {
+    run: Run,
+    exact: bool,
+}
+
+/// Reads `source` into steps (module documentation).
+///
+/// # Errors
+/// The reader's first error ([`GcodePlanError::Program`], with line and
+/// column); [`GcodePlanError::InvalidSetting`] for bad settings or an arc
+/// in a program planned with no approximation share.
+pub fn read_steps<R: BufRead>(
+    source: R,
+    settings: &PlanSettings,
+) -> Result<Reading, GcodePlanError> {
+    settings.validate()?;
+    let mut program = Program::new(source, settings.reader)?;
+    let mut reading = Reading {
+        start: settings.reader.start,
+        ..Reading::default()
+    };
+    let mut open: Option<Open> = None;
+    while let Some(motion) = program.next() {
+        let motion = motion?;
+        let control = program.interpreter().path_control();
+        let (exact, corner_tolerance) = match control {
+            PathControl::Exact => (true, settings.corner_tolerance()),
+            PathControl::Blend {
+                tolerance: Some(p), ..
+            } if p > 0.0 => (false, settings.corner_tolerance().min(p)),
+            PathControl::Blend { .. } => (false, settings.corner_tolerance()),
+        };
+        let (kind, feed, start, end, line) = match motion {
+            Motion::Rapid { start, end, line } => {
+                (RunKind::Rapid, settings.rapid_feed, start, end, line)
+            }
+            Motion::Line {
+                start,
+                end,
+                feed,
+                tool_on,
+                line,
+            } => (kind_of(tool_on), feed, start, end, line),
+            Motion::Arc {
+                arc,
+                feed,
+                tool_on,
+                line,
+            } => (kind_of(tool_on), feed, arc.start, arc.end, line),
+            Motion::Dwell { seconds, line } => {
+                close(&mut open, &mut reading, settings)?;
+                reading.steps.push(Step::Dwell { seconds, line });
+                continue;
+            }
+            Motion::Tool { on, line, .. } => {
+                close(&mut open, &mut reading, settings)?;
+                reading.steps.push(Step::Tool { on, line });
+                continue;
+            }
+            Motion::End { .. } => {
+                close(&mut open, &mut reading, settings)?;
+                break;
+            }
+        };
+        let points = match motion {
+            Motion::Arc { arc, .. } => {
+                reading.arcs += 1;
+                chords(&arc, settings, line)?
+            }
+            _ if start == end => Vec::new(),
+            _ => vec![end],
+        };
+        if points.is_empty() {
+            reading.zero_length_moves += 1;
+            continue;
+        }
+        let continues = open.as_ref().is_some_and(|o| {
+            o.run.kind == kind
+                && o.run.feed == feed
+                && o.run.corner_tolerance == corner_tolerance
+                && !o.exact
+                && !exact
+        });
+        if !continues {
+            close(&mut open, &mut reading, settings)?;
+            open = Some(Open {
+                run: Run {
+                    kind,
+                    points: vec![start],
+                    lines: vec![line],
+                    feed,
+                    corner_tolerance,
+                },
+                exact,
+            });
+        }
+        for p in points {
+            push_point(&mut open, &mut reading, settings, p, line)?;
+        }
+    }
+    close(&mut open, &mut reading, settings)?;
+    reading.lines = program.lines_read();
+    reading.skipped_blocks = program.skipped_blocks();
+    Ok(reading)
+}
+
+fn kind_of(tool_on: bool) -> RunKind {
+    if tool_on {
+        RunKind::Cut
+    } else {
+        RunKind::Travel
+    }
+}
+
+/// Appends `p` to the open run, first closing the run at its last point
+/// when the path reverses there.
+fn push_point(
+    open: &mut Option<Open>,
+    reading: &mut Reading,
+    settings: &PlanSettings,
+    p: [f64; 3],
+    line: usize,
+) -> Result<(), GcodePlanError> {
+    let Some(o) = open.as_mut() else {
+        return Ok(());
+    };
+    let n = o.run.points.len();
+    let last = o.run.points[n - 1];
+    if p == last {
+        return Ok(());
+    }
+    if n >= 2 && turn(o.run.points[n - 2], last, p) > std::f64::consts::PI - REVERSAL_MARGIN {
+        let run = Run {
+            points: vec![last],
+            lines: vec![o.run.lines[n - 1]],
+            ..o.run.clone()
+        };
+        let exact = o.exact;
+        close(open, reading, settings)?;
+        *open = Some(Open { run, exact });
+    }
+    if let Some(o) = open.as_mut() {
+        o.run.points.push(p);
+        o.run.lines.push(line);
+    }
+    Ok(())
+}
+
+/// The turning angle at `b` between a→b and b→c \[rad\].
+fn turn(a: [f64; 3], b: [f64; 3], c: [f64; 3]) -> f64 {
+    let u: [f64; 3] = std::array::from_fn(|k| b[k] - a[k]);
+    let v: [f64; 3] = std::array::from_fn(|k| c[k] - b[k]);
+    let cross = [
+        u[1] * v[2] - u[2] * v[1],
+        u[2] * v[0] - u[0] * v[2],
+        u[0] * v[1] - u[1] * v[0],
+    ];
+    let norm = (cross[0] * cross[0] + cross[1] * cross[1] + cross[2] * cross[2]).sqrt();
+    norm.atan2(u[0] * v[0] + u[1] * v[1] + u[2] * v[2])
+}
+
+/// Ends the open run: merges its nearly collinear points within δ_a / 2
+/// and keeps it when it moves.
+fn close(
+    open: &mut Option<Open>,
+    reading: &mut Reading,
+    settings: &PlanSettings,
+) -> Result<(), GcodePlanError> {
+    let Some(o) = open.take() else {
+        return Ok(());
+    };
+    let mut run = o.run;
+    if run.points.len() < 2 {
+        return Ok(());
+    }
+    let merge = 0.5 * settings.approximation_tolerance();
+    if merge > 0.0 && run.points.len() > 2 {
+        let kept = kerf_toolpath::merge_collinear(&run.points, merge).map_err(|error| {
+            GcodePlanError::Path {
+                line: run.lines[0],
+                error,
+            }
+        })?;
+        if kept.len() < run.points.len() {
+            // The kept points are a subsequence of the originals: carry their lines along.
+            let mut lines = Vec::with_capacity(kept.len());
+            let mut k = 0;
+            for p in &kept {
+                while run.points[k] != *p {
+                    k += 1;
+                }
+                lines.push(run.lines[k]);
+            }
+            run.points = kept;
+            run.lines = lines;
+        }
+    }
+    reading.steps.push(Step::Run(run));
+    Ok(())
+}
+
+/// The chords of an arc after its start, each with a sagitta ≤ δ_a / 2:
+/// n = ⌈|sweep| / φ⌉ equal steps, φ = 2 acos(1 − δ_a / (2r)) (the sagitta of
+/// a chord spanning φ on radius r is r (1 − cos(φ/2))), at least one per
+/// half turn. A helix's chord deviates from it no more than its projection
+/// does (the normal coordinate is linear in the angle on both).
+fn chords(
+    arc: &ArcMove,
+    settings: &PlanSettings,
+    line: usize,
+) -> Result<Vec<[f64; 3]>, GcodePlanError> {
+    let sagitta = 0.5 * settings.approximation_tolerance();
+    if sagitta <= 0.0 {
+        return Err(GcodePlanError::InvalidSetting {
+            name: "approximation share [-]".to_string(),
+            value: settings.approximation_share,
+            reason: format!(
+                "line {line} has an arc, and a share of 0 leaves no tolerance for its chords"
+            ),
+        });
+    }
+    let ratio = sagitta / arc.radius;
+    let step = if ratio >= 1.0 {
+        std::f64::consts::PI
+    } else {
+        (2.0 * (1.0 - ratio).acos()).min(std::f64::consts::PI)
+    };
+    let n = (arc.sweep.abs() / step).ceil().max(1.0) as usize;
+    let mut out = Vec::with_capacity(n);
+    for k in 1..=n {
+        out.push(if k == n {
+            arc.end
+        } else {
+            arc.point_at(k as f64 / n as f64)
+        });
+    }
+    out.dedup();
+    Ok(out)
+}

@@ -1,0 +1,224 @@
+//! [`PlanSettings`]: the tolerance, its split, the path limits and the
+//! trajectory's density (builder, validated).
+
+use kerf_gcode::ReaderSettings;
+use kerf_toolpath::{CurvatureLimits, FeedLimits, Servo};
+
+use crate::error::{check_positive, setting, GcodePlanError};
+
+/// Settings of [`crate::plan_program`]. SI units.
+///
+/// # The tolerance and its split
+/// The executed tool tip stays within [`PlanSettings::tolerance`] δ of the
+/// programmed geometry (lines and arcs). δ is spent in three places, each
+/// bounded on its own, so their sum bounds the whole (triangle inequality):
+///
+/// * δ_a = `approximation_share` · δ: arcs become chords whose sagitta is ≤
+///   δ_a / 2 and nearly collinear micro-segments merge within δ_a / 2
+///   ([`kerf_toolpath::merge_collinear`]);
+/// * δ_i = `interpolation_share` · δ: the executor's quintic Hermite between
+///   the trajectory's points, measured by forward kinematics at the control
+///   period against the planned point at the same time;
+/// * δ_c = δ − δ_a − δ_i: the corner transitions
+///   ([`kerf_toolpath::smooth_polyline`], exact deviation), or the program's
+///   `G64 P` where that is smaller.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PlanSettings {
+    /// δ: largest distance of the executed tool tip from the programmed
+    /// path \[m\].
+    pub tolerance: f64,
+    /// Share of δ for arcs and merging, in [0, 1).
+    pub approximation_share: f64,
+    /// Share of δ for the executor's interpolation, in (0, 1).
+    pub interpolation_share: f64,
+    /// The path's limits for cutting moves; `limits.curvature.feed` is the
+    /// machine's largest cutting feed (a programmed F above it is planned at
+    /// it, and the plan says so).
+    pub limits: FeedLimits,
+    /// Speed of G0 moves \[m/s\].
+    pub rapid_feed: f64,
+    /// Mean arc length between the planning samples of a corner \[m\].
+    pub sample_step: f64,
+    /// The executor's control period \[s\] (the trajectory is checked at it).
+    pub control_period: f64,
+    /// Time between trajectory points before refinement \[s\].
+    pub knot_spacing: f64,
+    /// Most trajectory points.
+    pub max_points: usize,
+    /// How the program is read.
+    pub reader: ReaderSettings,
+}
+
+impl PlanSettings {
+    /// Defaults for the laser cutter (seed 001): δ = 0.1 mm; cutting feed at
+    /// most 10 m/min, tangential and normal acceleration 8 m/s² and jerk
+    /// 80 m/s³ (seed 001 Table 1's path acceleration and jerk maxima, kerf's
+    /// reading); chord error at the 4 ms control period 10 µm; the servo of
+    /// seed 003 Table 1 (ω_n 60 rad/s, ζ 0.76) with a contour error of
+    /// 0.05 mm; rapids at 0.5 m/s.
+    pub fn laser_cutter() -> Self {
+        Self::with_limits(
+            FeedLimits {
+                curvature: CurvatureLimits {
+                    feed: 10.0 / 60.0,
+                    interpolation_period: 0.004,
+                    chord_error: 1e-5,
+                    normal_acceleration: 8.0,
+                    normal_jerk: 80.0,
+                    servo: Some(Servo {
+                        natural_frequency: 60.0,
+                        damping: 0.76,
+                        contour_error: 5e-5,
+                    }),
+                },
+                tangential_acceleration: 8.0,
+                tangential_jerk: 80.0,
+            },
+            0.5,
+        )
+    }
+
+    /// Defaults for the IRB 6660 milling cell: δ = 0.1 mm; cutting feed at
+    /// most 0.06 m/s (seed 004's f_max); the tangential and normal limits of
+    /// seed 003 Table 1 (a_t 0.8 m/s², j_t 20 m/s³, a_n 0.99 m/s², j_n
+    /// 29 m/s³, servo ω_n 60 rad/s, ζ 0.76, ε 0.05 mm); chord error at the
+    /// 4 ms control period 10 µm; rapids at 0.1 m/s.
+    pub fn irb6660() -> Self {
+        let table = CurvatureLimits::seed_003_table_1();
+        Self::with_limits(
+            FeedLimits {
+                curvature: CurvatureLimits {
+                    feed: 0.06,
+                    interpolation_period: 0.004,
+                    chord_error: 1e-5,
+                    ..table
+                },
+                tangential_acceleration: 0.8,
+                tangential_jerk: 20.0,
+            },
+            0.1,
+        )
+    }
+
+    fn with_limits(limits: FeedLimits, rapid_feed: f64) -> Self {
+        Self {
+            tolerance: 1e-4,
+            approximation_share: 0.2,
+            interpolation_share: 0.1,
+            limits,
+            rapid_feed,
+            sample_step: 1e-5,
+            control_period: 0.004,
+            knot_spacing: 0.02,
+            max_points: 2_000_000,
+            reader: ReaderSettings::default(),
+        }
+    }
+
+    /// With δ \[m\].
+    pub fn with_tolerance(mut self, tolerance: f64) -> Self {
+        self.tolerance = tolerance;
+        self
+    }
+
+    /// With the path limits.
+    pub fn with_limits_of(mut self, limits: FeedLimits) -> Self {
+        self.limits = limits;
+        self
+    }
+
+    /// With the rapid speed \[m/s\].
+    pub fn with_rapid_feed(mut self, feed: f64) -> Self {
+        self.rapid_feed = feed;
+        self
+    }
+
+    /// With the most trajectory points.
+    pub fn with_max_points(mut self, points: usize) -> Self {
+        self.max_points = points;
+        self
+    }
+
+    /// With the reader's settings.
+    pub fn with_reader(mut self, reader: ReaderSettings) -> Self {
+        self.reader = reader;
+        self
+    }
+
+    /// δ_a \[m\] (type documentation).
+    pub fn approximation_tolerance(&self) -> f64 {
+        self.approximation_share * self.tolerance
+    }
+
+    /// δ_i \[m\] (type documentation).
+    pub fn interpolation_tolerance(&self) -> f64 {
+        self.interpolation_share * self.tolerance
+    }
+
+    /// δ_c \[m\] (type documentation).
+    pub fn corner_tolerance(&self) -> f64 {
+        self.tolerance * (1.0 - self.approximation_share - self.interpolation_share)
+    }
+
+    /// Checks every setting.
+    ///
+    /// # Errors
+    /// [`GcodePlanError::InvalidSetting`] naming the setting.
+    pub fn validate(&self) -> Result<(), GcodePlanError> {
+        check_positive(&[
+            ("tolerance [m]", self.tolerance),
+            ("interpolation share [-]", self.interpolation_share),
+            ("rapid feed [m/s]", self.rapid_feed),
+            ("sample step [m]", self.sample_step),
+            ("control period [s]", self.control_period),
+            ("knot spacing [s]", self.knot_spacing),
+        ])?;
+        if self.tolerance > 0.01 {
+            return Err(invalid(
+                "tolerance [m]",
+                self.tolerance,
+                "must be <= 0.01 m: a larger tolerance is not a machining tolerance",
+            ));
+        }
+        if !(0.0..1.0).contains(&self.approximation_share) {
+            return Err(invalid(
+                "approximation share [-]",
+                self.approximation_share,
+                "must be in [0, 1)",
+            ));
+        }
+        if self.approximation_share + self.interpolation_share >= 1.0 {
+            return Err(invalid(
+                "interpolation share [-]",
+                self.interpolation_share,
+                "the shares of arcs and interpolation must leave some of the tolerance to the \
+                 corners (sum < 1)",
+            ));
+        }
+        if self.max_points < 2 {
+            return Err(invalid(
+                "max points",
+                self.max_points as f64,
+                "a trajectory needs at least two",
+            ));
+        }
+        if self.knot_spacing < self.control_period {
+            return Err(invalid(
+                "knot spacing [s]",
+                self.knot_spacing,
+                "must be at least the control period",
+            ));
+        }
+        self.limits.validate().map_err(setting)?;
+        self.reader.validate()?;
+        Ok(())
+    }
+}
+
+fn invalid(name: &str, value: f64, reason: &str) -> GcodePlanError {
+    GcodePlanError::InvalidSetting {
+        name: name.to_string(),
+        value,
+        reason: reason.to_string(),
+    }
+}
