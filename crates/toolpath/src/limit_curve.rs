@@ -76,9 +76,13 @@ pub fn limit_curve(samples: &[PathSample], constraints: &FeedConstraints<'_>) ->
             cap: cap_of(i),
             piece,
         });
-        // A line: the only interval of its piece, its tangent unchanged.
+        // A line: the only interval of its piece (a piece's samples after its
+        // first belong to it; the path's first sample to the first piece),
+        // its tangent unchanged.
         if let Some(q) = next {
-            let line = p.piece != q.piece && dot(p.tangent, q.tangent) >= 1.0 - 1e-12;
+            let only = (i == 0 || p.piece != q.piece)
+                && samples.get(i + 2).is_none_or(|r| r.piece != q.piece);
+            let line = only && dot(p.tangent, q.tangent) >= 1.0 - 1e-12;
             if line && q.s - p.s > 2.0 * w * (1.0 + 1e-9) {
                 let cap = constraints.cap_between(i);
                 for s in [p.s + w, q.s - w] {
