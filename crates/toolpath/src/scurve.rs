@@ -90,7 +90,7 @@ pub fn reachable(v0: f64, distance: f64, cap: f64, a: f64, j: f64) -> f64 {
 /// `distance`, in closed form: the inverse of [`scurve_distance`] in v₁.
 /// Below the knee (Δv < A²/J), with x = √Δv the distance
 /// (2v₀ + x²) x / √J is a depressed cubic x³ + 2v₀ x = d √J (one real root,
-/// by Newton from the upper bound min(∛(d√J), d√J/(2v₀))); above it,
+/// by Cardano's formula, polished by Newton from above); above it,
 /// d = (v₀ + Δv/2)(Δv/A + A/J) is a quadratic in Δv. The result is stepped
 /// down until its S-curve fits (as [`reachable`], which bisects instead;
 /// the two agree to 1e-9, `tests/feed_optimal.rs`).
@@ -102,7 +102,11 @@ pub fn reachable_closed_form(v0: f64, distance: f64, cap: f64, a: f64, j: f64) -
     let dv = if distance <= scurve_distance(v0, v0 + knee, a, j) {
         let q = distance * j.sqrt();
         let p = 2.0 * v0;
-        let mut x = q.cbrt();
+        // Cardano without cancellation: x = c − p/(3c), c = ∛(q/2 + √(q²/4 + p³/27)),
+        // nudged above the root (and within the upper bound min(∛q, q/p)).
+        let c = (0.5 * q + (0.25 * q * q + p * p * p / 27.0).sqrt()).cbrt();
+        let mut x = if c > 0.0 { c - p / (3.0 * c) } else { 0.0 };
+        x = (x * (1.0 + 1e-12)).min(q.cbrt());
         if p > 0.0 {
             x = x.min(q / p);
         }
