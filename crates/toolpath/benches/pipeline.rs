@@ -13,6 +13,11 @@
 //! Timing: the whole pipeline from the text in memory to the plan and T_lb, best of 20 runs, on
 //! one thread.
 //!
+//! A second table has kerf's near time-optimal planner (`plan_feed_optimal`) on the same
+//! smoothed paths and samples: T_m, T_lb, T_m/T_lb, the planning time alone (best of 20), the
+//! whole pipeline with it (best of 20), the largest ratio of `check_plan` (every limit on the
+//! output at the period) for it and for `plan_feed`, and with the laser cutter's axis limits.
+//!
 //! ```sh
 //! cargo bench -p kerf_toolpath --bench pipeline
 //! ```
@@ -22,7 +27,8 @@ use std::time::Instant;
 
 use kerf_gcode::{read_points, PointUnit};
 use kerf_toolpath::{
-    bang_bang_under, metrics, plan_feed, sample_path, smooth_polyline, CurvatureLimits, FeedLimits,
+    bang_bang_under, check_plan, metrics, plan_feed, plan_feed_optimal, sample_path,
+    smooth_polyline, AxisLimits, CurvatureLimits, FeedConstraints, FeedLimits,
 };
 
 /// Arc length between samples for planning \[m\].
@@ -110,6 +116,71 @@ fn main() {
                 m.max_chord_error * 1e6,
                 smoothed.max_deviation() * 1e3,
                 best * 1e3
+            );
+        }
+    }
+    println!();
+    println!(
+        "| outline | limits | T_m (s) | T_lb (s) | T_m/T_lb | plan_feed T_m/T_lb | planning (ms) | pipeline (ms) | worst check ratio | plan_feed worst check ratio | T_m with laser-cutter axes (s) | its worst check ratio |"
+    );
+    println!("|---|---|---:|---:|---:|---:|---:|---:|---|---|---:|---|");
+    for path in &names {
+        let text = std::fs::read_to_string(path).unwrap();
+        let name = path.file_stem().unwrap().to_string_lossy().to_string();
+        for (limits_name, delta, limits) in [&seed000, &seed003] {
+            let constraints = FeedConstraints::new(*limits);
+            let run = || {
+                let points = read_points(text.as_bytes(), PointUnit::Millimetre).unwrap();
+                let smoothed = smooth_polyline(&points, *delta).unwrap();
+                let samples = sample_path(&smoothed, STEP);
+                let plan = plan_feed_optimal(&samples, &constraints).unwrap();
+                let curve: Vec<f64> = samples
+                    .iter()
+                    .map(|p| limits.curvature.speed(p.curvature))
+                    .collect();
+                let lb = bang_bang_under(&samples, curve, limits.tangential_acceleration).unwrap();
+                (smoothed, samples, plan, lb)
+            };
+            let mut best = f64::INFINITY;
+            let mut result = None;
+            for _ in 0..20 {
+                let start = Instant::now();
+                let r = run();
+                best = best.min(start.elapsed().as_secs_f64());
+                result = Some(r);
+            }
+            let (smoothed, samples, plan, lb) = result.unwrap();
+            let mut planning = f64::INFINITY;
+            for _ in 0..20 {
+                let start = Instant::now();
+                let p = plan_feed_optimal(&samples, &constraints).unwrap();
+                planning = planning.min(start.elapsed().as_secs_f64());
+                assert_eq!(p.time, plan.time);
+            }
+            let period = limits.curvature.interpolation_period;
+            let worst = |p: &kerf_toolpath::FeedPlan, c: &FeedConstraints| {
+                let c = check_plan(&smoothed, &samples, p, c, period).unwrap();
+                let (what, w) = c.worst();
+                format!("{:.5} ({what})", w.ratio)
+            };
+            let old = plan_feed(&samples, limits).unwrap();
+            let axes = FeedConstraints {
+                axes: Some(AxisLimits::laser_cutter()),
+                ..constraints
+            };
+            let with_axes = plan_feed_optimal(&samples, &axes).unwrap();
+            println!(
+                "| {name} | {limits_name} | {:.3} | {:.3} | {:.4} | {:.4} | {:.1} | {:.1} | {} | {} | {:.3} | {} |",
+                plan.time,
+                lb.time,
+                plan.time / lb.time,
+                old.time / lb.time,
+                planning * 1e3,
+                best * 1e3,
+                worst(&plan, &constraints),
+                worst(&old, &constraints),
+                with_axes.time,
+                worst(&with_axes, &axes)
             );
         }
     }

@@ -3,16 +3,28 @@
 //! curvature-continuous transitions ([`corner`], [`smooth`]), arc-length
 //! samples ([`samples`]) and the bang-bang time bound T_lb
 //! ([`lower_bound`]).
+//!
+//! Feed planning: seed 003's constant-interval planner ([`feed`]) and kerf's
+//! near time-optimal one ([`feed_optimal`]) over a velocity-limit curve
+//! ([`limit_curve`](mod@limit_curve)) with per-sample feeds and axis limits ([`constraints`],
+//! [`axis`]), picked by [`FeedMethod`] and verified on their output by
+//! [`check_plan`] ([`plan_check`]).
 
+pub mod axis;
 pub mod baseline;
 pub mod bezier;
+pub mod constraints;
 pub mod corner;
 pub mod corner_curve;
 pub mod error;
 pub mod feed;
+pub mod feed_method;
+pub mod feed_optimal;
+pub mod limit_curve;
 pub mod lower_bound;
 pub mod merge;
 pub mod metrics;
+pub mod plan_check;
 mod quadrature;
 pub mod samples;
 pub mod scurve;
@@ -21,15 +33,21 @@ pub mod speed_limit;
 pub mod spline;
 pub mod vec3;
 
+pub use axis::AxisLimits;
 pub use baseline::{CornerMethod, NurbsSettings};
 pub use bezier::QuinticBezier;
+pub use constraints::FeedConstraints;
 pub use corner::{corner_transition, Binding, CornerShape, CornerTransition};
 pub use corner_curve::CornerCurve;
 pub use error::ToolpathError;
 pub use feed::{plan_feed, FeedLimits, FeedPlan, FeedSample};
+pub use feed_method::FeedMethod;
+pub use feed_optimal::plan_feed_optimal;
+pub use limit_curve::{limit_curve, LimitCurve};
 pub use lower_bound::{bang_bang, bang_bang_under, BangBang, BangBangLimits};
 pub use merge::merge_collinear;
 pub use metrics::{metrics, Metrics};
+pub use plan_check::{check_plan, PlanCheck, Worst};
 pub use samples::{derivatives_at, point_at, sample_path, PathSample};
 pub use smooth::smooth_polyline_with;
 pub use smooth::{smooth_polyline, Piece, SmoothedPath};

@@ -20,3 +20,44 @@ pub fn feed_limits() -> FeedLimits {
         tangential_jerk: 20.0,
     }
 }
+
+/// Seed 000's limits as the bench reads them (mm and s: v 10 mm/s, a 100 mm/s², j 10 000 mm/s³,
+/// T 0.5 ms; normal limits equal to the tangential ones) and its δ = 0.5 mm.
+pub fn seed_000_limits() -> (FeedLimits, f64) {
+    (
+        FeedLimits {
+            curvature: CurvatureLimits {
+                feed: 0.010,
+                interpolation_period: 5e-4,
+                chord_error: 5e-4,
+                normal_acceleration: 0.1,
+                normal_jerk: 10.0,
+                servo: None,
+            },
+            tangential_acceleration: 0.1,
+            tangential_jerk: 10.0,
+        },
+        5e-4,
+    )
+}
+
+/// The shipped outlines (`data/outlines/*.txt`, mm), by name, sorted.
+pub fn outlines() -> Vec<(String, Vec<[f64; 3]>)> {
+    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("data/outlines");
+    let mut names: Vec<_> = std::fs::read_dir(&dir)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|e| e == "txt"))
+        .collect();
+    names.sort();
+    names
+        .iter()
+        .map(|p| {
+            let text = std::fs::read_to_string(p).unwrap();
+            let points =
+                kerf_gcode::read_points(text.as_bytes(), kerf_gcode::PointUnit::Millimetre)
+                    .unwrap();
+            (p.file_stem().unwrap().to_string_lossy().to_string(), points)
+        })
+        .collect()
+}
