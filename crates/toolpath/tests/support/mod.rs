@@ -1,4 +1,5 @@
-//! Test data shared by the integration tests of `kerf_toolpath`.
+//! Test data shared by the integration tests of `kerf_toolpath` (each test uses a part).
+#![allow(dead_code)]
 
 use kerf_toolpath::{CurvatureLimits, FeedLimits};
 
