@@ -3,6 +3,7 @@
 //! pieces that chain, curvature against finite differences, determinism of the swarm, bad input.
 #![allow(clippy::unwrap_used, clippy::expect_used)] // tests report failures by panicking
 
+#[allow(dead_code)] // each test file uses some of the shared data
 mod support;
 
 use kerf_gcode::{read_points, PointUnit};

@@ -1,5 +1,4 @@
-//! Test data shared by the integration tests of `kerf_toolpath` (each test uses a part).
-#![allow(dead_code)]
+//! Test data shared by the integration tests of `kerf_toolpath`.
 
 use kerf_toolpath::{CurvatureLimits, FeedLimits};
 
