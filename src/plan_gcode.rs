@@ -1,7 +1,8 @@
 //! `kerf plan gcode`: plans one G-code program offline, without ROS (issue 14, item 6).
 //!
 //! ```sh
-//! kerf plan gcode FILE [--machine laser-cutter|irb6660] [--tolerance M] [--method kerf]
+//! kerf plan gcode FILE [--machine laser-cutter|irb6660] [--tolerance M]
+//!                      [--method kerf|icr|ccr|nurbs] [--feed-method near-optimal|constant-intervals]
 //!                      [--g RAD] [--origin X,Y,Z] [--plots DIR] [--out plan.json]
 //! ```
 //!
@@ -45,9 +46,12 @@ pub struct GcodeArgs {
     /// Largest distance of the executed tool tip from the programmed path (m).
     #[arg(long)]
     tolerance: Option<f64>,
-    /// Corner smoothing method.
+    /// Corner smoothing method: kerf, icr, ccr, nurbs.
     #[arg(long)]
     method: Option<String>,
+    /// Feed planner: near-optimal, constant-intervals.
+    #[arg(long)]
+    feed_method: Option<String>,
     /// IRB 6660: the redundancy angle g about the tool axis (rad).
     #[arg(long, allow_hyphen_values = true)]
     g: Option<f64>,
@@ -93,6 +97,7 @@ pub fn run(a: GcodeArgs) -> Result<(), String> {
         program_file,
         tolerance: a.tolerance,
         method: a.method.clone(),
+        feed_method: a.feed_method.clone(),
         origin: a.origin.as_ref().map(|o| [o[0], o[1], o[2]]),
         redundancy_angle: a.g,
         ..GcodeRequest::default()

@@ -19,7 +19,8 @@ pub use error::GcodePlanError;
 pub use machine::{JointBounds, LaserSheet, Machine, MillingPlane, DOF};
 pub use plan::{plan_program, GcodePlan, RunReport, ToolEvent};
 pub use request::{
-    plan_request, GcodeRequest, LimitOverrides, MachineBase, MachineKind, ProgramSource, METHODS,
+    corner_method, feed_method, plan_request, GcodeRequest, LimitOverrides, MachineBase,
+    MachineKind, ProgramSource, FEED_METHODS, METHODS,
 };
 pub use runs::{read_steps, Reading, Run, RunKind, Step};
 pub use settings::PlanSettings;

@@ -2,12 +2,13 @@
 //! checked as the executor will run it.
 //!
 //! 1. Read the program into runs and stops ([`crate::runs`]).
-//! 2. Per run: smooth its corners within δ_c
-//!    ([`kerf_toolpath::smooth_polyline`]), sample it, plan the feed
-//!    ([`kerf_toolpath::plan_feed`], the programmed F capped at the
-//!    machine's), and the bang-bang bound T_lb on the same path
-//!    ([`kerf_toolpath::bang_bang_under`] under seed 003 eq. 22's limit
-//!    curve).
+//! 2. Per run: smooth its corners within δ_c with the settings' corner
+//!    method ([`kerf_toolpath::smooth_polyline_with`]), sample it, plan the
+//!    feed with the settings' feed method ([`kerf_toolpath::FeedMethod`]:
+//!    every segment held to its programmed F, capped at the machine's, and
+//!    optionally the gantry's axis limits on the laser cutter), and the bang-bang
+//!    bound T_lb on the same path ([`kerf_toolpath::bang_bang_under`] under
+//!    seed 003 eq. 22's limit curve and the programmed feeds).
 //! 3. Per run: the joint points ([`crate::knots::run_knots`]), slowed
 //!    uniformly where a joint limit needs it.
 //! 4. The runs in order, from rest to rest, with dwells held.
@@ -24,7 +25,8 @@ use kerf_executor::{
     check_executable, ExecutorConfig, JointSample, TrajectoryPoint, TrajectoryRequest,
 };
 use kerf_toolpath::{
-    bang_bang_under, metrics, plan_feed, sample_path, smooth_polyline, FeedLimits, Metrics,
+    bang_bang_under, metrics, sample_path, smooth_polyline_with, FeedConstraints, FeedLimits,
+    Metrics, PathSample, Piece, SmoothedPath,
 };
 
 use crate::error::GcodePlanError;
@@ -215,11 +217,11 @@ pub fn plan_program<R: BufRead>(
             }),
             Step::Run(run) => {
                 reachable(machine, run, reference.as_ref())?;
-                let (timed, mut report) = time_run(run, settings, &mut warnings)?;
+                let prepared = prepare_run(run, machine, settings, &mut warnings)?;
                 let line = run.lines[0];
                 let knots = run_knots(
                     machine,
-                    &timed,
+                    &prepared.timed,
                     line,
                     reference.as_ref(),
                     settings.knot_spacing,
@@ -228,6 +230,9 @@ pub fn plan_program<R: BufRead>(
                     settings.max_points.saturating_sub(points),
                     budget,
                 )?;
+                let Prepared {
+                    timed, mut report, ..
+                } = prepared;
                 points += knots.knots.len();
                 if knots.slowdown > 1.0 {
                     warnings.push(format!(
@@ -350,45 +355,50 @@ fn reachable(
     Ok(())
 }
 
-/// Step 2 for one run.
-fn time_run(
+/// A run smoothed, sampled and timed, with its report so far.
+struct Prepared {
+    timed: TimedRun,
+    report: RunReport,
+}
+
+/// Step 2 for one run: smoothing, samples, programmed feeds, T_lb, and the feed plan under
+/// the programmed feeds.
+fn prepare_run(
     run: &Run,
+    machine: &dyn Machine,
     settings: &PlanSettings,
     warnings: &mut Vec<String>,
-) -> Result<(TimedRun, RunReport), GcodePlanError> {
+) -> Result<Prepared, GcodePlanError> {
     let line = run.lines[0];
     let last_line = run.lines.last().copied().unwrap_or(line);
     let path_error = |error| GcodePlanError::Path { line, error };
-    let cap = match run.kind {
-        RunKind::Rapid => run.feed,
+    let machine_max = match run.kind {
+        RunKind::Rapid => f64::INFINITY,
         _ => settings.limits.curvature.feed,
     };
-    let feed = run.feed.min(cap);
-    if run.feed > cap {
+    let programmed = run.feeds.iter().copied().fold(0.0, f64::max);
+    if programmed > machine_max {
         warnings.push(format!(
-            "lines {line}-{last_line}: F {:.4} m/s is above the machine's {:.4} m/s and is \
-             planned at {:.4} m/s",
-            run.feed, cap, feed
+            "lines {line}-{last_line}: F up to {programmed:.4} m/s is above the machine's \
+             {machine_max:.4} m/s and is planned at {machine_max:.4} m/s"
         ));
     }
+    let feeds: Vec<f64> = run.feeds.iter().map(|f| f.min(machine_max)).collect();
+    let feed = feeds.iter().copied().fold(0.0, f64::max);
     let mut limits: FeedLimits = settings.limits;
     limits.curvature.feed = feed;
-    let path = smooth_polyline(&run.points, run.corner_tolerance).map_err(path_error)?;
+    let path = smooth_polyline_with(&run.points, run.corner_tolerance, &settings.corner_method)
+        .map_err(path_error)?;
     let samples = sample_path(&path, settings.sample_step);
-    let plan = plan_feed(&samples, &limits).map_err(path_error)?;
+    let caps = sample_caps(&path, &samples, &run.points, &feeds);
     let curve: Vec<f64> = samples
         .iter()
-        .map(|p| limits.curvature.speed(p.curvature))
+        .zip(&caps)
+        .map(|(p, cap)| limits.curvature.speed(p.curvature).min(*cap))
         .collect();
     let lower =
         bang_bang_under(&samples, curve, limits.tangential_acceleration).map_err(path_error)?;
-    let m = metrics(
-        &plan,
-        &path,
-        &samples,
-        limits.curvature.interpolation_period,
-        limits.curvature.servo.as_ref(),
-    );
+    let plan = feed_plan(&samples, &caps, feed, &limits, machine, settings).map_err(path_error)?;
     let report = RunReport {
         kind: run.kind,
         lines: (line, last_line),
@@ -407,16 +417,95 @@ fn time_run(
             what: "velocity",
         },
         start_time: 0.0,
-        metrics: m,
+        metrics: metrics(
+            &plan,
+            &path,
+            &samples,
+            limits.curvature.interpolation_period,
+            limits.curvature.servo.as_ref(),
+        ),
     };
-    Ok((
-        TimedRun {
+    Ok(Prepared {
+        timed: TimedRun {
             path,
             samples,
             plan,
         },
         report,
-    ))
+    })
+}
+
+/// The feed plan under per-sample caps (`feed` when they are all equal to it).
+fn feed_plan(
+    samples: &[PathSample],
+    caps: &[f64],
+    feed: f64,
+    limits: &FeedLimits,
+    machine: &dyn Machine,
+    settings: &PlanSettings,
+) -> Result<kerf_toolpath::FeedPlan, kerf_toolpath::ToolpathError> {
+    let varies = caps.iter().any(|c| *c != feed);
+    let constraints = FeedConstraints {
+        limits: *limits,
+        axes: if settings.feed_axis_limits {
+            machine.axis_limits()
+        } else {
+            None
+        },
+        caps: varies.then_some(caps),
+    };
+    settings.feed_method.plan(samples, &constraints)
+}
+
+/// The programmed feed of every sample: a line piece's is the lowest feed of the polyline
+/// segments it lies on, a corner's the lower of its two segments'.
+fn sample_caps(
+    path: &SmoothedPath,
+    samples: &[PathSample],
+    points: &[[f64; 3]],
+    feeds: &[f64],
+) -> Vec<f64> {
+    let n = points.len();
+    let lowest = |a: usize, b: usize| {
+        feeds[a.min(feeds.len() - 1)..b.clamp(a + 1, feeds.len())]
+            .iter()
+            .copied()
+            .fold(f64::INFINITY, f64::min)
+    };
+    // The vertex index of every corner, in order.
+    let mut vertex = 0usize;
+    let mut corner_vertex: Vec<Option<usize>> = Vec::with_capacity(path.pieces.len());
+    for piece in &path.pieces {
+        match piece {
+            Piece::Corner(c) => {
+                let mut k = vertex + 1;
+                while k < n - 1 && points[k] != c.vertex {
+                    k += 1;
+                }
+                vertex = k;
+                corner_vertex.push(Some(k));
+            }
+            Piece::Line { .. } => corner_vertex.push(None),
+        }
+    }
+    let mut piece_caps = Vec::with_capacity(path.pieces.len());
+    let mut previous = 0usize;
+    for (i, v) in corner_vertex.iter().enumerate() {
+        piece_caps.push(match v {
+            Some(k) => {
+                previous = *k;
+                lowest(k - 1, k + 1)
+            }
+            None => {
+                let next = corner_vertex[i + 1..]
+                    .iter()
+                    .find_map(|v| *v)
+                    .unwrap_or(n - 1);
+                lowest(previous, next)
+            }
+        });
+    }
+    samples.iter().map(|s| piece_caps[s.piece]).collect()
 }
 
 /// Step 4: every run's points in scaled global time, dwells as a second

@@ -8,7 +8,8 @@
 //! tolerance: 1.0e-4            # m, default 1e-4
 //! ```
 //!
-//! Optional: `method` (`kerf`), `limits` (any of `max_feed`, `tangential_acceleration`,
+//! Optional: `method` (`kerf`, `icr`, `ccr`, `nurbs`), `feed_method` (`near-optimal`,
+//! `constant-intervals`), `limits` (any of `max_feed`, `tangential_acceleration`,
 //! `tangential_jerk`, `normal_acceleration`, `normal_jerk`, `chord_error`, `contour_error`,
 //! each replacing the machine's default), `rapid_feed`, `origin` (the program's zero in the
 //! machine's base frame), `redundancy_angle` (IRB 6660 only), `standoff_axis` (laser cutter
@@ -64,8 +65,48 @@ impl MachineKind {
     }
 }
 
-/// The corner smoothing methods.
-pub const METHODS: &[&str] = &["kerf"];
+/// The corner smoothing methods: kerf's quintic, the baselines ICR (Zhao, Zhu and Ding 2013),
+/// CCR (Xu and Sun 2018) and seed 003's NURBS corner by PSO ([`kerf_toolpath::CornerMethod`]).
+pub const METHODS: &[&str] = &["kerf", "icr", "ccr", "nurbs"];
+
+/// The feed planners ([`kerf_toolpath::FeedMethod`]).
+pub const FEED_METHODS: &[&str] = &["near-optimal", "constant-intervals"];
+
+/// The corner method named `name` (empty: kerf).
+///
+/// # Errors
+/// [`GcodePlanError::InvalidSetting`] naming the method and the ones known.
+pub fn corner_method(name: &str) -> Result<kerf_toolpath::CornerMethod, GcodePlanError> {
+    use kerf_toolpath::{CornerMethod, NurbsSettings};
+    match name {
+        "" | "kerf" => Ok(CornerMethod::Kerf),
+        "icr" => Ok(CornerMethod::Icr),
+        "ccr" => Ok(CornerMethod::Ccr),
+        "nurbs" => Ok(CornerMethod::Nurbs(NurbsSettings::default())),
+        other => Err(GcodePlanError::InvalidSetting {
+            name: format!("method '{other}'"),
+            value: f64::NAN,
+            reason: format!("unknown; use one of {}", METHODS.join(", ")),
+        }),
+    }
+}
+
+/// The feed method named `name` (empty: near-optimal).
+///
+/// # Errors
+/// [`GcodePlanError::InvalidSetting`] naming the method and the ones known.
+pub fn feed_method(name: &str) -> Result<kerf_toolpath::FeedMethod, GcodePlanError> {
+    use kerf_toolpath::FeedMethod;
+    match name {
+        "" | "near-optimal" => Ok(FeedMethod::NearOptimal),
+        "constant-intervals" => Ok(FeedMethod::ConstantIntervals),
+        other => Err(GcodePlanError::InvalidSetting {
+            name: format!("feed_method '{other}'"),
+            value: f64::NAN,
+            reason: format!("unknown; use one of {}", FEED_METHODS.join(", ")),
+        }),
+    }
+}
 
 /// Path limits that replace the machine's defaults (SI units).
 #[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
@@ -109,6 +150,9 @@ pub struct GcodeRequest {
     /// Corner smoothing method ([`METHODS`]), default `kerf`.
     #[serde(default)]
     pub method: Option<String>,
+    /// Feed planner ([`FEED_METHODS`]), default `near-optimal`.
+    #[serde(default)]
+    pub feed_method: Option<String>,
     /// Path limits.
     #[serde(default)]
     pub limits: Option<LimitOverrides>,
@@ -232,15 +276,8 @@ impl GcodeRequest {
         if let Some(t) = self.tolerance {
             s.tolerance = t;
         }
-        if let Some(m) = &self.method {
-            if !METHODS.contains(&m.as_str()) && !m.is_empty() {
-                return Err(GcodePlanError::InvalidSetting {
-                    name: format!("method '{m}'"),
-                    value: f64::NAN,
-                    reason: format!("unknown; use one of {}", METHODS.join(", ")),
-                });
-            }
-        }
+        s.corner_method = corner_method(self.method.as_deref().unwrap_or(""))?;
+        s.feed_method = feed_method(self.feed_method.as_deref().unwrap_or(""))?;
         if let Some(l) = &self.limits {
             let c = &mut s.limits.curvature;
             set(&mut c.feed, l.max_feed);

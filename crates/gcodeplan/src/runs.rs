@@ -5,7 +5,7 @@
 //! A run ends (the machine comes to rest) where:
 //! * the kind of move changes: a cut (G1/G2/G3 with the beam or spindle on),
 //!   a feed move with it off, a rapid (G0);
-//! * the programmed feed or the path control mode (G61, G64 P) changes;
+//! * the path control mode (G61, G64 P) changes;
 //! * the tool is switched (M3/M4/M5), a dwell (G4) or the end (M2/M30);
 //! * the path reverses (turns by more than π − [`REVERSAL_MARGIN`]): no
 //!   curvature-continuous transition fits a tolerance there;
@@ -51,8 +51,10 @@ pub struct Run {
     /// Source line of each point (the motion that ends there; the first
     /// point's is the run's first motion).
     pub lines: Vec<usize>,
-    /// Programmed feed \[m/s\] (G0: the rapid speed).
-    pub feed: f64,
+    /// Programmed feed of each segment \[m/s\] (G0: the rapid speed): `feeds[k]` of the
+    /// segment from point k to k + 1. A change of F does not stop the machine: the feed
+    /// plan holds each segment to its own.
+    pub feeds: Vec<f64>,
     /// The corner tolerance δ_c of this run \[m\] (a G64 P below δ_c
     /// replaces it).
     pub corner_tolerance: f64,
@@ -176,7 +178,7 @@ pub fn read_steps<R: BufRead>(
         }
         let continues = open.as_ref().is_some_and(|o| {
             o.run.kind == kind
-                && o.run.feed == feed
+                && (o.run.kind != RunKind::Rapid || o.run.feeds[0] == feed)
                 && o.run.corner_tolerance == corner_tolerance
                 && !o.exact
                 && !exact
@@ -188,14 +190,14 @@ pub fn read_steps<R: BufRead>(
                     kind,
                     points: vec![start],
                     lines: vec![line],
-                    feed,
+                    feeds: Vec::new(),
                     corner_tolerance,
                 },
                 exact,
             });
         }
         for p in points {
-            push_point(&mut open, &mut reading, settings, p, line)?;
+            push_point(&mut open, &mut reading, settings, p, line, feed)?;
         }
     }
     close(&mut open, &mut reading, settings)?;
@@ -220,6 +222,7 @@ fn push_point(
     settings: &PlanSettings,
     p: [f64; 3],
     line: usize,
+    feed: f64,
 ) -> Result<(), GcodePlanError> {
     let Some(o) = open.as_mut() else {
         return Ok(());
@@ -233,6 +236,7 @@ fn push_point(
         let run = Run {
             points: vec![last],
             lines: vec![o.run.lines[n - 1]],
+            feeds: Vec::new(),
             ..o.run.clone()
         };
         let exact = o.exact;
@@ -242,6 +246,7 @@ fn push_point(
     if let Some(o) = open.as_mut() {
         o.run.points.push(p);
         o.run.lines.push(line);
+        o.run.feeds.push(feed);
     }
     Ok(())
 }
@@ -275,24 +280,27 @@ fn close(
     }
     let merge = 0.5 * settings.approximation_tolerance();
     if merge > 0.0 && run.points.len() > 2 {
-        let kept = kerf_toolpath::merge_collinear(&run.points, merge).map_err(|error| {
+        let kept = kerf_toolpath::merge_collinear_indices(&run.points, merge).map_err(|error| {
             GcodePlanError::Path {
                 line: run.lines[0],
                 error,
             }
         })?;
         if kept.len() < run.points.len() {
-            // The kept points are a subsequence of the originals: carry their lines along.
-            let mut lines = Vec::with_capacity(kept.len());
-            let mut k = 0;
-            for p in &kept {
-                while run.points[k] != *p {
-                    k += 1;
-                }
-                lines.push(run.lines[k]);
-            }
-            run.points = kept;
-            run.lines = lines;
+            // A merged segment from kept point a to b replaces segments a..b: the lowest
+            // of their feeds.
+            let feeds = kept
+                .windows(2)
+                .map(|w| {
+                    run.feeds[w[0]..w[1]]
+                        .iter()
+                        .copied()
+                        .fold(f64::INFINITY, f64::min)
+                })
+                .collect();
+            run.lines = kept.iter().map(|&k| run.lines[k]).collect();
+            run.points = kept.iter().map(|&k| run.points[k]).collect();
+            run.feeds = feeds;
         }
     }
     reading.steps.push(Step::Run(run));

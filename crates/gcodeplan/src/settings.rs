@@ -2,7 +2,7 @@
 //! trajectory's density (builder, validated).
 
 use kerf_gcode::ReaderSettings;
-use kerf_toolpath::{CurvatureLimits, FeedLimits, Servo};
+use kerf_toolpath::{CornerMethod, CurvatureLimits, FeedLimits, FeedMethod, Servo};
 
 use crate::error::{check_positive, setting, GcodePlanError};
 
@@ -47,6 +47,18 @@ pub struct PlanSettings {
     pub max_points: usize,
     /// How the program is read.
     pub reader: ReaderSettings,
+    /// How corners are smoothed (default kerf's quintic).
+    pub corner_method: CornerMethod,
+    /// How the feed is planned (default the near time-optimal planner).
+    pub feed_method: FeedMethod,
+    /// Whether the feed plan also bounds the machine's Cartesian axes (the laser cutter's
+    /// gantry, [`crate::Machine::axis_limits`]) by the chain rule on the exact path (default
+    /// `false`). Either way every joint's velocity, acceleration and jerk is held on what the
+    /// executor runs (exact peaks of its quintics, a run slowed where needed): the exact path's
+    /// axis jerk has spikes of v³ dκ/ds at the small corners that the executed quintics, within
+    /// δ_i of the path, do not have, and bounding them costs 4x the time (W-shape 15.8 s
+    /// against 3.8 s with the slowdown; BENCHMARKS.md).
+    pub feed_axis_limits: bool,
 }
 
 impl PlanSettings {
@@ -112,6 +124,9 @@ impl PlanSettings {
             knot_spacing: 0.02,
             max_points: 2_000_000,
             reader: ReaderSettings::default(),
+            corner_method: CornerMethod::Kerf,
+            feed_method: FeedMethod::NearOptimal,
+            feed_axis_limits: false,
         }
     }
 
@@ -136,6 +151,18 @@ impl PlanSettings {
     /// With the most trajectory points.
     pub fn with_max_points(mut self, points: usize) -> Self {
         self.max_points = points;
+        self
+    }
+
+    /// With the corner method.
+    pub fn with_corner_method(mut self, method: CornerMethod) -> Self {
+        self.corner_method = method;
+        self
+    }
+
+    /// With the feed method.
+    pub fn with_feed_method(mut self, method: FeedMethod) -> Self {
+        self.feed_method = method;
         self
     }
 
@@ -210,6 +237,7 @@ impl PlanSettings {
             ));
         }
         self.limits.validate().map_err(setting)?;
+        self.corner_method.check().map_err(setting)?;
         self.reader.validate()?;
         Ok(())
     }

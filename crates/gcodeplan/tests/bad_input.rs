@@ -179,9 +179,23 @@ fn reversals_exact_path_and_blend_tolerances_shape_the_runs() {
     let plan = laser_plan("G1 X10 F600\nG1 Y10\nG1 X0\n", &settings).unwrap();
     assert!((plan.runs[0].corner_tolerance - 7e-5).abs() < 1e-15);
     assert!(plan.max_corner_deviation > 0.5 * 7e-5);
-    // A change of feed ends a run (a stop).
+    // A change of feed does not stop the machine: one run, each segment at its own F.
     let plan = laser_plan("G1 X10 F600\nG1 Y10 F300\n", &settings).unwrap();
-    assert_eq!(plan.runs.len(), 2);
+    assert_eq!(plan.runs.len(), 1);
+    let run = &plan.timed[0];
+    let mut fastest_second: f64 = 0.0;
+    for s in run.plan.sample(0.001) {
+        let point = kerf_toolpath::point_at(&run.path, &run.samples, s.s);
+        // Past the corner's reach (70 um), on the second segment: 5 mm/s at most.
+        if point[1] > 1e-3 {
+            fastest_second = fastest_second.max(s.v);
+        }
+        assert!(s.v <= 0.01 + 1e-12, "{s:?}");
+    }
+    assert!(
+        fastest_second <= 0.005 + 1e-12 && fastest_second > 0.0049,
+        "{fastest_second}"
+    );
 }
 
 #[test]

@@ -45,7 +45,7 @@ pub use feed_method::FeedMethod;
 pub use feed_optimal::plan_feed_optimal;
 pub use limit_curve::{limit_curve, LimitCurve};
 pub use lower_bound::{bang_bang, bang_bang_under, BangBang, BangBangLimits};
-pub use merge::merge_collinear;
+pub use merge::{merge_collinear, merge_collinear_indices};
 pub use metrics::{metrics, Metrics};
 pub use plan_check::{check_plan, PlanCheck, Worst};
 pub use samples::{derivatives_at, point_at, sample_path, PathSample};

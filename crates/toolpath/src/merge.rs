@@ -36,6 +36,22 @@ pub fn merge_collinear(
     points: &[[f64; 3]],
     tolerance: f64,
 ) -> Result<Vec<[f64; 3]>, ToolpathError> {
+    Ok(merge_collinear_indices(points, tolerance)?
+        .into_iter()
+        .map(|k| points[k])
+        .collect())
+}
+
+/// [`merge_collinear`] as the indices of the kept points (increasing, the
+/// first and the last always), for a caller that carries data along with
+/// the points.
+///
+/// # Errors
+/// As [`merge_collinear`].
+pub fn merge_collinear_indices(
+    points: &[[f64; 3]],
+    tolerance: f64,
+) -> Result<Vec<usize>, ToolpathError> {
     check_positive(&[("merge tolerance [m]", tolerance)])?;
     if points.len() < 2 {
         return Err(ToolpathError::InvalidParameter {
@@ -51,7 +67,7 @@ pub fn merge_collinear(
         });
     }
     let n = points.len();
-    let mut kept = vec![points[0]];
+    let mut kept = vec![0];
     let mut i = 0;
     while i < n - 1 {
         let mut best = i + 1;
@@ -63,7 +79,7 @@ pub fn merge_collinear(
                 break;
             }
         }
-        kept.push(points[best]);
+        kept.push(best);
         i = best;
     }
     Ok(kept)

@@ -494,6 +494,8 @@ pub struct GcodeRequest {
     pub tolerance: f64,
     /// One of the `METHOD_*` constants; empty = kerf.
     pub method: String,
+    /// One of the `FEED_*` constants; empty = near-optimal.
+    pub feed_method: String,
     /// Whether the path limits below are given; false = the machine's.
     pub has_limits: bool,
     /// Largest cutting feed (m/s).
@@ -532,6 +534,16 @@ impl GcodeRequest {
     pub const MACHINE_IRB6660: &'static str = "irb6660";
     /// kerf's curvature-continuous quintic corner.
     pub const METHOD_KERF: &'static str = "kerf";
+    /// Inscribed cubic B-spline corner (ICR).
+    pub const METHOD_ICR: &'static str = "icr";
+    /// Circumscribed double cubic B-spline corner (CCR).
+    pub const METHOD_CCR: &'static str = "ccr";
+    /// Seed 003's NURBS corner by PSO.
+    pub const METHOD_NURBS: &'static str = "nurbs";
+    /// The near time-optimal feed planner.
+    pub const FEED_NEAR_OPTIMAL: &'static str = "near-optimal";
+    /// Seed 003's constant-interval feed planner.
+    pub const FEED_CONSTANT_INTERVALS: &'static str = "constant-intervals";
 }
 
 /// `kerf_msgs/msg/GcodeToolEvent`: a beam or spindle switch of a planned program, at rest.

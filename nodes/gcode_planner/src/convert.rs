@@ -64,6 +64,7 @@ pub fn request_from_msg(m: &msg::GcodeRequest) -> Result<GcodeRequest, GcodePlan
         program_file,
         tolerance: given(m.tolerance),
         method: (!m.method.is_empty()).then(|| m.method.clone()),
+        feed_method: (!m.feed_method.is_empty()).then(|| m.feed_method.clone()),
         limits: m.has_limits.then_some(LimitOverrides {
             max_feed: Some(m.max_feed),
             tangential_acceleration: Some(m.tangential_acceleration),

@@ -119,6 +119,16 @@ impl Machine for LaserSheet {
         Ok(q)
     }
 
+    /// q1, q2, q3 are the program's X, Y, Z (a translation apart).
+    fn axis_limits(&self) -> Option<kerf_toolpath::AxisLimits> {
+        let b = &self.bounds;
+        Some(kerf_toolpath::AxisLimits {
+            velocity: [b[0].velocity, b[1].velocity, b[2].velocity],
+            acceleration: [b[0].acceleration, b[1].acceleration, b[2].acceleration],
+            jerk: [b[0].jerk, b[1].jerk, b[2].jerk],
+        })
+    }
+
     fn tip(&self, q: &[f64; DOF]) -> Result<[f64; 3], String> {
         if q.iter().any(|v| !v.is_finite()) {
             return Err(format!("joint vector {q:?} is not finite"));

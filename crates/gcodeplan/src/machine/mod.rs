@@ -63,6 +63,12 @@ pub trait Machine: Sync {
     /// A sentence for a non-finite joint vector.
     fn tip(&self, q: &[f64; DOF]) -> Result<[f64; 3], String>;
 
+    /// Limits of the program frame's Cartesian axes when the machine's joints are those axes
+    /// (the laser cutter's gantry), for the feed plan; `None` when the joints are not.
+    fn axis_limits(&self) -> Option<kerf_toolpath::AxisLimits> {
+        None
+    }
+
     /// The executor's view of the limits (model order).
     ///
     /// # Errors
