@@ -9,7 +9,7 @@
 use std::{fmt::Debug, marker::PhantomData, thread::JoinHandle, time::Duration};
 
 use kerf_msgs::{
-    msg::{self, CutPlan, MillPlan},
+    msg::{self, CutPlan, GcodePlan, MillPlan},
     std_msgs::StringMsg,
     trajectory_msgs::JointTrajectory,
     RosType,
@@ -68,6 +68,13 @@ pub fn mill() -> Planner<msg::MillRequest, MillPlan> {
     })
 }
 
+/// The G-code planner node (`kerf_gcode_planner`).
+pub fn gcode() -> Planner<msg::GcodeRequest, GcodePlan> {
+    Planner::new("/gcode_planner", "gcode", |a, e, s| {
+        kerf_gcode_planner::run(a, e, s).map_err(|e| e.to_string())
+    })
+}
+
 /// An answer message (`CutPlan`, `MillPlan`, …) as the tests read it: what the harness reads
 /// of it ([`PlanAnswer`]: request id, status, message, trajectory) and more.
 pub trait Answer: PlanAnswer + DeserializeOwned + Debug + PartialEq {
@@ -102,6 +109,11 @@ macro_rules! answer {
 answer!(CutPlan, "trajectory", |p| p.trajectory().points.is_empty());
 answer!(MillPlan, "plan", |p| p.trajectory().points.is_empty()
     && p.segments.is_empty());
+answer!(GcodePlan, "trajectory", |p| p
+    .trajectory()
+    .points
+    .is_empty()
+    && p.tool_events.is_empty());
 
 /// Checks an answer: its request id is `id`, its status `status` (compared by name), its
 /// message contains every needle, and a failure carries nothing planned.

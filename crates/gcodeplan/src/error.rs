@@ -22,6 +22,14 @@ pub enum GcodePlanError {
         /// The rule it breaks.
         reason: String,
     },
+    /// A field of a request is bad (not a number: a name, a file, a machine).
+    #[error("{field}: {reason}")]
+    InvalidRequest {
+        /// The field.
+        field: String,
+        /// What is wrong.
+        reason: String,
+    },
     /// The path of a run could not be smoothed or timed.
     #[error("line {line}: {error}")]
     Path {

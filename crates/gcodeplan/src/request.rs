@@ -48,9 +48,8 @@ impl MachineKind {
         match name {
             "" | "laser-cutter" | "laser_cutter" => Ok(MachineKind::LaserCutter),
             "irb6660" => Ok(MachineKind::Irb6660),
-            other => Err(GcodePlanError::InvalidSetting {
-                name: format!("machine '{other}'"),
-                value: f64::NAN,
+            other => Err(GcodePlanError::InvalidRequest {
+                field: format!("machine '{other}'"),
                 reason: "unknown; use laser-cutter or irb6660".to_string(),
             }),
         }
@@ -83,9 +82,8 @@ pub fn corner_method(name: &str) -> Result<kerf_toolpath::CornerMethod, GcodePla
         "icr" => Ok(CornerMethod::Icr),
         "ccr" => Ok(CornerMethod::Ccr),
         "nurbs" => Ok(CornerMethod::Nurbs(NurbsSettings::default())),
-        other => Err(GcodePlanError::InvalidSetting {
-            name: format!("method '{other}'"),
-            value: f64::NAN,
+        other => Err(GcodePlanError::InvalidRequest {
+            field: format!("method '{other}'"),
             reason: format!("unknown; use one of {}", METHODS.join(", ")),
         }),
     }
@@ -100,9 +98,8 @@ pub fn feed_method(name: &str) -> Result<kerf_toolpath::FeedMethod, GcodePlanErr
     match name {
         "" | "near-optimal" => Ok(FeedMethod::NearOptimal),
         "constant-intervals" => Ok(FeedMethod::ConstantIntervals),
-        other => Err(GcodePlanError::InvalidSetting {
-            name: format!("feed_method '{other}'"),
-            value: f64::NAN,
+        other => Err(GcodePlanError::InvalidRequest {
+            field: format!("feed_method '{other}'"),
             reason: format!("unknown; use one of {}", FEED_METHODS.join(", ")),
         }),
     }
@@ -189,9 +186,8 @@ impl GcodeRequest {
     /// [`GcodePlanError::InvalidSetting`] naming `request` with the parser's message.
     pub fn from_yaml_str(text: &str) -> Result<Self, GcodePlanError> {
         kerf_robot::document::from_yaml_or_json(text).map_err(|reason| {
-            GcodePlanError::InvalidSetting {
-                name: "request".to_string(),
-                value: f64::NAN,
+            GcodePlanError::InvalidRequest {
+                field: "request".to_string(),
                 reason,
             }
         })
@@ -211,9 +207,8 @@ impl GcodeRequest {
     /// [`GcodePlanError::InvalidSetting`] for both or neither given, an empty one, or a URI
     /// that does not resolve.
     pub fn source(&self) -> Result<ProgramSource, GcodePlanError> {
-        let bad = |reason: String| GcodePlanError::InvalidSetting {
-            name: "program".to_string(),
-            value: f64::NAN,
+        let bad = |reason: String| GcodePlanError::InvalidRequest {
+            field: "program".to_string(),
             reason,
         };
         match (&self.program, &self.program_file) {
@@ -342,9 +337,8 @@ impl MachineBase {
     /// # Errors
     /// [`GcodePlanError::InvalidSetting`] naming `machine` when its files cannot be loaded.
     pub fn load(kind: MachineKind) -> Result<Self, GcodePlanError> {
-        let bad = |reason: String| GcodePlanError::InvalidSetting {
-            name: "machine".to_string(),
-            value: f64::NAN,
+        let bad = |reason: String| GcodePlanError::InvalidRequest {
+            field: "machine".to_string(),
             reason,
         };
         match kind {
@@ -381,9 +375,8 @@ impl MachineBase {
     pub fn place(&self, request: &GcodeRequest) -> Result<Box<dyn crate::Machine>, GcodePlanError> {
         let asked = request.machine_kind()?;
         if asked != self.kind() {
-            return Err(GcodePlanError::InvalidSetting {
-                name: format!("machine '{}'", request.machine),
-                value: f64::NAN,
+            return Err(GcodePlanError::InvalidRequest {
+                field: format!("machine '{}'", request.machine),
                 reason: format!(
                     "this planner plans for {} (start one with machine {} for the other)",
                     self.kind().name(),
@@ -408,9 +401,8 @@ impl MachineBase {
                         let p =
                             cell.path()
                                 .point(0.0)
-                                .map_err(|e| GcodePlanError::InvalidSetting {
-                                    name: "machine".to_string(),
-                                    value: f64::NAN,
+                                .map_err(|e| GcodePlanError::InvalidRequest {
+                                    field: "machine".to_string(),
                                     reason: e.to_string(),
                                 })?;
                         [p.x, p.y, p.z]
@@ -443,9 +435,8 @@ pub fn plan_request(
             crate::plan_program(text.as_bytes(), machine.as_ref(), &settings, budget)
         }
         ProgramSource::File(path) => {
-            let file = std::fs::File::open(&path).map_err(|e| GcodePlanError::InvalidSetting {
-                name: format!("program_file {}", path.display()),
-                value: f64::NAN,
+            let file = std::fs::File::open(&path).map_err(|e| GcodePlanError::InvalidRequest {
+                field: format!("program_file {}", path.display()),
                 reason: e.to_string(),
             })?;
             crate::plan_program(

@@ -9,7 +9,7 @@ use kerf_msgs::msg;
 /// |---|---|
 /// | reader error, a path that cannot be smoothed, an empty program | PROGRAM_ERROR |
 /// | a point out of reach | UNREACHABLE |
-/// | a bad setting, too many points | INVALID_REQUEST |
+/// | a bad setting or field, too many points | INVALID_REQUEST |
 /// | the time budget ran out | TIMEOUT |
 /// | cancelled, not executable | INTERNAL_ERROR |
 pub fn status_of(e: &GcodePlanError) -> u8 {
@@ -18,9 +18,9 @@ pub fn status_of(e: &GcodePlanError) -> u8 {
             msg::GcodePlan::PROGRAM_ERROR
         }
         GcodePlanError::Unreachable { .. } => msg::GcodePlan::UNREACHABLE,
-        GcodePlanError::InvalidSetting { .. } | GcodePlanError::TooManyPoints { .. } => {
-            msg::GcodePlan::INVALID_REQUEST
-        }
+        GcodePlanError::InvalidSetting { .. }
+        | GcodePlanError::InvalidRequest { .. }
+        | GcodePlanError::TooManyPoints { .. } => msg::GcodePlan::INVALID_REQUEST,
         GcodePlanError::Interrupted(kerf_budget::Interrupt::TimedOut { .. }) => {
             msg::GcodePlan::TIMEOUT
         }
@@ -51,9 +51,8 @@ pub fn request_from_msg(m: &msg::GcodeRequest) -> Result<GcodeRequest, GcodePlan
     let program = (!m.program.is_empty()).then(|| m.program.clone());
     let program_file = (!m.program_uri.is_empty()).then(|| m.program_uri.clone());
     if program.is_some() == program_file.is_some() {
-        return Err(GcodePlanError::InvalidSetting {
-            name: "program / program_uri".to_string(),
-            value: f64::NAN,
+        return Err(GcodePlanError::InvalidRequest {
+            field: "program / program_uri".to_string(),
             reason: "exactly one must be non-empty".to_string(),
         });
     }

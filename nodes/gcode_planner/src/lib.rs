@@ -126,9 +126,8 @@ impl GcodeService {
         self.machine.place(&request).map_err(fail)?;
         if let ProgramSource::File(path) = request.source().map_err(fail)? {
             self.allowed_roots.check(&path).map_err(|reason| {
-                fail(GcodePlanError::InvalidSetting {
-                    name: format!("program_uri {}", path.display()),
-                    value: f64::NAN,
+                fail(GcodePlanError::InvalidRequest {
+                    field: format!("program_uri {}", path.display()),
                     reason,
                 })
             })?;

@@ -26,9 +26,8 @@ pub fn parse_request(text: &str) -> Result<GcodeRequest, TextRequestError> {
         return Err(TextRequestError {
             request_id: String::new(),
             planner: String::new(),
-            error: Box::new(GcodePlanError::InvalidSetting {
-                name: "request".to_string(),
-                value: f64::NAN,
+            error: Box::new(GcodePlanError::InvalidRequest {
+                field: "request".to_string(),
                 reason: "the text is empty; send a YAML GcodeRequest such as \
                          `{program: \"G1 X10 F600\"}`"
                     .to_string(),

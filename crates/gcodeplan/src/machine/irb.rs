@@ -40,17 +40,15 @@ impl MillingPlane {
     /// # Errors
     /// As [`MillCell::default_cell`] and [`MillingPlane::new`].
     pub fn default_plane(g: f64) -> Result<Self, GcodePlanError> {
-        let cell = MillCell::default_cell().map_err(|e| GcodePlanError::InvalidSetting {
-            name: "machine".to_string(),
-            value: f64::NAN,
+        let cell = MillCell::default_cell().map_err(|e| GcodePlanError::InvalidRequest {
+            field: "machine".to_string(),
             reason: e.to_string(),
         })?;
         let origin = cell
             .path()
             .point(0.0)
-            .map_err(|e| GcodePlanError::InvalidSetting {
-                name: "machine".to_string(),
-                value: f64::NAN,
+            .map_err(|e| GcodePlanError::InvalidRequest {
+                field: "machine".to_string(),
                 reason: e.to_string(),
             })?;
         Self::new(cell, [origin.x, origin.y, origin.z], g)

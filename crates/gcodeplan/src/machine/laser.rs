@@ -40,9 +40,8 @@ impl LaserSheet {
     /// As [`LaserMachine::default_machine`] and [`LaserSheet::new`].
     pub fn default_sheet() -> Result<Self, GcodePlanError> {
         let machine =
-            LaserMachine::default_machine().map_err(|e| GcodePlanError::InvalidSetting {
-                name: "machine".to_string(),
-                value: f64::NAN,
+            LaserMachine::default_machine().map_err(|e| GcodePlanError::InvalidRequest {
+                field: "machine".to_string(),
                 reason: e.to_string(),
             })?;
         Self::new(machine, DEFAULT_SHEET_ORIGIN, DEFAULT_STANDOFF_AXIS)

@@ -76,9 +76,8 @@ pub trait Machine: Sync {
     fn executor_limits(&self) -> Result<Vec<JointLimits>, GcodePlanError> {
         self.robot()
             .executor_limits()
-            .map_err(|e| GcodePlanError::InvalidSetting {
-                name: "machine".to_string(),
-                value: f64::NAN,
+            .map_err(|e| GcodePlanError::InvalidRequest {
+                field: "machine".to_string(),
                 reason: e.to_string(),
             })
     }
@@ -102,9 +101,8 @@ pub(crate) fn bounds_of(robot: &RobotModel) -> Result<[JointBounds; DOF], GcodeP
             ),
         });
     }
-    let missing = |name: &str, what: &str| GcodePlanError::InvalidSetting {
-        name: format!("{name} {what} limit"),
-        value: f64::NAN,
+    let missing = |name: &str, what: &str| GcodePlanError::InvalidRequest {
+        field: format!("{name} {what} limit"),
         reason: "the limits YAML must give it: the trajectory is checked against it".to_string(),
     };
     let mut out: Vec<JointBounds> = Vec::with_capacity(DOF);
