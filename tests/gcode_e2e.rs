@@ -23,7 +23,7 @@ use ros2_client::ServiceMapping;
 
 #[allow(dead_code)] // shared with the other end-to-end tests
 mod support;
-use support::{expect, planner::gcode, PlannerClient, QUICK};
+use support::{planner::gcode, PlannerClient, QUICK};
 
 /// Waiting for an answer that runs the planner on a busy machine.
 const PLANNING: Duration = Duration::from_secs(120);
