@@ -1,0 +1,194 @@
+//! The G-code planner on the shipped programs (issue 14 figures): per program and machine, the
+//! plan's time, T_m along the path, T_lb and T_m/T_lb, the largest joint slowdown, the executed
+//! deviation, the trajectory's points and the planning time (median of 3); the corner methods
+//! on two programs; and a dense synthetic program of `--lines N` G01 moves (default 100 000,
+//! [`Dense`]) planned whole, with its time and peak memory.
+//!
+//! `cargo bench -p kerf_gcodeplan --bench programs [-- --lines 1000000]`
+#![allow(clippy::unwrap_used, clippy::expect_used)]
+
+use std::io::Read;
+use std::time::Instant;
+
+use kerf_budget::Budget;
+use kerf_gcodeplan::{
+    plan_program, plan_request, GcodePlan, GcodeRequest, LaserSheet, MachineBase, MachineKind,
+    PlanSettings,
+};
+
+fn median_plan(request: &GcodeRequest, base: &MachineBase) -> (GcodePlan, f64) {
+    let mut times = Vec::new();
+    let mut plan = None;
+    for _ in 0..3 {
+        let t = Instant::now();
+        let p = plan_request(request, base, &Budget::unlimited()).unwrap();
+        times.push(t.elapsed().as_secs_f64());
+        plan = Some(p);
+    }
+    times.sort_by(f64::total_cmp);
+    (plan.unwrap(), times[1])
+}
+
+fn row(name: &str, machine: &str, plan: &GcodePlan, took: f64) {
+    let slowdown = plan.runs.iter().map(|r| r.slowdown).fold(1.0, f64::max);
+    println!(
+        "| {name} | {machine} | {} | {} | {} | {:.3} | {:.3} | {:.3} | {:.3} | {:.2} | {:.2} | {:.1} |",
+        plan.lines,
+        plan.runs.len(),
+        plan.trajectory.points.len(),
+        plan.duration,
+        plan.feed_time,
+        plan.lower_bound,
+        plan.lower_bound_ratio(),
+        slowdown,
+        plan.max_interpolation_deviation * 1e6,
+        took * 1e3
+    );
+}
+
+/// Peak resident set (kB), from /proc/self/status.
+fn peak_kib() -> Option<u64> {
+    let mut s = String::new();
+    std::fs::File::open("/proc/self/status")
+        .ok()?
+        .read_to_string(&mut s)
+        .ok()?;
+    s.lines()
+        .find(|l| l.starts_with("VmHWM:"))?
+        .split_whitespace()
+        .nth(1)?
+        .parse()
+        .ok()
+}
+
+/// A reader of a dense G01 program generated line by line, as CAM output of a wavy contour:
+/// `n` moves 0.1 mm apart along X on serpentine rows 1 m long (10 000 moves each) 5 mm
+/// apart, each row a 1 mm sine of 20 mm wavelength (every vertex a corner of 1.8° at most),
+/// F 3000 mm/min, beam on.
+struct Dense {
+    n: usize,
+    k: usize,
+    line: Vec<u8>,
+    at: usize,
+}
+
+/// Moves per row.
+const ROW: usize = 10_000;
+
+impl Dense {
+    /// The k-th point (mm).
+    fn point(k: usize) -> (f64, f64) {
+        let (row, i) = (k / (ROW + 1), k % (ROW + 1));
+        let along = 0.1 * i as f64;
+        let x = if row % 2 == 0 { along } else { 1000.0 - along };
+        let y = 5.0 * row as f64 + (std::f64::consts::TAU * x / 20.0).sin();
+        (x, y)
+    }
+}
+
+impl Read for Dense {
+    fn read(&mut self, out: &mut [u8]) -> std::io::Result<usize> {
+        if self.at == self.line.len() {
+            self.line.clear();
+            self.at = 0;
+            if self.k == 0 {
+                self.line
+                    .extend_from_slice(b"G21 G90 G17\nG0 X0 Y0\nM3\nF3000\n");
+            } else if self.k <= self.n {
+                let (x, y) = Self::point(self.k);
+                self.line
+                    .extend_from_slice(format!("G1 X{x:.4} Y{y:.4}\n").as_bytes());
+            } else if self.k == self.n + 1 {
+                self.line.extend_from_slice(b"M5\nM30\n");
+            } else {
+                return Ok(0);
+            }
+            self.k += 1;
+        }
+        let m = out.len().min(self.line.len() - self.at);
+        out[..m].copy_from_slice(&self.line[self.at..self.at + m]);
+        self.at += m;
+        Ok(m)
+    }
+}
+
+fn main() {
+    let args: Vec<String> = std::env::args().collect();
+    let lines = args
+        .iter()
+        .position(|a| a == "--lines")
+        .and_then(|i| args.get(i + 1))
+        .map_or(100_000, |v| v.parse().unwrap());
+    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../gcode/data/programs");
+    let mut names: Vec<_> = std::fs::read_dir(&dir)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|e| e == "ngc"))
+        .collect();
+    names.sort();
+    let laser = MachineBase::load(MachineKind::LaserCutter).unwrap();
+    let irb = MachineBase::load(MachineKind::Irb6660).unwrap();
+    println!("| program | machine | lines | runs | points | T [s] | T_m [s] | T_lb [s] | T_m/T_lb | slowdown | dev. [um] | plan [ms] |");
+    println!("|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|");
+    for path in &names {
+        let name = path.file_stem().unwrap().to_string_lossy().to_string();
+        for base in [&laser, &irb] {
+            let request = GcodeRequest {
+                request_id: name.clone(),
+                machine: base.kind().name().into(),
+                program_file: Some(path.display().to_string()),
+                ..GcodeRequest::default()
+            };
+            let (plan, took) = median_plan(&request, base);
+            row(&name, base.kind().name(), &plan, took);
+        }
+    }
+    println!();
+    println!("| program | method | T [s] | T_m [s] | T_lb [s] | kappa_max [1/m] | slowdown | plan [ms] |");
+    println!("|---|---|---:|---:|---:|---:|---:|---:|");
+    for name in ["dress", "w_shape"] {
+        for method in ["kerf", "icr", "ccr", "nurbs"] {
+            let request = GcodeRequest {
+                request_id: name.into(),
+                program_file: Some(dir.join(format!("{name}.ngc")).display().to_string()),
+                method: Some(method.into()),
+                ..GcodeRequest::default()
+            };
+            let (plan, took) = median_plan(&request, &laser);
+            let slowdown = plan.runs.iter().map(|r| r.slowdown).fold(1.0, f64::max);
+            println!(
+                "| {name} | {method} | {:.3} | {:.3} | {:.3} | {:.0} | {:.2} | {:.1} |",
+                plan.duration,
+                plan.feed_time,
+                plan.lower_bound,
+                plan.cut_metrics().max_curvature,
+                slowdown,
+                took * 1e3
+            );
+        }
+    }
+    println!();
+    let before = peak_kib();
+    let sheet = LaserSheet::default_sheet().unwrap();
+    let t = Instant::now();
+    let source = std::io::BufReader::new(Dense {
+        n: lines,
+        k: 0,
+        line: Vec::new(),
+        at: 0,
+    });
+    let settings = PlanSettings::laser_cutter().with_max_points(20_000_000);
+    let plan = plan_program(source, &sheet, &settings, &Budget::unlimited());
+    let took = t.elapsed().as_secs_f64();
+    match plan {
+        Ok(plan) => println!(
+            "dense program, {lines} G01 lines: planned in {took:.2} s; {} points, T {:.1} s, T_m/T_lb {:.3}; peak RSS {:?} -> {:?} kB",
+            plan.trajectory.points.len(),
+            plan.duration,
+            plan.lower_bound_ratio(),
+            before,
+            peak_kib()
+        ),
+        Err(e) => println!("dense program, {lines} G01 lines: failed after {took:.2} s: {e}"),
+    }
+}
