@@ -153,8 +153,15 @@ pub fn run(a: LaunchArgs) -> Result<(), String> {
                 .display()
                 .to_string(),
         ),
-        ("machine", gcode_machine(a.robot).to_string()),
     ];
+    let defaults: Vec<(&str, String)> = if a.with_planner {
+        // Only the G-code planner reads it: without it, no node of the launch would.
+        let mut d = defaults.to_vec();
+        d.push(("machine", gcode_machine(a.robot).to_string()));
+        d
+    } else {
+        defaults.to_vec()
+    };
     for (i, (name, value)) in defaults.into_iter().enumerate() {
         args.params.insert(
             i,

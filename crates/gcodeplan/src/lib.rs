@@ -19,8 +19,8 @@ pub use error::GcodePlanError;
 pub use machine::{JointBounds, LaserSheet, Machine, MillingPlane, DOF};
 pub use plan::{plan_program, GcodePlan, RunReport, ToolEvent};
 pub use request::{
-    corner_method, feed_method, plan_request, GcodeRequest, LimitOverrides, MachineBase,
-    MachineKind, ProgramSource, FEED_METHODS, METHODS,
+    corner_method, feed_method, plan_request, plan_request_within, GcodeRequest, LimitOverrides,
+    MachineBase, MachineKind, ProgramSource, FEED_METHODS, METHODS,
 };
 pub use runs::{read_steps, Reading, Run, RunKind, Step};
 pub use settings::PlanSettings;

@@ -428,7 +428,24 @@ pub fn plan_request(
     base: &MachineBase,
     budget: &kerf_budget::Budget,
 ) -> Result<crate::GcodePlan, GcodePlanError> {
-    let settings = request.settings()?;
+    plan_request_within(request, base, budget, None)
+}
+
+/// [`plan_request`] with at most `max_points` trajectory points (a node's answer size),
+/// refused with [`GcodePlanError::TooManyPoints`] as soon as the plan needs more.
+///
+/// # Errors
+/// As [`plan_request`].
+pub fn plan_request_within(
+    request: &GcodeRequest,
+    base: &MachineBase,
+    budget: &kerf_budget::Budget,
+    max_points: Option<usize>,
+) -> Result<crate::GcodePlan, GcodePlanError> {
+    let mut settings = request.settings()?;
+    if let Some(m) = max_points {
+        settings.max_points = settings.max_points.min(m);
+    }
     let machine = base.place(request)?;
     match request.source()? {
         ProgramSource::Text(text) => {

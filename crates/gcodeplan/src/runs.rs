@@ -124,6 +124,15 @@ pub fn read_steps<R: BufRead>(
     let mut open: Option<Open> = None;
     while let Some(motion) = program.next() {
         let motion = motion?;
+        if program.lines_read() > settings.max_lines {
+            return Err(GcodePlanError::InvalidRequest {
+                field: "program".to_string(),
+                reason: format!(
+                    "more than {} lines (the limit of this planner: split the program)",
+                    settings.max_lines
+                ),
+            });
+        }
         let control = program.interpreter().path_control();
         let (exact, corner_tolerance) = match control {
             PathControl::Exact => (true, settings.corner_tolerance()),

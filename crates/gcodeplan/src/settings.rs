@@ -45,6 +45,10 @@ pub struct PlanSettings {
     pub knot_spacing: f64,
     /// Most trajectory points.
     pub max_points: usize,
+    /// Most program lines read: a longer program is refused as soon as the line after the
+    /// last allowed is read (the planner keeps every run's path in memory, about 1.6 kB per
+    /// G01 line of a dense program; BENCHMARKS.md).
+    pub max_lines: usize,
     /// How the program is read.
     pub reader: ReaderSettings,
     /// How corners are smoothed (default kerf's quintic).
@@ -123,6 +127,7 @@ impl PlanSettings {
             control_period: 0.004,
             knot_spacing: 0.02,
             max_points: 2_000_000,
+            max_lines: 1_000_000,
             reader: ReaderSettings::default(),
             corner_method: CornerMethod::Kerf,
             feed_method: FeedMethod::NearOptimal,
@@ -163,6 +168,12 @@ impl PlanSettings {
     /// With the feed method.
     pub fn with_feed_method(mut self, method: FeedMethod) -> Self {
         self.feed_method = method;
+        self
+    }
+
+    /// With the most program lines read.
+    pub fn with_max_lines(mut self, lines: usize) -> Self {
+        self.max_lines = lines;
         self
     }
 
@@ -227,6 +238,13 @@ impl PlanSettings {
                 "max points",
                 self.max_points as f64,
                 "a trajectory needs at least two",
+            ));
+        }
+        if self.max_lines < 1 {
+            return Err(invalid(
+                "max lines",
+                self.max_lines as f64,
+                "a program needs at least one",
             ));
         }
         if self.knot_spacing < self.control_period {

@@ -145,6 +145,20 @@ fn too_many_points_is_refused_not_truncated() {
 }
 
 #[test]
+fn a_program_longer_than_the_line_limit_is_refused_while_reading() {
+    let settings = PlanSettings::laser_cutter().with_max_lines(3);
+    let e = laser_plan("G1 X1 F600\nG1 X2\nG1 X3\nG1 X4\nG1 X5\n", &settings).unwrap_err();
+    assert!(e.to_string().contains("more than 3 lines"), "{e}");
+    assert!(laser_plan("G1 X1 F600\nG1 X2\nG1 X3\n", &settings).is_ok());
+    let e = laser_plan(
+        "G1 X1 F600\n",
+        &PlanSettings::laser_cutter().with_max_lines(0),
+    )
+    .unwrap_err();
+    assert!(e.to_string().contains("max lines"), "{e}");
+}
+
+#[test]
 fn a_feed_above_the_machine_is_planned_at_its_maximum_and_said() {
     // 20 m/min asked; the laser cutter's default cuts at most 10 m/min.
     let plan = laser_plan("M3\nG1 X100 F20000\n", &PlanSettings::laser_cutter()).unwrap();

@@ -44,7 +44,9 @@ use std::time::Duration;
 
 use kerf_budget::Budget;
 use kerf_executor::JointLimits;
-use kerf_gcodeplan::{plan_request, GcodePlanError, GcodeRequest, MachineBase, ProgramSource};
+use kerf_gcodeplan::{
+    plan_request_within, GcodePlanError, GcodeRequest, MachineBase, ProgramSource,
+};
 use kerf_msgs::msg::{self, GcodePlan};
 use kerf_robot::roots::AllowedRoots;
 use kerf_ros::{
@@ -190,7 +192,8 @@ impl PlanningService for GcodeService {
     }
 
     /// Not known before planning (the points depend on the program's runs and the
-    /// tolerance): the answer is checked after planning.
+    /// tolerance): the plan itself stops at the answer's most points
+    /// ([`planner::max_answer_points`], TooManyPoints → INVALID_REQUEST).
     fn answer_size(&self, _: &GcodeRequest) -> Option<AnswerSize> {
         None
     }
@@ -200,7 +203,9 @@ impl PlanningService for GcodeService {
     }
 
     fn plan(&self, request: GcodeRequest, budget: &Budget) -> GcodePlan {
-        match plan_request(&request, &self.machine, budget) {
+        // At most what an answer carries: a longer plan is refused as soon as it is known.
+        let max_points = planner::max_answer_points(self.limits.len());
+        match plan_request_within(&request, &self.machine, budget, Some(max_points)) {
             Ok(plan) => match convert::plan_to_msg(&request, &plan) {
                 Ok(m) => m,
                 Err(reason) => convert::failure_msg(
