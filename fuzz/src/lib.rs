@@ -48,6 +48,8 @@ pub const TARGETS: &[(&str, Target)] = &[
     ("mill_msg", targets::mill_msg),
     ("trajectory_msg", targets::trajectory_msg),
     ("cdr", targets::cdr),
+    ("gcode_program", targets::gcode_program),
+    ("gcode_text", targets::gcode_text),
 ];
 
 /// The target called `name`.

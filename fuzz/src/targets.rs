@@ -458,3 +458,100 @@ pub fn cdr(data: &[u8]) {
         cdr_in::<BigEndian>(kind, body);
     }
 }
+
+// ---------------------------------------------------------------------------------------------
+// G-code (issue 14)
+// ---------------------------------------------------------------------------------------------
+
+/// `kerf_gcode::Program` over the text (what `kerf plan gcode` and the node stream): every
+/// motion read is finite, an arc's radius is positive and its end lies on its circle within
+/// the reader's tolerance, and reading stops at the first error.
+pub fn gcode_program(data: &[u8]) {
+    use kerf_gcode::{Motion, Program, ReaderSettings};
+    let text = text(data);
+    let settings = ReaderSettings::default();
+    let Ok(program) = Program::new(text.as_bytes(), settings) else {
+        panic!("the default reader settings are refused");
+    };
+    let finite = |p: &[f64; 3]| p.iter().all(|v| v.is_finite());
+    for m in program {
+        match m {
+            Ok(Motion::Rapid { start, end, .. }) => {
+                assert!(finite(&start) && finite(&end), "a rapid is not finite");
+            }
+            Ok(Motion::Line {
+                start, end, feed, ..
+            }) => {
+                assert!(finite(&start) && finite(&end), "a line is not finite");
+                assert!(feed.is_finite() && feed > 0.0, "a line's feed is {feed}");
+            }
+            Ok(Motion::Arc { arc, feed, .. }) => {
+                assert!(
+                    finite(&arc.start) && finite(&arc.end) && finite(&arc.center),
+                    "an arc is not finite"
+                );
+                assert!(
+                    arc.radius.is_finite() && arc.radius > 0.0,
+                    "arc radius {}",
+                    arc.radius
+                );
+                assert!(arc.sweep.is_finite(), "arc sweep {}", arc.sweep);
+                assert!(feed.is_finite() && feed > 0.0, "an arc's feed is {feed}");
+            }
+            Ok(Motion::Dwell { seconds, .. }) => {
+                assert!(seconds.is_finite() && seconds >= 0.0, "dwell {seconds}");
+            }
+            Ok(_) => {}
+            Err(e) => {
+                drop(e.to_string());
+                break;
+            }
+        }
+    }
+}
+
+/// The G-code planner node's text request (`kerf_gcode_planner::text::parse_request`) and,
+/// when it is accepted, its settings and the whole plan on the laser cutter under small limits
+/// (200 lines, 2 000 points): a value or an error, never a panic; a plan's trajectory is
+/// executable and its executed deviation within the interpolation tolerance.
+pub fn gcode_text(data: &[u8]) {
+    let text = text(data);
+    let Ok(req) = kerf_gcode_planner::text::parse_request(&text) else {
+        return;
+    };
+    let Ok(settings) = req.settings() else { return };
+    if req.machine_kind() != Ok(kerf_gcodeplan::MachineKind::LaserCutter) {
+        return;
+    }
+    let Ok(kerf_gcodeplan::ProgramSource::Text(program)) = req.source() else {
+        return;
+    };
+    let settings = settings.with_max_lines(200).with_max_points(2_000);
+    let Some(machine) = laser_sheet() else { return };
+    if let Ok(plan) = kerf_gcodeplan::plan_program(
+        program.as_bytes(),
+        machine,
+        &settings,
+        &kerf_budget::Budget::unlimited(),
+    ) {
+        assert!(
+            plan.max_interpolation_deviation <= settings.interpolation_tolerance(),
+            "executed deviation {} over {}",
+            plan.max_interpolation_deviation,
+            settings.interpolation_tolerance()
+        );
+        assert!(
+            plan.trajectory.points.len() <= 2_000,
+            "{} points",
+            plan.trajectory.points.len()
+        );
+    }
+}
+
+/// The shipped laser cutter over its default sheet, loaded once.
+fn laser_sheet() -> Option<&'static kerf_gcodeplan::LaserSheet> {
+    static SHEET: OnceLock<Option<kerf_gcodeplan::LaserSheet>> = OnceLock::new();
+    SHEET
+        .get_or_init(|| kerf_gcodeplan::LaserSheet::default_sheet().ok())
+        .as_ref()
+}

@@ -90,4 +90,6 @@ fuzz_tests! {
     mill_msg: 700,
     trajectory_msg: 50000,
     cdr: 3000,
+    gcode_program: 20000,
+    gcode_text: 300,
 }

@@ -571,43 +571,43 @@ fn executed_deviation(
 ) -> Result<(f64, Vec<(usize, f64)>), GcodePlanError> {
     let period = settings.control_period;
     let tolerance = settings.interpolation_tolerance();
-    let (t0, t1) = (prepared.start_time(), prepared.end_time());
-    let steps = ((t1 - t0) / period).ceil() as usize;
+    let t0 = prepared.start_time();
     let mut sample = JointSample::default();
     let mut worst: f64 = 0.0;
     let mut bad = Vec::new();
-    let mut run = 0usize;
-    for k in 0..=steps {
-        if k % 4096 == 0 {
-            budget.check("executor check")?;
-        }
-        let t = (k as f64 * period).min(t1 - t0);
-        prepared.sample_into(t0 + t, &mut sample);
-        while run + 1 < placed.len() && placed[run + 1].start <= t {
-            run += 1;
-        }
-        let p = &placed[run];
+    let mut count = 0usize;
+    // Each run's time window on the executor's clock (every control period in it, and its
+    // end); between runs the robot stands still (a dwell, or the shared rest point), exactly.
+    for (run, p) in placed.iter().enumerate() {
         let end = p.start + p.timed.duration() * p.knots.slowdown;
-        let local = ((t - p.start) / p.knots.slowdown).clamp(0.0, p.timed.duration());
-        // Beyond the run's end (a dwell), the tool stands at the run's end.
-        let planned = p
-            .timed
-            .motion(if t > end { p.timed.duration() } else { local })
-            .point;
-        let q: [f64; DOF] =
-            std::array::from_fn(|j| sample.positions.get(j).copied().unwrap_or(f64::NAN));
-        let tip = machine
-            .tip(&q)
-            .map_err(|reason| GcodePlanError::NotExecutable {
-                reason: format!("at {t:.4} s: {reason}"),
-            })?;
-        let d = (0..3)
-            .map(|i| (tip[i] - planned[i]).powi(2))
-            .sum::<f64>()
-            .sqrt();
-        worst = worst.max(d);
-        if d > tolerance {
-            bad.push((run, local));
+        let first = (p.start / period).ceil() as u64;
+        let last = (end / period).floor() as u64;
+        let times = (first..=last)
+            .map(|k| k as f64 * period)
+            .chain(std::iter::once(end));
+        for t in times {
+            count += 1;
+            if count.is_multiple_of(4096) {
+                budget.check("executor check")?;
+            }
+            prepared.sample_into(t0 + t, &mut sample);
+            let local = ((t - p.start) / p.knots.slowdown).clamp(0.0, p.timed.duration());
+            let planned = p.timed.motion(local).point;
+            let q: [f64; DOF] =
+                std::array::from_fn(|j| sample.positions.get(j).copied().unwrap_or(f64::NAN));
+            let tip = machine
+                .tip(&q)
+                .map_err(|reason| GcodePlanError::NotExecutable {
+                    reason: format!("at {t:.4} s: {reason}"),
+                })?;
+            let d = (0..3)
+                .map(|i| (tip[i] - planned[i]).powi(2))
+                .sum::<f64>()
+                .sqrt();
+            worst = worst.max(d);
+            if d > tolerance {
+                bad.push((run, local));
+            }
         }
     }
     Ok((worst, bad))

@@ -342,7 +342,18 @@ fn chords(
     } else {
         (2.0 * (1.0 - ratio).acos()).min(std::f64::consts::PI)
     };
-    let n = (arc.sweep.abs() / step).ceil().max(1.0) as usize;
+    let chords = (arc.sweep.abs() / step).ceil().max(1.0);
+    if chords.is_nan() || chords > settings.max_points as f64 {
+        return Err(GcodePlanError::InvalidRequest {
+            field: "program".to_string(),
+            reason: format!(
+                "line {line}: the arc of radius {:.6e} m needs {chords:.3e} chords within \
+                 {sagitta:.1e} m, more than the {} points allowed",
+                arc.radius, settings.max_points
+            ),
+        });
+    }
+    let n = chords as usize;
     let mut out = Vec::with_capacity(n);
     for k in 1..=n {
         out.push(if k == n {

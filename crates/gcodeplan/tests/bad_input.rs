@@ -159,6 +159,14 @@ fn a_program_longer_than_the_line_limit_is_refused_while_reading() {
 }
 
 #[test]
+fn an_arc_needing_more_chords_than_points_is_refused() {
+    let settings = PlanSettings::laser_cutter().with_max_points(100);
+    // A full circle of 100 m radius within 10 um needs 2 222 chords.
+    let e = laser_plan("G1 X1 F600\nG2 X1 Y0 I100000 J0\n", &settings).unwrap_err();
+    assert!(e.to_string().contains("line 2: the arc of radius"), "{e}");
+}
+
+#[test]
 fn a_feed_above_the_machine_is_planned_at_its_maximum_and_said() {
     // 20 m/min asked; the laser cutter's default cuts at most 10 m/min.
     let plan = laser_plan("M3\nG1 X100 F20000\n", &PlanSettings::laser_cutter()).unwrap();
