@@ -79,6 +79,33 @@ impl PlacedPhase {
     }
 }
 
+/// Constant-jerk phases placed end to end from rest at arc length `s0` (exact integration
+/// of each; phases of no duration are skipped).
+///
+/// # Returns
+/// The placed phases and their total time \[s\].
+pub(crate) fn place_phases(
+    phases: impl IntoIterator<Item = Phase>,
+    s0: f64,
+) -> (Vec<PlacedPhase>, f64) {
+    let mut placed = Vec::new();
+    let (mut t, mut s, mut v, mut acc) = (0.0, s0, 0.0, 0.0);
+    for ph in phases.into_iter().filter(|p| p.duration > 0.0) {
+        let p = PlacedPhase {
+            t0: t,
+            s0: s,
+            v0: v,
+            a0: acc,
+            phase: ph,
+        };
+        let (s1, v1, a1) = p.at(ph.duration);
+        placed.push(p);
+        t += ph.duration;
+        (s, v, acc) = (s1, v1, a1);
+    }
+    (placed, t)
+}
+
 /// One sample of a feed plan in time.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct FeedSample {
@@ -249,24 +276,7 @@ pub fn plan_feed(samples: &[PathSample], limits: &FeedLimits) -> Result<FeedPlan
             });
         }
     }
-    // Place the phases in time (exact integration).
-    let mut placed = Vec::with_capacity(phases.len());
-    let (mut t, mut s, mut v, mut acc) = (0.0, 0.0, 0.0, 0.0);
-    for ph in phases.into_iter().filter(|p| p.duration > 0.0) {
-        let p = PlacedPhase {
-            t0: t,
-            s0: s,
-            v0: v,
-            a0: acc,
-            phase: ph,
-        };
-        let (s1, v1, a1) = p.at(ph.duration);
-        placed.push(p);
-        t += ph.duration;
-        s = s1;
-        v = v1;
-        acc = a1;
-    }
+    let (placed, t) = place_phases(phases, 0.0);
     Ok(FeedPlan {
         phases: placed,
         time: t,

@@ -54,7 +54,7 @@
 //! 24 mm/s with A_t 0.8 m/s², J_t 20 m/s³).
 
 use crate::constraints::FeedConstraints;
-use crate::feed::{FeedPlan, PlacedPhase};
+use crate::feed::{place_phases, FeedPlan, PlacedPhase};
 use crate::limit_curve::{limit_curve, LimitCurve};
 use crate::samples::PathSample;
 use crate::scurve::{reachable_closed_form as reachable, scurve_distance, scurve_phases, Phase};
@@ -438,27 +438,11 @@ fn time_of_speed(ph: &PlacedPhase, v: f64) -> f64 {
 
 /// The plan: every gap's phases in order, placed by exact integration.
 fn place(knots: &[Knot], curve: &LimitCurve, a: f64, j: f64) -> FeedPlan {
-    let mut placed = Vec::new();
-    let (mut t, mut s, mut v, mut acc) = (0.0, curve.s[0], 0.0, 0.0);
-    for w in knots.windows(2) {
+    let phases = knots.windows(2).flat_map(|w| {
         let d = curve.s[w[1].node] - curve.s[w[0].node];
-        for ph in gap_phases(w[0].v, w[1].v, d, w[0].cap, a, j) {
-            if ph.duration <= 0.0 {
-                continue;
-            }
-            let p = PlacedPhase {
-                t0: t,
-                s0: s,
-                v0: v,
-                a0: acc,
-                phase: ph,
-            };
-            let (s1, v1, a1) = p.at(ph.duration);
-            placed.push(p);
-            t += ph.duration;
-            (s, v, acc) = (s1, v1, a1);
-        }
-    }
+        gap_phases(w[0].v, w[1].v, d, w[0].cap, a, j)
+    });
+    let (placed, t) = place_phases(phases, curve.s[0]);
     FeedPlan {
         phases: placed,
         time: t,

@@ -48,8 +48,7 @@
 //! The spacing ratios (equal steps on the line, |Q₃ − V| = d) are our
 //! choice: the seed does not give Xu and Sun's.
 
-use crate::corner::{Binding, CornerTransition};
-use crate::corner_curve::CornerCurve;
+use crate::corner::CornerTransition;
 use crate::error::ToolpathError;
 use crate::spline::CubicSpline;
 use crate::vec3::{add, norm, scale, sub};
@@ -99,24 +98,13 @@ pub fn transition(
     tolerance: f64,
     available: f64,
 ) -> Result<CornerTransition, ToolpathError> {
-    let half = (0.5 * turn).sin();
-    let by_tolerance = tolerance / (PEAK * half);
-    let by_length = available / 3.0;
-    let (d, binding) = if by_tolerance <= by_length {
-        (by_tolerance, Binding::Tolerance)
-    } else {
-        (by_length, Binding::Length)
-    };
-    let c = CornerCurve::Spline(curve(v, t1, t2, d)?);
-    Ok(CornerTransition {
-        curve: c,
-        vertex: v,
+    super::scaled_transition(
+        v,
         turn,
-        shape: None,
-        scale: d,
-        tangent_length: 3.0 * d,
-        deviation: PEAK * d * half,
-        max_curvature: c.max_curvature_on(0.0, 0.5, super::CURVATURE_SAMPLES),
-        binding,
-    })
+        tolerance,
+        available,
+        PEAK * (0.5 * turn).sin(),
+        3.0,
+        |d| curve(v, t1, t2, d),
+    )
 }

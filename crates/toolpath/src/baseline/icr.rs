@@ -40,8 +40,7 @@
 //! # Scale
 //! d = min(4δ / sin θ, available / 2) (the curve uses 2d of each segment).
 
-use crate::corner::{Binding, CornerTransition};
-use crate::corner_curve::CornerCurve;
+use crate::corner::CornerTransition;
 use crate::error::ToolpathError;
 use crate::spline::CubicSpline;
 use crate::vec3::{add, scale, sub};
@@ -82,23 +81,13 @@ pub fn transition(
     tolerance: f64,
     available: f64,
 ) -> Result<CornerTransition, ToolpathError> {
-    let by_tolerance = tolerance / (MID_WEIGHT * turn.sin());
-    let by_length = available / 2.0;
-    let (d, binding) = if by_tolerance <= by_length {
-        (by_tolerance, Binding::Tolerance)
-    } else {
-        (by_length, Binding::Length)
-    };
-    let c = CornerCurve::Spline(curve(v, t1, t2, d)?);
-    Ok(CornerTransition {
-        curve: c,
-        vertex: v,
+    super::scaled_transition(
+        v,
         turn,
-        shape: None,
-        scale: d,
-        tangent_length: 2.0 * d,
-        deviation: MID_WEIGHT * d * turn.sin(),
-        max_curvature: c.max_curvature_on(0.0, 0.5, super::CURVATURE_SAMPLES),
-        binding,
-    })
+        tolerance,
+        available,
+        MID_WEIGHT * turn.sin(),
+        2.0,
+        |d| curve(v, t1, t2, d),
+    )
 }

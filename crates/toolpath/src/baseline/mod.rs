@@ -19,8 +19,10 @@ pub mod pso;
 
 pub use nurbs::NurbsSettings;
 
-use crate::corner::{corner_frame, corner_transition, CornerTransition};
+use crate::corner::{corner_frame, corner_transition, Binding, CornerTransition};
+use crate::corner_curve::CornerCurve;
 use crate::error::ToolpathError;
+use crate::spline::CubicSpline;
 
 /// Curvature samples on the half curve for a baseline's largest curvature
 /// (then refined), as kerf's corner ([`crate::corner::CURVATURE_SAMPLES`]).
@@ -106,4 +108,44 @@ impl CornerMethod {
             }),
         }
     }
+}
+
+/// A symmetric spline corner whose spacing d scales both its deviation and its reach: d is
+/// the smaller of the tolerance's (`tolerance / deviation_per_d`) and the segments'
+/// (`available / reach_per_d`), and the transition is built from `curve(d)` (ICR and CCR).
+///
+/// # Arguments
+/// * `deviation_per_d` — the exact deviation from the polyline per unit of d.
+/// * `reach_per_d` — the distance from the vertex to the curve's ends per unit of d.
+///
+/// # Errors
+/// The curve's own ([`CubicSpline::new`]).
+pub(crate) fn scaled_transition(
+    v: [f64; 3],
+    turn: f64,
+    tolerance: f64,
+    available: f64,
+    deviation_per_d: f64,
+    reach_per_d: f64,
+    curve: impl Fn(f64) -> Result<CubicSpline, ToolpathError>,
+) -> Result<CornerTransition, ToolpathError> {
+    let by_tolerance = tolerance / deviation_per_d;
+    let by_length = available / reach_per_d;
+    let (d, binding) = if by_tolerance <= by_length {
+        (by_tolerance, Binding::Tolerance)
+    } else {
+        (by_length, Binding::Length)
+    };
+    let c = CornerCurve::Spline(curve(d)?);
+    Ok(CornerTransition {
+        curve: c,
+        vertex: v,
+        turn,
+        shape: None,
+        scale: d,
+        tangent_length: reach_per_d * d,
+        deviation: deviation_per_d * d,
+        max_curvature: c.max_curvature_on(0.0, 0.5, CURVATURE_SAMPLES),
+        binding,
+    })
 }
