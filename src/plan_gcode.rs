@@ -161,9 +161,11 @@ fn summary(plan: &GcodePlan, took: f64) -> String {
     );
     let _ = writeln!(
         s,
-        "time {:.3} s: along the path T_m {:.3} s, T_lb {:.3} s, T_m/T_lb {:.3}; dwell {:.3} s",
+        "time {:.3} s: feed plan as run {:.3} s; under the path limits T_m {:.3} s, T_lb {:.3} s, \
+         T_m/T_lb {:.3}; dwell {:.3} s",
         plan.duration,
         plan.feed_time,
+        plan.path_time,
         plan.lower_bound,
         plan.lower_bound_ratio(),
         plan.dwell_time
@@ -189,7 +191,15 @@ fn summary(plan: &GcodePlan, took: f64) -> String {
     let _ = writeln!(
         s,
         "{:>4} {:>7} {:>13} {:>8} {:>10} {:>9} {:>9} {:>9} {:>8}  binding",
-        "run", "kind", "lines", "corners", "length [m]", "F [m/s]", "T_m [s]", "T_lb [s]", "slowed"
+        "run",
+        "kind",
+        "lines",
+        "corners",
+        "length [m]",
+        "F [m/s]",
+        "T_run [s]",
+        "T_lb [s]",
+        "slowed"
     );
     for (k, r) in plan.runs.iter().enumerate() {
         let _ = writeln!(

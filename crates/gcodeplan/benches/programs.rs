@@ -32,12 +32,13 @@ fn median_plan(request: &GcodeRequest, base: &MachineBase) -> (GcodePlan, f64) {
 fn row(name: &str, machine: &str, plan: &GcodePlan, took: f64) {
     let slowdown = plan.runs.iter().map(|r| r.slowdown).fold(1.0, f64::max);
     println!(
-        "| {name} | {machine} | {} | {} | {} | {:.3} | {:.3} | {:.3} | {:.3} | {:.2} | {:.2} | {:.1} |",
+        "| {name} | {machine} | {} | {} | {} | {:.3} | {:.3} | {:.3} | {:.3} | {:.3} | {:.2} | {:.2} | {:.1} |",
         plan.lines,
         plan.runs.len(),
         plan.trajectory.points.len(),
         plan.duration,
         plan.feed_time,
+        plan.path_time,
         plan.lower_bound,
         plan.lower_bound_ratio(),
         slowdown,
@@ -128,8 +129,8 @@ fn main() {
     names.sort();
     let laser = MachineBase::load(MachineKind::LaserCutter).unwrap();
     let irb = MachineBase::load(MachineKind::Irb6660).unwrap();
-    println!("| program | machine | lines | runs | points | T [s] | T_m [s] | T_lb [s] | T_m/T_lb | slowdown | dev. [um] | plan [ms] |");
-    println!("|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|");
+    println!("| program | machine | lines | runs | points | T [s] | T_run [s] | T_m [s] | T_lb [s] | T_m/T_lb | slowdown | dev. [um] | plan [ms] |");
+    println!("|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|");
     for path in &names {
         let name = path.file_stem().unwrap().to_string_lossy().to_string();
         for base in [&laser, &irb] {
@@ -144,7 +145,7 @@ fn main() {
         }
     }
     println!();
-    println!("| program | method | T [s] | T_m [s] | T_lb [s] | kappa_max [1/m] | slowdown | plan [ms] |");
+    println!("| program | method | T [s] | T_run [s] | T_lb [s] | kappa_max [1/m] | slowdown | plan [ms] |");
     println!("|---|---|---:|---:|---:|---:|---:|---:|");
     for name in ["dress", "w_shape"] {
         for method in ["kerf", "icr", "ccr", "nurbs"] {

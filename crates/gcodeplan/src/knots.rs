@@ -79,6 +79,8 @@ pub struct RunKnots {
     pub slowdown: f64,
     /// The binding limit before the slowdown.
     pub peak: Peak,
+    /// The pieces beyond a limit before the slowdown: (start, end) local times and their r.
+    pub over: Vec<(f64, f64, f64)>,
 }
 
 impl RunKnots {
@@ -329,10 +331,13 @@ pub fn run_knots(
         what: "velocity",
     };
     let mut ratio: f64 = 0.0;
+    let mut over = Vec::new();
     for w in knots.windows(2) {
         let peaks = piece_peaks(machine, &w[0], &w[1]);
+        let mut piece: f64 = 0.0;
         for (j, p) in peaks.iter().enumerate() {
             let scaled = [p[0], p[1].sqrt(), p[2].cbrt()];
+            piece = piece.max(scaled[0]).max(scaled[1]).max(scaled[2]);
             for (k, what) in ["velocity", "acceleration", "jerk"].into_iter().enumerate() {
                 if scaled[k] > ratio {
                     ratio = scaled[k];
@@ -343,6 +348,9 @@ pub fn run_knots(
                     };
                 }
             }
+        }
+        if piece > 1.0 {
+            over.push((w[0].t, w[1].t, piece));
         }
     }
     if !(ratio.is_finite() && ratio <= MAX_SLOWDOWN) {
@@ -364,5 +372,6 @@ pub fn run_knots(
         knots,
         slowdown,
         peak,
+        over,
     })
 }

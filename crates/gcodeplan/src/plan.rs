@@ -58,8 +58,10 @@ pub struct RunReport {
     pub corner_tolerance: f64,
     /// The largest corner deviation from its polyline (exact) \[m\].
     pub max_corner_deviation: f64,
-    /// Time of its feed plan \[s\].
+    /// Time of its feed plan as run (lowered in corners for the joints) \[s\].
     pub feed_time: f64,
+    /// Time of its feed plan under the path's limits alone \[s\] (T_m for T_m / T_lb).
+    pub path_time: f64,
     /// T_lb on the same path \[s\].
     pub lower_bound: f64,
     /// Uniform slowdown for the joint limits (1: none).
@@ -97,9 +99,11 @@ pub struct GcodePlan {
     pub events: Vec<ToolEvent>,
     /// The trajectory's duration \[s\].
     pub duration: f64,
-    /// Σ feed-plan times of the runs: the machining time T_m before any
-    /// joint slowdown \[s\].
+    /// Σ feed-plan times of the runs as run (lowered in corners for the joints), before any
+    /// uniform slowdown \[s\].
     pub feed_time: f64,
+    /// Σ feed-plan times under the path's limits alone: T_m of T_m / T_lb \[s\].
+    pub path_time: f64,
     /// Σ T_lb \[s\].
     pub lower_bound: f64,
     /// Σ dwell times \[s\].
@@ -130,9 +134,10 @@ pub struct GcodePlan {
 }
 
 impl GcodePlan {
-    /// T_m / T_lb of the feed plans.
+    /// T_m / T_lb: the feed plans under the path's limits against the bound on the same
+    /// paths and limits.
     pub fn lower_bound_ratio(&self) -> f64 {
-        self.feed_time / self.lower_bound
+        self.path_time / self.lower_bound
     }
 
     /// Metrics over every cutting run: times summed, maxima of the maxima,
@@ -217,22 +222,32 @@ pub fn plan_program<R: BufRead>(
             }),
             Step::Run(run) => {
                 reachable(machine, run, reference.as_ref())?;
-                let prepared = prepare_run(run, machine, settings, &mut warnings)?;
+                let mut prepared = prepare_run(run, machine, settings, &mut warnings)?;
                 let line = run.lines[0];
-                let knots = run_knots(
+                let knots = run_joints(
                     machine,
-                    &prepared.timed,
+                    &mut prepared,
                     line,
                     reference.as_ref(),
-                    settings.knot_spacing,
-                    settings.control_period,
-                    settings.interpolation_tolerance(),
+                    settings,
                     settings.max_points.saturating_sub(points),
                     budget,
                 )?;
                 let Prepared {
-                    timed, mut report, ..
+                    timed,
+                    mut report,
+                    limits,
+                    ..
                 } = prepared;
+                // The plan the joints follow (lowered in corners where they needed it).
+                report.feed_time = timed.plan.time;
+                report.metrics = metrics(
+                    &timed.plan,
+                    &timed.path,
+                    &timed.samples,
+                    limits.curvature.interpolation_period,
+                    limits.curvature.servo.as_ref(),
+                );
                 points += knots.knots.len();
                 if knots.slowdown > 1.0 {
                     warnings.push(format!(
@@ -311,6 +326,7 @@ pub fn plan_program<R: BufRead>(
         machine: machine.name().to_string(),
         trajectory,
         feed_time: reports.iter().map(|r| r.feed_time).sum(),
+        path_time: reports.iter().map(|r| r.path_time).sum(),
         lower_bound: reports.iter().map(|r| r.lower_bound).sum(),
         max_corner_deviation: reports
             .iter()
@@ -358,6 +374,8 @@ fn reachable(
 /// A run smoothed, sampled and timed, with its report so far.
 struct Prepared {
     timed: TimedRun,
+    caps: Vec<f64>,
+    limits: FeedLimits,
     report: RunReport,
 }
 
@@ -409,6 +427,7 @@ fn prepare_run(
         corner_tolerance: run.corner_tolerance,
         max_corner_deviation: path.max_deviation(),
         feed_time: plan.time,
+        path_time: plan.time,
         lower_bound: lower.time,
         slowdown: 1.0,
         peak: Peak {
@@ -431,6 +450,8 @@ fn prepare_run(
             samples,
             plan,
         },
+        caps,
+        limits,
         report,
     })
 }
@@ -455,6 +476,110 @@ fn feed_plan(
         caps: varies.then_some(caps),
     };
     settings.feed_method.plan(samples, &constraints)
+}
+
+/// Rounds of local slowdown in corners (step 3) before what remains is a uniform slowdown.
+pub const LOCAL_ROUNDS: usize = 4;
+
+/// Step 3 for one run: its joint points. Where a piece needs r > 1 for a joint limit, the
+/// corner samples of its arc-length span are capped at the piece's highest planned speed /
+/// (1.02 r) and the feed is replanned (the v³ dκ/ds term that binds in corners scales as the
+/// cube of the speed: r is already its cube root), at most [`LOCAL_ROUNDS`] times; what
+/// remains is the uniform slowdown of [`crate::knots`]. Only corner samples are capped: a line
+/// is sampled at its ends, and a cap at a line's end would hold the whole line. The round
+/// with the least executed time (plan time × its uniform slowdown) is kept: capping can also
+/// cost time (more S-curves), so the uniform slowdown of round 0 stays when it is better.
+fn run_joints(
+    machine: &dyn Machine,
+    prepared: &mut Prepared,
+    line: usize,
+    reference: Option<&[f64; DOF]>,
+    settings: &PlanSettings,
+    max_points: usize,
+    budget: &Budget,
+) -> Result<RunKnots, GcodePlanError> {
+    let knots_of = |timed: &TimedRun| {
+        run_knots(
+            machine,
+            timed,
+            line,
+            reference,
+            settings.knot_spacing,
+            settings.control_period,
+            settings.interpolation_tolerance(),
+            max_points,
+            budget,
+        )
+    };
+    let feed = prepared.report.feed;
+    let mut caps = prepared.caps.clone();
+    let first = knots_of(&prepared.timed)?;
+    let mut over = first.over.clone();
+    // The round whose executed time (plan time × its uniform slowdown) is the least.
+    let mut best = (
+        prepared.timed.duration() * first.slowdown,
+        prepared.timed.plan.clone(),
+        first,
+    );
+    for _ in 0..LOCAL_ROUNDS {
+        if over.is_empty() || !lower_corner_caps(&prepared.timed, &over, &mut caps) {
+            break;
+        }
+        budget.check("local slowdown")?;
+        prepared.timed.plan = feed_plan(
+            &prepared.timed.samples,
+            &caps,
+            feed,
+            &prepared.limits,
+            machine,
+            settings,
+        )
+        .map_err(|error| GcodePlanError::Path { line, error })?;
+        let knots = knots_of(&prepared.timed)?;
+        over = knots.over.clone();
+        let executed = prepared.timed.duration() * knots.slowdown;
+        if executed < best.0 {
+            best = (executed, prepared.timed.plan.clone(), knots);
+        }
+    }
+    let (_, plan, knots) = best;
+    prepared.timed.plan = plan;
+    Ok(knots)
+}
+
+/// Caps the corner samples of each over-limit piece's arc-length span at the piece's highest
+/// planned speed / (1.02 r) ([`run_joints`]); whether any cap was lowered.
+fn lower_corner_caps(timed: &TimedRun, over: &[(f64, f64, f64)], caps: &mut [f64]) -> bool {
+    let samples = &timed.samples;
+    let in_corner = |k: usize| {
+        matches!(
+            timed.path.pieces.get(samples[k].piece),
+            Some(Piece::Corner(_))
+        ) && samples
+            .get(k + 1)
+            .is_none_or(|n| n.piece == samples[k].piece)
+    };
+    let mut lowered = false;
+    for &(t0, t1, r) in over {
+        let (s0, _, _) = timed.state(t0);
+        let (s1, _, _) = timed.state(t1);
+        let vmax = (0..=8)
+            .map(|i| timed.state(t0 + (t1 - t0) * f64::from(i) / 8.0).1)
+            .fold(0.0, f64::max);
+        let cap = vmax / (1.02 * r);
+        if cap <= 0.0 {
+            continue;
+        }
+        let lo = samples.partition_point(|p| p.s < s0).saturating_sub(1);
+        let hi = samples.partition_point(|p| p.s <= s1).min(caps.len() - 1);
+        for (k, c) in caps.iter_mut().enumerate().take(hi + 1).skip(lo) {
+            if in_corner(k) && *c > cap {
+                *c = cap;
+                lowered = true;
+            }
+        }
+    }
+    lowered
 }
 
 /// The programmed feed of every sample: a line piece's is the lowest feed of the polyline

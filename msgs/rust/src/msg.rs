@@ -578,11 +578,11 @@ pub struct GcodePlan {
     pub error_line: u32,
     /// The trajectory's duration (s).
     pub machining_time: f64,
-    /// The feed plans' time T_m (s).
+    /// The feed plans' time as run (s).
     pub feed_time: f64,
     /// T_lb (s).
     pub lower_bound_time: f64,
-    /// T_m / T_lb.
+    /// T_m (the feed plans under the path's limits) / T_lb.
     pub lower_bound_ratio: f64,
     /// Total dwell time (s).
     pub dwell_time: f64,

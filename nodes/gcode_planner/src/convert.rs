@@ -130,14 +130,14 @@ pub fn error_to_msg(request: &GcodeRequest, machine: &str, e: &GcodePlanError) -
 pub fn success_message(plan: &GcodePlan) -> String {
     let cuts = plan.runs.iter().filter(|r| r.kind == RunKind::Cut).count();
     let mut text = format!(
-        "{} lines, {} runs ({cuts} cutting), {} points: {:.3} s ({:.3} s along the path, \
-         T_lb {:.3} s, ratio {:.3}), corners within {:.1} um, executed tip within {:.2} um of \
-         the plan (tolerance {:.1} um)",
+        "{} lines, {} runs ({cuts} cutting), {} points: {:.3} s (under the path limits \
+         {:.3} s, T_lb {:.3} s, ratio {:.3}), corners within {:.1} um, executed tip within \
+         {:.2} um of the plan (tolerance {:.1} um)",
         plan.lines,
         plan.runs.len(),
         plan.trajectory.points.len(),
         plan.duration,
-        plan.feed_time,
+        plan.path_time,
         plan.lower_bound,
         plan.lower_bound_ratio(),
         plan.max_corner_deviation * 1e6,
