@@ -244,3 +244,32 @@ fn a_cancelled_or_expired_budget_stops_the_plan() {
     .unwrap_err();
     assert!(e.to_string().contains("time budget"), "{e}");
 }
+
+#[test]
+fn an_unknown_machine_or_method_is_named() {
+    use kerf_gcodeplan::{GcodeRequest, MachineKind};
+    let request = GcodeRequest {
+        machine: "drill".into(),
+        program: Some("G1 X1 F100".into()),
+        ..GcodeRequest::default()
+    };
+    let e = request.settings().unwrap_err();
+    assert!(e.to_string().contains("machine 'drill'"), "{e}");
+    assert!(e.to_string().contains("laser-cutter or irb6660"), "{e}");
+    assert!(MachineKind::parse("irb6660").is_ok());
+    let request = GcodeRequest {
+        feed_method: Some("fast".into()),
+        program: Some("G1 X1 F100".into()),
+        ..GcodeRequest::default()
+    };
+    let e = request.settings().unwrap_err();
+    assert!(e.to_string().contains("feed_method 'fast'"), "{e}");
+    // A field of the other machine is refused, not ignored.
+    let request = GcodeRequest {
+        redundancy_angle: Some(0.3),
+        program: Some("G1 X1 F100".into()),
+        ..GcodeRequest::default()
+    };
+    let e = request.settings().unwrap_err();
+    assert!(e.to_string().contains("other machine"), "{e}");
+}
