@@ -4,9 +4,9 @@
 //!   trajectory goes planner → executor (trajectory topic remapped) → `/joint_states`, which
 //!   follow the plan to its last point, at rest, with SUCCEEDED. The node's answer equals the
 //!   library's plan of the same program.
-//! * Bad requests — an unsupported code, a point out of the stroke, a NaN tolerance, both a
-//!   program and a file, a request for the other machine, a method that does not exist, a
-//!   YAML error, an empty text — each get one `GcodePlan` with the right status, a message
+//! * Bad requests — an unsupported code, a point out of the stroke, a NaN or zero tolerance, a
+//!   negative limit, both a program and a file, a request for the other machine or an unknown
+//!   one, a method that does not exist, a YAML error, an empty text — each get one `GcodePlan` with the right status, a message
 //!   naming the cause (and `error_line` for program lines), in arrival order; no trajectory is
 //!   published for them and the node keeps serving.
 //! * The IRB 6660 node plans a program from a file URI (`package://kerf/...`).
@@ -108,7 +108,7 @@ fn a_program_runs_from_planner_through_executor_and_bad_ones_are_answered() {
     support::assert_rests_at(&states, &last, 1e-6, "square");
 
     // Bad requests, one answer each, in order; nothing published.
-    let bad: [(&str, String, u8, &[&str]); 6] = [
+    let bad: [(&str, String, u8, &[&str]); 9] = [
         (
             "g93",
             text_request("g93", "G21\nG1 X1 F100\nG93 X2\n"),
@@ -138,6 +138,25 @@ fn a_program_runs_from_planner_through_executor_and_bad_ones_are_answered() {
             "request_id: method\nmethod: spline\nprogram: \"G1 X1 F100\"\n".into(),
             GcodePlan::INVALID_REQUEST,
             &["method 'spline'", "kerf, icr, ccr, nurbs"],
+        ),
+        (
+            "drill",
+            "request_id: drill\nmachine: drill\nprogram: \"G1 X1 F100\"\n".into(),
+            GcodePlan::INVALID_REQUEST,
+            &["machine 'drill'", "laser-cutter or irb6660"],
+        ),
+        (
+            "zero-tolerance",
+            "request_id: zero-tolerance\ntolerance: 0.0\nprogram: \"G1 X1 F100\"\n".into(),
+            GcodePlan::INVALID_REQUEST,
+            &["tolerance", "must be finite and > 0"],
+        ),
+        (
+            "negative-jerk",
+            "request_id: negative-jerk\nlimits: {tangential_jerk: -1.0}\nprogram: \"G1 X1 F100\"\n"
+                .into(),
+            GcodePlan::INVALID_REQUEST,
+            &["tangential jerk"],
         ),
         (
             "yaml",
