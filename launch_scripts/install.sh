@@ -12,6 +12,7 @@
 #   crates/mjto/cases/                      the laser-cutting cases of seed 001
 #   crates/millplan/policies/               the milling planner's shipped policies
 #   crates/millplan/data/indicator_cache.bin  the indicator cache of the default cell
+#   crates/gcode/data/programs/             the shipped G-code programs (package://kerf/...)
 #   launch_scripts/params/                  the example parameter files
 # An existing PREFIX/share/kerf is replaced.
 set -euo pipefail
@@ -47,6 +48,7 @@ if [ "$mode" != --binary-only ]; then
     crates/mjto/cases
     crates/millplan/policies
     crates/millplan/data/indicator_cache.bin
+    crates/gcode/data/programs
     launch_scripts/params
   )
   for rel in "${data[@]}"; do

@@ -9,8 +9,9 @@ ament packages, so they are started with ExecuteProcess and the usual --ros-args
 Arguments:
     robot       laser_cutter | irb6660 (selects urdf/<robot>.urdf and its limits YAML);
                 laser_cutter also starts the MJTO planner (mjto_planner), irb6660 the
-                milling planner (milling_planner), its ~/joint_trajectory remapped to the
-                executor's input
+                milling planner (milling_planner); both start the G-code planner
+                (gcode_planner, machine:= the robot); each planner's ~/joint_trajectory is
+                remapped to the executor's input
     namespace   node namespace (default /)
     params_file executor parameters (default launch_scripts/params/<robot>.yaml)
     kerf_root   the kerf source tree (default: the parent of this file's directory)
@@ -95,6 +96,24 @@ def _nodes(context):
                 ],
             )
         )
+    # The G-code planner (issue 14) for the robot; its trajectories go straight to the executor.
+    gcode_binary = os.path.join(root, "target", profile, "gcode_planner")
+    if not os.path.exists(gcode_binary):
+        raise RuntimeError(f"{gcode_binary} not found: run 'cargo build --{profile} --workspace' in {root}")
+    ns = namespace.rstrip("/")
+    nodes.append(
+        ExecuteProcess(
+            name="gcode_planner",
+            output="screen",
+            cmd=[
+                gcode_binary,
+                "--ros-args",
+                "-r", f"__ns:={namespace}",
+                "-r", f"~/joint_trajectory:={ns}/trajectory_executor/joint_trajectory",
+                "-p", f"machine:={'laser-cutter' if robot == 'laser_cutter' else 'irb6660'}",
+            ],
+        )
+    )
     return nodes
 
 

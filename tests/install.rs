@@ -104,6 +104,7 @@ fn an_installed_kerf_plans_case_1_and_draws_lobes_from_another_directory() {
         "crates/millplan/policies/ddpg.json",
         "crates/millplan/policies/fixed_g.safetensors",
         "crates/millplan/data/indicator_cache.bin",
+        "crates/gcode/data/programs/w_shape.ngc",
         "launch_scripts/params/irb6660.yaml",
     ] {
         assert!(share.join(rel).is_file(), "{rel} not installed");
