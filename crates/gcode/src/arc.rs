@@ -80,7 +80,10 @@ pub(crate) fn build_arc(
                     r.abs()
                 ));
             }
-            let h = (r * r - half * half).max(0.0).sqrt();
+            // h = √(r² − (d/2)²), as |r| √((1 − q)(1 + q)) with q = (d/2)/|r|: r² overflows
+            // for |R| above 1e154 m (found by fuzzing: R with 166 digits).
+            let q = (half / r.abs()).min(1.0);
+            let h = r.abs() * ((1.0 - q) * (1.0 + q)).max(0.0).sqrt();
             // Left normal of the chord; the short arc's centre lies left of
             // the chord for G3 and right for G2, the long arc's (R < 0) on
             // the other side.

@@ -387,3 +387,16 @@ fn random_text_never_panics() {
     }
     assert!(errors > 0);
 }
+
+#[test]
+fn a_huge_radius_gives_a_finite_arc() {
+    // R of 166 digits (inches): r² overflows; the centre must still be finite.
+    let text = format!("G20 G91\nG1 X1 Y1 F10\nG2 X1 Y1 R1{}\n", "8".repeat(165));
+    let motions = read_program(&text, ReaderSettings::default()).unwrap();
+    let Motion::Arc { arc, .. } = motions[1] else {
+        panic!("{:?}", motions[1])
+    };
+    assert!(arc.center.iter().all(|v| v.is_finite()), "{:?}", arc.center);
+    assert!(arc.radius.is_finite() && arc.radius > 1e160);
+    assert!(arc.sweep.is_finite() && arc.sweep < 0.0);
+}
