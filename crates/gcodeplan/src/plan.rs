@@ -25,8 +25,8 @@ use kerf_executor::{
     check_executable, ExecutorConfig, JointSample, TrajectoryPoint, TrajectoryRequest,
 };
 use kerf_toolpath::{
-    bang_bang_under, metrics, sample_path, smooth_polyline_with, FeedConstraints, FeedLimits,
-    Metrics, PathSample, Piece, SmoothedPath,
+    bang_bang_under, check_plan, metrics, sample_path, smooth_polyline_with, FeedConstraints,
+    FeedLimits, Metrics, PathSample, Piece, SmoothedPath,
 };
 
 use crate::error::GcodePlanError;
@@ -407,8 +407,37 @@ fn prepare_run(
     limits.curvature.feed = feed;
     let path = smooth_polyline_with(&run.points, run.corner_tolerance, &settings.corner_method)
         .map_err(path_error)?;
-    let samples = sample_path(&path, settings.sample_step);
-    let caps = sample_caps(&path, &samples, &run.points, &feeds);
+    // The feed plan, checked on its output at the interpolation period against every limit
+    // (kerf_toolpath::check_plan); where it breaks one between its samples, the path is
+    // sampled 4x finer and planned again, at most SAMPLE_REFINEMENTS times.
+    let mut step = settings.sample_step;
+    let mut attempt = 0;
+    let (samples, caps, plan) = loop {
+        let samples = sample_path(&path, step);
+        let caps = sample_caps(&path, &samples, &run.points, &feeds);
+        let plan =
+            feed_plan(&samples, &caps, feed, &limits, machine, settings).map_err(path_error)?;
+        match plan_violation(
+            &path, &samples, &caps, feed, &limits, &plan, machine, settings,
+        )
+        .map_err(path_error)?
+        {
+            None => break (samples, caps, plan),
+            Some((what, ratio, time)) if attempt == SAMPLE_REFINEMENTS => {
+                return Err(GcodePlanError::NotExecutable {
+                    reason: format!(
+                        "lines {line}-{last_line}: the feed plan breaks the {what} limit \
+                         ({ratio:.4} of it at {time:.3} s into the run) even with samples \
+                         {step:.1e} m apart"
+                    ),
+                });
+            }
+            Some(_) => {
+                step *= 0.25;
+                attempt += 1;
+            }
+        }
+    };
     let curve: Vec<f64> = samples
         .iter()
         .zip(&caps)
@@ -416,7 +445,6 @@ fn prepare_run(
         .collect();
     let lower =
         bang_bang_under(&samples, curve, limits.tangential_acceleration).map_err(path_error)?;
-    let plan = feed_plan(&samples, &caps, feed, &limits, machine, settings).map_err(path_error)?;
     let report = RunReport {
         kind: run.kind,
         lines: (line, last_line),
@@ -465,8 +493,22 @@ fn feed_plan(
     machine: &dyn Machine,
     settings: &PlanSettings,
 ) -> Result<kerf_toolpath::FeedPlan, kerf_toolpath::ToolpathError> {
+    settings
+        .feed_method
+        .plan(samples, &constraints(caps, feed, limits, machine, settings))
+}
+
+/// The constraints of a run's feed plan: its limits, the per-sample feeds when they vary, and
+/// the machine's axis limits when the settings ask for them.
+fn constraints<'a>(
+    caps: &'a [f64],
+    feed: f64,
+    limits: &FeedLimits,
+    machine: &dyn Machine,
+    settings: &PlanSettings,
+) -> FeedConstraints<'a> {
     let varies = caps.iter().any(|c| *c != feed);
-    let constraints = FeedConstraints {
+    FeedConstraints {
         limits: *limits,
         axes: if settings.feed_axis_limits {
             machine.axis_limits()
@@ -474,8 +516,43 @@ fn feed_plan(
             None
         },
         caps: varies.then_some(caps),
-    };
-    settings.feed_method.plan(samples, &constraints)
+    }
+}
+
+/// Times the samples of a run are made 4x finer when its feed plan breaks a limit between
+/// them (step 2) before the run is refused.
+pub const SAMPLE_REFINEMENTS: usize = 3;
+
+/// Rounding margin of the plan check: a ratio up to 1 + this holds.
+pub const CHECK_MARGIN: f64 = 1e-6;
+
+/// The worst limit a feed plan breaks on its output at the interpolation period
+/// ([`kerf_toolpath::check_plan`]): its name, ratio and time; `None` when every limit holds
+/// (within [`CHECK_MARGIN`]).
+#[allow(clippy::too_many_arguments)]
+fn plan_violation(
+    path: &SmoothedPath,
+    samples: &[PathSample],
+    caps: &[f64],
+    feed: f64,
+    limits: &FeedLimits,
+    plan: &kerf_toolpath::FeedPlan,
+    machine: &dyn Machine,
+    settings: &PlanSettings,
+) -> Result<Option<(&'static str, f64, f64)>, kerf_toolpath::ToolpathError> {
+    let constraints = constraints(caps, feed, limits, machine, settings);
+    let check = check_plan(
+        path,
+        samples,
+        plan,
+        &constraints,
+        limits.curvature.interpolation_period,
+    )?;
+    if check.holds(CHECK_MARGIN) {
+        return Ok(None);
+    }
+    let (what, worst) = check.worst();
+    Ok(Some((what, worst.ratio, worst.time)))
 }
 
 /// Rounds of local slowdown in corners (step 3) before what remains is a uniform slowdown.
@@ -521,12 +598,17 @@ fn run_joints(
         prepared.timed.plan.clone(),
         first,
     );
-    for _ in 0..LOCAL_ROUNDS {
+    // Seed 003's constant-interval planner takes no per-sample caps: uniform slowdown only.
+    let rounds = match settings.feed_method {
+        kerf_toolpath::FeedMethod::NearOptimal => LOCAL_ROUNDS,
+        kerf_toolpath::FeedMethod::ConstantIntervals => 0,
+    };
+    for _ in 0..rounds {
         if over.is_empty() || !lower_corner_caps(&prepared.timed, &over, &mut caps) {
             break;
         }
         budget.check("local slowdown")?;
-        prepared.timed.plan = feed_plan(
+        let plan = feed_plan(
             &prepared.timed.samples,
             &caps,
             feed,
@@ -535,6 +617,24 @@ fn run_joints(
             settings,
         )
         .map_err(|error| GcodePlanError::Path { line, error })?;
+        // A replanned feed that breaks a path limit is not used (the last checked one stays).
+        let timed = &prepared.timed;
+        if plan_violation(
+            &timed.path,
+            &timed.samples,
+            &caps,
+            feed,
+            &prepared.limits,
+            &plan,
+            machine,
+            settings,
+        )
+        .map_err(|error| GcodePlanError::Path { line, error })?
+        .is_some()
+        {
+            break;
+        }
+        prepared.timed.plan = plan;
         let knots = knots_of(&prepared.timed)?;
         over = knots.over.clone();
         let executed = prepared.timed.duration() * knots.slowdown;

@@ -107,6 +107,26 @@ fn laser_cutter_cuts_both_contours_within_the_tolerance() {
         assert_eq!(&p.positions[3..], &[0.0, 0.0, -0.08]);
         assert!((p.positions[2] - 0.58).abs() < 1e-12);
     }
+    // Every run's feed plan holds every path limit on its output at the interpolation period,
+    // checked here independently of the planner's own check.
+    for (report, timed) in plan.runs.iter().zip(&plan.timed) {
+        let mut limits = settings.limits;
+        limits.curvature.feed = report.feed;
+        let check = kerf_toolpath::check_plan(
+            &timed.path,
+            &timed.samples,
+            &timed.plan,
+            &kerf_toolpath::FeedConstraints::new(limits),
+            limits.curvature.interpolation_period,
+        )
+        .unwrap();
+        assert!(
+            check.holds(1e-6),
+            "lines {:?}: {:?}",
+            report.lines,
+            check.worst()
+        );
+    }
     let origin = laser.origin();
     let worst = check(&laser, &plan, &Isometry3::identity(), |p| {
         [p[0] - origin[0], p[1] - origin[1], p[2] - origin[2]]
