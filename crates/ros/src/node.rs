@@ -519,6 +519,14 @@ impl KerfNode {
 
     /// Waits until `publisher` has a matched subscription; `false` on timeout. A volatile
     /// sample published before matching is lost, so one-shot publishers wait for this first.
+    ///
+    /// Polls the publisher's matched-subscription count (every 5 ms) rather than awaiting
+    /// ros2-client's `wait_for_subscription`: that future wakes on the node's graph events,
+    /// which go through a bounded channel of 8 that drops events when full (ros2-client 0.12
+    /// `Node::send_status_event`, `try_send`). In a burst of discovery (several nodes
+    /// declaring their topics and services at once) the event of the match can be dropped,
+    /// and with no later event the wait never ends although the match is there. The count
+    /// is kept by the spinner from the DDS events themselves, so polling it cannot miss.
     pub fn wait_for_subscriber<M: Serialize>(
         &self,
         publisher: &Publisher<M>,
@@ -527,7 +535,16 @@ impl KerfNode {
         let Some(node) = self.node.as_ref() else {
             return false;
         };
-        block_on_timeout(publisher.wait_for_subscription(node), timeout).is_some()
+        let deadline = std::time::Instant::now() + timeout;
+        loop {
+            if publisher.get_subscription_count(node) > 0 {
+                return true;
+            }
+            if std::time::Instant::now() >= deadline {
+                return false;
+            }
+            std::thread::sleep(std::time::Duration::from_millis(5));
+        }
     }
 
     /// Waits until a server is matched for a service client; `false` on timeout.
