@@ -24,8 +24,10 @@
 //!    geometry, the same deviation).
 
 use kerf_budget::Budget;
-use kerf_executor::roots::extrema;
-use kerf_executor::spline::{coefficients, evaluate, Interpolation, Knot};
+use kerf_executor::roots::{derivative, extrema};
+use kerf_executor::spline::{
+    acceleration_coefficients, coefficients, evaluate, velocity_coefficients, Interpolation, Knot,
+};
 
 use crate::error::GcodePlanError;
 use crate::machine::{Machine, DOF};
@@ -187,9 +189,9 @@ pub fn piece_peaks(machine: &dyn Machine, a: &JointKnot, b: &JointKnot) -> [[f64
     let dt = b.t - a.t;
     std::array::from_fn(|j| {
         let c = quintic(a, b, j);
-        let v = [c[1], 2.0 * c[2], 3.0 * c[3], 4.0 * c[4], 5.0 * c[5]];
-        let acc = [2.0 * c[2], 6.0 * c[3], 12.0 * c[4], 20.0 * c[5]];
-        let jerk = [6.0 * c[3], 24.0 * c[4], 60.0 * c[5]];
+        let v = velocity_coefficients(&c);
+        let acc = acceleration_coefficients(&c);
+        let jerk = derivative(&acc);
         let largest = |p: &[f64]| {
             let ((_, lo), (_, hi)) = extrema(p, 0.0, dt);
             lo.abs().max(hi.abs())

@@ -30,7 +30,7 @@ use kerf_toolpath::{
 };
 
 use crate::error::GcodePlanError;
-use crate::knots::{knot_at, run_knots, JointKnot, Peak, RunKnots};
+use crate::knots::{knot_at, run_knots, Peak, RunKnots};
 use crate::machine::{Machine, DOF};
 use crate::runs::{read_steps, Run, RunKind, Step};
 use crate::settings::PlanSettings;
@@ -235,25 +235,19 @@ pub fn plan_program<R: BufRead>(
                 )?;
                 let Prepared {
                     timed,
-                    mut report,
                     limits,
+                    feed,
+                    lines,
+                    path_time,
+                    lower_bound,
                     ..
                 } = prepared;
-                // The plan the joints follow (lowered in corners where they needed it).
-                report.feed_time = timed.plan.time;
-                report.metrics = metrics(
-                    &timed.plan,
-                    &timed.path,
-                    &timed.samples,
-                    limits.curvature.interpolation_period,
-                    limits.curvature.servo.as_ref(),
-                );
                 points += knots.knots.len();
                 if knots.slowdown > 1.0 {
                     warnings.push(format!(
                         "lines {}-{}: {} run slowed {:.3}x for the {} limit of {}",
-                        report.lines.0,
-                        report.lines.1,
+                        lines.0,
+                        lines.1,
                         run.kind.name(),
                         knots.slowdown,
                         knots.peak.what,
@@ -261,9 +255,31 @@ pub fn plan_program<R: BufRead>(
                     ));
                 }
                 reference = knots.knots.last().map(|k| k.q);
-                report.slowdown = knots.slowdown;
-                report.peak = knots.peak.clone();
-                report.start_time = time;
+                // Figures of the plan the joints follow (lowered in corners where they
+                // needed it).
+                let report = RunReport {
+                    kind: run.kind,
+                    lines,
+                    vertices: run.points.len(),
+                    corners: timed.path.corners().count(),
+                    length: timed.plan.length,
+                    feed,
+                    corner_tolerance: run.corner_tolerance,
+                    max_corner_deviation: timed.path.max_deviation(),
+                    feed_time: timed.plan.time,
+                    path_time,
+                    lower_bound,
+                    slowdown: knots.slowdown,
+                    peak: knots.peak.clone(),
+                    start_time: time,
+                    metrics: metrics(
+                        &timed.plan,
+                        &timed.path,
+                        &timed.samples,
+                        limits.curvature.interpolation_period,
+                        limits.curvature.servo.as_ref(),
+                    ),
+                };
                 let start = time;
                 time += timed.duration() * knots.slowdown;
                 reports.push(report);
@@ -371,12 +387,21 @@ fn reachable(
     Ok(())
 }
 
-/// A run smoothed, sampled and timed, with its report so far.
+/// A run smoothed, sampled and timed under the path limits, with what its report needs.
 struct Prepared {
     timed: TimedRun,
+    /// The programmed feed of every sample (capped at the machine's).
     caps: Vec<f64>,
+    /// The path limits, `curvature.feed` the run's highest feed.
     limits: FeedLimits,
-    report: RunReport,
+    /// The run's highest feed \[m/s\].
+    feed: f64,
+    /// First and last source line.
+    lines: (usize, usize),
+    /// T_m: the plan's time under the path limits alone \[s\].
+    path_time: f64,
+    /// T_lb \[s\].
+    lower_bound: f64,
 }
 
 /// Step 2 for one run: smoothing, samples, programmed feeds, T_lb, and the feed plan under
@@ -445,33 +470,7 @@ fn prepare_run(
         .collect();
     let lower =
         bang_bang_under(&samples, curve, limits.tangential_acceleration).map_err(path_error)?;
-    let report = RunReport {
-        kind: run.kind,
-        lines: (line, last_line),
-        vertices: run.points.len(),
-        corners: path.corners().count(),
-        length: plan.length,
-        feed,
-        corner_tolerance: run.corner_tolerance,
-        max_corner_deviation: path.max_deviation(),
-        feed_time: plan.time,
-        path_time: plan.time,
-        lower_bound: lower.time,
-        slowdown: 1.0,
-        peak: Peak {
-            ratio: 0.0,
-            joint: String::new(),
-            what: "velocity",
-        },
-        start_time: 0.0,
-        metrics: metrics(
-            &plan,
-            &path,
-            &samples,
-            limits.curvature.interpolation_period,
-            limits.curvature.servo.as_ref(),
-        ),
-    };
+    let path_time = plan.time;
     Ok(Prepared {
         timed: TimedRun {
             path,
@@ -480,7 +479,10 @@ fn prepare_run(
         },
         caps,
         limits,
-        report,
+        feed,
+        lines: (line, last_line),
+        path_time,
+        lower_bound: lower.time,
     })
 }
 
@@ -588,7 +590,7 @@ fn run_joints(
             budget,
         )
     };
-    let feed = prepared.report.feed;
+    let feed = prepared.feed;
     let mut caps = prepared.caps.clone();
     let first = knots_of(&prepared.timed)?;
     let mut over = first.over.clone();
@@ -739,35 +741,9 @@ fn sample_caps(
 fn assemble(machine: &dyn Machine, placed: &[Placed], holds: &[(f64, f64)]) -> TrajectoryRequest {
     let names: Vec<String> = machine.bounds().iter().map(|b| b.name.clone()).collect();
     let mut points: Vec<TrajectoryPoint> = Vec::new();
-    let mut hold = holds.iter().peekable();
-    let push = |points: &mut Vec<TrajectoryPoint>, k: &JointKnot| {
-        points.push(TrajectoryPoint {
-            positions: k.q.to_vec(),
-            velocities: k.qd.to_vec(),
-            accelerations: k.qdd.to_vec(),
-            effort: Vec::new(),
-            time_from_start: k.t,
-        });
-    };
-    for p in placed {
-        while let Some((at, seconds)) = hold.next_if(|(at, _)| *at <= p.start) {
-            if let Some(last) = points.last().cloned() {
-                points.push(TrajectoryPoint {
-                    time_from_start: at + seconds,
-                    velocities: vec![0.0; DOF],
-                    accelerations: vec![0.0; DOF],
-                    ..last
-                });
-            }
-        }
-        for (i, k) in p.knots.scaled(p.start).enumerate() {
-            if i == 0 && !points.is_empty() {
-                continue;
-            }
-            push(&mut points, &k);
-        }
-    }
-    for (at, seconds) in hold {
+    // A dwell is the last point again, at rest, at the dwell's end (before the first run the
+    // first point's own time holds the robot where it stands).
+    let hold = |points: &mut Vec<TrajectoryPoint>, &(at, seconds): &(f64, f64)| {
         if let Some(last) = points.last().cloned() {
             points.push(TrajectoryPoint {
                 time_from_start: at + seconds,
@@ -776,6 +752,25 @@ fn assemble(machine: &dyn Machine, placed: &[Placed], holds: &[(f64, f64)]) -> T
                 ..last
             });
         }
+    };
+    let mut dwells = holds.iter().peekable();
+    for p in placed {
+        while let Some(dwell) = dwells.next_if(|(at, _)| *at <= p.start) {
+            hold(&mut points, dwell);
+        }
+        let skip = usize::from(!points.is_empty());
+        for k in p.knots.scaled(p.start).skip(skip) {
+            points.push(TrajectoryPoint {
+                positions: k.q.to_vec(),
+                velocities: k.qd.to_vec(),
+                accelerations: k.qdd.to_vec(),
+                effort: Vec::new(),
+                time_from_start: k.t,
+            });
+        }
+    }
+    for dwell in dwells {
+        hold(&mut points, dwell);
     }
     TrajectoryRequest {
         joint_names: names,
