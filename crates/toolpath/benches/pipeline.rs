@@ -25,48 +25,24 @@
 
 use std::time::Instant;
 
+#[allow(dead_code)] // the tests' shared data; each bench uses some of it
+#[path = "../tests/support/mod.rs"]
+mod support;
+
 use kerf_gcode::{read_points, PointUnit};
 use kerf_toolpath::{
     bang_bang_under, check_plan, metrics, plan_feed, plan_feed_optimal, sample_path,
-    smooth_polyline, AxisLimits, CurvatureLimits, FeedConstraints, FeedLimits,
+    smooth_polyline, AxisLimits, FeedConstraints,
 };
 
 /// Arc length between samples for planning \[m\].
 const STEP: f64 = 1e-5;
 
 fn main() {
-    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("data/outlines");
-    let mut names: Vec<_> = std::fs::read_dir(&dir)
-        .unwrap()
-        .map(|e| e.unwrap().path())
-        .filter(|p| p.extension().is_some_and(|e| e == "txt"))
-        .collect();
-    names.sort();
-    let seed000 = (
-        "seed 000",
-        5e-4,
-        FeedLimits {
-            curvature: CurvatureLimits {
-                feed: 0.010,
-                interpolation_period: 5e-4,
-                chord_error: 5e-4,
-                normal_acceleration: 0.1,
-                normal_jerk: 10.0,
-                servo: None,
-            },
-            tangential_acceleration: 0.1,
-            tangential_jerk: 10.0,
-        },
-    );
-    let seed003 = (
-        "seed 003",
-        1e-4,
-        FeedLimits {
-            curvature: CurvatureLimits::seed_003_table_1(),
-            tangential_acceleration: 0.8,
-            tangential_jerk: 20.0,
-        },
-    );
+    let names = support::outline_files();
+    let (limits000, delta000) = support::seed_000_limits();
+    let seed000 = ("seed 000", delta000, limits000);
+    let seed003 = ("seed 003", 1e-4, support::feed_limits());
     println!(
         "| outline | limits | corners | T_m (s) | T_lb (s) | T_m/T_lb | κ_max (1/mm) | θ_max (°) | a_rms (mm/s²) | j_rms (mm/s³) | max chord error (µm) | max deviation (mm) | pipeline (ms) |"
     );

@@ -41,8 +41,8 @@ pub fn seed_000_limits() -> (FeedLimits, f64) {
     )
 }
 
-/// The shipped outlines (`data/outlines/*.txt`, mm), by name, sorted.
-pub fn outlines() -> Vec<(String, Vec<[f64; 3]>)> {
+/// The shipped outline files (`data/outlines/*.txt`), sorted.
+pub fn outline_files() -> Vec<std::path::PathBuf> {
     let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("data/outlines");
     let mut names: Vec<_> = std::fs::read_dir(&dir)
         .unwrap()
@@ -51,6 +51,11 @@ pub fn outlines() -> Vec<(String, Vec<[f64; 3]>)> {
         .collect();
     names.sort();
     names
+}
+
+/// The shipped outlines (`data/outlines/*.txt`, mm), by name, sorted.
+pub fn outlines() -> Vec<(String, Vec<[f64; 3]>)> {
+    outline_files()
         .iter()
         .map(|p| {
             let text = std::fs::read_to_string(p).unwrap();
