@@ -56,64 +56,40 @@ def _nodes(context):
             "-p", f"joint_limits_file:={os.path.join(urdf_dir, robot + '_limits.yaml')}",
         ],
     )
-    nodes = [executor]
-    if robot == "laser_cutter":
-        # The MJTO planner (issue 3); its trajectories go straight to the executor.
-        planner_binary = os.path.join(root, "target", profile, "mjto_planner")
+    ns = namespace.rstrip("/")
+
+    def planner(name, *params):
+        """A planner node whose trajectories go straight to the executor."""
+        planner_binary = os.path.join(root, "target", profile, name)
         if not os.path.exists(planner_binary):
             raise RuntimeError(f"{planner_binary} not found: run 'cargo build --{profile} --workspace' in {root}")
-        ns = namespace.rstrip("/")
+        cmd = [
+            planner_binary,
+            "--ros-args",
+            "-r", f"__ns:={namespace}",
+            "-r", f"~/joint_trajectory:={ns}/trajectory_executor/joint_trajectory",
+        ]
+        for p in params:
+            cmd += ["-p", p]
+        return ExecuteProcess(name=name, output="screen", cmd=cmd)
+
+    nodes = [executor]
+    if robot == "laser_cutter":
+        # The MJTO planner (issue 3).
         nodes.append(
-            ExecuteProcess(
-                name="mjto_planner",
-                output="screen",
-                cmd=[
-                    planner_binary,
-                    "--ros-args",
-                    "-r", f"__ns:={namespace}",
-                    "-r", f"~/joint_trajectory:={ns}/trajectory_executor/joint_trajectory",
-                    "-p", f"urdf_file:={os.path.join(urdf_dir, robot + '.urdf')}",
-                    "-p", f"joint_limits_file:={os.path.join(urdf_dir, robot + '_limits.yaml')}",
-                ],
+            planner(
+                "mjto_planner",
+                f"urdf_file:={os.path.join(urdf_dir, robot + '.urdf')}",
+                f"joint_limits_file:={os.path.join(urdf_dir, robot + '_limits.yaml')}",
             )
         )
     if robot == "irb6660":
         # The milling planner (issue 5): the shipped cell urdf/irb6660_milling.yaml, its
-        # indicator cache and policies; its trajectories go straight to the executor.
-        planner_binary = os.path.join(root, "target", profile, "milling_planner")
-        if not os.path.exists(planner_binary):
-            raise RuntimeError(f"{planner_binary} not found: run 'cargo build --{profile} --workspace' in {root}")
-        ns = namespace.rstrip("/")
-        nodes.append(
-            ExecuteProcess(
-                name="milling_planner",
-                output="screen",
-                cmd=[
-                    planner_binary,
-                    "--ros-args",
-                    "-r", f"__ns:={namespace}",
-                    "-r", f"~/joint_trajectory:={ns}/trajectory_executor/joint_trajectory",
-                ],
-            )
-        )
-    # The G-code planner (issue 14) for the robot; its trajectories go straight to the executor.
-    gcode_binary = os.path.join(root, "target", profile, "gcode_planner")
-    if not os.path.exists(gcode_binary):
-        raise RuntimeError(f"{gcode_binary} not found: run 'cargo build --{profile} --workspace' in {root}")
-    ns = namespace.rstrip("/")
-    nodes.append(
-        ExecuteProcess(
-            name="gcode_planner",
-            output="screen",
-            cmd=[
-                gcode_binary,
-                "--ros-args",
-                "-r", f"__ns:={namespace}",
-                "-r", f"~/joint_trajectory:={ns}/trajectory_executor/joint_trajectory",
-                "-p", f"machine:={'laser-cutter' if robot == 'laser_cutter' else 'irb6660'}",
-            ],
-        )
-    )
+        # indicator cache and policies.
+        nodes.append(planner("milling_planner"))
+    # The G-code planner (issue 14) for the robot.
+    machine = "laser-cutter" if robot == "laser_cutter" else "irb6660"
+    nodes.append(planner("gcode_planner", f"machine:={machine}"))
     return nodes
 
 
