@@ -37,8 +37,12 @@ pub struct PlanSettings {
     pub limits: FeedLimits,
     /// Speed of G0 moves \[m/s\].
     pub rapid_feed: f64,
-    /// Mean arc length between the planning samples of a corner \[m\].
+    /// The longest step between the planning samples of a corner \[m\]
+    /// ([`kerf_toolpath::sample_path_adaptive`]).
     pub sample_step: f64,
+    /// The largest turning of the tangent between two planning samples
+    /// \[rad\], in (0, π/2] ([`kerf_toolpath::sample_path_adaptive`]).
+    pub sample_turn: f64,
     /// The executor's control period \[s\] (the trajectory is checked at it).
     pub control_period: f64,
     /// Time between trajectory points before refinement \[s\].
@@ -123,7 +127,8 @@ impl PlanSettings {
             interpolation_share: 0.1,
             limits,
             rapid_feed,
-            sample_step: 1e-5,
+            sample_step: 1e-3,
+            sample_turn: 2f64.to_radians(),
             control_period: 0.004,
             knot_spacing: 0.02,
             max_points: 2_000_000,
@@ -211,6 +216,13 @@ impl PlanSettings {
             ("control period [s]", self.control_period),
             ("knot spacing [s]", self.knot_spacing),
         ])?;
+        if !(self.sample_turn > 0.0 && self.sample_turn <= std::f64::consts::FRAC_PI_2) {
+            return Err(invalid(
+                "sample turn [rad]",
+                self.sample_turn,
+                "must be in (0, pi/2]",
+            ));
+        }
         if self.tolerance > 0.01 {
             return Err(invalid(
                 "tolerance [m]",

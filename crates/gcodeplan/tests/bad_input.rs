@@ -104,6 +104,20 @@ fn bad_settings_are_named() {
         ),
         (
             PlanSettings {
+                sample_turn: 0.0,
+                ..PlanSettings::laser_cutter()
+            },
+            "sample turn",
+        ),
+        (
+            PlanSettings {
+                sample_turn: 2.0,
+                ..PlanSettings::laser_cutter()
+            },
+            "sample turn",
+        ),
+        (
+            PlanSettings {
                 knot_spacing: 0.001,
                 ..PlanSettings::laser_cutter()
             },

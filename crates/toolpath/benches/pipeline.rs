@@ -1,7 +1,7 @@
 //! The G-code front end's deterministic pipeline on the shipped outlines (issue 14, items 2–4, first
 //! figures: kerf's corner transition and the jerk-limited feed plan; the baselines come later):
 //! read the point list (`kerf_gcode::read_points`), smooth every corner within δ
-//! (`smooth_polyline`), sample by arc length, plan the feed (`plan_feed`), T_lb
+//! (`smooth_polyline`), sample by arc length (every 10 µm), plan the feed (`plan_feed`), T_lb
 //! (`bang_bang_under`) and the metrics at the interpolation period (`metrics`). Two limit sets:
 //!
 //! * seed 000's (its appendix C, units not stated; read as mm and s: v 10 mm/s, a 100 mm/s²,
@@ -14,9 +14,11 @@
 //! one thread.
 //!
 //! A second table has kerf's near time-optimal planner (`plan_feed_optimal`) on the same
-//! smoothed paths and samples: T_m, T_lb, T_m/T_lb, the planning time alone (best of 20), the
+//! smoothed paths, sampled by `sample_path_adaptive` (steps of at most 1 mm and 2° of turning,
+//! a sample at every extremum of a corner's curvature): T_m, T_lb, T_m/T_lb, the planning time alone (best of 20), the
 //! whole pipeline with it (best of 20), the largest ratio of `check_plan` (every limit on the
-//! output at the period) for it and for `plan_feed`, and with the laser cutter's axis limits.
+//! output at the period) for it and for `plan_feed` (on its 10 µm samples), and with the laser
+//! cutter's axis limits.
 //!
 //! ```sh
 //! cargo bench -p kerf_toolpath --bench pipeline
@@ -32,11 +34,17 @@ mod support;
 use kerf_gcode::{read_points, PointUnit};
 use kerf_toolpath::{
     bang_bang_under, check_plan, metrics, plan_feed, plan_feed_optimal, sample_path,
-    smooth_polyline, AxisLimits, FeedConstraints,
+    sample_path_adaptive, smooth_polyline, AxisLimits, FeedConstraints,
 };
 
-/// Arc length between samples for planning \[m\].
-const STEP: f64 = 1e-5;
+/// Arc length between samples for seed 003's planner (`plan_feed`, first table) \[m\].
+const FIXED_STEP: f64 = 1e-5;
+
+/// The longest step between samples for kerf's planner \[m\] (`sample_path_adaptive`).
+const STEP: f64 = 1e-3;
+
+/// The largest turning between samples for planning \[rad\] (2°).
+const TURN: f64 = 2.0 * std::f64::consts::PI / 180.0;
 
 fn main() {
     let names = support::outline_files();
@@ -54,7 +62,7 @@ fn main() {
             let run = || {
                 let points = read_points(text.as_bytes(), PointUnit::Millimetre).unwrap();
                 let smoothed = smooth_polyline(&points, *delta).unwrap();
-                let samples = sample_path(&smoothed, STEP);
+                let samples = sample_path(&smoothed, FIXED_STEP);
                 let plan = plan_feed(&samples, limits).unwrap();
                 let curve: Vec<f64> = samples
                     .iter()
@@ -108,7 +116,7 @@ fn main() {
             let run = || {
                 let points = read_points(text.as_bytes(), PointUnit::Millimetre).unwrap();
                 let smoothed = smooth_polyline(&points, *delta).unwrap();
-                let samples = sample_path(&smoothed, STEP);
+                let samples = sample_path_adaptive(&smoothed, STEP, TURN).unwrap();
                 let plan = plan_feed_optimal(&samples, &constraints).unwrap();
                 let curve: Vec<f64> = samples
                     .iter()
@@ -134,12 +142,17 @@ fn main() {
                 assert_eq!(p.time, plan.time);
             }
             let period = limits.curvature.interpolation_period;
-            let worst = |p: &kerf_toolpath::FeedPlan, c: &FeedConstraints| {
-                let c = check_plan(&smoothed, &samples, p, c, period).unwrap();
+            let worst_on = |s: &[kerf_toolpath::PathSample],
+                            p: &kerf_toolpath::FeedPlan,
+                            c: &FeedConstraints| {
+                let c = check_plan(&smoothed, s, p, c, period).unwrap();
                 let (what, w) = c.worst();
                 format!("{:.5} ({what})", w.ratio)
             };
-            let old = plan_feed(&samples, limits).unwrap();
+            let worst = |p: &kerf_toolpath::FeedPlan, c: &FeedConstraints| worst_on(&samples, p, c);
+            // Seed 003's planner on the samples it is built for (every 10 µm).
+            let fixed = sample_path(&smoothed, FIXED_STEP);
+            let old = plan_feed(&fixed, limits).unwrap();
             let axes = FeedConstraints {
                 axes: Some(AxisLimits::laser_cutter()),
                 ..constraints
@@ -154,7 +167,7 @@ fn main() {
                 planning * 1e3,
                 best * 1e3,
                 worst(&plan, &constraints),
-                worst(&old, &constraints),
+                worst_on(&fixed, &old, &constraints),
                 with_axes.time,
                 worst(&with_axes, &axes)
             );

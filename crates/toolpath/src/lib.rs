@@ -48,7 +48,7 @@ pub use lower_bound::{bang_bang, bang_bang_under, BangBang, BangBangLimits};
 pub use merge::{merge_collinear, merge_collinear_indices};
 pub use metrics::{metrics, Metrics};
 pub use plan_check::{check_plan, PlanCheck, Worst};
-pub use samples::{derivatives_at, point_at, sample_path, PathSample};
+pub use samples::{derivatives_at, point_at, sample_path, sample_path_adaptive, PathSample};
 pub use smooth::smooth_polyline_with;
 pub use smooth::{smooth_polyline, Piece, SmoothedPath};
 pub use speed_limit::{CurvatureLimits, Servo};

@@ -18,7 +18,11 @@
 //!   of those nodes (a peak between two samples exceeds both: on a corner of
 //!   five 10 µm steps the peak was 36 % above the samples on both sides of
 //!   it), and at least the mean curvature of the interval (its tangent's
-//!   turning angle over its length); about 0 on a straight interval;
+//!   turning angle over its length); about 0 on a straight interval. Where
+//!   the samples hold every extremum of the curvature
+//!   ([`crate::sample_path_adaptive`], [`PathSample::monotone`]), the
+//!   curvature is monotone over the interval and κ̂ is the larger of its
+//!   ends times 1 + [`MONOTONE_SLACK`] (and at least the mean);
 //! * seed 003 eq. 16 (chord error) at the largest curvature within w of the
 //!   interval: a step of one period that reaches the interval is at most w
 //!   long, so its own speed bound covers its whole chord (eq. 15 with the
@@ -31,7 +35,7 @@
 //! The limit of a node is the lower of its two intervals'.
 
 use crate::constraints::FeedConstraints;
-use crate::samples::PathSample;
+use crate::samples::{PathSample, MONOTONE_SLACK};
 use crate::speed_limit::CurvatureLimits;
 use crate::vec3::{dot, norm, sub};
 
@@ -58,6 +62,9 @@ struct Node {
     cap: f64,
     /// The piece of the interval from this node to the next.
     piece: usize,
+    /// The curvature is monotone from this node to the next
+    /// ([`PathSample::monotone`]).
+    monotone: bool,
 }
 
 /// The velocity-limit curve of `samples` under `constraints` (module
@@ -77,6 +84,7 @@ pub fn limit_curve(samples: &[PathSample], constraints: &FeedConstraints<'_>) ->
             tangent: p.tangent,
             cap: cap_of(i),
             piece,
+            monotone: p.monotone,
         });
         // A line: the only interval of its piece (a piece's samples after its
         // first belong to it; the path's first sample to the first piece),
@@ -94,6 +102,7 @@ pub fn limit_curve(samples: &[PathSample], constraints: &FeedConstraints<'_>) ->
                         tangent: p.tangent,
                         cap,
                         piece,
+                        monotone: true,
                     });
                 }
             }
@@ -106,7 +115,8 @@ pub fn limit_curve(samples: &[PathSample], constraints: &FeedConstraints<'_>) ->
         Vec::new()
     };
     let chord_kappa = window_max(&nodes, w);
-    let free = feed_curvature(lim);
+    let critical = lim.contour_critical_radius();
+    let free = feed_curvature(lim, critical);
     let (a_eff, j_eff) = constraints.tangential();
     let mut interval = Vec::with_capacity(n - 1);
     for k in 0..n - 1 {
@@ -134,15 +144,20 @@ pub fn limit_curve(samples: &[PathSample], constraints: &FeedConstraints<'_>) ->
         // two samples: there the full change, else half of it.
         let ends = p.kappa.max(q.kappa);
         let outer = nodes[lo].kappa.max(nodes[hi + 1].kappa);
-        let slack = if ends >= outer && change > 0.5 * ends {
+        let slack = if p.monotone {
+            MONOTONE_SLACK * ends
+        } else if ends >= outer && change > 0.5 * ends {
             change
         } else {
             0.5 * change
         };
         let kappa = (ends + slack).max(turn / ds);
+        // The least curvature over the interval, for the contour law, which
+        // rises with κ above 1/ρ* (CurvatureLimits::contour_critical_radius).
+        let kappa_lo = (p.kappa.min(q.kappa) - slack).max(0.0);
         let mut v = lim.feed.min(p.cap).min(q.cap);
         if kappa > free {
-            v = v.min(curvature_speed(lim, kappa, v));
+            v = v.min(curvature_speed(lim, kappa_lo, kappa, v, critical));
         }
         let kc = chord_kappa[k].max(kappa);
         if kc > free {
@@ -206,17 +221,23 @@ fn window_max(nodes: &[Node], w: f64) -> Vec<f64> {
     out
 }
 
-/// The largest curvature at which no curvature limit is below the feed
-/// (every law of [`CurvatureLimits::speed`] decreases with κ), by bisection
-/// on log κ, rounded down: below it the limit is F without evaluating them.
-fn feed_curvature(lim: &CurvatureLimits) -> f64 {
+/// The largest curvature below which no curvature limit is below the feed,
+/// by bisection on log κ, rounded down: below it the limit is F without
+/// evaluating them. The laws of eqs. 19 and 21 fall with κ; eq. 17 falls up
+/// to 1/ρ* and rises beyond ([`CurvatureLimits::contour_critical_radius`]),
+/// so the bisection runs on the least speed over [0, κ], which falls with κ.
+fn feed_curvature(lim: &CurvatureLimits, critical: Option<f64>) -> f64 {
+    let below = |kappa: f64| {
+        curvature_speed(lim, 0.0, kappa, f64::INFINITY, critical) >= lim.feed
+            && lim.chord_speed(1.0 / kappa) >= lim.feed
+    };
     let (mut lo, mut hi) = (1e-12f64, 1e12f64);
-    if lim.speed(lo) < lim.feed {
+    if !below(lo) {
         return 0.0;
     }
     for _ in 0..100 {
         let mid = (lo * hi).sqrt();
-        if lim.speed(mid) >= lim.feed {
+        if below(mid) {
             lo = mid;
         } else {
             hi = mid;
@@ -225,17 +246,24 @@ fn feed_curvature(lim: &CurvatureLimits) -> f64 {
     lo * (1.0 - 1e-9)
 }
 
-/// min(`v`, eqs. 17, 19, 21 at κ) as [`CurvatureLimits::speed`] without its
-/// chord term (the chord is bounded separately), the cube root only where
-/// it is below `v` (ρ² j_n < v³).
-fn curvature_speed(lim: &CurvatureLimits, kappa: f64, v: f64) -> f64 {
+/// min(`v`, eqs. 19 and 21 at `kappa`, eq. 17 at its least over
+/// [`kappa_lo`, `kappa`]) as [`CurvatureLimits::speed`] without its chord
+/// term (the chord is bounded separately), the cube root only where it is
+/// below `v` (ρ² j_n < v³).
+fn curvature_speed(
+    lim: &CurvatureLimits,
+    kappa_lo: f64,
+    kappa: f64,
+    v: f64,
+    critical: Option<f64>,
+) -> f64 {
     let rho = 1.0 / kappa;
     let mut v = v.min((rho * lim.normal_acceleration).sqrt());
     let jerk = rho * rho * lim.normal_jerk;
     if jerk < v * v * v {
         v = jerk.cbrt();
     }
-    v.min(lim.contour_speed(rho))
+    v.min(lim.contour_speed_over(kappa_lo, kappa, critical))
 }
 
 /// |x‴| at every node, per axis, from the tangents: m_k = Δt/Δs ≈ κ n over

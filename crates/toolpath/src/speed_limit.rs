@@ -104,6 +104,58 @@ impl CurvatureLimits {
         .fold(f64::INFINITY, f64::min)
     }
 
+    /// The radius at which eq. 17's speed is least \[m\] (`None` without a
+    /// servo).
+    ///
+    /// Eq. 17 is not monotone in ρ: with r = ρ/ε, v_c² = ε² ω_n² r² y(r),
+    /// y = −a + √(a² + x), x = (2r − 1)/(r − 1)², a = 2ζ² − 1. For large r,
+    /// v_c ≈ ω_n √(ερ/a) grows with ρ; as r → 1⁺, x → ∞ and v_c → ∞ (a
+    /// circle barely larger than ε cannot shrink by ε). Between them v_c has
+    /// one minimum, at r* depending on ζ alone, found here by golden section
+    /// on ln(r − 1) ∈ [−20, 20]. On curvatures above 1/ρ* (radii of a few ε)
+    /// the contour law rises with κ, so the least speed over a range of
+    /// curvature is not at its largest ([`Self::contour_speed_over`]).
+    pub fn contour_critical_radius(&self) -> Option<f64> {
+        let servo = self.servo.as_ref()?;
+        let e = servo.contour_error;
+        let v = |t: f64| self.contour_speed(e * (1.0 + t.exp()));
+        let (mut lo, mut hi) = (-20.0f64, 20.0f64);
+        let g = 0.5 * (5f64.sqrt() - 1.0);
+        for _ in 0..120 {
+            let m1 = hi - g * (hi - lo);
+            let m2 = lo + g * (hi - lo);
+            if v(m1) < v(m2) {
+                hi = m2;
+            } else {
+                lo = m1;
+            }
+        }
+        Some(e * (1.0 + (0.5 * (lo + hi)).exp()))
+    }
+
+    /// The least speed of eq. 17 over the curvatures [`kappa_lo`,
+    /// `kappa_hi`] \[m/s\]: at the critical radius
+    /// ([`Self::contour_critical_radius`], passed as `critical`) where it
+    /// lies in the range, else at the end nearer to it (eq. 17 falls with κ
+    /// below 1/ρ* and rises above). Infinite without a servo or for
+    /// `kappa_hi` ≤ 0.
+    pub fn contour_speed_over(&self, kappa_lo: f64, kappa_hi: f64, critical: Option<f64>) -> f64 {
+        let Some(rho_star) = critical else {
+            return f64::INFINITY;
+        };
+        if kappa_hi <= 0.0 {
+            return f64::INFINITY;
+        }
+        let k_star = 1.0 / rho_star;
+        if kappa_hi <= k_star {
+            self.contour_speed(1.0 / kappa_hi)
+        } else if kappa_lo >= k_star {
+            self.contour_speed(1.0 / kappa_lo.max(f64::MIN_POSITIVE))
+        } else {
+            self.contour_speed(rho_star)
+        }
+    }
+
     /// Eq. 16: v_Δ = 2 √(2ρΔ − Δ²) / T. Where Δ_lim ≥ ρ no chord can sag
     /// more than Δ_lim (a chord spans at most the diameter), and the speed
     /// is that of a chord of one diameter, 2ρ / T (eq. 16 at Δ = ρ).

@@ -104,3 +104,65 @@ fn contour_speed_does_not_cancel_on_nearly_straight_paths() {
         assert!(l.speed(kappa) > 0.0);
     }
 }
+
+/// Eq. 17 falls with the radius down to ρ* and rises below it (radii of a few ε): the critical
+/// radius is the least of a dense log grid, and the least speed over a curvature range is at ρ*
+/// where the range holds it, else at the range's end nearer to it (the laser cutter's torch run
+/// once broke its contour limit by 2·10⁻⁶ where the limit curve took the speed at the largest
+/// curvature, 12 447 1/m with ε = 50 µm, beyond 1/ρ*).
+#[test]
+fn the_contour_law_has_one_minimum_and_ranges_take_it() {
+    let l = CurvatureLimits::seed_003_table_1();
+    let e = l.servo.unwrap().contour_error;
+    let star = l.contour_critical_radius().unwrap();
+    assert!(star > e && star < 100.0 * e, "ρ* {star} against ε {e}");
+    let grid: Vec<f64> = (0..4000)
+        .map(|k| e * (1.0 + 10f64.powf(-6.0 + 12.0 * k as f64 / 4000.0)))
+        .collect();
+    let speeds: Vec<f64> = grid.iter().map(|&r| l.contour_speed(r)).collect();
+    let (k_min, v_min) =
+        speeds
+            .iter()
+            .copied()
+            .enumerate()
+            .fold(
+                (0, f64::INFINITY),
+                |b, (k, v)| if v < b.1 { (k, v) } else { b },
+            );
+    assert!(l.contour_speed(star) <= v_min * (1.0 + 1e-12));
+    assert!(
+        (grid[k_min] - star).abs() < 0.01 * star,
+        "{} vs {star}",
+        grid[k_min]
+    );
+    // Falling towards ρ* from above, rising towards ε from ρ*.
+    for w in speeds.windows(2).take(k_min) {
+        assert!(w[1] <= w[0] * (1.0 + 1e-12), "not falling below ρ*");
+    }
+    for w in speeds.windows(2).skip(k_min + 1) {
+        assert!(w[1] >= w[0] * (1.0 - 1e-12), "not rising above ρ*");
+    }
+    let k_star = 1.0 / star;
+    let over = |lo: f64, hi: f64| l.contour_speed_over(lo, hi, Some(star));
+    let dense = |lo: f64, hi: f64| {
+        (0..=1000)
+            .map(|k| l.contour_speed(1.0 / (lo + (hi - lo) * k as f64 / 1000.0)))
+            .fold(f64::INFINITY, f64::min)
+    };
+    for (lo, hi) in [
+        (0.2 * k_star, 0.5 * k_star),
+        (0.5 * k_star, 2.0 * k_star),
+        (1.5 * k_star, 3.0 * k_star),
+        (0.9 * k_star, 0.99 * k_star),
+    ] {
+        let (a, b) = (over(lo, hi), dense(lo, hi));
+        assert!(
+            a <= b * (1.0 + 1e-12) && a >= b * (1.0 - 1e-6),
+            "[{lo}, {hi}]: {a} vs {b}"
+        );
+    }
+    assert!(over(0.0, 0.0).is_infinite());
+    assert!(CurvatureLimits { servo: None, ..l }
+        .contour_critical_radius()
+        .is_none());
+}
