@@ -10,6 +10,7 @@
 //! [`axis`]), picked by [`FeedMethod`] and verified on their output by
 //! [`check_plan`] ([`plan_check`]).
 
+pub mod adaptive;
 pub mod axis;
 pub mod baseline;
 pub mod bezier;
@@ -33,6 +34,7 @@ pub mod speed_limit;
 pub mod spline;
 pub mod vec3;
 
+pub use adaptive::sample_path_adaptive;
 pub use axis::AxisLimits;
 pub use baseline::{CornerMethod, NurbsSettings};
 pub use bezier::QuinticBezier;
@@ -48,7 +50,7 @@ pub use lower_bound::{bang_bang, bang_bang_under, BangBang, BangBangLimits};
 pub use merge::{merge_collinear, merge_collinear_indices};
 pub use metrics::{metrics, Metrics};
 pub use plan_check::{check_plan, PlanCheck, Worst};
-pub use samples::{derivatives_at, point_at, sample_path, sample_path_adaptive, PathSample};
+pub use samples::{derivatives_at, point_at, sample_path, PathSample};
 pub use smooth::smooth_polyline_with;
 pub use smooth::{smooth_polyline, Piece, SmoothedPath};
 pub use speed_limit::{CurvatureLimits, Servo};

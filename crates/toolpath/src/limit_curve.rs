@@ -30,12 +30,17 @@
 //! * the per-axis bound [`crate::AxisLimits::speed`] with |x′| the largest
 //!   tangent component at the ends plus κ̂ Δs / 2 (the tangent turns at rate
 //!   κ), |x″| ≤ κ̂ on every axis and |x‴| the largest second difference of
-//!   the tangents over nodes k − 1 .. k + 2, times 1.5.
+//!   the tangents over nodes k − 1 .. k + 2, times 1.5; on a monotone
+//!   interval of adaptive samples |x‴| ≤ |κ′| + κ̂² (x‴ = κ′ n − κ² t,
+//!   Frenet–Serret on a planar corner), |κ′| the larger of its ends'
+//!   [`PathSample::curvature_slope`] (every maximum of |κ′| is sampled)
+//!   times 1 + [`SLOPE_SLACK`].
 //!
 //! The limit of a node is the lower of its two intervals'.
 
+use crate::adaptive::{MONOTONE_SLACK, SLOPE_SLACK};
 use crate::constraints::FeedConstraints;
-use crate::samples::{PathSample, MONOTONE_SLACK};
+use crate::samples::PathSample;
 use crate::speed_limit::CurvatureLimits;
 use crate::vec3::{dot, norm, sub};
 
@@ -65,6 +70,8 @@ struct Node {
     /// The curvature is monotone from this node to the next
     /// ([`PathSample::monotone`]).
     monotone: bool,
+    /// |dκ/ds| at the node ([`PathSample::curvature_slope`]).
+    slope: f64,
 }
 
 /// The velocity-limit curve of `samples` under `constraints` (module
@@ -85,6 +92,7 @@ pub fn limit_curve(samples: &[PathSample], constraints: &FeedConstraints<'_>) ->
             cap: cap_of(i),
             piece,
             monotone: p.monotone,
+            slope: p.curvature_slope,
         });
         // A line: the only interval of its piece (a piece's samples after its
         // first belong to it; the path's first sample to the first piece),
@@ -103,6 +111,7 @@ pub fn limit_curve(samples: &[PathSample], constraints: &FeedConstraints<'_>) ->
                         cap,
                         piece,
                         monotone: true,
+                        slope: 0.0,
                     });
                 }
             }
@@ -168,9 +177,16 @@ pub fn limit_curve(samples: &[PathSample], constraints: &FeedConstraints<'_>) ->
                 (p.tangent[a].abs().max(q.tangent[a].abs()) + 0.5 * kappa * ds).min(1.0)
             });
             let mut d3 = [0.0f64; 3];
-            for t in &third[lo..=hi + 1] {
-                for a in 0..3 {
-                    d3[a] = d3[a].max(THIRD_DERIVATIVE_FACTOR * t[a]);
+            if p.monotone {
+                // x‴ = κ′ n − κ² t on a planar corner (Frenet–Serret), so every
+                // axis's |x‴| ≤ |κ′| + κ², |κ′| bounded by its sampled maxima.
+                let bound = p.slope.max(q.slope) * (1.0 + SLOPE_SLACK) + kappa * kappa;
+                d3 = [bound; 3];
+            } else {
+                for t in &third[lo..=hi + 1] {
+                    for a in 0..3 {
+                        d3[a] = d3[a].max(THIRD_DERIVATIVE_FACTOR * t[a]);
+                    }
                 }
             }
             v = v.min(axes.speed(d1, [kappa; 3], d3, a_eff, j_eff));
