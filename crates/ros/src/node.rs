@@ -507,14 +507,16 @@ impl KerfNode {
         let Some(node) = self.node.as_ref() else {
             return false;
         };
-        let all = async {
-            futures::join!(
-                client.goal_client().wait_for_service(node),
-                client.cancel_client().wait_for_service(node),
-                client.result_client().wait_for_service(node),
-            )
-        };
-        block_on_timeout(all, timeout).is_some()
+        poll_until(timeout, |slice| {
+            let all = async {
+                futures::join!(
+                    client.goal_client().wait_for_service(node),
+                    client.cancel_client().wait_for_service(node),
+                    client.result_client().wait_for_service(node),
+                )
+            };
+            block_on_timeout(all, slice).is_some()
+        })
     }
 
     /// Waits until `publisher` has a matched subscription; `false` on timeout. A volatile
@@ -560,7 +562,36 @@ impl KerfNode {
         let Some(node) = self.node.as_ref() else {
             return false;
         };
-        block_on_timeout(client.wait_for_service(node), timeout).is_some()
+        poll_until(timeout, |slice| {
+            block_on_timeout(client.wait_for_service(node), slice).is_some()
+        })
+    }
+}
+
+/// How long one wait for a match lasts before [`poll_until`] asks again.
+const MATCH_POLL: std::time::Duration = std::time::Duration::from_millis(50);
+
+/// Calls `ready` with a slice of the time left (at most [`MATCH_POLL`]) until it returns true
+/// or `timeout` has passed.
+///
+/// ros2-client's waits for a match (`Client::wait_for_service`, the action client's three)
+/// check the matched state once when they are created, then wake on the node's graph events,
+/// which go through a bounded channel of 8 that drops events when full (ros2-client 0.12
+/// `Node::send_status_event`, `try_send`): a dropped match event left the wait hanging until
+/// its timeout. A fresh wait every [`MATCH_POLL`] checks the matched state again.
+fn poll_until(
+    timeout: std::time::Duration,
+    mut ready: impl FnMut(std::time::Duration) -> bool,
+) -> bool {
+    let deadline = std::time::Instant::now() + timeout;
+    loop {
+        let left = deadline.saturating_duration_since(std::time::Instant::now());
+        if ready(left.min(MATCH_POLL)) {
+            return true;
+        }
+        if left.is_zero() {
+            return false;
+        }
     }
 }
 

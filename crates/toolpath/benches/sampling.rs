@@ -62,7 +62,9 @@ fn main() {
             .collect(),
         Err(_) => vec![
             Sampler::Fixed(1e-5),
-            Sampler::Adaptive(1e-4, 1f64.to_radians()),
+            Sampler::Adaptive(1e-3, 1f64.to_radians()),
+            Sampler::Adaptive(1e-3, 2f64.to_radians()),
+            Sampler::Adaptive(1e-3, 4f64.to_radians()),
         ],
     };
     let (limits000, delta000) = support::seed_000_limits();
