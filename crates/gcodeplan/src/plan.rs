@@ -25,8 +25,8 @@ use kerf_executor::{
     check_executable, ExecutorConfig, JointSample, TrajectoryPoint, TrajectoryRequest,
 };
 use kerf_toolpath::{
-    bang_bang_under, check_plan, metrics, sample_path_adaptive, smooth_polyline_with,
-    FeedConstraints, FeedLimits, Metrics, PathSample, Piece, SmoothedPath,
+    bang_bang_under, check_plan, metrics, smooth_polyline_with, FeedConstraints, FeedLimits,
+    Metrics, PathSample, Piece, SmoothedPath,
 };
 
 use crate::error::GcodePlanError;
@@ -434,12 +434,12 @@ fn prepare_run(
         .map_err(path_error)?;
     // The feed plan, checked on its output at the interpolation period against every limit
     // (kerf_toolpath::check_plan); where it breaks one between its samples, the path is
-    // sampled 4x finer (both its step and turning bound) and planned again, at most
+    // sampled 4x finer (every bound of its sampling) and planned again, at most
     // SAMPLE_REFINEMENTS times.
-    let (mut step, mut turn) = (settings.sample_step, settings.sample_turn);
+    let mut sampling = settings.sampling;
     let mut attempt = 0;
     let (samples, caps, plan) = loop {
-        let samples = sample_path_adaptive(&path, step, turn).map_err(path_error)?;
+        let samples = sampling.sample(&path).map_err(path_error)?;
         let caps = sample_caps(&path, &samples, &run.points, &feeds);
         let plan =
             feed_plan(&samples, &caps, feed, &limits, machine, settings).map_err(path_error)?;
@@ -453,15 +453,13 @@ fn prepare_run(
                 return Err(GcodePlanError::NotExecutable {
                     reason: format!(
                         "lines {line}-{last_line}: the feed plan breaks the {what} limit \
-                         ({ratio:.4} of it at {time:.3} s into the run) even with samples \
-                         at most {step:.1e} m and {:.3} deg apart",
-                        turn.to_degrees()
+                         ({ratio:.4} of it at {time:.3} s into the run) even with the \
+                         samples {sampling:?}"
                     ),
                 });
             }
             Some(_) => {
-                step *= 0.25;
-                turn *= 0.25;
+                sampling = sampling.finer(4.0);
                 attempt += 1;
             }
         }

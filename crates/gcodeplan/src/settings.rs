@@ -2,7 +2,7 @@
 //! trajectory's density (builder, validated).
 
 use kerf_gcode::ReaderSettings;
-use kerf_toolpath::{CornerMethod, CurvatureLimits, FeedLimits, FeedMethod, Servo};
+use kerf_toolpath::{CornerMethod, CurvatureLimits, FeedLimits, FeedMethod, Sampling, Servo};
 
 use crate::error::{check_positive, setting, GcodePlanError};
 
@@ -37,12 +37,11 @@ pub struct PlanSettings {
     pub limits: FeedLimits,
     /// Speed of G0 moves \[m/s\].
     pub rapid_feed: f64,
-    /// The longest step between the planning samples of a corner \[m\]
-    /// ([`kerf_toolpath::sample_path_adaptive`]).
-    pub sample_step: f64,
-    /// The largest turning of the tangent between two planning samples
-    /// \[rad\], in (0, π/2] ([`kerf_toolpath::sample_path_adaptive`]).
-    pub sample_turn: f64,
+    /// How each run's smoothed path is sampled for its feed plan: fixed
+    /// 10 µm steps by default. [`Sampling::adaptive`] plans closer to T_lb
+    /// on the path, but as executed it is slower on most shipped programs
+    /// (the joints' jerk binds more: BENCHMARKS.md, "Sampling the path").
+    pub sampling: Sampling,
     /// The executor's control period \[s\] (the trajectory is checked at it).
     pub control_period: f64,
     /// Time between trajectory points before refinement \[s\].
@@ -127,8 +126,7 @@ impl PlanSettings {
             interpolation_share: 0.1,
             limits,
             rapid_feed,
-            sample_step: 1e-3,
-            sample_turn: 2f64.to_radians(),
+            sampling: Sampling::default(),
             control_period: 0.004,
             knot_spacing: 0.02,
             max_points: 2_000_000,
@@ -212,16 +210,21 @@ impl PlanSettings {
             ("tolerance [m]", self.tolerance),
             ("interpolation share [-]", self.interpolation_share),
             ("rapid feed [m/s]", self.rapid_feed),
-            ("sample step [m]", self.sample_step),
             ("control period [s]", self.control_period),
             ("knot spacing [s]", self.knot_spacing),
         ])?;
-        if !(self.sample_turn > 0.0 && self.sample_turn <= std::f64::consts::FRAC_PI_2) {
-            return Err(invalid(
-                "sample turn [rad]",
-                self.sample_turn,
-                "must be in (0, pi/2]",
-            ));
+        match self.sampling {
+            Sampling::Fixed { step } => check_positive(&[("sample step [m]", step)])?,
+            Sampling::Adaptive { max_step, max_turn } => {
+                check_positive(&[("sample step [m]", max_step)])?;
+                if !(max_turn > 0.0 && max_turn <= std::f64::consts::FRAC_PI_2) {
+                    return Err(invalid(
+                        "sample turn [rad]",
+                        max_turn,
+                        "must be in (0, pi/2]",
+                    ));
+                }
+            }
         }
         if self.tolerance > 0.01 {
             return Err(invalid(

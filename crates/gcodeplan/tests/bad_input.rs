@@ -8,6 +8,7 @@ use kerf_budget::{Budget, CancelToken};
 use kerf_gcodeplan::{
     plan_program, GcodePlanError, LaserSheet, MillingPlane, PlanSettings, RunKind,
 };
+use kerf_toolpath::Sampling;
 
 fn laser_plan(
     text: &str,
@@ -104,17 +105,20 @@ fn bad_settings_are_named() {
         ),
         (
             PlanSettings {
-                sample_turn: 0.0,
+                sampling: Sampling::Adaptive {
+                    max_step: 1e-3,
+                    max_turn: 0.0,
+                },
                 ..PlanSettings::laser_cutter()
             },
             "sample turn",
         ),
         (
             PlanSettings {
-                sample_turn: 2.0,
+                sampling: Sampling::Fixed { step: -1e-5 },
                 ..PlanSettings::laser_cutter()
             },
-            "sample turn",
+            "sample step",
         ),
         (
             PlanSettings {

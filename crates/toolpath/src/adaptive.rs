@@ -363,3 +363,74 @@ fn march(
     }
     local
 }
+
+/// How a smoothed path is sampled for feed planning.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Sampling {
+    /// [`crate::sample_path`]: corners at equal parameter steps of `step`
+    /// arc length on average \[m\].
+    Fixed {
+        /// Mean arc length between a corner's samples \[m\], > 0.
+        step: f64,
+    },
+    /// [`sample_path_adaptive`].
+    Adaptive {
+        /// The longest step on a corner \[m\], > 0.
+        max_step: f64,
+        /// The largest turning over one step \[rad\], in (0, π/2].
+        max_turn: f64,
+    },
+}
+
+impl Default for Sampling {
+    /// Fixed 10 µm steps (the figures of BENCHMARKS.md's G-code sections).
+    fn default() -> Self {
+        Sampling::Fixed { step: 1e-5 }
+    }
+}
+
+impl Sampling {
+    /// Adaptive samples of at most 1 mm and 2° (BENCHMARKS.md, "Sampling
+    /// the path").
+    pub fn adaptive() -> Self {
+        Sampling::Adaptive {
+            max_step: 1e-3,
+            max_turn: 2f64.to_radians(),
+        }
+    }
+
+    /// Samples `path`.
+    ///
+    /// # Errors
+    /// `InvalidParameter` for a bound out of range.
+    pub fn sample(&self, path: &SmoothedPath) -> Result<Vec<PathSample>, ToolpathError> {
+        match *self {
+            Sampling::Fixed { step } => {
+                if !(step.is_finite() && step > 0.0) {
+                    return Err(ToolpathError::InvalidParameter {
+                        name: "sample step".to_string(),
+                        value: step,
+                        reason: "must be finite and > 0".to_string(),
+                    });
+                }
+                Ok(crate::samples::sample_path(path, step))
+            }
+            Sampling::Adaptive { max_step, max_turn } => {
+                sample_path_adaptive(path, max_step, max_turn)
+            }
+        }
+    }
+
+    /// The same sampling `factor` times finer (every bound divided by it).
+    pub fn finer(&self, factor: f64) -> Self {
+        match *self {
+            Sampling::Fixed { step } => Sampling::Fixed {
+                step: step / factor,
+            },
+            Sampling::Adaptive { max_step, max_turn } => Sampling::Adaptive {
+                max_step: max_step / factor,
+                max_turn: max_turn / factor,
+            },
+        }
+    }
+}

@@ -34,7 +34,7 @@ pub mod speed_limit;
 pub mod spline;
 pub mod vec3;
 
-pub use adaptive::sample_path_adaptive;
+pub use adaptive::{sample_path_adaptive, Sampling};
 pub use axis::AxisLimits;
 pub use baseline::{CornerMethod, NurbsSettings};
 pub use bezier::QuinticBezier;

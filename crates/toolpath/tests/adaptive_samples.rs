@@ -10,7 +10,7 @@ use support::{feed_limits, outlines, seed_000_limits};
 use kerf_toolpath::{
     bang_bang_under, check_plan, plan_feed_optimal, sample_path, sample_path_adaptive,
     smooth_polyline, smooth_polyline_with, AxisLimits, CornerMethod, FeedConstraints, FeedLimits,
-    PathSample, Piece, SmoothedPath, ToolpathError,
+    PathSample, Piece, Sampling, SmoothedPath, ToolpathError,
 };
 
 const STEP: f64 = 1e-3;
@@ -249,7 +249,26 @@ fn bad_bounds_are_refused() {
     ] {
         let e = sample_path_adaptive(&path, step, turn).unwrap_err();
         assert!(matches!(e, ToolpathError::InvalidParameter { .. }), "{e}");
+        let e = Sampling::Adaptive {
+            max_step: step,
+            max_turn: turn,
+        }
+        .sample(&path)
+        .unwrap_err();
+        assert!(matches!(e, ToolpathError::InvalidParameter { .. }), "{e}");
     }
+    for step in [0.0, -1e-5, f64::NAN, f64::INFINITY] {
+        let e = Sampling::Fixed { step }.sample(&path).unwrap_err();
+        assert!(matches!(e, ToolpathError::InvalidParameter { .. }), "{e}");
+    }
+    // Finer divides every bound.
+    assert_eq!(
+        Sampling::adaptive().finer(4.0),
+        Sampling::Adaptive {
+            max_step: 2.5e-4,
+            max_turn: 0.5f64.to_radians(),
+        }
+    );
 }
 
 /// Positions and derivatives by arc length (`derivatives_at`) on adaptive samples agree with
