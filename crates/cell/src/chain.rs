@@ -122,9 +122,9 @@ impl Chain {
     /// # Errors
     /// [`CellError::EffortLimit`] for an effort limit ≤ 0 or not finite;
     /// [`CellError::Inertia`] when a moving body has no mass (none of its links is in the
-    /// sidecar), when the sidecar names a link the URDF does not have, or a link on the
-    /// fixed base; [`CellError::CellFile`]-free: joint names unknown to the URDF in the
-    /// sidecar are [`CellError::JointMismatch`].
+    /// sidecar) or the sidecar names a link the URDF does not have;
+    /// [`CellError::JointMismatch`] when the sidecar names a joint that is not a movable
+    /// joint of the URDF. Links on the fixed base may have a mass (it is not simulated).
     pub fn build(model: &RobotModel, inertia: &InertiaFile) -> Result<Self, CellError> {
         let urdf = model.urdf();
         for spec in model.joints() {

@@ -92,8 +92,9 @@ fn irb6660_holds_a_stretched_pose_for_2_s_without_sag() {
     );
 }
 
-/// Tracking bound for a smooth (quintic) motion within the acceleration limits.
-const TRACK_BOUND: f64 = 1e-4;
+/// Tracking bound for a smooth (quintic) motion within the acceleration limits: 50 um or
+/// 50 urad (measured: at most 19 um and 32 urad on the laser cutter, 12 urad on the IRB 6660).
+const TRACK_BOUND: f64 = 5e-5;
 
 #[test]
 fn irb6660_tracks_a_smooth_motion_within_the_bound() {
