@@ -578,8 +578,8 @@ impl Cell {
             Mode::Dynamic => {
                 self.world.positions(&self.chain, &mut state.positions);
                 self.world.velocities(&mut state.velocities);
-                for j in 0..n {
-                    state.accelerations[j] = (state.velocities[j] - v_before[j]) / self.dt_physics;
+                for (j, v0) in v_before.iter().enumerate() {
+                    state.accelerations[j] = (state.velocities[j] - v0) / self.dt_physics;
                     state.tracking_error[j] = end.positions[j] - state.positions[j];
                 }
             }

@@ -128,8 +128,8 @@ fn case_1_plan_runs_in_the_cell_without_contact() {
                 "{mode:?} period {i}: {:?}",
                 state.contacts
             );
-            for j in 0..6 {
-                max_error[j] = max_error[j].max(state.tracking_error[j].abs());
+            for (m, e) in max_error.iter_mut().zip(&state.tracking_error) {
+                *m = m.max(e.abs());
             }
             if i % 5 == 0 {
                 let d = cell

@@ -38,6 +38,7 @@ fn run(
     let steps = (duration / dt).round() as usize;
     for i in 1..=steps {
         let state = cell.step(&command(i as f64 * dt), dt).unwrap();
+        #[allow(clippy::needless_range_loop)] // four vectors indexed alike
         for j in 0..n {
             err[j] = err[j].max(state.tracking_error[j].abs());
             effort[j] = effort[j].max(state.efforts[j].abs() / limits[j]);
@@ -107,13 +108,8 @@ fn irb6660_tracks_a_smooth_motion_within_the_bound() {
     assert!(!saturated);
     assert!(err.iter().all(|&e| e < TRACK_BOUND), "{err:?}");
     let end = &cell.state().positions;
-    for j in 0..6 {
-        assert!(
-            (end[j] - b[j]).abs() < TRACK_BOUND,
-            "joint {j}: {} vs {}",
-            end[j],
-            b[j]
-        );
+    for (j, (e, b)) in end.iter().zip(&b).enumerate() {
+        assert!((e - b).abs() < TRACK_BOUND, "joint {j}: {e} vs {b}");
     }
 }
 
