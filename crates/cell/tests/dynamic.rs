@@ -142,3 +142,24 @@ fn a_motion_beyond_the_drives_saturates_without_exceeding_the_limit() {
     // The limited drive falls behind: the error is far above the tracking bound.
     assert!(err[0] > 0.05, "{err:?}");
 }
+
+#[test]
+fn joint_limits_hold_against_a_command_beyond_them() {
+    let mut cell = shipped("laser_bpillar", Mode::Dynamic);
+    let a = cell.state().positions.clone();
+    let mut b = a.clone();
+    // q6's range is [-0.1, 0.02] m: command 0.05 m (the executor refuses such a goal; the
+    // simulated axis stops at its end anyway).
+    b[5] = 0.05;
+    let dt = 1.0 / cell.settings().control_rate_hz;
+    let mut highest: f64 = f64::NEG_INFINITY;
+    for i in 1..=500 {
+        let state = cell.step(&quintic(&a, &b, 1.0, i as f64 * dt), dt).unwrap();
+        highest = highest.max(state.positions[5]);
+    }
+    println!("q6 highest {highest} m");
+    assert!(highest <= 0.02 + 1e-5, "{highest}");
+    assert!(highest > 0.019, "{highest}");
+    // The drive pushes against the stop: its error is the 30 mm beyond.
+    assert!((cell.state().tracking_error[5] - 0.03).abs() < 1e-3);
+}
