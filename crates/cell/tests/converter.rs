@@ -54,3 +54,12 @@ fn every_moving_body_has_the_sidecar_mass() {
     let robot: f64 = masses.iter().sum::<f64>() - 57.5 + 400.0;
     assert!((robot - 1910.0).abs() < 1e-9, "{robot}");
 }
+
+#[test]
+fn a_cell_can_move_to_the_control_thread() {
+    fn send<T: Send>(_: &T) {}
+    let cell = shipped("laser_bpillar", Mode::Dynamic);
+    send(&cell);
+    let handle = std::thread::spawn(move || cell.state().positions.len());
+    assert_eq!(handle.join().unwrap(), 6);
+}
