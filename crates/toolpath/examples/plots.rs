@@ -12,7 +12,10 @@
 
 use std::path::PathBuf;
 
-use kerf_gcode::{read_program, Motion, ReaderSettings};
+#[allow(dead_code)] // the tests' shared data; this example uses some of it
+#[path = "../tests/support/mod.rs"]
+mod support;
+
 use kerf_toolpath::plot::pipeline_charts;
 use kerf_toolpath::{
     corner_metrics, plan_feed, sample_path, smooth_polyline, CurvatureLimits, FeedLimits,
@@ -30,17 +33,7 @@ fn main() {
     };
     let period = limits.curvature.interpolation_period;
     for name in ["w_shape", "dress", "torch", "rosette_dense_g64"] {
-        let file = root.join(format!("crates/gcode/data/programs/{name}.ngc"));
-        let text = std::fs::read_to_string(&file).unwrap();
-        let mut polyline = Vec::new();
-        for m in read_program(&text, ReaderSettings::default()).unwrap() {
-            if let Motion::Line { start, end, .. } = m {
-                if polyline.is_empty() {
-                    polyline.push(start);
-                }
-                polyline.push(end);
-            }
-        }
+        let polyline = support::program_polyline(name);
         let path = smooth_polyline(&polyline, 1e-4).unwrap();
         let samples = sample_path(&path, 1e-5);
         let plan = plan_feed(&samples, &limits).unwrap();

@@ -5,7 +5,7 @@
 
 #[allow(dead_code)] // the tests' shared data; this file uses some of it
 mod support;
-use support::{feed_limits, outlines, seed_000_limits};
+use support::{feed_limits, outlines, program_polyline, seed_000_limits};
 
 use kerf_toolpath::{
     bang_bang_under, check_plan, plan_feed_optimal, sample_path, sample_path_adaptive,
@@ -22,24 +22,9 @@ fn turn() -> f64 {
 
 /// The shipped G-code programs' G01 polylines \[m\].
 fn programs() -> Vec<(&'static str, Vec<[f64; 3]>)> {
-    use kerf_gcode::{read_program, Motion, ReaderSettings};
-    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
     ["w_shape", "dress", "torch", "rosette_dense_g64"]
         .into_iter()
-        .map(|name| {
-            let file = root.join(format!("crates/gcode/data/programs/{name}.ngc"));
-            let text = std::fs::read_to_string(&file).unwrap();
-            let mut polyline = Vec::new();
-            for m in read_program(&text, ReaderSettings::default()).unwrap() {
-                if let Motion::Line { start, end, .. } = m {
-                    if polyline.is_empty() {
-                        polyline.push(start);
-                    }
-                    polyline.push(end);
-                }
-            }
-            (name, polyline)
-        })
+        .map(|name| (name, program_polyline(name)))
         .collect()
 }
 

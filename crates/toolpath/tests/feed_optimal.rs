@@ -424,21 +424,9 @@ const PROGRAM_RATIO: [(&str, f64); 4] = [
 /// joints where κ ≈ 3·10⁻¹⁴ 1/m (where plan_feed once failed).
 #[test]
 fn every_limit_holds_on_the_programs() {
-    use kerf_gcode::{read_program, Motion, ReaderSettings};
-    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
     let limits = feed_limits();
     for name in ["w_shape", "dress", "torch", "rosette_dense_g64"] {
-        let file = root.join(format!("crates/gcode/data/programs/{name}.ngc"));
-        let text = std::fs::read_to_string(&file).unwrap();
-        let mut polyline = Vec::new();
-        for m in read_program(&text, ReaderSettings::default()).unwrap() {
-            if let Motion::Line { start, end, .. } = m {
-                if polyline.is_empty() {
-                    polyline.push(start);
-                }
-                polyline.push(end);
-            }
-        }
+        let polyline = support::program_polyline(name);
         let path = smooth_polyline(&polyline, 1e-4).unwrap();
         let samples = sample_path(&path, 1e-5);
         let c = FeedConstraints::new(limits);

@@ -66,3 +66,22 @@ pub fn outlines() -> Vec<(String, Vec<[f64; 3]>)> {
         })
         .collect()
 }
+
+/// The G01 polyline \[m\] of a shipped program (`crates/gcode/data/programs/{name}.ngc`): every
+/// line move's end after the first move's start.
+pub fn program_polyline(name: &str) -> Vec<[f64; 3]> {
+    use kerf_gcode::{read_program, Motion, ReaderSettings};
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
+    let file = root.join(format!("crates/gcode/data/programs/{name}.ngc"));
+    let text = std::fs::read_to_string(&file).unwrap();
+    let mut polyline = Vec::new();
+    for m in read_program(&text, ReaderSettings::default()).unwrap() {
+        if let Motion::Line { start, end, .. } = m {
+            if polyline.is_empty() {
+                polyline.push(start);
+            }
+            polyline.push(end);
+        }
+    }
+    polyline
+}
