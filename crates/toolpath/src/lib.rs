@@ -16,6 +16,7 @@ pub mod bezier;
 pub mod constraints;
 pub mod corner;
 pub mod corner_curve;
+pub mod corner_jerk;
 pub mod error;
 pub mod feed;
 pub mod feed_method;
@@ -37,7 +38,10 @@ pub use axis::AxisLimits;
 pub use baseline::{CornerMethod, NurbsSettings};
 pub use bezier::QuinticBezier;
 pub use constraints::FeedConstraints;
-pub use corner::{corner_transition, Binding, CornerShape, CornerTransition};
+pub use corner::{
+    corner_transition, corner_transition_with, Binding, CornerShape, CornerTransition,
+    ShapeObjective,
+};
 pub use corner_curve::CornerCurve;
 pub use error::ToolpathError;
 pub use feed::{plan_feed, FeedLimits, FeedPlan, FeedSample};
