@@ -42,9 +42,9 @@ fn main() {
         CornerMethod::Nurbs(NurbsSettings::default()),
     ];
     println!(
-        "| outline | limits | method | T_m (s) | T_lb (s) | κ_max (1/mm) | g_max (1/mm²) | θ_max (°) | a_rms (mm/s²) | j_rms (mm/s³) | max chord error (µm) | max deviation (mm) | smoothing (ms) | near-opt. T_m (s) | near-opt. T_m/T_lb | near-opt. j_rms (mm/s³) |"
+        "| outline | limits | method | T_m (s) | T_lb (s) | κ_max (1/mm) | g_max (1/mm²) | θ_max (°) | a_rms (mm/s²) | j_rms (mm/s³) | max chord error (µm) | max deviation (mm) | smoothing (ms) | near-opt. T_m (s) | near-opt. T_m/T_lb | near-opt. j_rms (mm/s³) | whole j_n: T_m (s) | whole j_n: T_m/T_lb | whole j_n: j_rms (mm/s³) |"
     );
-    println!("|---|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|");
+    println!("|---|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|");
     for path in &names {
         let text = std::fs::read_to_string(path).unwrap();
         let name = path.file_stem().unwrap().to_string_lossy().to_string();
@@ -87,12 +87,29 @@ fn main() {
                     limits.curvature.interpolation_period,
                     limits.curvature.servo.as_ref(),
                 );
+                // The near-optimal plan bounding the whole normal jerk v³ √(κ′² + κ⁴) (against the
+                // same T_lb).
+                let whole = plan_feed_optimal(
+                    &samples,
+                    &FeedConstraints {
+                        whole_normal_jerk: true,
+                        ..FeedConstraints::new(*limits)
+                    },
+                )
+                .unwrap();
+                let mw = metrics(
+                    &whole,
+                    &smoothed,
+                    &samples,
+                    limits.curvature.interpolation_period,
+                    limits.curvature.servo.as_ref(),
+                );
                 let g_max = smoothed
                     .corners()
                     .map(|c| sampled_max_jerk_norm(&c.curve, 4000))
                     .fold(0.0, f64::max);
                 println!(
-                    "| {name} | {limits_name} | {} | {:.3} | {:.3} | {:.3} | {:.1} | {:.2} | {:.1} | {:.0} | {:.3} | {:.4} | {:.2} | {:.3} | {:.3} | {:.0} |",
+                    "| {name} | {limits_name} | {} | {:.3} | {:.3} | {:.3} | {:.1} | {:.2} | {:.1} | {:.0} | {:.3} | {:.4} | {:.2} | {:.3} | {:.3} | {:.0} | {:.3} | {:.3} | {:.0} |",
                     method.name(),
                     m.time,
                     lb.time,
@@ -106,7 +123,10 @@ fn main() {
                     best * 1e3,
                     optimal.time,
                     optimal.time / lb.time,
-                    mo.rms_jerk * 1e3
+                    mo.rms_jerk * 1e3,
+                    whole.time,
+                    whole.time / lb.time,
+                    mw.rms_jerk * 1e3
                 );
             }
         }
