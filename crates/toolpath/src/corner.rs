@@ -48,9 +48,13 @@
 //!   (length binding) below the curvature shape's, for a κ_max 5–20 % and
 //!   8–67 % above the least (`tests/corner_jerk.rs` prints the ranges). Its
 //!   g is nearly constant along the curve (equiripple): at 150° g_max is
-//!   only 15 % above the least possible κ_max², at 90° 38 %, at 30° 3.8
-//!   times (there κ′ dominates; a G3 corner, κ′ = 0 at the ends, would be
-//!   the next step for small turns).
+//!   only 15 % above the least κ_max² of any shape, at 90° 38 %, at 30° 3.8
+//!   times, where κ′ dominates: κ must rise from 0 to its peak over half
+//!   the curve. A symmetric G3 septic (four control points on each line,
+//!   three free legs, the same deviation proof with weights C(7, k)/128)
+//!   was tried by a coordinate search at 30°, 90° and 150°: its best g_max ·
+//!   δ² was 0.0045, 0.119 and 0.648, the quintic's 0.0045, 0.119 and 0.642;
+//!   no gain, so it is not built.
 //! * **Curvature**: the least κ_max · δ or κ_max · L, [`SHAPES`]. Its short
 //!   end leg (c ≈ 0.02–0.7) makes the curvature rise steeply where the curve
 //!   leaves the line: κ′(0) = 0.48 a sin θ / (c³ s²) (the derivative of
