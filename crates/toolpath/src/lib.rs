@@ -1,6 +1,7 @@
 //! Tool path geometry of kerf's G-code front end (issue 14, items 2 and 3):
 //! corner smoothing of G01 polylines under a tolerance with
-//! curvature-continuous transitions ([`corner`], [`smooth`]), arc-length
+//! curvature-continuous transitions ([`corner`], [`smooth`]; their shape of
+//! least jerk norm √(κ′² + κ⁴) by default, [`corner_jerk`]), arc-length
 //! samples ([`samples`]) and the bang-bang time bound T_lb
 //! ([`lower_bound`]).
 //!
