@@ -67,7 +67,7 @@
 
 use crate::bezier::QuinticBezier;
 use crate::corner_curve::CornerCurve;
-use crate::corner_jerk::{max_jerk_norm, normalized_jerk};
+use crate::corner_jerk::{max_jerk_norm, normalized_jerk, PowerQuintic};
 use crate::error::{check_positive, ToolpathError};
 use crate::vec3::{add, dot, norm, scale, sub};
 
@@ -203,10 +203,12 @@ pub(crate) fn curve(
 /// sampled at [`CURVATURE_SAMPLES`] + 1 points, the best refined by golden
 /// section on its neighbouring interval.
 fn max_curvature(curve: &QuinticBezier) -> f64 {
+    let power = PowerQuintic::new(curve);
+    let curvature = |u: f64| power.curvature(u);
     let n = CURVATURE_SAMPLES;
     let mut best = (0.0, 0usize);
     for k in 0..=n {
-        let kappa = curve.curvature(0.5 * k as f64 / n as f64);
+        let kappa = curvature(0.5 * k as f64 / n as f64);
         if kappa > best.0 {
             best = (kappa, k);
         }
@@ -220,13 +222,13 @@ fn max_curvature(curve: &QuinticBezier) -> f64 {
     for _ in 0..24 {
         let m1 = hi - g * (hi - lo);
         let m2 = lo + g * (hi - lo);
-        if curve.curvature(m1) < curve.curvature(m2) {
+        if curvature(m1) < curvature(m2) {
             lo = m1;
         } else {
             hi = m2;
         }
     }
-    best.0.max(curve.curvature(0.5 * (lo + hi)))
+    best.0.max(curvature(0.5 * (lo + hi)))
 }
 
 /// The unit direction from `a` to `b` and the distance.

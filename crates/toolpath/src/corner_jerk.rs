@@ -82,14 +82,91 @@ pub fn jerk_norm(curve: &QuinticBezier, normal: [f64; 3], u: f64) -> f64 {
     (rate * rate + k.powi(4)).sqrt()
 }
 
+/// A quintic in the power basis, b(u) = Σ aₖ uᵏ with
+/// aₖ = C(5, k) Σᵢ (−1)^(k−i) C(k, i) Pᵢ (Farin section 5.7, the monomial
+/// form): its first three derivatives by Horner's rule, about three times
+/// cheaper than three de Casteljau runs.
+pub(crate) struct PowerQuintic {
+    a: [[f64; 3]; 6],
+}
+
+impl PowerQuintic {
+    pub(crate) fn new(curve: &QuinticBezier) -> Self {
+        const C: [[f64; 6]; 6] = [
+            [1.0, 0.0, 0.0, 0.0, 0.0, 0.0],
+            [1.0, 1.0, 0.0, 0.0, 0.0, 0.0],
+            [1.0, 2.0, 1.0, 0.0, 0.0, 0.0],
+            [1.0, 3.0, 3.0, 1.0, 0.0, 0.0],
+            [1.0, 4.0, 6.0, 4.0, 1.0, 0.0],
+            [1.0, 5.0, 10.0, 10.0, 5.0, 1.0],
+        ];
+        let p = &curve.control;
+        let a = std::array::from_fn(|k| {
+            std::array::from_fn(|d| {
+                let sum: f64 = (0..=k)
+                    .map(|i| {
+                        let sign = if (k - i) % 2 == 0 { 1.0 } else { -1.0 };
+                        sign * C[k][i] * p[i][d]
+                    })
+                    .sum();
+                C[5][k] * sum
+            })
+        });
+        Self { a }
+    }
+
+    /// (b′, b″, b‴) at u.
+    fn derivatives(&self, u: f64) -> ([f64; 3], [f64; 3], [f64; 3]) {
+        let a = &self.a;
+        let d1 = std::array::from_fn(|d| {
+            a[1][d]
+                + u * (2.0 * a[2][d]
+                    + u * (3.0 * a[3][d] + u * (4.0 * a[4][d] + u * 5.0 * a[5][d])))
+        });
+        let d2 = std::array::from_fn(|d| {
+            2.0 * a[2][d] + u * (6.0 * a[3][d] + u * (12.0 * a[4][d] + u * 20.0 * a[5][d]))
+        });
+        let d3 = std::array::from_fn(|d| 6.0 * a[3][d] + u * (24.0 * a[4][d] + u * 60.0 * a[5][d]));
+        (d1, d2, d3)
+    }
+
+    /// The curvature at u (Farin eq. 10.5); 0 where b′ = 0.
+    pub(crate) fn curvature(&self, u: f64) -> f64 {
+        let (d1, d2, _) = self.derivatives(u);
+        let speed = norm(d1);
+        if speed == 0.0 {
+            return 0.0;
+        }
+        norm(cross(d1, d2)) / (speed * speed * speed)
+    }
+
+    /// g at u about `normal` (as [`jerk_norm`]).
+    fn jerk_norm(&self, normal: [f64; 3], u: f64) -> f64 {
+        let (d1, d2, d3) = self.derivatives(u);
+        let speed2 = dot(d1, d1);
+        if speed2 == 0.0 {
+            return 0.0;
+        }
+        let speed = speed2.sqrt();
+        let speed3 = speed2 * speed;
+        let k = dot(cross(d1, d2), normal) / speed3;
+        let rate = (dot(cross(d1, d3), normal) / speed3 - 3.0 * k * dot(d1, d2) / speed2) / speed;
+        (rate * rate + k.powi(4)).sqrt()
+    }
+}
+
 /// The largest jerk norm g of a symmetric corner curve \[1/m²\]: the first
 /// half at [`JERK_SAMPLES`] + 1 parameters, the best refined by golden
 /// section on its neighbouring interval; 0 for a straight curve.
+///
+/// # Performance
+/// About 115 evaluations of the first three derivatives in the power basis.
 pub fn max_jerk_norm(curve: &QuinticBezier) -> f64 {
     let Some(m) = plane_normal(curve) else {
         return 0.0;
     };
-    let g = |u: f64| jerk_norm(curve, m, u);
+    let power = PowerQuintic::new(curve);
+    let g = |u: f64| power.jerk_norm(m, u);
     let n = JERK_SAMPLES;
     let mut best = (0.0, 0usize);
     for k in 0..=n {
