@@ -294,9 +294,10 @@ fn axis_limits_bind_and_hold() {
     let j = check.axis_jerk.iter().fold(0.0f64, |m, w| m.max(w.ratio));
     // The tangential budget takes half of each axis's acceleration and jerk (AxisLimits): on
     // a straight line along an axis the acceleration reaches exactly half, in the corners the
-    // jerk goes beyond.
+    // jerk goes beyond. (With kerf's jerk-shape corner the axis jerk here is 0.615 of its limit,
+    // 0.588 with main's limit curve of the adaptive sampling merged in.)
     assert!((a - 0.5).abs() < 1e-9, "a {a}");
-    assert!(j > 0.6, "j {j}");
+    assert!(j > 0.55, "j {j}");
     // The laser cutter's slides on an outline: never faster than without them.
     let (_, points) = outlines().into_iter().find(|(n, _)| n == "rose").unwrap();
     let path = smooth_polyline(&points, 1e-4).unwrap();
