@@ -1,7 +1,8 @@
 //! The G-code planner on the shipped programs (issue 14 figures): per program and machine, the
 //! plan's time, T_m along the path, T_lb and T_m/T_lb, the largest joint slowdown, the executed
 //! deviation, the trajectory's points and the planning time (median of 3); the corner methods
-//! on two programs; and a dense synthetic program of `--lines N` G01 moves (default 100 000,
+//! on three programs on the laser cutter (also with the feed plan bounding the whole normal jerk,
+//! `PlanSettings::feed_whole_normal_jerk`); and a dense synthetic program of `--lines N` G01 moves (default 100 000,
 //! [`Dense`]) planned whole, with its time and peak memory.
 //!
 //! `cargo bench -p kerf_gcodeplan --bench programs [-- --lines 1000000]`
@@ -157,13 +158,14 @@ impl Read for Dense {
 /// Seed 003 Table 2's comparison on the W-shape (and the dress and torch): per corner, the
 /// largest curvature and the exact deviation of seed 003's method 1 (five control points: two
 /// on each segment and the vertex, which is ICR's construction) "before" and of its NURBS corner
-/// optimised by the swarm "after", with the reduction, and kerf's corner beside them; δ = 0.1
+/// optimised by the swarm "after", with the reduction, and kerf's corner (its default jerk
+/// shape and its min-κ shape) beside them; δ = 0.1
 /// mm as the seed's case 1.
 fn corner_table(dir: &std::path::Path) {
     use kerf_gcode::{read_program, Motion, ReaderSettings};
     use kerf_toolpath::{corner_metrics, smooth_polyline_with, CornerMethod, NurbsSettings};
-    println!("| program | corner | turn [°] | ICR κ_max [1/mm] | NURBS κ_max [1/mm] | reduction | NURBS dev. [mm] | kerf κ_max [1/mm] |");
-    println!("|---|---:|---:|---:|---:|---:|---:|---:|");
+    println!("| program | corner | turn [°] | ICR κ_max [1/mm] | NURBS κ_max [1/mm] | reduction | NURBS dev. [mm] | kerf κ_max [1/mm] | kerf min-κ κ_max [1/mm] |");
+    println!("|---|---:|---:|---:|---:|---:|---:|---:|---:|");
     for name in ["w_shape", "dress", "torch"] {
         let text = std::fs::read_to_string(dir.join(format!("{name}.ngc"))).unwrap();
         let mut polyline: Vec<[f64; 3]> = Vec::new();
@@ -187,15 +189,23 @@ fn corner_table(dir: &std::path::Path) {
         let icr = metrics(CornerMethod::Icr);
         let nurbs = metrics(CornerMethod::Nurbs(NurbsSettings::default()));
         let kerf = metrics(CornerMethod::Kerf);
-        for (k, ((a, b), c)) in icr.iter().zip(&nurbs).zip(&kerf).enumerate() {
+        let kerf_kappa = metrics(CornerMethod::KerfCurvature);
+        for (k, (((a, b), c), d)) in icr
+            .iter()
+            .zip(&nurbs)
+            .zip(&kerf)
+            .zip(&kerf_kappa)
+            .enumerate()
+        {
             println!(
-                "| {name} | {k} | {:.1} | {:.3} | {:.3} | {:.1} % | {:.4} | {:.3} |",
+                "| {name} | {k} | {:.1} | {:.3} | {:.3} | {:.1} % | {:.4} | {:.3} | {:.3} |",
                 a.turn.to_degrees(),
                 a.max_curvature * 1e-3,
                 b.max_curvature * 1e-3,
                 100.0 * (a.max_curvature - b.max_curvature) / a.max_curvature,
                 b.approximation_error * 1e3,
-                c.max_curvature * 1e-3
+                c.max_curvature * 1e-3,
+                d.max_curvature * 1e-3
             );
         }
     }
@@ -233,20 +243,51 @@ fn main() {
         }
     }
     println!();
-    println!("| program | method | T [s] | T_run [s] | T_lb [s] | kappa_max [1/m] | slowdown | plan [ms] |");
-    println!("|---|---|---:|---:|---:|---:|---:|---:|");
-    for name in ["dress", "w_shape"] {
-        for method in ["kerf", "icr", "ccr", "nurbs"] {
+    println!("| program | method | whole j_n | T [s] | T_run [s] | T_lb [s] | kappa_max [1/m] | slowdown | plan [ms] |");
+    println!("|---|---|---|---:|---:|---:|---:|---:|---:|");
+    for name in ["dress", "torch", "w_shape"] {
+        for (method, whole) in [
+            ("kerf", false),
+            ("kerf", true),
+            ("kerf-curvature", false),
+            ("kerf-curvature", true),
+            ("icr", false),
+            ("icr", true),
+            ("ccr", false),
+            ("nurbs", false),
+        ] {
+            let file = dir.join(format!("{name}.ngc"));
             let request = GcodeRequest {
                 request_id: name.into(),
-                program_file: Some(dir.join(format!("{name}.ngc")).display().to_string()),
+                program_file: Some(file.display().to_string()),
                 method: Some(method.into()),
                 ..GcodeRequest::default()
             };
-            let (plan, took) = median_plan(&request, &laser);
+            // The feed plan bounding the whole normal jerk (`feed_whole_normal_jerk`): the
+            // request's settings and machine, planned by `plan_program`.
+            let (plan, took) = if whole {
+                let mut settings = request.settings().unwrap();
+                settings.feed_whole_normal_jerk = true;
+                let machine = laser.place(&request).unwrap();
+                let mut times = Vec::new();
+                let mut plan = None;
+                for _ in 0..3 {
+                    let t = Instant::now();
+                    let source = std::io::BufReader::new(std::fs::File::open(&file).unwrap());
+                    let p = plan_program(source, machine.as_ref(), &settings, &Budget::unlimited())
+                        .unwrap();
+                    times.push(t.elapsed().as_secs_f64());
+                    plan = Some(p);
+                }
+                times.sort_by(f64::total_cmp);
+                (plan.unwrap(), times[1])
+            } else {
+                median_plan(&request, &laser)
+            };
             let slowdown = plan.runs.iter().map(|r| r.slowdown).fold(1.0, f64::max);
             println!(
-                "| {name} | {method} | {:.3} | {:.3} | {:.3} | {:.0} | {:.2} | {:.1} |",
+                "| {name} | {method} | {} | {:.3} | {:.3} | {:.3} | {:.0} | {:.2} | {:.1} |",
+                if whole { "yes" } else { "no" },
                 plan.duration,
                 plan.feed_time,
                 plan.lower_bound,

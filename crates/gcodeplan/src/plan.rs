@@ -519,6 +519,7 @@ fn constraints<'a>(
             None
         },
         caps: varies.then_some(caps),
+        whole_normal_jerk: settings.feed_whole_normal_jerk,
     }
 }
 

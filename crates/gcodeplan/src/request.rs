@@ -64,9 +64,10 @@ impl MachineKind {
     }
 }
 
-/// The corner smoothing methods: kerf's quintic, the baselines ICR (Zhao, Zhu and Ding 2013),
-/// CCR (Xu and Sun 2018) and seed 003's NURBS corner by PSO ([`kerf_toolpath::CornerMethod`]).
-pub const METHODS: &[&str] = &["kerf", "icr", "ccr", "nurbs"];
+/// The corner smoothing methods: kerf's quintic (its shape of least jerk norm; `kerf-curvature`:
+/// of least κ_max), the baselines ICR (Zhao, Zhu and Ding 2013), CCR (Xu and Sun 2018) and seed
+/// 003's NURBS corner by PSO ([`kerf_toolpath::CornerMethod`]).
+pub const METHODS: &[&str] = &["kerf", "kerf-curvature", "icr", "ccr", "nurbs"];
 
 /// The feed planners ([`kerf_toolpath::FeedMethod`]).
 pub const FEED_METHODS: &[&str] = &["near-optimal", "constant-intervals"];
@@ -79,6 +80,7 @@ pub fn corner_method(name: &str) -> Result<kerf_toolpath::CornerMethod, GcodePla
     use kerf_toolpath::{CornerMethod, NurbsSettings};
     match name {
         "" | "kerf" => Ok(CornerMethod::Kerf),
+        "kerf-curvature" => Ok(CornerMethod::KerfCurvature),
         "icr" => Ok(CornerMethod::Icr),
         "ccr" => Ok(CornerMethod::Ccr),
         "nurbs" => Ok(CornerMethod::Nurbs(NurbsSettings::default())),

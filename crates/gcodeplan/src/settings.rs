@@ -66,6 +66,11 @@ pub struct PlanSettings {
     /// δ_i of the path, do not have, and bounding them costs 4x the time (W-shape 15.8 s
     /// against 3.8 s with the slowdown; BENCHMARKS.md).
     pub feed_axis_limits: bool,
+    /// Whether the feed plan bounds the whole jerk of the normal acceleration vector,
+    /// v³ √(κ′² + κ⁴), by the normal jerk limit instead of seed 003 eq. 21's v³ κ² alone
+    /// ([`kerf_toolpath::FeedConstraints::whole_normal_jerk`]; default `false`). T_lb stays the
+    /// bound under seed 003's limits, so T_m/T_lb shows what the extra bound costs.
+    pub feed_whole_normal_jerk: bool,
 }
 
 impl PlanSettings {
@@ -135,6 +140,7 @@ impl PlanSettings {
             corner_method: CornerMethod::Kerf,
             feed_method: FeedMethod::NearOptimal,
             feed_axis_limits: false,
+            feed_whole_normal_jerk: false,
         }
     }
 

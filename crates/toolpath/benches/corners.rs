@@ -22,8 +22,8 @@ mod support;
 
 use kerf_gcode::{read_points, PointUnit};
 use kerf_toolpath::{
-    bang_bang_under, metrics, plan_feed, sample_path, smooth_polyline_with, CornerMethod,
-    NurbsSettings,
+    bang_bang_under, corner_jerk::sampled_max_jerk_norm, metrics, plan_feed, plan_feed_optimal,
+    sample_path, smooth_polyline_with, CornerMethod, FeedConstraints, NurbsSettings,
 };
 
 /// Arc length between samples for planning \[m\] (as the pipeline bench).
@@ -36,14 +36,15 @@ fn main() {
     let seed003 = ("seed 003", 1e-4, support::feed_limits());
     let methods = [
         CornerMethod::Kerf,
+        CornerMethod::KerfCurvature,
         CornerMethod::Icr,
         CornerMethod::Ccr,
         CornerMethod::Nurbs(NurbsSettings::default()),
     ];
     println!(
-        "| outline | limits | method | T_m (s) | T_lb (s) | κ_max (1/mm) | θ_max (°) | a_rms (mm/s²) | j_rms (mm/s³) | max chord error (µm) | max deviation (mm) | smoothing (ms) |"
+        "| outline | limits | method | T_m (s) | T_lb (s) | κ_max (1/mm) | g_max (1/mm²) | θ_max (°) | a_rms (mm/s²) | j_rms (mm/s³) | max chord error (µm) | max deviation (mm) | smoothing (ms) | near-opt. T_m (s) | near-opt. T_m/T_lb | near-opt. j_rms (mm/s³) | whole j_n: T_m (s) | whole j_n: T_m/T_lb | whole j_n: j_rms (mm/s³) |"
     );
-    println!("|---|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|");
+    println!("|---|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|");
     for path in &names {
         let text = std::fs::read_to_string(path).unwrap();
         let name = path.file_stem().unwrap().to_string_lossy().to_string();
@@ -78,18 +79,54 @@ fn main() {
                     limits.curvature.interpolation_period,
                     limits.curvature.servo.as_ref(),
                 );
+                let optimal = plan_feed_optimal(&samples, &FeedConstraints::new(*limits)).unwrap();
+                let mo = metrics(
+                    &optimal,
+                    &smoothed,
+                    &samples,
+                    limits.curvature.interpolation_period,
+                    limits.curvature.servo.as_ref(),
+                );
+                // The near-optimal plan bounding the whole normal jerk v³ √(κ′² + κ⁴) (against the
+                // same T_lb).
+                let whole = plan_feed_optimal(
+                    &samples,
+                    &FeedConstraints {
+                        whole_normal_jerk: true,
+                        ..FeedConstraints::new(*limits)
+                    },
+                )
+                .unwrap();
+                let mw = metrics(
+                    &whole,
+                    &smoothed,
+                    &samples,
+                    limits.curvature.interpolation_period,
+                    limits.curvature.servo.as_ref(),
+                );
+                let g_max = smoothed
+                    .corners()
+                    .map(|c| sampled_max_jerk_norm(&c.curve, 4000))
+                    .fold(0.0, f64::max);
                 println!(
-                    "| {name} | {limits_name} | {} | {:.3} | {:.3} | {:.3} | {:.2} | {:.1} | {:.0} | {:.3} | {:.4} | {:.2} |",
+                    "| {name} | {limits_name} | {} | {:.3} | {:.3} | {:.3} | {:.1} | {:.2} | {:.1} | {:.0} | {:.3} | {:.4} | {:.2} | {:.3} | {:.3} | {:.0} | {:.3} | {:.3} | {:.0} |",
                     method.name(),
                     m.time,
                     lb.time,
                     m.max_curvature * 1e-3,
+                    g_max * 1e-6,
                     m.max_turning_angle.to_degrees(),
                     m.rms_acceleration * 1e3,
                     m.rms_jerk * 1e3,
                     m.max_chord_error * 1e6,
                     smoothed.max_deviation() * 1e3,
-                    best * 1e3
+                    best * 1e3,
+                    optimal.time,
+                    optimal.time / lb.time,
+                    mo.rms_jerk * 1e3,
+                    whole.time,
+                    whole.time / lb.time,
+                    mw.rms_jerk * 1e3
                 );
             }
         }

@@ -18,6 +18,11 @@ pub struct FeedConstraints<'a> {
     /// The programmed feed of every sample \[m/s\], one per sample; between
     /// two samples the lower of their two feeds holds (`None`: F only).
     pub caps: Option<&'a [f64]>,
+    /// Bound the whole jerk of the normal acceleration vector at constant
+    /// speed, v³ √(κ′² + κ⁴) (κ′ = dκ/ds, [`crate::corner_jerk`]), by the
+    /// normal jerk limit instead of seed 003 eq. 21's v³ κ² alone
+    /// ([`crate::limit_curve`](mod@crate::limit_curve)); `false`: eq. 21.
+    pub whole_normal_jerk: bool,
 }
 
 impl<'a> FeedConstraints<'a> {
@@ -27,6 +32,7 @@ impl<'a> FeedConstraints<'a> {
             limits,
             axes: None,
             caps: None,
+            whole_normal_jerk: false,
         }
     }
 

@@ -37,16 +37,37 @@
 //!
 //! # Choice of a, b, c and s
 //! s is the largest with e ≤ δ and (a+b+c) s ≤ the available length. The
-//! shape minimizes the curve's largest curvature for the binding
-//! constraint: [`SHAPES`] holds, per turning angle, the shape of least
-//! κ_max · δ (tolerance binding) and of least κ_max · L (length binding),
-//! found by the grid search of [`search_shape`] (`cargo run -p kerf_toolpath
-//! --example corner_shapes` prints the table; a test checks it against the
-//! search). Any positive shape satisfies the bound above: the table only
-//! makes the corner flatter.
+//! shape is chosen from a table per turning angle for the binding
+//! constraint, by one of two objectives ([`ShapeObjective`]):
+//! * **Jerk** (the default): the least largest jerk norm
+//!   g = √(κ′² + κ⁴) (κ′ = dκ/ds), g_max · δ² (tolerance binding) or
+//!   g_max · L² (length binding), [`JERK_SHAPES`]. At constant speed v the
+//!   Cartesian jerk along the corner is v³ g ([`crate::corner_jerk`]): this
+//!   shape allows the highest jerk-limited corner speed. Over the table's
+//!   rows its g_max is 8.9–40 times (tolerance binding) and 13–44 times
+//!   (length binding) below the curvature shape's, for a κ_max 5–20 % and
+//!   8–67 % above the least (`tests/corner_jerk.rs` prints the ranges). Its
+//!   g is nearly constant along the curve (equiripple): at 150° g_max is
+//!   only 15 % above the least κ_max² of any shape, at 90° 38 %, at 30° 3.8
+//!   times, where κ′ dominates: κ must rise from 0 to its peak over half
+//!   the curve. A symmetric G3 septic (four control points on each line,
+//!   three free legs, the same deviation proof with weights C(7, k)/128)
+//!   was tried by a coordinate search at 30°, 90° and 150°: its best g_max ·
+//!   δ² was 0.0045, 0.119 and 0.648, the quintic's 0.0045, 0.119 and 0.642;
+//!   no gain, so it is not built.
+//! * **Curvature**: the least κ_max · δ or κ_max · L, [`SHAPES`]. Its short
+//!   end leg (c ≈ 0.02–0.7) makes the curvature rise steeply where the curve
+//!   leaves the line: κ′(0) = 0.48 a sin θ / (c³ s²) (the derivative of
+//!   Farin eq. 10.5 at u = 0), which the jerk shape's longer leg avoids.
+//!
+//! Both tables come from the grid search of [`search_shape`] (`cargo run -p
+//! kerf_toolpath --example corner_shapes` prints them; a test checks them
+//! against the search). Any positive shape satisfies the bound above: the
+//! tables only choose among exact, proven corners.
 
 use crate::bezier::QuinticBezier;
 use crate::corner_curve::CornerCurve;
+use crate::corner_jerk::{max_jerk_norm, normalized_jerk, PowerQuintic};
 use crate::error::{check_positive, ToolpathError};
 use crate::vec3::{add, dot, norm, scale, sub};
 
@@ -91,6 +112,44 @@ pub enum Binding {
     Length,
 }
 
+/// What a corner's shape minimizes (module documentation).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum ShapeObjective {
+    /// The largest jerk norm √(κ′² + κ⁴) ([`crate::corner_jerk`]):
+    /// [`JERK_SHAPES`].
+    #[default]
+    Jerk,
+    /// The largest curvature κ_max: [`SHAPES`].
+    Curvature,
+}
+
+impl ShapeObjective {
+    /// The objective of a shape per unit of the binding constraint:
+    /// [`normalized_curvature`] or [`crate::corner_jerk::normalized_jerk`].
+    pub fn normalized(&self, turn: f64, shape: CornerShape, binding: Binding) -> f64 {
+        match self {
+            ShapeObjective::Curvature => normalized_curvature(turn, shape, binding),
+            ShapeObjective::Jerk => normalized_jerk(turn, shape, binding),
+        }
+    }
+
+    /// The objective of a built curve (its largest curvature or jerk norm).
+    fn of_curve(&self, c: &QuinticBezier, max_curvature: f64) -> f64 {
+        match self {
+            ShapeObjective::Curvature => max_curvature,
+            ShapeObjective::Jerk => max_jerk_norm(c),
+        }
+    }
+
+    /// The grid of [`search_shape`]: the largest b and c.
+    fn search_box(&self) -> (f64, f64) {
+        match self {
+            ShapeObjective::Curvature => (4.0, 2.0),
+            ShapeObjective::Jerk => (6.0, 4.0),
+        }
+    }
+}
+
 /// A corner's transition: kerf's ([`corner_transition`]) or a baseline's
 /// ([`crate::baseline`]).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -120,7 +179,13 @@ pub struct CornerTransition {
 }
 
 /// The curve of a shape at a scale.
-fn curve(v: [f64; 3], t1: [f64; 3], t2: [f64; 3], shape: CornerShape, s: f64) -> QuinticBezier {
+pub(crate) fn curve(
+    v: [f64; 3],
+    t1: [f64; 3],
+    t2: [f64; 3],
+    shape: CornerShape,
+    s: f64,
+) -> QuinticBezier {
     let (a, b, c) = (s, shape.b * s, shape.c * s);
     QuinticBezier {
         control: [
@@ -138,10 +203,12 @@ fn curve(v: [f64; 3], t1: [f64; 3], t2: [f64; 3], shape: CornerShape, s: f64) ->
 /// sampled at [`CURVATURE_SAMPLES`] + 1 points, the best refined by golden
 /// section on its neighbouring interval.
 fn max_curvature(curve: &QuinticBezier) -> f64 {
+    let power = PowerQuintic::new(curve);
+    let curvature = |u: f64| power.curvature(u);
     let n = CURVATURE_SAMPLES;
     let mut best = (0.0, 0usize);
     for k in 0..=n {
-        let kappa = curve.curvature(0.5 * k as f64 / n as f64);
+        let kappa = curvature(0.5 * k as f64 / n as f64);
         if kappa > best.0 {
             best = (kappa, k);
         }
@@ -155,13 +222,13 @@ fn max_curvature(curve: &QuinticBezier) -> f64 {
     for _ in 0..24 {
         let m1 = hi - g * (hi - lo);
         let m2 = lo + g * (hi - lo);
-        if curve.curvature(m1) < curve.curvature(m2) {
+        if curvature(m1) < curvature(m2) {
             lo = m1;
         } else {
             hi = m2;
         }
     }
-    best.0.max(curve.curvature(0.5 * (lo + hi)))
+    best.0.max(curvature(0.5 * (lo + hi)))
 }
 
 /// The unit direction from `a` to `b` and the distance.
@@ -236,8 +303,9 @@ pub(crate) fn corner_frame(
 ///
 /// # Returns
 /// `None` for a straight corner (θ < [`MIN_TURN`]); the transition
-/// otherwise, of the table shape ([`SHAPES`]) with the smaller largest
-/// curvature of the two bindings.
+/// otherwise, of the default objective's table shape
+/// ([`ShapeObjective::Jerk`]: [`JERK_SHAPES`]) with the smaller largest
+/// jerk norm of the two bindings.
 ///
 /// # Errors
 /// [`ToolpathError::InvalidParameter`] for δ or `available` not finite
@@ -253,14 +321,49 @@ pub fn corner_transition(
     tolerance: f64,
     available: f64,
 ) -> Result<Option<CornerTransition>, ToolpathError> {
+    corner_transition_with(
+        prev,
+        vertex,
+        next,
+        tolerance,
+        available,
+        ShapeObjective::default(),
+    )
+}
+
+/// The transition at the corner `prev` → `vertex` → `next` whose shape
+/// minimizes `objective`.
+///
+/// # Arguments
+/// * `tolerance`, `available` — as [`corner_transition`].
+/// * `objective` — the table the shape comes from ([`ShapeObjective`]).
+///
+/// # Returns
+/// `None` for a straight corner; the transition otherwise, of the table
+/// shape of the two bindings whose curve has the smaller objective.
+///
+/// # Errors
+/// As [`corner_transition`].
+///
+/// # Performance
+/// Two curvature searches, and for [`ShapeObjective::Jerk`] two jerk
+/// searches, of about 100 curve evaluations each.
+pub fn corner_transition_with(
+    prev: [f64; 3],
+    vertex: [f64; 3],
+    next: [f64; 3],
+    tolerance: f64,
+    available: f64,
+    objective: ShapeObjective,
+) -> Result<Option<CornerTransition>, ToolpathError> {
     let Some(CornerFrame { t1, t2, turn }) =
         corner_frame(prev, vertex, next, tolerance, available)?
     else {
         return Ok(None);
     };
-    let mut best: Option<CornerTransition> = None;
+    let mut best: Option<(f64, CornerTransition)> = None;
     for binding in [Binding::Tolerance, Binding::Length] {
-        let shape = table_shape(turn, binding);
+        let shape = objective.table_shape(turn, binding);
         let by_tolerance = 32.0 * tolerance / (turn.sin() * shape.deviation_weight());
         let by_length = available / shape.length_weight();
         let (s, bound) = if by_tolerance <= by_length {
@@ -269,6 +372,7 @@ pub fn corner_transition(
             (by_length, Binding::Length)
         };
         let c = curve(vertex, t1, t2, shape, s);
+        let max_curvature = max_curvature(&c);
         let t = CornerTransition {
             curve: CornerCurve::Quintic(c),
             vertex,
@@ -277,14 +381,15 @@ pub fn corner_transition(
             scale: s,
             tangent_length: s * shape.length_weight(),
             deviation: turn.sin() * s * shape.deviation_weight() / 32.0,
-            max_curvature: max_curvature(&c),
+            max_curvature,
             binding: bound,
         };
-        if best.is_none_or(|b| t.max_curvature < b.max_curvature) {
-            best = Some(t);
+        let value = objective.of_curve(&c, max_curvature);
+        if best.is_none_or(|(b, _)| value < b) {
+            best = Some((value, t));
         }
     }
-    Ok(best)
+    Ok(best.map(|(_, t)| t))
 }
 
 /// The largest curvature per unit of the binding constraint of a shape at a
@@ -304,60 +409,107 @@ pub fn normalized_curvature(turn: f64, shape: CornerShape, binding: Binding) -> 
     max_curvature(&c)
 }
 
-/// The grid search behind [`SHAPES`]: b and c on `steps` × `steps` points
-/// of (0, 4] × (0, 2], the shape of least [`normalized_curvature`], then a
-/// local grid of a tenth of the step around it.
+/// The grid search behind [`SHAPES`] ([`ShapeObjective::search_shape`] for
+/// [`ShapeObjective::Curvature`]).
 pub fn search_shape(turn: f64, binding: Binding, steps: usize) -> CornerShape {
-    let mut best = (f64::INFINITY, CornerShape { b: 1.0, c: 0.5 });
-    let scan = |b_lo: f64, b_hi: f64, c_lo: f64, c_hi: f64, best: &mut (f64, CornerShape)| {
-        for i in 0..=steps {
-            for j in 0..=steps {
-                let shape = CornerShape {
-                    b: b_lo + (b_hi - b_lo) * i as f64 / steps as f64,
-                    c: c_lo + (c_hi - c_lo) * j as f64 / steps as f64,
-                };
-                if shape.b <= 0.0 || shape.c <= 0.0 {
-                    continue;
-                }
-                let k = normalized_curvature(turn, shape, binding);
-                if k < best.0 {
-                    *best = (k, shape);
-                }
-            }
-        }
-    };
-    scan(0.0, 4.0, 0.0, 2.0, &mut best);
-    let (db, dc) = (4.0 / steps as f64, 2.0 / steps as f64);
-    let centre = best.1;
-    scan(
-        centre.b - db,
-        centre.b + db,
-        centre.c - dc,
-        centre.c + dc,
-        &mut best,
-    );
-    best.1
+    ShapeObjective::Curvature.search_shape(turn, binding, steps)
 }
 
-/// The table shape at a turning angle: linear interpolation in [`SHAPES`]
-/// (which holds θ = 5°, 10°, …, 175°; clamped outside).
+/// The curvature table's shape ([`ShapeObjective::table_shape`] for
+/// [`ShapeObjective::Curvature`]).
 pub fn table_shape(turn: f64, binding: Binding) -> CornerShape {
-    let deg = turn.to_degrees().clamp(5.0, 175.0);
-    let k = ((deg - 5.0) / 5.0).floor().min((SHAPES.len() - 2) as f64) as usize;
-    let f = (deg - 5.0) / 5.0 - k as f64;
-    let pick = |row: &[f64; 5]| match binding {
-        Binding::Tolerance => (row[1], row[2]),
-        Binding::Length => (row[3], row[4]),
-    };
-    let (b0, c0) = pick(&SHAPES[k]);
-    let (b1, c1) = pick(&SHAPES[k + 1]);
-    CornerShape {
-        b: b0 + f * (b1 - b0),
-        c: c0 + f * (c1 - c0),
+    ShapeObjective::Curvature.table_shape(turn, binding)
+}
+
+impl ShapeObjective {
+    /// The grid search behind [`SHAPES`] and [`JERK_SHAPES`]: b and c on
+    /// `steps` × `steps` points of (0, b_max] × (0, c_max] ((0, 4] × (0, 2]
+    /// for the curvature, (0, 6] × (0, 4] for the jerk, both times
+    /// min(1, (π − θ)/(π/6)) past 150°), the shape of least
+    /// [`ShapeObjective::normalized`], then the same count of points on a
+    /// local grid of ± one step around it.
+    pub fn search_shape(&self, turn: f64, binding: Binding, steps: usize) -> CornerShape {
+        let mut best = (f64::INFINITY, CornerShape { b: 1.0, c: 0.5 });
+        let scan = |b_lo: f64, b_hi: f64, c_lo: f64, c_hi: f64, best: &mut (f64, CornerShape)| {
+            for i in 0..=steps {
+                for j in 0..=steps {
+                    let shape = CornerShape {
+                        b: b_lo + (b_hi - b_lo) * i as f64 / steps as f64,
+                        c: c_lo + (c_hi - c_lo) * j as f64 / steps as f64,
+                    };
+                    if shape.b <= 0.0 || shape.c <= 0.0 {
+                        continue;
+                    }
+                    let k = self.normalized(turn, shape, binding);
+                    if k < best.0 {
+                        *best = (k, shape);
+                    }
+                }
+            }
+        };
+        // Near a reversal the best shapes shrink about as π − θ (the tables'
+        // last rows): the box with them, so that the grid resolves them.
+        let shrink = ((std::f64::consts::PI - turn) / std::f64::consts::FRAC_PI_6).clamp(1e-3, 1.0);
+        let (b_max, c_max) = self.search_box();
+        let (b_max, c_max) = (b_max * shrink, c_max * shrink);
+        scan(0.0, b_max, 0.0, c_max, &mut best);
+        let (db, dc) = (b_max / steps as f64, c_max / steps as f64);
+        let centre = best.1;
+        scan(
+            centre.b - db,
+            centre.b + db,
+            centre.c - dc,
+            centre.c + dc,
+            &mut best,
+        );
+        best.1
+    }
+
+    /// The table shape at a turning angle: linear interpolation in
+    /// [`SHAPES`] or [`JERK_SHAPES`] between their rows (θ = 5°, 10°, …,
+    /// 175°, then 176°, …, 179°, 179.5°, 179.8°, 179.9°, 179.95°; clamped
+    /// outside).
+    pub fn table_shape(&self, turn: f64, binding: Binding) -> CornerShape {
+        let table = match self {
+            ShapeObjective::Curvature => &SHAPES,
+            ShapeObjective::Jerk => &JERK_SHAPES,
+        };
+        let last = table.len() - 1;
+        let deg = turn.to_degrees().clamp(table[0][0], table[last][0]);
+        // The row at or below θ, at most the last but one.
+        let k = table
+            .partition_point(|row| row[0] <= deg)
+            .saturating_sub(1)
+            .min(last - 1);
+        let f = (deg - table[k][0]) / (table[k + 1][0] - table[k][0]);
+        let pick = |row: &[f64; 5]| match binding {
+            Binding::Tolerance => (row[1], row[2]),
+            Binding::Length => (row[3], row[4]),
+        };
+        let (b0, c0) = pick(&table[k]);
+        let (b1, c1) = pick(&table[k + 1]);
+        CornerShape {
+            b: b0 + f * (b1 - b0),
+            c: c0 + f * (c1 - c0),
+        }
     }
 }
 
+/// The turning angles of the rows of [`SHAPES`] and [`JERK_SHAPES`]
+/// \[degrees\]: every 5° to 175°, then closer towards the reversal.
+pub fn table_angles() -> Vec<f64> {
+    let mut out: Vec<f64> = (0..35).map(|k| 5.0 + 5.0 * k as f64).collect();
+    out.extend([176.0, 177.0, 178.0, 179.0, 179.5, 179.8, 179.9, 179.95]);
+    out
+}
+
 /// Per turning angle (degrees): the shape (b, c) of least κ_max · δ and of
-/// least κ_max · L ([`search_shape`] with 40 steps; generated by `cargo run
-/// -p kerf_toolpath --example corner_shapes`).
-pub const SHAPES: [[f64; 5]; 35] = include!("corner_shapes.in");
+/// least κ_max · L ([`ShapeObjective::search_shape`] with 40 steps;
+/// generated by `cargo run -p kerf_toolpath --example corner_shapes`).
+pub const SHAPES: [[f64; 5]; 43] = include!("corner_shapes.in");
+
+/// Per turning angle (degrees): the shape (b, c) of least g_max · δ² and of
+/// least g_max · L² (g = √(κ′² + κ⁴), [`crate::corner_jerk`];
+/// [`ShapeObjective::search_shape`] with 40 steps; generated by `cargo run
+/// -p kerf_toolpath --example corner_shapes -- jerk`).
+pub const JERK_SHAPES: [[f64; 5]; 43] = include!("corner_jerk_shapes.in");

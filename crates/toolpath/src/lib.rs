@@ -1,6 +1,7 @@
 //! Tool path geometry of kerf's G-code front end (issue 14, items 2 and 3):
 //! corner smoothing of G01 polylines under a tolerance with
-//! curvature-continuous transitions ([`corner`], [`smooth`]), arc-length
+//! curvature-continuous transitions ([`corner`], [`smooth`]; their shape of
+//! least jerk norm √(κ′² + κ⁴) by default, [`corner_jerk`]), arc-length
 //! samples ([`samples`]) and the bang-bang time bound T_lb
 //! ([`lower_bound`]).
 //!
@@ -17,6 +18,7 @@ pub mod bezier;
 pub mod constraints;
 pub mod corner;
 pub mod corner_curve;
+pub mod corner_jerk;
 pub mod error;
 pub mod feed;
 pub mod feed_method;
@@ -39,7 +41,10 @@ pub use axis::AxisLimits;
 pub use baseline::{CornerMethod, NurbsSettings};
 pub use bezier::QuinticBezier;
 pub use constraints::FeedConstraints;
-pub use corner::{corner_transition, Binding, CornerShape, CornerTransition};
+pub use corner::{
+    corner_transition, corner_transition_with, Binding, CornerShape, CornerTransition,
+    ShapeObjective,
+};
 pub use corner_curve::CornerCurve;
 pub use error::ToolpathError;
 pub use feed::{plan_feed, FeedLimits, FeedPlan, FeedSample};

@@ -36,6 +36,13 @@
 //!   [`PathSample::curvature_slope`] (every maximum of |κ′| is sampled)
 //!   times 1 + [`SLOPE_SLACK`].
 //!
+//! * with [`FeedConstraints::whole_normal_jerk`], the whole jerk of the
+//!   normal acceleration vector at constant speed, v³ √(κ′² + κ̂⁴) ≤ J_n
+//!   (Frenet–Serret, [`crate::corner_jerk`]; seed 003's eq. 21 is its κ⁴
+//!   term alone), with |κ′| the largest difference quotient of the node
+//!   curvatures over nodes k − 1 .. k + 2 of the same piece, times 1.5 (as
+//!   |x‴| above: an estimate from the samples, not a bound).
+//!
 //! The limit of a node is the lower of its two intervals'.
 
 use crate::adaptive::{MONOTONE_SLACK, SLOPE_SLACK};
@@ -168,6 +175,15 @@ pub fn limit_curve(samples: &[PathSample], constraints: &FeedConstraints<'_>) ->
         if kappa > free {
             v = v.min(curvature_speed(lim, kappa_lo, kappa, v, critical));
         }
+        if constraints.whole_normal_jerk {
+            let rate = THIRD_DERIVATIVE_FACTOR
+                * (lo..=hi)
+                    .map(|r| {
+                        (nodes[r + 1].kappa - nodes[r].kappa).abs() / (nodes[r + 1].s - nodes[r].s)
+                    })
+                    .fold(0.0, f64::max);
+            v = v.min(rate_jerk_speed(lim.normal_jerk, kappa, rate));
+        }
         let kc = chord_kappa[k].max(kappa);
         if kc > free {
             v = v.min(lim.chord_speed(1.0 / kc));
@@ -280,6 +296,18 @@ fn curvature_speed(
         v = jerk.cbrt();
     }
     v.min(lim.contour_speed_over(kappa_lo, kappa, critical))
+}
+
+/// The speed at which the normal acceleration vector's whole jerk at
+/// constant speed, v³ √(κ′² + κ⁴), equals `normal_jerk` (infinite on a
+/// straight interval).
+pub fn rate_jerk_speed(normal_jerk: f64, kappa: f64, rate: f64) -> f64 {
+    let g = (rate * rate + kappa.powi(4)).sqrt();
+    if g > 0.0 {
+        (normal_jerk / g).cbrt()
+    } else {
+        f64::INFINITY
+    }
 }
 
 /// |x‴| at every node, per axis, from the tangents: m_k = Δt/Δs ≈ κ n over

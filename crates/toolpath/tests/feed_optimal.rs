@@ -99,12 +99,14 @@ fn plan_and_check(
 /// 1.10; the gear is above it (1.125): its 24 teeth are 24 rises and falls between binding
 /// corners 7 mm apart, and each double S-curve at J_t = 20 m/s³ takes about 1.2 times the
 /// bang-bang time (0.161 s instead of 0.135 s from 27 to 24 mm/s over 6.8 mm), which no
-/// jerk-limited plan avoids.
+/// jerk-limited plan avoids. kerf's default corner is the jerk shape (`corner_jerk`): its
+/// κ_max is 5–20 % above the min-κ shape's, which seed 003's limits (v³κ² only) see, so the gear
+/// is at 1.141 and the rose at 1.039 with it (1.125 and 1.029 with the min-κ shape).
 const SEED_003_RATIO: [(&str, f64); 4] = [
     ("butterfly", 1.07),
-    ("gear", 1.13),
+    ("gear", 1.15),
     ("heart", 1.05),
-    ("rose", 1.035),
+    ("rose", 1.045),
 ];
 
 #[test]
@@ -292,9 +294,10 @@ fn axis_limits_bind_and_hold() {
     let j = check.axis_jerk.iter().fold(0.0f64, |m, w| m.max(w.ratio));
     // The tangential budget takes half of each axis's acceleration and jerk (AxisLimits): on
     // a straight line along an axis the acceleration reaches exactly half, in the corners the
-    // jerk goes beyond.
+    // jerk goes beyond. (With kerf's jerk-shape corner the axis jerk here is 0.615 of its limit,
+    // 0.588 with main's limit curve of the adaptive sampling merged in.)
     assert!((a - 0.5).abs() < 1e-9, "a {a}");
-    assert!(j > 0.6, "j {j}");
+    assert!(j > 0.55, "j {j}");
     // The laser cutter's slides on an outline: never faster than without them.
     let (_, points) = outlines().into_iter().find(|(n, _)| n == "rose").unwrap();
     let path = smooth_polyline(&points, 1e-4).unwrap();
@@ -382,8 +385,10 @@ fn check_plan_finds_a_broken_limit() {
         .into_iter()
         .find(|(n, _)| n == "butterfly")
         .unwrap();
+    // Samples every 100 µm: at 10 µm plan_feed breaks the normal jerk by only 1.3 % on kerf's
+    // default corner (κ_max 57/mm on the butterfly), and by 0.3 % on ICR's.
     let path = smooth_polyline(&points, 1e-4).unwrap();
-    let samples = sample_path(&path, 1e-5);
+    let samples = sample_path(&path, 1e-4);
     let c = FeedConstraints::new(feed_limits());
     let old = plan_feed(&samples, &c.limits).unwrap();
     let check = check_plan(&path, &samples, &old, &c, 0.002).unwrap();
@@ -494,6 +499,7 @@ fn random_polylines_hold_every_limit() {
             limits,
             axes: (case % 4 < 2).then_some(axes),
             caps: (case % 3 != 1).then_some(&caps[..]),
+            whole_normal_jerk: false,
         };
         let (plan, _) = plan_and_check(&path, &samples, &c);
         assert!(plan.time >= t_lb(&samples, &limits), "case {case}");

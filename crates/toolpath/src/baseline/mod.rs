@@ -19,7 +19,10 @@ pub mod pso;
 
 pub use nurbs::NurbsSettings;
 
-use crate::corner::{corner_frame, corner_transition, Binding, CornerTransition};
+use crate::corner::{
+    corner_frame, corner_transition, corner_transition_with, Binding, CornerTransition,
+    ShapeObjective,
+};
 use crate::corner_curve::CornerCurve;
 use crate::error::ToolpathError;
 use crate::spline::CubicSpline;
@@ -31,9 +34,13 @@ pub const CURVATURE_SAMPLES: usize = 64;
 /// How a corner is smoothed.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub enum CornerMethod {
-    /// kerf's curvature-optimal symmetric quintic ([`crate::corner`]).
+    /// kerf's symmetric quintic ([`crate::corner`]), its shape of least
+    /// jerk norm √(κ′² + κ⁴) ([`crate::corner::ShapeObjective::Jerk`]).
     #[default]
     Kerf,
+    /// kerf's symmetric quintic, its shape of least κ_max
+    /// ([`crate::corner::ShapeObjective::Curvature`]).
+    KerfCurvature,
     /// ICR ([`icr`]).
     Icr,
     /// CCR ([`ccr`]).
@@ -47,6 +54,7 @@ impl CornerMethod {
     pub fn name(&self) -> &'static str {
         match self {
             CornerMethod::Kerf => "kerf",
+            CornerMethod::KerfCurvature => "kerf min-κ",
             CornerMethod::Icr => "ICR",
             CornerMethod::Ccr => "CCR",
             CornerMethod::Nurbs(_) => "NURBS-PSO",
@@ -97,6 +105,14 @@ impl CornerMethod {
             };
         match self {
             CornerMethod::Kerf => corner_transition(prev, vertex, next, tolerance, available),
+            CornerMethod::KerfCurvature => corner_transition_with(
+                prev,
+                vertex,
+                next,
+                tolerance,
+                available,
+                ShapeObjective::Curvature,
+            ),
             CornerMethod::Icr => {
                 framed(&|t1, t2, turn| icr::transition(vertex, t1, t2, turn, tolerance, available))
             }
