@@ -176,12 +176,20 @@ pub fn limit_curve(samples: &[PathSample], constraints: &FeedConstraints<'_>) ->
             v = v.min(curvature_speed(lim, kappa_lo, kappa, v, critical));
         }
         if constraints.whole_normal_jerk {
-            let rate = THIRD_DERIVATIVE_FACTOR
-                * (lo..=hi)
-                    .map(|r| {
-                        (nodes[r + 1].kappa - nodes[r].kappa).abs() / (nodes[r + 1].s - nodes[r].s)
-                    })
-                    .fold(0.0, f64::max);
+            // |κ′| over the interval: the samples' slopes where every maximum
+            // of |κ′| is sampled (adaptive samples), else the largest
+            // difference quotient of the neighbouring intervals times 1.5.
+            let rate = if p.monotone {
+                p.slope.max(q.slope) * (1.0 + SLOPE_SLACK)
+            } else {
+                THIRD_DERIVATIVE_FACTOR
+                    * (lo..=hi)
+                        .map(|r| {
+                            (nodes[r + 1].kappa - nodes[r].kappa).abs()
+                                / (nodes[r + 1].s - nodes[r].s)
+                        })
+                        .fold(0.0, f64::max)
+            };
             v = v.min(rate_jerk_speed(lim.normal_jerk, kappa, rate));
         }
         let kc = chord_kappa[k].max(kappa);
