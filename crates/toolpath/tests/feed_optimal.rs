@@ -293,10 +293,11 @@ fn axis_limits_bind_and_hold() {
         .fold(0.0f64, |m, w| m.max(w.ratio));
     let j = check.axis_jerk.iter().fold(0.0f64, |m, w| m.max(w.ratio));
     // The tangential budget takes half of each axis's acceleration and jerk (AxisLimits): on
-    // a straight line along an axis the acceleration reaches exactly half, in the corners the
-    // jerk goes beyond. (With kerf's jerk-shape corner the axis jerk here is 0.615 of its limit,
-    // 0.588 with main's limit curve of the adaptive sampling merged in.)
-    assert!((a - 0.5).abs() < 1e-9, "a {a}");
+    // a straight line along an axis the acceleration reaches half, in the corners it may go
+    // beyond with the normal part (0.502 with kerf's jerk-shaped corner, where the min-kappa
+    // corner stayed at exactly half), and so does the jerk. (With the jerk-shaped corner the
+    // axis jerk here is 0.615 of its limit, 0.588 with the limit curve of the adaptive sampling.)
+    assert!(a >= 0.5 - 1e-9 && a <= 1.0 + 1e-9, "a {a}");
     assert!(j > 0.55, "j {j}");
     // The laser cutter's slides on an outline: never faster than without them.
     let (_, points) = outlines().into_iter().find(|(n, _)| n == "rose").unwrap();
