@@ -2,7 +2,7 @@
 //!
 //! ```sh
 //! kerf plan gcode FILE [--machine laser-cutter|irb6660] [--tolerance M]
-//!                      [--method kerf|icr|ccr|nurbs] [--feed-method near-optimal|constant-intervals]
+//!                      [--method kerf|kerf-curvature|icr|ccr|nurbs] [--feed-method near-optimal|constant-intervals]
 //!                      [--g RAD] [--origin X,Y,Z] [--plots DIR] [--out plan.json]
 //! ```
 //!
@@ -46,7 +46,7 @@ pub struct GcodeArgs {
     /// Largest distance of the executed tool tip from the programmed path (m).
     #[arg(long)]
     tolerance: Option<f64>,
-    /// Corner smoothing method: kerf, icr, ccr, nurbs.
+    /// Corner smoothing method: kerf, kerf-curvature, icr, ccr, nurbs.
     #[arg(long)]
     method: Option<String>,
     /// Feed planner: near-optimal, constant-intervals.

@@ -8,7 +8,7 @@
 //! tolerance: 1.0e-4            # m, default 1e-4
 //! ```
 //!
-//! Optional: `method` (`kerf`, `icr`, `ccr`, `nurbs`), `feed_method` (`near-optimal`,
+//! Optional: `method` (`kerf`, `kerf-curvature`, `icr`, `ccr`, `nurbs`), `feed_method` (`near-optimal`,
 //! `constant-intervals`), `limits` (any of `max_feed`, `tangential_acceleration`,
 //! `tangential_jerk`, `normal_acceleration`, `normal_jerk`, `chord_error`, `contour_error`,
 //! each replacing the machine's default), `rapid_feed`, `origin` (the program's zero in the

@@ -532,8 +532,10 @@ impl GcodeRequest {
     pub const MACHINE_LASER_CUTTER: &'static str = "laser-cutter";
     /// The ABB IRB 6660 milling cell of seed 004.
     pub const MACHINE_IRB6660: &'static str = "irb6660";
-    /// kerf's curvature-continuous quintic corner.
+    /// kerf's curvature-continuous quintic corner, its shape of least jerk norm.
     pub const METHOD_KERF: &'static str = "kerf";
+    /// kerf's quintic corner with its shape of least curvature.
+    pub const METHOD_KERF_CURVATURE: &'static str = "kerf-curvature";
     /// Inscribed cubic B-spline corner (ICR).
     pub const METHOD_ICR: &'static str = "icr";
     /// Circumscribed double cubic B-spline corner (CCR).
