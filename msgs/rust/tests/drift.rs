@@ -498,6 +498,7 @@ fn rust_constants() -> ConstantTable {
                 c_str("MACHINE_LASER_CUTTER", Gr::MACHINE_LASER_CUTTER),
                 c_str("MACHINE_IRB6660", Gr::MACHINE_IRB6660),
                 c_str("METHOD_KERF", Gr::METHOD_KERF),
+                c_str("METHOD_KERF_CURVATURE", Gr::METHOD_KERF_CURVATURE),
                 c_str("METHOD_ICR", Gr::METHOD_ICR),
                 c_str("METHOD_CCR", Gr::METHOD_CCR),
                 c_str("METHOD_NURBS", Gr::METHOD_NURBS),
