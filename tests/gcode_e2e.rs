@@ -137,7 +137,7 @@ fn a_program_runs_from_planner_through_executor_and_bad_ones_are_answered() {
             "method",
             "request_id: method\nmethod: spline\nprogram: \"G1 X1 F100\"\n".into(),
             GcodePlan::INVALID_REQUEST,
-            &["method 'spline'", "kerf, icr, ccr, nurbs"],
+            &["method 'spline'", "kerf, kerf-curvature, icr, ccr, nurbs"],
         ),
         (
             "drill",
