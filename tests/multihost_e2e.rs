@@ -219,6 +219,10 @@ fn case1_planned_on_one_host_runs_on_another() {
 
     // The plan and the trajectory (each carrying every point) came in over the veth.
     let received = after.0 - before.0;
+    println!(
+        "host A's veth received {received} B during the run ({trajectory_bytes} B of \
+         trajectory arrays per message)"
+    );
     assert!(
         received as usize > 2 * trajectory_bytes,
         "host A's veth received {received} B, less than the plan and trajectory ({} B each)",
