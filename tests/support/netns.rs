@@ -113,7 +113,7 @@ impl HostPair {
             Link::Switched => 2,
             Link::Routed => 3,
         };
-        for name in self.names[..hosts].to_vec() {
+        for name in self.names[..hosts].iter().cloned() {
             ip(&["netns", "add", &name])?;
             self.created.push(name);
         }
