@@ -30,6 +30,12 @@
 //!   through the public API. Writing SPDP datagrams by hand would compete with the
 //!   participant's own writer for sequence numbers.
 //!
+//! The internal mechanism is enough: a copy of RustDDS 0.15.1 whose event loop also put each
+//! peer's well-known SPDP ports (participant ids 0–11) into the SPDP writer's extra unicast
+//! destinations let two participants on subnets joined by a unicast-only router match and
+//! deliver within 0.44 s when each listed the other (not within 9 s when only one did). What
+//! is missing is a public option to do it.
+//!
 //! Accepting the variable and ignoring it would leave the hosts silently apart, so it is
 //! refused. The workaround is a network path that carries multicast between the cell's
 //! hosts — a dedicated interface or VLAN for the cell with `ROS_AUTOMATIC_DISCOVERY_RANGE=SUBNET`
