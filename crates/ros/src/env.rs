@@ -8,8 +8,39 @@
 //! | `ROS_DOMAIN_ID` | DDS domain, default 0. kerf accepts 0..=232, the range whose RTPS ports fit in 16 bits. |
 //! | `ROS_AUTOMATIC_DISCOVERY_RANGE` | `SUBNET` (default), `LOCALHOST` (loopback only), `OFF`, `SYSTEM_DEFAULT`. |
 //! | `ROS_LOCALHOST_ONLY` | deprecated in Jazzy; `1` means `LOCALHOST` when the range is not set. |
-//! | `ROS_STATIC_PEERS` | not supported (RustDDS has no static peer list): refused with an error. |
+//! | `ROS_STATIC_PEERS` | not supported: refused with an error (see below). |
 //! | `RMW_IMPLEMENTATION` | which RMW the *peers* use, so services and actions use their RPC mapping: unset or `rmw_fastrtps_cpp` / `rmw_fastrtps_dynamic_cpp` / `rmw_connextdds` → Enhanced (Jazzy's default), `rmw_cyclonedds_cpp` → Cyclone's mapping; anything else is refused. Topics are the same for every RMW. |
+//!
+//! # Why `ROS_STATIC_PEERS` is refused
+//!
+//! In Jazzy, `ROS_STATIC_PEERS` (addresses separated by `;`) makes the participant send its
+//! SPDP announcements by unicast to each peer's well-known discovery ports of the domain
+//! (7400 + 250·domain + 10 + 2·participant id), so hosts find each other where multicast is
+//! blocked. RustDDS 0.15.1, which ros2-client 0.12 uses, cannot be told to do that:
+//!
+//! * `DomainParticipantBuilder` has no peer or initial-locator option; its only knobs are the
+//!   interfaces (`with_only_networks`), `same_host_loopback` and socket buffer sizes.
+//! * The SPDP writer does have fixed extra unicast destinations
+//!   (`Writer::set_extra_unicast_destinations`), but the event loop fills them only with the
+//!   *localhost* SPDP ports (127.0.0.1, participant ids 0–11), and the writer lives in the
+//!   crate-private `rtps` module.
+//! * Announcing from outside is not possible either: a user `DataWriter` cannot take the
+//!   built-in SPDP writer's entity id, and `SpdpDiscoveredParticipantData`'s fields have
+//!   crate-private types (locators, builtin endpoint set), so an announcement cannot be built
+//!   through the public API. Writing SPDP datagrams by hand would compete with the
+//!   participant's own writer for sequence numbers.
+//!
+//! The internal mechanism is enough: a copy of RustDDS 0.15.1 whose event loop also put each
+//! peer's well-known SPDP ports (participant ids 0–11) into the SPDP writer's extra unicast
+//! destinations let two participants on subnets joined by a unicast-only router match and
+//! deliver within 0.44 s when each listed the other (not within 9 s when only one did). What
+//! is missing is a public option to do it.
+//!
+//! Accepting the variable and ignoring it would leave the hosts silently apart, so it is
+//! refused. The workaround is a network path that carries multicast between the cell's
+//! hosts — a dedicated interface or VLAN for the cell with `ROS_AUTOMATIC_DISCOVERY_RANGE=SUBNET`
+//! (`tests/multihost_e2e.rs` runs a cut across such a link) — or a unicast bridge between
+//! hosts that keeps DDS local on each (e.g. `zenoh-bridge-ros2dds`, not tested with kerf).
 
 use std::net::Ipv4Addr;
 
@@ -88,8 +119,11 @@ impl RosEnv {
             return Err(RosError::UnsupportedEnv {
                 variable: "ROS_STATIC_PEERS".into(),
                 value: peers,
-                reason: "RustDDS has no static peer list; unset it, or use \
-                         ROS_AUTOMATIC_DISCOVERY_RANGE=SUBNET"
+                reason: "RustDDS 0.15 has no static peer list (it announces itself by \
+                         unicast only to 127.0.0.1), so these peers could not be reached \
+                         without multicast; unset it and connect the hosts through a network \
+                         or dedicated interface that carries multicast, with \
+                         ROS_AUTOMATIC_DISCOVERY_RANGE=SUBNET (README, 'Across hosts')"
                     .into(),
             });
         }
@@ -225,7 +259,18 @@ mod tests {
         let err = env(&[("ROS_AUTOMATIC_DISCOVERY_RANGE", "localhost")]).unwrap_err();
         assert!(err.to_string().contains("LOCALHOST"), "{err}");
         assert!(env(&[("ROS_AUTOMATIC_DISCOVERY_RANGE", "OFF")]).is_err());
-        assert!(env(&[("ROS_STATIC_PEERS", "10.0.0.1")]).is_err());
+        let err = env(&[("ROS_STATIC_PEERS", "10.0.0.1;host-b")]).unwrap_err();
+        assert!(matches!(err, RosError::UnsupportedEnv { .. }), "{err}");
+        for needle in [
+            "10.0.0.1;host-b",
+            "no static peer list",
+            "multicast",
+            "SUBNET",
+        ] {
+            assert!(err.to_string().contains(needle), "{err} lacks {needle:?}");
+        }
+        // Blank means unset, as in Jazzy.
+        assert!(env(&[("ROS_STATIC_PEERS", " ")]).is_ok());
         let err = env(&[("RMW_IMPLEMENTATION", "rmw_zenoh_cpp")]).unwrap_err();
         assert!(
             err.to_string().contains("rmw_fastrtps_cpp, rmw_connextdds"),
