@@ -297,7 +297,7 @@ fn axis_limits_bind_and_hold() {
     // beyond with the normal part (0.502 with kerf's jerk-shaped corner, where the min-kappa
     // corner stayed at exactly half), and so does the jerk. (With the jerk-shaped corner the
     // axis jerk here is 0.615 of its limit, 0.588 with the limit curve of the adaptive sampling.)
-    assert!(a >= 0.5 - 1e-9 && a <= 1.0 + 1e-9, "a {a}");
+    assert!((0.5 - 1e-9..=1.0 + 1e-9).contains(&a), "a {a}");
     assert!(j > 0.55, "j {j}");
     // The laser cutter's slides on an outline: never faster than without them.
     let (_, points) = outlines().into_iter().find(|(n, _)| n == "rose").unwrap();
