@@ -311,7 +311,10 @@ fn main() {
         line: Vec::new(),
         at: 0,
     });
-    let settings = PlanSettings::laser_cutter().with_max_points(20_000_000);
+    // The program's header and footer lines come on top of its G01 lines.
+    let settings = PlanSettings::laser_cutter()
+        .with_max_points(20_000_000)
+        .with_max_lines(lines + 100);
     let plan = plan_program(source, &sheet, &settings, &Budget::unlimited());
     let took = t.elapsed().as_secs_f64();
     match plan {
