@@ -420,3 +420,38 @@ fn path_tolerances_are_judged_on_the_simulated_state() {
     // Efforts are the drives' in dynamic mode too.
     assert!(seen.states.iter().all(|s| s.effort.len() == 6));
 }
+
+/// `kerf demo cut` and `kerf demo mill`: plan → executor → simulated cell in one process; the
+/// goal succeeds with no contact and the report names time, tracking error and final state.
+#[test]
+fn kerf_demo_cut_and_mill_succeed_without_contact() {
+    for (what, mode) in [("cut", "dynamic"), ("mill", "kinematic")] {
+        let out = std::process::Command::new(env!("CARGO_BIN_EXE_kerf"))
+            .args(["demo", what, "--mode", mode])
+            .output()
+            .unwrap();
+        let text = String::from_utf8_lossy(&out.stdout);
+        assert!(
+            out.status.success(),
+            "{what}: {text}{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        for needle in [
+            "goal: SUCCEEDED",
+            "contacts: 0 periods",
+            "max tracking error",
+            "final state: positions",
+            "time: planned",
+        ] {
+            assert!(text.contains(needle), "{what}: {needle}: {text}");
+        }
+    }
+    // A bad physics rate is refused with the reason.
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_kerf"))
+        .args(["demo", "cut", "--physics-rate", "1100"])
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("not an integer multiple"), "{err}");
+}
