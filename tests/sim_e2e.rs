@@ -3,13 +3,15 @@
 //!
 //! * Case 1's plan runs in the cell with no contact and the goal succeeds; `/clock` and
 //!   `~/contacts` are published and `/joint_states` carries efforts.
-//! * A hand-made trajectory that drives the head into the part is aborted with the contact
+//! * Hand-made trajectories that drive the head into the part are aborted with the contact
 //!   named, and the penetration stays below the depth stated from the approach speed, one
-//!   control period of detection and the controlled stop.
+//!   control period of detection and the controlled stop: straight down (the C-axis housing
+//!   comes within the 2 mm threshold first), and the nozzle along its axis into the sheet
+//!   (the tip, a contact only when it touches, penetrates).
 //! * Path tolerances are checked in sim mode (dynamic cell): a path tolerance tighter than the
 //!   measured state's lag aborts the goal.
 //!
-//! Each test runs its own executor (in this process, own Context) on its own domain (140-142).
+//! Each test runs its own executor (in this process, own Context) on its own domain (140-143).
 #![allow(clippy::unwrap_used, clippy::expect_used)] // tests report failures by panicking
 
 use std::{
@@ -454,4 +456,72 @@ fn kerf_demo_cut_and_mill_succeed_without_contact() {
     assert_eq!(out.status.code(), Some(2));
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(err.contains("not an integer multiple"), "{err}");
+}
+
+/// The nozzle driven along its own axis (q6, the standoff axis) into the sheet at case 1's
+/// first CL point: the tip is a contact only when it touches (standoff allowance), so here the
+/// head really penetrates, and the stated depth bounds it.
+#[test]
+fn nozzle_driven_into_the_sheet_penetrates_less_than_the_stated_depth() {
+    let mut planner = Planner::new(LaserMachine::default_machine().unwrap()).unwrap();
+    let plan = planner.plan(&case1()).unwrap();
+    // 10 mm back from the cut's start along the tool axis (q6 up: C = M + q6 O).
+    let mut start = plan.positions[0];
+    start[5] += 0.010;
+    // Then 20 mm/s towards the sheet, 30 mm (20 mm past the CL point), within q6's -0.1 m.
+    let v = 0.02;
+    let length = (start[5] + 0.1 - 0.001).min(0.03);
+    assert!(length > 0.015, "q6 starts at {}", start[5]);
+    let ta = 0.2;
+    let (_, total) = approach(v, ta, length, 0.0);
+    let n = (total / 0.01).ceil() as usize;
+    let points = (0..=n)
+        .map(|k| {
+            let t = (k as f64 * 0.01).min(total);
+            let ((p, dp, ddp), _) = approach(v, ta, length, t);
+            let mut positions = start.to_vec();
+            positions[5] -= p;
+            let mut velocities = vec![0.0; 6];
+            velocities[5] = -dp;
+            let mut accelerations = vec![0.0; 6];
+            accelerations[5] = -ddp;
+            JointTrajectoryPoint {
+                positions,
+                velocities,
+                accelerations,
+                effort: vec![],
+                time_from_start: RosDuration::from_secs_f64(t).unwrap(),
+            }
+        })
+        .collect();
+    let trajectory = JointTrajectory {
+        joint_names: JOINTS.map(String::from).to_vec(),
+        points,
+        ..Default::default()
+    };
+    let urdf = format!("{ROOT}/urdf/laser_cutter.urdf");
+    let limits = format!("{ROOT}/urdf/laser_cutter_limits.yaml");
+    let robot = kerf_robot::RobotModel::from_files(urdf.as_ref(), Some(limits.as_ref())).unwrap();
+    let a6 = robot.executor_limits().unwrap()[5].max_acceleration;
+    // The stated depth: at most v * DT in the period the contact is found (the period
+    // before, the tip did not touch), then the controlled stop's v² / (2 a) along q6.
+    let bound = v * DT + v * v / (2.0 * a6);
+
+    let cell = SimCell::start(143, "kinematic", &start);
+    let id = cell.send(trajectory, &[]);
+    let mut seen = Seen::default();
+    let (status, result) = cell.result(id, &mut seen);
+    assert_eq!(status, GoalStatusEnum::Aborted, "{result:?}");
+    let msg = &result.error_string;
+    for needle in ["link 'nozzle'", "shape 'nozzle/0'", "'bpillar'", "depth"] {
+        assert!(msg.contains(needle), "{needle}: {msg}");
+    }
+    let (deepest, count) = seen.deepest();
+    println!("deepest penetration {deepest} m (bound {bound} m); {msg}");
+    assert!(count > 0, "no contact was published");
+    assert!(deepest > 0.0, "the tip never touched");
+    assert!(deepest <= bound, "penetration {deepest} m > {bound} m");
+    std::thread::sleep(Duration::from_millis(300));
+    let end = support::take_newest(&cell.states, QUICK, "joint state after the stop");
+    assert!(end.velocity.iter().all(|v| v.abs() < 1e-9), "{end:?}");
 }
