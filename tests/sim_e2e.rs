@@ -11,7 +11,7 @@
 //! * Path tolerances are checked in sim mode (dynamic cell): a path tolerance tighter than the
 //!   measured state's lag aborts the goal.
 //!
-//! Each test runs its own executor (in this process, own Context) on its own domain (140-143).
+//! Each test runs its own executor (in this process, own Context) on its own domain (140-144).
 #![allow(clippy::unwrap_used, clippy::expect_used)] // tests report failures by panicking
 
 use std::{
@@ -524,4 +524,57 @@ fn nozzle_driven_into_the_sheet_penetrates_less_than_the_stated_depth() {
     std::thread::sleep(Duration::from_millis(300));
     let end = support::take_newest(&cell.states, QUICK, "joint state after the stop");
     assert!(end.velocity.iter().all(|v| v.abs() < 1e-9), "{end:?}");
+}
+
+/// `kerf launch --sim --robot laser-cutter`: the executor on the simulated cell with the
+/// planners, in a child process; `/clock`, `~/contacts` and efforts on `/joint_states` arrive
+/// over DDS, and Ctrl-C ends it cleanly.
+#[test]
+fn kerf_launch_sim_starts_the_cell_and_the_planners() {
+    let mut command = std::process::Command::new(env!("CARGO_BIN_EXE_kerf"));
+    command
+        .args(["launch", "--sim", "--robot", "laser-cutter"])
+        .env("ROS_DOMAIN_ID", "144")
+        .env("ROS_AUTOMATIC_DISCOVERY_RANGE", "LOCALHOST")
+        .env_remove("ROS_STATIC_PEERS")
+        .env_remove("RMW_IMPLEMENTATION");
+    let (mut launch, mut lines) = support::Lines::spawn(command);
+    let ready = lines.wait_for("simulated cell", QUICK);
+    assert!(ready.contains("laser_bpillar.yaml"), "{ready}");
+
+    let env = support::loopback(144, ServiceMapping::Enhanced);
+    let mut client = support::client_node("launch_watch", &env);
+    let states = client
+        .subscription::<JointState>("/joint_states", JointState::ROS_TYPE, qos::state())
+        .unwrap();
+    let clock = client
+        .subscription::<Clock>("/clock", Clock::ROS_TYPE, qos::state())
+        .unwrap();
+    let contacts = client
+        .subscription::<CellContacts>(
+            "/trajectory_executor/contacts",
+            CellContacts::ROS_TYPE,
+            qos::state(),
+        )
+        .unwrap();
+    let s = support::take(&states, QUICK, "joint state");
+    assert_eq!(s.effort.len(), 6, "{s:?}");
+    let c0 = support::take(&clock, QUICK, "clock").clock.as_nanos();
+    let c1 = support::take(&clock, QUICK, "clock").clock.as_nanos();
+    assert!(c1 > c0, "{c0} then {c1}");
+    let contact = support::take(&contacts, QUICK, "contacts");
+    assert_eq!(contact.header.frame_id, "base_link");
+    // The planners run beside it (their plan writers are discovered).
+    support::wait_for_writer(&client, "/mjto_planner/cut_plan", QUICK, "the MJTO planner");
+    support::wait_for_writer(
+        &client,
+        "/gcode_planner/gcode_plan",
+        QUICK,
+        "the G-code planner",
+    );
+    drop((states, clock, contacts, client));
+
+    support::interrupt(&launch.0);
+    lines.wait_for("shutting down", QUICK);
+    support::assert_clean_exit(&mut launch.0, Duration::from_secs(20));
 }
