@@ -51,8 +51,8 @@
 //! motion (here: a controlled stop within the acceleration limits) and the robot holds.
 //!
 //! Every cycle follows ros2_control's read → update → write order: the measured state is read
-//! from the (mock) hardware, the executor computes the reference, the reference is written to
-//! the hardware and published on `~/joint_command`.
+//! from the hardware (mock or simulated cell), the executor computes the reference, the
+//! reference is written to the hardware and published on `~/joint_command`.
 
 pub mod action;
 pub mod config;
