@@ -14,6 +14,11 @@
 //! With `KERF_JITTER_RT=N`, the executor's control thread runs `SCHED_FIFO` at priority N
 //! (parameter `realtime_priority`; needs CAP_SYS_NICE).
 //!
+//! With `KERF_JITTER_SIM=kinematic` or `dynamic`, the executor drives the simulated cell of
+//! the IRB 6660 (`hardware: sim`, `urdf/cells/irb6660_plate.yaml`, physics 1 kHz) from all
+//! joints at 0 (so that the load trajectory is the same). Its `header.stamp`s are then
+//! simulated time, exactly one period apart: the arrival period is the figure to compare.
+//!
 //! Run: `cargo bench --bench joint_states_jitter`. Timings are reported, never asserted.
 #![allow(clippy::unwrap_used, clippy::expect_used)] // tests report failures by panicking
 
@@ -100,7 +105,18 @@ fn main() {
         .unwrap_or(5000);
     let env = support::loopback(97, ServiceMapping::Enhanced);
     let rt = std::env::var("KERF_JITTER_RT").unwrap_or_else(|_| "0".into());
-    let (stop, exec) = support::spawn_executor(&env, &[format!("realtime_priority:={rt}")]);
+    let mut params = vec![format!("realtime_priority:={rt}")];
+    let sim = std::env::var("KERF_JITTER_SIM").ok();
+    if let Some(mode) = &sim {
+        let cell = concat!(env!("CARGO_MANIFEST_DIR"), "/urdf/cells/irb6660_plate.yaml");
+        params.extend([
+            "hardware:=sim".to_string(),
+            format!("sim_cell:={cell}"),
+            format!("sim_mode:={mode}"),
+            support::initial_positions(&[0.0; 6]),
+        ]);
+    }
+    let (stop, exec) = support::spawn_executor(&env, &params);
     let mut sub_node = support::client_node("jitter_probe", &env);
     let sub = sub_node
         .subscription::<JointState>("/joint_states", JointState::ROS_TYPE, qos::state())
@@ -154,7 +170,11 @@ fn main() {
         .collect();
     drop(traj_pub);
     println!(
-        "joint_states jitter at 250 Hz over loopback ({} samples; {sent} trajectories of {} points sent during the run)",
+        "joint_states jitter at 250 Hz over loopback, {} ({} samples; {sent} trajectories of {} points sent during the run)",
+        match &sim {
+            Some(mode) => format!("simulated cell ({mode})"),
+            None => "mock hardware".to_string(),
+        },
         stamps.len(),
         heavy.points.len()
     );

@@ -5,6 +5,7 @@ ament packages, so they are started with ExecuteProcess and the usual --ros-args
 
     ros2 launch launch_scripts/kerf.launch.py robot:=irb6660
     ros2 launch launch_scripts/kerf.launch.py robot:=laser_cutter namespace:=/cell
+    ros2 launch launch_scripts/kerf.launch.py robot:=laser_cutter sim:=true sim_mode:=dynamic
 
 Arguments:
     robot       laser_cutter | irb6660 (selects urdf/<robot>.urdf and its limits YAML);
@@ -16,6 +17,9 @@ Arguments:
     params_file executor parameters (default launch_scripts/params/<robot>.yaml)
     kerf_root   the kerf source tree (default: the parent of this file's directory)
     profile     cargo profile whose binaries to run: release (default) or debug
+    sim         true: the executor drives the robot's simulated cell (hardware:=sim,
+                urdf/cells/laser_bpillar.yaml or irb6660_plate.yaml); default false (mock)
+    sim_mode    kinematic (default) or dynamic, with sim:=true
 
 Build first: cargo build --release --workspace
 The nodes honour ROS_DOMAIN_ID and ROS_AUTOMATIC_DISCOVERY_RANGE like any Jazzy node.
@@ -41,6 +45,21 @@ def _nodes(context):
         HERE, "params", f"{robot}.yaml"
     )
     urdf_dir = os.path.join(root, "urdf")
+    sim = LaunchConfiguration("sim").perform(context).lower()
+    if sim not in ("true", "false"):
+        raise RuntimeError(f"sim must be true or false, got {sim!r}")
+    sim_mode = LaunchConfiguration("sim_mode").perform(context)
+    if sim_mode not in ("kinematic", "dynamic"):
+        raise RuntimeError(f"sim_mode must be kinematic or dynamic, got {sim_mode!r}")
+    sim_params = []
+    if sim == "true":
+        # The simulated cell (issue 15): the executor publishes /clock and ~/contacts.
+        cell = "laser_bpillar" if robot == "laser_cutter" else "irb6660_plate"
+        sim_params = [
+            "-p", "hardware:=sim",
+            "-p", f"sim_cell:={os.path.join(urdf_dir, 'cells', cell + '.yaml')}",
+            "-p", f"sim_mode:={sim_mode}",
+        ]
     binary = os.path.join(root, "target", profile, "trajectory_executor")
     if not os.path.exists(binary):
         raise RuntimeError(f"{binary} not found: run 'cargo build --{profile} --workspace' in {root}")
@@ -54,7 +73,8 @@ def _nodes(context):
             "--params-file", params,
             "-p", f"urdf_file:={os.path.join(urdf_dir, robot + '.urdf')}",
             "-p", f"joint_limits_file:={os.path.join(urdf_dir, robot + '_limits.yaml')}",
-        ],
+        ]
+        + sim_params,
     )
     ns = namespace.rstrip("/")
 
@@ -101,6 +121,8 @@ def generate_launch_description():
             DeclareLaunchArgument("params_file", default_value=""),
             DeclareLaunchArgument("kerf_root", default_value=""),
             DeclareLaunchArgument("profile", default_value="release"),
+            DeclareLaunchArgument("sim", default_value="false"),
+            DeclareLaunchArgument("sim_mode", default_value="kinematic"),
             OpaqueFunction(function=_nodes),
         ]
     )

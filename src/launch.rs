@@ -1,6 +1,8 @@
 //! `kerf launch`: every node in one process, each with its own Context and thread: the
 //! trajectory executor, and with `--with-planner` the robot's planners (laser cutter: the MJTO
 //! planner; IRB 6660: the milling planner; both: the G-code planner for that machine).
+//! `--sim` runs the executor on the robot's simulated cell (`hardware: sim`, issue 15) and
+//! starts the planners too.
 
 use std::path::PathBuf;
 
@@ -25,6 +27,14 @@ impl Robot {
             Robot::Irb6660 => "irb6660",
         }
     }
+
+    /// The robot's shipped cell file, `urdf/cells/<cell>.yaml`.
+    fn cell(self) -> &'static str {
+        match self {
+            Robot::LaserCutter => "laser_bpillar",
+            Robot::Irb6660 => "irb6660_plate",
+        }
+    }
 }
 
 /// Arguments of `kerf launch`.
@@ -40,6 +50,12 @@ pub struct LaunchArgs {
     /// `~/joint_trajectory` reaches the executor only when remapped (README).
     #[arg(long)]
     with_planner: bool,
+    /// Run the executor on the robot's simulated cell (`hardware: sim`, `sim_cell` the
+    /// shipped `urdf/cells/laser_bpillar.yaml` or `irb6660_plate.yaml`; `-p sim_mode:=dynamic`
+    /// and `-p sim_physics_rate:=…` after `--ros-args`), and start the planners as
+    /// `--with-planner` does.
+    #[arg(long)]
+    sim: bool,
     /// Directory holding the robot descriptions (default: `$KERF_URDF_DIR`, else the `urdf/`
     /// of the kerf data directory: `$KERF_DATA_DIR`, the share directory beside the binary,
     /// the source tree kerf was built from).
@@ -131,6 +147,21 @@ fn gcode_machine(robot: Robot) -> &'static str {
     }
 }
 
+/// The executor parameters of `--sim`: the simulated hardware and the robot's cell file in
+/// `dir/cells/`.
+fn sim_defaults(dir: &std::path::Path, robot: Robot) -> [(&'static str, String); 2] {
+    [
+        ("hardware", "sim".to_string()),
+        (
+            "sim_cell",
+            dir.join("cells")
+                .join(format!("{}.yaml", robot.cell()))
+                .display()
+                .to_string(),
+        ),
+    ]
+}
+
 /// Runs `kerf launch` until Ctrl-C or until a node fails.
 pub fn run(a: LaunchArgs) -> Result<(), String> {
     let mut args = RosArgs::parse(a.ros_args.iter().cloned()).map_err(|e| e.to_string())?;
@@ -154,14 +185,15 @@ pub fn run(a: LaunchArgs) -> Result<(), String> {
                 .to_string(),
         ),
     ];
-    let defaults: Vec<(&str, String)> = if a.with_planner {
+    let with_planner = a.with_planner || a.sim;
+    let mut defaults: Vec<(&str, String)> = defaults.to_vec();
+    if with_planner {
         // Only the G-code planner reads it: without it, no node of the launch would.
-        let mut d = defaults.to_vec();
-        d.push(("machine", gcode_machine(a.robot).to_string()));
-        d
-    } else {
-        defaults.to_vec()
-    };
+        defaults.push(("machine", gcode_machine(a.robot).to_string()));
+    }
+    if a.sim {
+        defaults.extend(sim_defaults(&dir, a.robot));
+    }
     for (i, (name, value)) in defaults.into_iter().enumerate() {
         args.params.insert(
             i,
@@ -177,7 +209,7 @@ pub fn run(a: LaunchArgs) -> Result<(), String> {
         kerf_trajectory_executor::KNOWN_PARAMS,
         |a, e, s| kerf_trajectory_executor::run(a, e, s).map_err(|e| e.to_string()),
     )];
-    if a.with_planner {
+    if with_planner {
         nodes.push(planner_node(a.robot));
         nodes.push(gcode_node());
     }
@@ -215,6 +247,36 @@ pub fn run(a: LaunchArgs) -> Result<(), String> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn sim_names_the_shipped_cell_of_each_robot() {
+        let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("urdf");
+        for robot in [Robot::LaserCutter, Robot::Irb6660] {
+            let [(h, hv), (c, cv)] = sim_defaults(&dir, robot);
+            assert_eq!((h, hv.as_str()), ("hardware", "sim"));
+            assert_eq!(c, "sim_cell");
+            assert!(std::path::Path::new(&cv).is_file(), "{cv}");
+            // The cell is the robot's: its executor configuration loads it.
+            let stem = robot.stem();
+            let args = RosArgs::parse([
+                "--ros-args".to_string(),
+                "-p".into(),
+                format!("urdf_file:={}/{stem}.urdf", dir.display()),
+                "-p".into(),
+                format!("joint_limits_file:={}/{stem}_limits.yaml", dir.display()),
+                "-p".into(),
+                "hardware:=sim".into(),
+                "-p".into(),
+                format!("sim_cell:={cv}"),
+            ])
+            .unwrap();
+            let params = args
+                .params_for("/trajectory_executor", "trajectory_executor")
+                .unwrap();
+            let cfg = kerf_trajectory_executor::NodeConfig::from_params(&params).unwrap();
+            kerf_trajectory_executor::hardware::Hardware::build(&cfg).unwrap();
+        }
+    }
 
     #[test]
     fn robots_are_named_as_in_the_launch_file() {

@@ -13,9 +13,13 @@
 //!   failure).
 //! * `kerf train mill --out FILE` trains the DDPG milling policy of seed 004 (exit code 2 on
 //!   failure).
+//! * `kerf demo cut|mill [--mode kinematic|dynamic]` runs a plan on the simulated cell in this
+//!   process: request → planner → executor → cell (issue 15; exit code 2 unless the goal
+//!   succeeds).
 //! * `kerf lobes --segment N --g RAD` draws the stability lobes and the feed × speed chatter
 //!   map of a milling state (issue 4) and prints a table (exit code 2 on failure).
 
+mod demo;
 mod echo;
 mod launch;
 mod lobes;
@@ -56,6 +60,10 @@ enum Command {
     Plan(plan_cut::PlanArgs),
     /// Stability lobes and feed map of a milling state (`kerf lobes --segment 50 --g 0`).
     Lobes(lobes::LobesArgs),
+    /// Run a plan on the simulated cell in this process: `kerf demo cut`, `kerf demo mill`
+    /// (request → planner → executor → cell; prints time, tracking error, contacts, final
+    /// state).
+    Demo(demo::DemoArgs),
     /// Train a planner's policy (`kerf train mill --out policy.safetensors`).
     Train(Box<train_mill::TrainArgs>),
 }
@@ -78,6 +86,7 @@ fn main() -> ExitCode {
         Command::Plan(a) => plan_cut::run(a),
         Command::Lobes(a) => lobes::run(a),
         Command::Train(a) => train_mill::run(*a),
+        Command::Demo(a) => demo::run(a),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

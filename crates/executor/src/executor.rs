@@ -348,6 +348,39 @@ impl Executor {
         Ok(())
     }
 
+    /// A fault found outside the executor (e.g. a contact reported by a simulated cell):
+    /// brings a moving reference to a controlled stop (see [`StopProfile`]; a stop already in
+    /// progress continues) and aborts the active goal, if any, with `error_code` and
+    /// `message`.
+    ///
+    /// [`Outcome::Aborted`] is reported by the next [`Executor::update`], as for a path
+    /// tolerance violation.
+    ///
+    /// # Returns
+    /// The aborted goal, if one was active.
+    pub fn fault(
+        &mut self,
+        now: f64,
+        error_code: i32,
+        message: String,
+    ) -> Result<Option<GoalId>, ExecutorError> {
+        let t = self.request_time("now", now)?;
+        if matches!(self.motion, Motion::Trajectory(_)) && self.is_moving(t) {
+            self.start_stop(t);
+        }
+        let Some(goal) = self.active.take() else {
+            return Ok(None);
+        };
+        self.pending.push(GoalEvent {
+            id: goal.id,
+            outcome: Outcome::Aborted {
+                error_code,
+                message,
+            },
+        });
+        Ok(Some(goal.id))
+    }
+
     fn start_stop(&mut self, t: f64) {
         let state = self.commanded_at(t);
         self.replace_motion(Motion::Stop(StopProfile::new(&self.limits, &state, t)));

@@ -677,3 +677,56 @@ fn finishing_shares_segments_and_replaced_trajectories_are_handed_back() {
     assert!(second.shares_segments_with(&b));
     assert!(exec.take_retired().is_none());
 }
+
+#[test]
+fn fault_aborts_with_its_message_and_stops_within_limits() {
+    let limits = limits6();
+    let mut exec = executor(&limits, ExecutorConfig::default(), 0.0);
+    let mut hw = MockHardware::new(vec![0.0; 6]);
+    let big: Vec<f64> = TARGET.iter().map(|p| 3.0 * p).collect();
+    let id = exec
+        .submit(
+            &min_jerk_request(&[0.0; 6], &big, 2.0, 10),
+            &GoalTolerances::default(),
+            0.0,
+        )
+        .unwrap();
+    let before = run(&mut exec, &mut hw, 0.0, 1.0);
+    let message = "contact: nozzle/0 with bpillar, depth 0.3 mm".to_string();
+    let aborted = exec.fault(1.0, PATH_TOLERANCE_VIOLATED, message.clone());
+    assert_eq!(aborted.unwrap(), Some(id));
+    assert_eq!(exec.active_goal(), None);
+    // A second fault during the stop aborts nothing and keeps the stop going.
+    assert_eq!(
+        exec.fault(1.0, PATH_TOLERANCE_VIOLATED, "again".into())
+            .unwrap(),
+        None
+    );
+    let after = run(&mut exec, &mut hw, 1.0, 2.0);
+    assert_eq!(
+        events(&after),
+        vec![(
+            after[0].time,
+            GoalEvent {
+                id,
+                outcome: Outcome::Aborted {
+                    error_code: PATH_TOLERANCE_VIOLATED,
+                    message
+                }
+            }
+        )]
+    );
+    let mut all = before;
+    all.extend(after.iter().cloned());
+    assert_continuous(&all);
+    let last = &after.last().unwrap().reference;
+    assert!(last.velocities.iter().all(|v| *v == 0.0));
+    assert!(!exec.is_moving(2.0));
+    // At rest and idle a fault changes nothing.
+    assert_eq!(
+        exec.fault(2.0, PATH_TOLERANCE_VIOLATED, "idle".into())
+            .unwrap(),
+        None
+    );
+    assert!(!exec.is_moving(2.1));
+}

@@ -13,7 +13,7 @@
 //!
 //! Module layout follows the ROS 2 packages: [`builtin_interfaces`],
 //! [`std_msgs`], [`geometry_msgs`], [`trajectory_msgs`], [`sensor_msgs`],
-//! [`control_msgs`]; kerf's own interfaces are in [`msg`] and [`srv`].
+//! [`control_msgs`], [`rosgraph_msgs`]; kerf's own interfaces are in [`msg`] and [`srv`].
 //! Every mirror implements [`RosType`]. With the `ros2` feature every mirror
 //! also implements `ros2_client::Message`.
 //!
@@ -27,6 +27,7 @@ pub mod geometry_msgs;
 pub mod idl;
 pub mod msg;
 mod ros_type;
+pub mod rosgraph_msgs;
 pub mod sensor_msgs;
 pub mod srv;
 pub mod std_msgs;

@@ -2,7 +2,7 @@
 //! [`TrajectoryStatus`], the MJTO planner's [`CutRequest`] / [`CutPlan`] (with [`CutRto`],
 //! [`CutMetrics`], [`CutCollision`]) and the milling planner's [`MillRequest`] / [`MillPlan`]
 //! (with [`MillSegment`]) and the G-code planner's [`GcodeRequest`] / [`GcodePlan`] (with
-//! [`GcodeToolEvent`]).
+//! [`GcodeToolEvent`]), and the simulated cell's [`CellContacts`] (with [`CellContact`]).
 
 use serde::{Deserialize, Serialize};
 
@@ -175,6 +175,36 @@ pub struct CutMetrics {
     pub colliding_samples: u32,
 }
 impl_ros_type!(CutMetrics, "kerf_msgs", msg, "CutMetrics");
+
+/// `kerf_msgs/msg/CellContact`: one contact of the simulated cell (`kerf_cell`): a robot
+/// shape nearer to a scene object than the contact threshold, or inside it.
+#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
+pub struct CellContact {
+    /// The robot link (URDF name).
+    pub robot_link: String,
+    /// The robot shape: `<link>/<collision index>` or a tool shape's name.
+    pub robot_shape: String,
+    /// The scene object.
+    pub scene_object: String,
+    /// Signed distance (m): > 0 a gap below the threshold, < 0 a penetration.
+    pub distance: f64,
+    /// Penetration depth `max(0, -distance)` (m).
+    pub depth: f64,
+    /// The robot shape's point nearest to (or deepest in) the object, base frame (m).
+    pub position: Point,
+}
+impl_ros_type!(CellContact, "kerf_msgs", msg, "CellContact");
+
+/// `kerf_msgs/msg/CellContacts`: the contacts of the simulated cell in one control period,
+/// published by the trajectory executor in sim mode on `~/contacts` every cycle.
+#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
+pub struct CellContacts {
+    /// `stamp`: simulated time at the end of the period; `frame_id`: the robot's base link.
+    pub header: Header,
+    /// The contacts; empty when none.
+    pub contacts: Vec<CellContact>,
+}
+impl_ros_type!(CellContacts, "kerf_msgs", msg, "CellContacts");
 
 /// `kerf_msgs/msg/CutCollision`: one rejected sample of a [`CutPlan`] with status
 /// [`COLLISION`](CutPlan::COLLISION).

@@ -17,15 +17,32 @@ pub const KNOWN_PARAMS: &[&str] = &[
     "initial_positions",
     "start_tolerance",
     "realtime_priority",
+    "hardware",
+    "sim_cell",
+    "sim_mode",
+    "sim_physics_rate",
     "constraints.*",
     "hardware.*",
 ];
+
+/// The simulated cell's settings (`hardware: sim`).
+#[derive(Debug, Clone, PartialEq)]
+pub struct SimConfig {
+    /// The cell file (`sim_cell`), e.g. `urdf/cells/laser_bpillar.yaml`.
+    pub cell_file: PathBuf,
+    /// Kinematic or dynamic (`sim_mode`).
+    pub mode: kerf_cell::Mode,
+    /// Physics rate (Hz, `sim_physics_rate`): an integer multiple of the control rate.
+    pub physics_rate: f64,
+}
 
 /// Everything the node needs, checked.
 #[derive(Debug, Clone)]
 pub struct NodeConfig {
     /// The robot.
     pub robot: RobotModel,
+    /// The URDF file the robot was loaded from (`urdf_file`).
+    pub urdf_file: PathBuf,
     /// Joint limits in model order (from the URDF and the limits YAML).
     pub limits: Vec<JointLimits>,
     /// Executor settings (control period, default tolerances, start tolerance).
@@ -40,6 +57,8 @@ pub struct NodeConfig {
     pub lag_time_constant: f64,
     /// `SCHED_FIFO` priority of the control thread (1–99); 0 = normal scheduling.
     pub realtime_priority: i64,
+    /// The simulated cell (`hardware: sim`); `None` for the mock hardware.
+    pub sim: Option<SimConfig>,
 }
 
 fn param_err(name: &str, reason: String) -> NodeError {
@@ -77,7 +96,14 @@ impl NodeConfig {
     /// * `constraints.stopped_velocity_tolerance` (0.01), `constraints.goal_time` (s, 0 = wait
     ///   forever), `constraints.<joint>.trajectory` and `constraints.<joint>.goal` (position
     ///   tolerances, 0 = unchecked): JTC's names and defaults.
-    /// * `hardware.lag_time_constant` (s, default 0: the mock follows commands exactly).
+    /// * `hardware` (`mock` or `sim`, default `mock`): the hardware the control loop drives.
+    /// * `hardware.lag_time_constant` (s, default 0: the mock follows commands exactly; must
+    ///   be 0 with `hardware: sim`).
+    /// * `sim_cell` (string, required with `hardware: sim`): the cell file (`kerf_cell`);
+    ///   `sim_mode` (`kinematic` or `dynamic`, default `kinematic`); `sim_physics_rate` (Hz,
+    ///   default 1000, an integer multiple of `control_rate`). Refused with `hardware: mock`.
+    ///   With `hardware: sim` and no `initial_positions`, the robot starts at the cell file's
+    ///   `robot.initial_positions`.
     /// * `realtime_priority` (0 = normal scheduling, 1–99 = `SCHED_FIFO` for the control
     ///   thread; refused at start-up if the OS does not allow it).
     pub fn from_params(params: &Params) -> Result<Self, NodeError> {
@@ -161,9 +187,25 @@ impl NodeConfig {
             ));
         }
 
-        let initial_positions = match params.f64_array("initial_positions")? {
-            Some(v) => v,
-            None => vec![0.0; robot.dof()],
+        let sim = sim_config(params)?;
+        if sim.is_some() && lag_time_constant != 0.0 {
+            return Err(param_err(
+                "hardware.lag_time_constant",
+                format!(
+                    "{lag_time_constant}: a lag applies to hardware: mock only (0 or unset with \
+                     hardware: sim); the simulated cell has its own dynamics (sim_mode)"
+                ),
+            ));
+        }
+        let initial_positions = match (params.f64_array("initial_positions")?, &sim) {
+            (Some(v), _) => v,
+            (None, Some(sim)) => {
+                kerf_cell::CellFile::from_file(&sim.cell_file)
+                    .map_err(|e| param_err("sim_cell", e.to_string()))?
+                    .robot
+                    .initial_positions
+            }
+            (None, None) => vec![0.0; robot.dof()],
         };
         if initial_positions.len() != robot.dof() {
             return Err(param_err(
@@ -182,6 +224,7 @@ impl NodeConfig {
 
         Ok(Self {
             robot,
+            urdf_file: urdf,
             limits,
             executor,
             control_rate,
@@ -189,6 +232,55 @@ impl NodeConfig {
             initial_positions,
             lag_time_constant,
             realtime_priority,
+            sim,
         })
+    }
+}
+
+/// Reads `hardware` and the `sim_*` parameters.
+fn sim_config(params: &Params) -> Result<Option<SimConfig>, NodeError> {
+    let hardware = params.string("hardware")?;
+    match hardware.as_deref().unwrap_or("mock") {
+        "mock" => {
+            for name in ["sim_cell", "sim_mode", "sim_physics_rate"] {
+                if params.get(name).is_some() {
+                    return Err(param_err(
+                        name,
+                        "applies to hardware: sim only (hardware is mock)".into(),
+                    ));
+                }
+            }
+            Ok(None)
+        }
+        "sim" => {
+            let cell_file = PathBuf::from(params.string("sim_cell")?.ok_or_else(|| {
+                param_err(
+                    "sim_cell",
+                    "required with hardware: sim (a kerf_cell cell file, e.g. \
+                     urdf/cells/laser_bpillar.yaml)"
+                        .into(),
+                )
+            })?);
+            let mode = match params.string("sim_mode")?.as_deref().unwrap_or("kinematic") {
+                "kinematic" => kerf_cell::Mode::Kinematic,
+                "dynamic" => kerf_cell::Mode::Dynamic,
+                other => {
+                    return Err(param_err(
+                        "sim_mode",
+                        format!("must be kinematic or dynamic, got '{other}'"),
+                    ))
+                }
+            };
+            let physics_rate = positive(params, "sim_physics_rate", 1000.0)?;
+            Ok(Some(SimConfig {
+                cell_file,
+                mode,
+                physics_rate,
+            }))
+        }
+        other => Err(param_err(
+            "hardware",
+            format!("must be mock or sim, got '{other}'"),
+        )),
     }
 }

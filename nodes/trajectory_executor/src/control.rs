@@ -1,6 +1,6 @@
 //! The control thread: read → update → write every control period, and nothing else.
 //!
-//! The thread owns the executor core and the (mock) hardware. It never touches DDS except
+//! The thread owns the executor core and the hardware ([`Hardware`]: mock or simulated cell). It never touches DDS except
 //! through [`Streamer`] queues, never deserializes, validates, copies or frees anything whose
 //! size depends on a trajectory, and never blocks:
 //! * requests arrive as [`Command`]s already prepared by the preparation worker
@@ -13,6 +13,16 @@
 //!   ([`Executor::defer_drops`]);
 //! * answers, goal ends, feedback and log lines go back as [`Report`]s on an unbounded
 //!   channel (a send never blocks).
+//!
+//! # Contacts (simulated cell)
+//! After each write the cell's contacts are checked ([`ContactWatch`]). While the reference
+//! moves or a goal is active, a contact is a fault unless it was already there when the
+//! motion started and has not got deeper since (by more than [`DEEPER`]): the executor
+//! brings the motion to a controlled stop (`Executor::fault`) and aborts the goal with
+//! PATH_TOLERANCE_VIOLATED and a message naming the links, shapes, objects and depths. The
+//! robot is not pushed back by the scene, so it travels on during the stop; the depth
+//! reached is at most the depth at detection plus the stopping distance (`v² / 2a` of the
+//! slowest-stopping joint, mapped to the tool).
 
 use std::{
     sync::{
@@ -23,18 +33,28 @@ use std::{
     time::{Duration as StdDuration, Instant},
 };
 
+use kerf_cell::Contact;
 use kerf_executor::{
-    Cycle, Executor, GoalId as ExecGoalId, GoalTolerances, JointLimits, JointSample, MockHardware,
-    Outcome, PreparedTrajectory, ValidatedTrajectory,
+    Cycle, Executor, GoalId as ExecGoalId, GoalTolerances, JointLimits, JointSample, Outcome,
+    PreparedTrajectory, ValidatedTrajectory, PATH_TOLERANCE_VIOLATED,
 };
 use kerf_msgs::{
     control_msgs::{FollowJointTrajectoryFeedback, JointTrajectoryControllerState},
+    geometry_msgs::Point,
+    msg::{CellContact, CellContacts},
+    rosgraph_msgs::Clock as ClockMsg,
     sensor_msgs::JointState,
     std_msgs::Header,
 };
 use kerf_ros::{LogLevel, Streamer};
 
 use crate::convert::{self, Clock, Rejection};
+use crate::hardware::Hardware;
+
+/// A contact present when a motion started stays tolerated while its signed distance does
+/// not fall more than this below the distance it had then (m): 0.1 mm, above the cell's
+/// distance noise, well below the depths a fault is meant to catch.
+pub const DEEPER: f64 = 1e-4;
 
 /// Commands the control thread takes in one cycle at most; the rest wait for the next cycle,
 /// so a burst of requests costs at most this many O(joints) hand-overs per cycle.
@@ -171,6 +191,85 @@ pub struct Streams {
     pub controller_state: Streamer<JointTrajectoryControllerState>,
     /// `~/joint_command`.
     pub command: Streamer<JointState>,
+    /// The simulated cell's streams (`hardware: sim`).
+    pub sim: Option<SimStreams>,
+}
+
+/// The streams of the simulated cell.
+pub struct SimStreams {
+    /// `/clock`: the simulated time.
+    pub clock: Streamer<ClockMsg>,
+    /// `~/contacts`.
+    pub contacts: Streamer<CellContacts>,
+    /// `frame_id` of the contacts: the robot's base link.
+    pub frame_id: String,
+}
+
+/// Decides which contacts are faults: those that appear, or get deeper, during a motion.
+#[derive(Debug, Default)]
+pub struct ContactWatch {
+    /// (shape, object, signed distance) of the contacts present when the motion started.
+    tolerated: Vec<(String, String, f64)>,
+}
+
+impl ContactWatch {
+    /// Takes the contacts of one period; `moving` says whether a motion is under way.
+    ///
+    /// # Returns
+    /// The contacts that are faults (empty while at rest: then the contacts present become
+    /// the tolerated ones).
+    pub fn check<'a>(&mut self, contacts: &'a [Contact], moving: bool) -> Vec<&'a Contact> {
+        if !moving {
+            self.tolerated.clear();
+            self.tolerated.extend(
+                contacts
+                    .iter()
+                    .map(|c| (c.shape.clone(), c.object.clone(), c.distance)),
+            );
+            return Vec::new();
+        }
+        // A tolerated pair that cleared is no longer tolerated.
+        self.tolerated.retain(|(shape, object, _)| {
+            contacts
+                .iter()
+                .any(|c| &c.shape == shape && &c.object == object)
+        });
+        contacts
+            .iter()
+            .filter(|c| {
+                !self.tolerated.iter().any(|(shape, object, d)| {
+                    &c.shape == shape && &c.object == object && c.distance >= d - DEEPER
+                })
+            })
+            .collect()
+    }
+}
+
+/// The abort message of a contact fault: every faulting contact with its link, shape,
+/// object, depth and distance.
+pub fn contact_message(faults: &[&Contact], time: f64) -> String {
+    let list: Vec<String> = faults
+        .iter()
+        .map(|c| {
+            format!(
+                "link '{}' (shape '{}') with '{}': depth {:.3} mm (signed distance {:.3} mm) \
+                 at [{:.4}, {:.4}, {:.4}] m",
+                c.link,
+                c.shape,
+                c.object,
+                c.depth * 1e3,
+                c.distance * 1e3,
+                c.position[0],
+                c.position[1],
+                c.position[2],
+            )
+        })
+        .collect();
+    format!(
+        "contact during motion at t = {time:.3} s (simulated cell): {}; the motion was \
+         brought to a controlled stop",
+        list.join("; ")
+    )
 }
 
 /// Settings of the control loop.
@@ -188,7 +287,9 @@ pub struct LoopConfig {
 /// The control loop's state; [`ControlLoop::run`] runs it on the calling thread.
 pub struct ControlLoop {
     exec: Executor,
-    hw: MockHardware,
+    hw: Hardware,
+    contacts: ContactWatch,
+    efforts: Vec<f64>,
     cfg: LoopConfig,
     names: Vec<String>,
     streams: Streams,
@@ -211,7 +312,7 @@ impl ControlLoop {
     #[allow(clippy::too_many_arguments)]
     pub fn new(
         mut exec: Executor,
-        hw: MockHardware,
+        hw: Hardware,
         cfg: LoopConfig,
         streams: Streams,
         commands: Receiver<Command>,
@@ -224,6 +325,8 @@ impl ControlLoop {
         Self {
             exec,
             hw,
+            contacts: ContactWatch::default(),
+            efforts: Vec::new(),
             cfg,
             names,
             streams,
@@ -378,9 +481,62 @@ impl ControlLoop {
         }
     }
 
+    /// Simulated cell only, after the write at `now`: advances the clock to the cell's time,
+    /// publishes `/clock` and `~/contacts`, and turns a contact during motion into a fault.
+    fn after_write(&mut self, now: f64) {
+        let Some(state) = self.hw.sim_state() else {
+            return;
+        };
+        let Some(sim) = &self.streams.sim else {
+            return;
+        };
+        let time = state.time;
+        self.clock.set(time);
+        let stamp = self.clock.stamp(time);
+        let f = &mut self.publish_failures;
+        let clock = ClockMsg { clock: stamp };
+        Self::publish(&sim.clock, clock, f, &self.reports, "clock");
+        let msg = CellContacts {
+            header: Header {
+                stamp,
+                frame_id: sim.frame_id.clone(),
+            },
+            contacts: state
+                .contacts
+                .iter()
+                .map(|c| CellContact {
+                    robot_link: c.link.clone(),
+                    robot_shape: c.shape.clone(),
+                    scene_object: c.object.clone(),
+                    distance: c.distance,
+                    depth: c.depth,
+                    position: Point {
+                        x: c.position[0],
+                        y: c.position[1],
+                        z: c.position[2],
+                    },
+                })
+                .collect(),
+        };
+        Self::publish(&sim.contacts, msg, f, &self.reports, "contacts");
+        let moving = self.exec.is_moving(now) || self.exec.active_goal().is_some();
+        let faults = self.contacts.check(&state.contacts, moving);
+        if faults.is_empty() {
+            return;
+        }
+        let message = contact_message(&faults, time);
+        // With no active goal the only motion is a stop already in progress (a cancel or an
+        // earlier fault): `fault` lets it run on, and the fault was already reported.
+        if let Err(e) = self.exec.fault(now, PATH_TOLERANCE_VIOLATED, message) {
+            self.log(LogLevel::Error, format!("contact fault: {e}"));
+        }
+    }
+
     /// Read → update → write at `now`, then the state streams, goal ends and feedback.
     fn control_cycle(&mut self, now: f64) {
         let measured = self.hw.state().clone();
+        self.efforts.clear();
+        self.efforts.extend_from_slice(self.hw.efforts());
         let mut cycle = std::mem::take(&mut self.cycle);
         if let Err(e) = self.exec.update_into(now, &measured, &mut cycle) {
             self.cycle_failures += 1;
@@ -405,6 +561,7 @@ impl ControlLoop {
                 format!("hardware refused the command: {e}"),
             );
         }
+        self.after_write(now);
         let header = Header {
             stamp: self.clock.stamp(now),
             frame_id: String::new(),
@@ -416,7 +573,8 @@ impl ControlLoop {
             velocity: s.velocities.clone(),
             effort: Vec::new(),
         };
-        let js = joint_state(&measured);
+        let mut js = joint_state(&measured);
+        js.effort.clone_from(&self.efforts);
         let cmd = joint_state(&cycle.reference);
         let tfs = cycle.feedback.map_or(0.0, |f| f.time_from_start.max(0.0));
         let state = JointTrajectoryControllerState {
@@ -473,5 +631,57 @@ impl ControlLoop {
             }
         }
         self.cycle = cycle;
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn contact(shape: &str, distance: f64) -> Contact {
+        Contact {
+            link: "nozzle".into(),
+            shape: shape.into(),
+            object: "bpillar".into(),
+            distance,
+            depth: (-distance).max(0.0),
+            position: [0.1, 0.2, 0.3],
+            object_point: [0.1, 0.2, 0.3],
+            time: 1.0,
+        }
+    }
+
+    #[test]
+    fn contacts_are_faults_when_new_or_deeper_during_motion() {
+        let mut w = ContactWatch::default();
+        // At rest: never a fault; the contact present is tolerated for the next motion.
+        assert!(w.check(&[contact("nozzle/1", 0.001)], false).is_empty());
+        // Moving: the tolerated one is no fault while it does not get deeper.
+        assert!(w.check(&[contact("nozzle/1", 0.0015)], true).is_empty());
+        assert!(w
+            .check(&[contact("nozzle/1", 0.001 - DEEPER / 2.0)], true)
+            .is_empty());
+        let deeper = [contact("nozzle/1", 0.001 - 2.0 * DEEPER)];
+        assert_eq!(w.check(&deeper, true).len(), 1);
+        // A new pair during motion is a fault.
+        let both = [contact("nozzle/1", 0.001), contact("nozzle/0", -0.0003)];
+        let faults = w.check(&both, true);
+        assert_eq!(faults.len(), 1);
+        assert_eq!(faults[0].shape, "nozzle/0");
+        // Once a tolerated pair clears, its return is a fault.
+        assert!(w.check(&[], true).is_empty());
+        assert_eq!(w.check(&[contact("nozzle/1", 0.0015)], true).len(), 1);
+        // The message names link, shape, object and depth.
+        let c = contact("nozzle/0", -0.0003);
+        let m = contact_message(&[&c], 2.5);
+        for needle in [
+            "'nozzle'",
+            "'nozzle/0'",
+            "'bpillar'",
+            "depth 0.300 mm",
+            "t = 2.500 s",
+        ] {
+            assert!(m.contains(needle), "{needle}: {m}");
+        }
     }
 }

@@ -32,10 +32,17 @@ impl From<ExecutorError> for Rejection {
 ///
 /// The executor core runs on seconds since the origin (an `f64` keeps sub-ns resolution for
 /// months), messages carry system time (ROS time without `use_sim_time`).
-#[derive(Debug, Clone, Copy)]
+///
+/// A simulated clock ([`Clock::simulated`]) reads the time the control loop sets
+/// ([`Clock::set`]: the simulated cell's time) instead of the monotonic clock; its origin is
+/// still the system time at the start, so stamps of either kind are close while the
+/// simulation keeps pace with the wall clock.
+#[derive(Debug, Clone)]
 pub struct Clock {
     origin: std::time::Instant,
     origin_ns: i64,
+    /// The simulated time (s since the origin) as `f64` bits; `None` for the system clock.
+    sim: Option<std::sync::Arc<std::sync::atomic::AtomicU64>>,
 }
 
 impl Clock {
@@ -48,12 +55,38 @@ impl Clock {
         Self {
             origin: std::time::Instant::now(),
             origin_ns,
+            sim: None,
+        }
+    }
+
+    /// A simulated clock starting now at 0 s; it advances only by [`Clock::set`].
+    pub fn simulated() -> Self {
+        Self {
+            sim: Some(std::sync::Arc::new(std::sync::atomic::AtomicU64::new(
+                0.0f64.to_bits(),
+            ))),
+            ..Self::start()
+        }
+    }
+
+    /// Whether this clock is simulated.
+    pub fn is_simulated(&self) -> bool {
+        self.sim.is_some()
+    }
+
+    /// Sets the simulated time (s since the origin); no effect on a system clock.
+    pub fn set(&self, t: f64) {
+        if let Some(sim) = &self.sim {
+            sim.store(t.to_bits(), std::sync::atomic::Ordering::Release);
         }
     }
 
     /// Seconds since the origin.
     pub fn now(&self) -> f64 {
-        self.origin.elapsed().as_secs_f64()
+        match &self.sim {
+            Some(sim) => f64::from_bits(sim.load(std::sync::atomic::Ordering::Acquire)),
+            None => self.origin.elapsed().as_secs_f64(),
+        }
     }
 
     /// The ROS time of a clock reading.

@@ -13,6 +13,24 @@
 //! | `~/controller_state` | `control_msgs/msg/JointTrajectoryControllerState` | every control cycle |
 //! | `~/joint_command` | `sensor_msgs/msg/JointState` | command stream for a hardware driver |
 //! | `~/trajectory_status` | `kerf_msgs/msg/TrajectoryStatus` | accepted / rejected / finished |
+//! | `/clock` | `rosgraph_msgs/msg/Clock` | simulated time, every control cycle (`hardware: sim`) |
+//! | `~/contacts` | `kerf_msgs/msg/CellContacts` | the cell's contacts, every control cycle (`hardware: sim`) |
+//!
+//! # Hardware
+//! `hardware: mock` (the default) drives `kerf_executor::MockHardware`; `hardware: sim`
+//! drives a simulated cell (`kerf_cell`, parameters `sim_cell`, `sim_mode`,
+//! `sim_physics_rate`), whose physics steps run in lock-step with the control loop
+//! ([`hardware::Hardware`]). In sim mode:
+//! * the executor runs on the simulated time, which advances exactly one control period per
+//!   cycle from the system time of the node's start; it is published on `/clock` and stamps
+//!   every message (so `use_sim_time` nodes and nodes on the system clock both see times
+//!   close to their own, unless the loop overruns);
+//! * `/joint_states` is the simulated state with the drive efforts; path and goal tolerances
+//!   are judged on it (as JTC judges them on the hardware's state);
+//! * a contact during motion is a fault ([`control`]): the motion is brought to a controlled
+//!   stop within the limits and the goal is aborted (PATH_TOLERANCE_VIOLATED) with a message
+//!   naming the links, the objects and the depths. Contacts present when a motion starts are
+//!   tolerated while they do not get deeper, so that the robot can be moved out of them.
 //!
 //! # Threads
 //! * **control** ([`control::ControlLoop`]): read → update → write every control period. It
@@ -33,14 +51,15 @@
 //! motion (here: a controlled stop within the acceleration limits) and the robot holds.
 //!
 //! Every cycle follows ros2_control's read → update → write order: the measured state is read
-//! from the (mock) hardware, the executor computes the reference, the reference is written to
-//! the hardware and published on `~/joint_command`.
+//! from the hardware (mock or simulated cell), the executor computes the reference, the
+//! reference is written to the hardware and published on `~/joint_command`.
 
 pub mod action;
 pub mod config;
 pub mod control;
 pub mod convert;
 mod goals;
+pub mod hardware;
 mod validate_service;
 
 use std::{
@@ -55,7 +74,7 @@ use std::{
 };
 
 use kerf_executor::{
-    prepare, Executor, ExecutorError, GoalId as ExecGoalId, GoalTolerances, MockHardware, Outcome,
+    prepare, Executor, ExecutorError, GoalId as ExecGoalId, GoalTolerances, Outcome,
     PreparedTrajectory, TrajectoryRequest, INVALID_GOAL, SUCCESSFUL,
 };
 use kerf_msgs::{
@@ -64,7 +83,8 @@ use kerf_msgs::{
         FollowJointTrajectoryFeedback, FollowJointTrajectoryGoal, FollowJointTrajectoryResult,
         JointTrajectoryControllerState,
     },
-    msg::TrajectoryStatus,
+    msg::{CellContacts, TrajectoryStatus},
+    rosgraph_msgs::Clock as ClockMsg,
     sensor_msgs::JointState,
     srv::{ValidateTrajectoryRequest, ValidateTrajectoryResponse},
     std_msgs::Header,
@@ -233,7 +253,7 @@ impl ExecutorNode {
             cfg.executor.clone(),
             cfg.initial_positions.clone(),
         )?;
-        let hw = MockHardware::with_lag(cfg.initial_positions.clone(), cfg.lag_time_constant)?;
+        let hw = hardware::Hardware::build(&cfg)?;
         // Read on its own thread: deserializing a large trajectory takes milliseconds.
         let traj_sub = node.inbox(
             "~/joint_trajectory",
@@ -258,6 +278,19 @@ impl ExecutorNode {
                 q,
             )?,
             command: node.streamer("~/joint_command", JointState::ROS_TYPE, qos::state(), q)?,
+            sim: match &cfg.sim {
+                None => None,
+                Some(_) => Some(control::SimStreams {
+                    clock: node.streamer("/clock", ClockMsg::ROS_TYPE, qos::state(), q)?,
+                    contacts: node.streamer(
+                        "~/contacts",
+                        CellContacts::ROS_TYPE,
+                        qos::state(),
+                        q,
+                    )?,
+                    frame_id: cfg.robot.root_link().to_string(),
+                }),
+            },
         };
         let status = node.streamer(
             "~/trajectory_status",
@@ -266,8 +299,13 @@ impl ExecutorNode {
             q,
         )?;
         let log = node.logger();
-        let clock = Clock::start();
+        let clock = if cfg.sim.is_some() {
+            Clock::simulated()
+        } else {
+            Clock::start()
+        };
         let (limits, exec_cfg) = (cfg.limits.clone(), cfg.executor.clone());
+        let prep_clock = clock.clone();
         let prep = Worker::spawn("prepare", 1, move |incoming: Incoming| {
             let prepared = |req: TrajectoryRequest, tol: GoalTolerances| -> Prepared {
                 Ok((prepare(&limits, &exec_cfg, &req)?, tol))
@@ -275,11 +313,12 @@ impl ExecutorNode {
             match incoming {
                 Incoming::Stop => None,
                 Incoming::Trajectory(msg) => Some(
-                    convert::trajectory_request(&msg, &clock)
+                    convert::trajectory_request(&msg, &prep_clock)
                         .and_then(|req| prepared(req, GoalTolerances::default())),
                 ),
                 Incoming::Goal(goal) => Some(
-                    convert::goal_request(&goal, &clock).and_then(|(req, tol)| prepared(req, tol)),
+                    convert::goal_request(&goal, &prep_clock)
+                        .and_then(|(req, tol)| prepared(req, tol)),
                 ),
             }
         })
@@ -305,7 +344,7 @@ impl ExecutorNode {
             command_rx,
             report_tx,
             Arc::clone(&control_running),
-            clock,
+            clock.clone(),
         );
         let priority = cfg.realtime_priority;
         // Ok(a warning) once the loop runs, Err(why) if it cannot.
@@ -356,8 +395,20 @@ impl ExecutorNode {
             ));
         }
         let names: Vec<&str> = cfg.limits.iter().map(|l| l.name.as_str()).collect();
+        let hardware = match &cfg.sim {
+            None => "mock hardware".to_string(),
+            Some(sim) => format!(
+                "simulated cell {} ({}, physics {} Hz)",
+                sim.cell_file.display(),
+                match sim.mode {
+                    kerf_cell::Mode::Kinematic => "kinematic",
+                    kerf_cell::Mode::Dynamic => "dynamic",
+                },
+                sim.physics_rate
+            ),
+        };
         log.info(&format!(
-            "ready: robot '{}', joints [{}], {} Hz; trajectories on {}, action {}",
+            "ready: robot '{}', joints [{}], {} Hz, {hardware}; trajectories on {}, action {}",
             cfg.robot.name(),
             names.join(", "),
             cfg.control_rate,
