@@ -4,7 +4,7 @@
 //! (`support/netns.rs`: private addresses that exist only inside them, created and deleted by
 //! the test). Every node uses `ROS_AUTOMATIC_DISCOVERY_RANGE=SUBNET`, Jazzy's default.
 //!
-//! * Host A runs the cell: the trajectory executor of the laser cutter (mock hardware) and
+//! * Host A runs the cell: the trajectory executor of the laser cutter (the simulated cell, `hardware:=sim`, kinematic) and
 //!   the cell controller, a client node that sends the cut request and watches
 //!   `/joint_states` and the trajectory status.
 //! * Host B runs the MJTO planner, its trajectory remapped to the executor's input.
@@ -55,11 +55,15 @@ fn subnet(domain: u16) -> RosEnv {
     }
 }
 
-/// The executor's hardware parameters on host A: the mock (no parameter). When the
-/// simulated cell (`crates/cell`) lands, its parameters go here and the test runs against
-/// the simulated robot unchanged.
+/// The executor's hardware parameters on host A: the simulated cell (`kerf_cell`, kinematic,
+/// the laser cutter with the B-pillar of case 1), so the cut runs against the cell's robot and
+/// its contact checks.
 fn cell_hardware() -> Vec<String> {
-    Vec::new()
+    vec![
+        "hardware:=sim".into(),
+        format!("sim_cell:={ROOT}/urdf/cells/laser_bpillar.yaml"),
+        "sim_mode:=kinematic".into(),
+    ]
 }
 
 /// Case 1's request file as text, and its request.
