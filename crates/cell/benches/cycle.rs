@@ -1,4 +1,5 @@
-//! CPU time per 4 ms control cycle of the simulated cell (4 physics sub-steps at 1 kHz),
+//! CPU time per 4 ms control cycle of the simulated cell (4 physics sub-steps at 1 kHz, or
+//! the rate in `KERF_CELL_PHYSICS_HZ`),
 //! kinematic and dynamic, free and in contact with the 4 964-triangle B-pillar.
 //!
 //! Run: `cargo bench -p kerf_cell --bench cycle`. Prints, per scenario, the mean, median,
@@ -116,9 +117,17 @@ fn thread_cpu() -> f64 {
     ts.tv_sec as f64 + ts.tv_nsec as f64 * 1e-9
 }
 
+/// The physics rate: `KERF_CELL_PHYSICS_HZ`, else the cell's default (1 kHz).
+fn physics_rate() -> f64 {
+    std::env::var("KERF_CELL_PHYSICS_HZ")
+        .map(|v| v.parse().expect("KERF_CELL_PHYSICS_HZ: a rate in Hz"))
+        .unwrap_or(CellSettings::default().physics_rate_hz)
+}
+
 fn run(name: &str, cell_name: &str, mode: Mode, path: &Path) {
     let settings = CellSettings {
         mode,
+        physics_rate_hz: physics_rate(),
         ..CellSettings::default()
     };
     let urdf = if cell_name.starts_with("laser") {
@@ -232,7 +241,10 @@ fn main() {
     let cutting = case1_joints(0.0);
     let contact = case1_joints(-0.002);
     let milling = milling_joints();
-    println!("laser cutter + B-pillar (4 964 triangles), 4 ms control cycle, 1 kHz physics");
+    println!(
+        "laser cutter + B-pillar (4 964 triangles), 4 ms control cycle, {} Hz physics",
+        physics_rate()
+    );
     for mode in [Mode::Kinematic, Mode::Dynamic] {
         run(
             "case 1 plan, 0.3 m above the part",
