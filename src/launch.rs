@@ -1,8 +1,8 @@
 //! `kerf launch`: every node in one process, each with its own Context and thread: the
 //! trajectory executor, and with `--with-planner` the robot's planners (laser cutter: the MJTO
 //! planner; IRB 6660: the milling planner; both: the G-code planner for that machine).
-//! `--sim` runs the executor on the robot's simulated cell (`hardware: sim`, issue 15) and
-//! starts the planners too.
+//! `--sim` runs the executor on the robot's simulated cell (`hardware: sim`, issue 15),
+//! starts the planners too and connects their trajectories to the executor.
 
 use std::path::PathBuf;
 
@@ -52,8 +52,9 @@ pub struct LaunchArgs {
     with_planner: bool,
     /// Run the executor on the robot's simulated cell (`hardware: sim`, `sim_cell` the
     /// shipped `urdf/cells/laser_bpillar.yaml` or `irb6660_plate.yaml`; `-p sim_mode:=dynamic`
-    /// and `-p sim_physics_rate:=…` after `--ros-args`), and start the planners as
-    /// `--with-planner` does.
+    /// and `-p sim_physics_rate:=…` after `--ros-args`), start the planners as
+    /// `--with-planner` does, and remap their `~/joint_trajectory` to the executor's input, so
+    /// that a request runs in the cell.
     #[arg(long)]
     sim: bool,
     /// Directory holding the robot descriptions (default: `$KERF_URDF_DIR`, else the `urdf/`
@@ -147,6 +148,25 @@ fn gcode_machine(robot: Robot) -> &'static str {
     }
 }
 
+/// The remap rules of `--sim`: the robot's planners' `~/joint_trajectory` to the executor's
+/// input (`<planner>:~/joint_trajectory:=/trajectory_executor/joint_trajectory`), as
+/// `kerf.launch.py` connects them.
+fn sim_connections(robot: Robot) -> Vec<String> {
+    let planner = match robot {
+        Robot::LaserCutter => kerf_mjto_planner::DEFAULT_NAME,
+        Robot::Irb6660 => kerf_milling_planner::DEFAULT_NAME,
+    };
+    [planner, kerf_gcode_planner::DEFAULT_NAME]
+        .iter()
+        .map(|node| {
+            format!(
+                "{node}:~/joint_trajectory:=/{}/joint_trajectory",
+                kerf_trajectory_executor::DEFAULT_NAME
+            )
+        })
+        .collect()
+}
+
 /// The executor parameters of `--sim`: the simulated hardware and the robot's cell file in
 /// `dir/cells/`.
 fn sim_defaults(dir: &std::path::Path, robot: Robot) -> [(&'static str, String); 2] {
@@ -193,6 +213,12 @@ pub fn run(a: LaunchArgs) -> Result<(), String> {
     }
     if a.sim {
         defaults.extend(sim_defaults(&dir, a.robot));
+        // The simulated cell is a whole cell: each planner's trajectory goes to the executor.
+        // The rules come after the command line's, whose rules match first.
+        for rule in sim_connections(a.robot) {
+            args.remaps
+                .push(kerf_ros::names::Remap::parse(&rule).map_err(|e| e.to_string())?);
+        }
     }
     for (i, (name, value)) in defaults.into_iter().enumerate() {
         args.params.insert(

@@ -528,12 +528,27 @@ fn nozzle_driven_into_the_sheet_penetrates_less_than_the_stated_depth() {
 
 /// `kerf launch --sim --robot laser-cutter`: the executor on the simulated cell with the
 /// planners, in a child process; `/clock`, `~/contacts` and efforts on `/joint_states` arrive
-/// over DDS, and Ctrl-C ends it cleanly.
+/// over DDS; case 1's request on the MJTO planner's text topic is planned and runs in the cell
+/// to its end (the launch connects the planners to the executor); Ctrl-C ends it cleanly.
 #[test]
 fn kerf_launch_sim_starts_the_cell_and_the_planners() {
+    let offline = Planner::new(LaserMachine::default_machine().unwrap())
+        .unwrap()
+        .plan(&case1())
+        .unwrap();
+    let first = offline.positions[0].to_vec();
+    let last = offline.positions.last().unwrap().to_vec();
     let mut command = std::process::Command::new(env!("CARGO_BIN_EXE_kerf"));
     command
-        .args(["launch", "--sim", "--robot", "laser-cutter"])
+        .args([
+            "launch",
+            "--sim",
+            "--robot",
+            "laser-cutter",
+            "--ros-args",
+            "-p",
+        ])
+        .arg(support::initial_positions(&first))
         .env("ROS_DOMAIN_ID", "144")
         .env("ROS_AUTOMATIC_DISCOVERY_RANGE", "LOCALHOST")
         .env_remove("ROS_STATIC_PEERS")
@@ -572,7 +587,47 @@ fn kerf_launch_sim_starts_the_cell_and_the_planners() {
         QUICK,
         "the G-code planner",
     );
-    drop((states, clock, contacts, client));
+    // A request on the planner's text topic runs in the cell.
+    let requests = client
+        .publisher(
+            "/mjto_planner/cut_request_text",
+            kerf_msgs::std_msgs::StringMsg::ROS_TYPE,
+            qos::commands(),
+        )
+        .unwrap();
+    assert!(
+        client.wait_for_subscriber(&requests, QUICK),
+        "the MJTO planner's request topic"
+    );
+    let (watch, cell_states, statuses) = support::watch_cell(&env, "launch_cell", &first);
+    let text =
+        std::fs::read_to_string(std::path::Path::new(ROOT).join("crates/mjto/cases/case1.yaml"))
+            .unwrap();
+    requests
+        .publish(kerf_msgs::std_msgs::StringMsg { data: text })
+        .unwrap();
+    let deadline = Instant::now() + MOTION;
+    let mut succeeded = false;
+    while Instant::now() < deadline && !succeeded {
+        succeeded |= support::drain_statuses(&statuses, "case 1 in the launched cell")
+            .contains(&kerf_msgs::msg::TrajectoryStatus::SUCCEEDED);
+        std::thread::sleep(Duration::from_millis(10));
+    }
+    assert!(
+        succeeded,
+        "case 1 did not run to its end in the launched cell"
+    );
+    support::assert_rests_at(&cell_states, &last, 1e-4, "case 1 in the launched cell");
+    drop((
+        states,
+        clock,
+        contacts,
+        requests,
+        client,
+        watch,
+        cell_states,
+        statuses,
+    ));
 
     support::interrupt(&launch.0);
     lines.wait_for("shutting down", QUICK);
