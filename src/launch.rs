@@ -275,6 +275,24 @@ mod tests {
     use super::*;
 
     #[test]
+    fn sim_connects_each_robots_planners_to_the_executor() {
+        let laser = sim_connections(Robot::LaserCutter);
+        assert_eq!(
+            laser,
+            [
+                "mjto_planner:~/joint_trajectory:=/trajectory_executor/joint_trajectory",
+                "gcode_planner:~/joint_trajectory:=/trajectory_executor/joint_trajectory",
+            ]
+        );
+        let irb = sim_connections(Robot::Irb6660);
+        assert!(irb[0].starts_with("milling_planner:"), "{irb:?}");
+        for rule in laser.iter().chain(&irb) {
+            let r = kerf_ros::names::Remap::parse(rule).unwrap();
+            assert_eq!(r.to, "/trajectory_executor/joint_trajectory");
+        }
+    }
+
+    #[test]
     fn sim_names_the_shipped_cell_of_each_robot() {
         let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("urdf");
         for robot in [Robot::LaserCutter, Robot::Irb6660] {
