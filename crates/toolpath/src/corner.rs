@@ -69,6 +69,7 @@ use crate::bezier::QuinticBezier;
 use crate::corner_curve::CornerCurve;
 use crate::corner_jerk::{max_jerk_norm, normalized_jerk, PowerQuintic};
 use crate::error::{check_positive, ToolpathError};
+use crate::maximum::sampled_maximum;
 use crate::vec3::{add, dot, norm, scale, sub};
 
 /// Turning angles below this are straight \[rad\]: no transition.
@@ -204,31 +205,7 @@ pub(crate) fn curve(
 /// section on its neighbouring interval.
 fn max_curvature(curve: &QuinticBezier) -> f64 {
     let power = PowerQuintic::new(curve);
-    let curvature = |u: f64| power.curvature(u);
-    let n = CURVATURE_SAMPLES;
-    let mut best = (0.0, 0usize);
-    for k in 0..=n {
-        let kappa = curvature(0.5 * k as f64 / n as f64);
-        if kappa > best.0 {
-            best = (kappa, k);
-        }
-    }
-    let h = 0.5 / n as f64;
-    let (mut lo, mut hi) = (
-        (best.1 as f64 * h - h).max(0.0),
-        (best.1 as f64 * h + h).min(0.5),
-    );
-    let g = 0.5 * (5f64.sqrt() - 1.0);
-    for _ in 0..24 {
-        let m1 = hi - g * (hi - lo);
-        let m2 = lo + g * (hi - lo);
-        if curvature(m1) < curvature(m2) {
-            lo = m1;
-        } else {
-            hi = m2;
-        }
-    }
-    best.0.max(curvature(0.5 * (lo + hi)))
+    sampled_maximum(|u| power.curvature(u), 0.0, 0.5, CURVATURE_SAMPLES)
 }
 
 /// The unit direction from `a` to `b` and the distance.

@@ -3,6 +3,7 @@
 //! (parameter u ∈ [0, 1] from the incoming segment to the outgoing one).
 
 use crate::bezier::QuinticBezier;
+use crate::maximum::sampled_maximum;
 use crate::spline::CubicSpline;
 
 /// The curve of a corner transition.
@@ -106,27 +107,6 @@ impl CornerCurve {
     /// spaced parameters, the best refined by 24 golden-section steps on its
     /// neighbouring interval (a sampled estimate, as kerf's corner's).
     pub fn max_curvature_on(&self, u0: f64, u1: f64, samples: usize) -> f64 {
-        let n = samples.max(1);
-        let h = (u1 - u0) / n as f64;
-        let mut best = (0.0, 0usize);
-        for k in 0..=n {
-            let kappa = self.curvature(u0 + k as f64 * h);
-            if kappa > best.0 {
-                best = (kappa, k);
-            }
-        }
-        let centre = u0 + best.1 as f64 * h;
-        let (mut lo, mut hi) = ((centre - h).max(u0), (centre + h).min(u1));
-        let g = 0.5 * (5f64.sqrt() - 1.0);
-        for _ in 0..24 {
-            let m1 = hi - g * (hi - lo);
-            let m2 = lo + g * (hi - lo);
-            if self.curvature(m1) < self.curvature(m2) {
-                lo = m1;
-            } else {
-                hi = m2;
-            }
-        }
-        best.0.max(self.curvature(0.5 * (lo + hi)))
+        sampled_maximum(|u| self.curvature(u), u0, u1, samples)
     }
 }

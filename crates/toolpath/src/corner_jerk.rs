@@ -29,6 +29,7 @@
 
 use crate::bezier::QuinticBezier;
 use crate::corner::{curve, Binding, CornerShape};
+use crate::maximum::sampled_maximum;
 use crate::vec3::{cross, dot, norm, scale, sub};
 
 /// Samples of the half curve for its largest jerk norm (then refined).
@@ -166,31 +167,7 @@ pub fn max_jerk_norm(curve: &QuinticBezier) -> f64 {
         return 0.0;
     };
     let power = PowerQuintic::new(curve);
-    let g = |u: f64| power.jerk_norm(m, u);
-    let n = JERK_SAMPLES;
-    let mut best = (0.0, 0usize);
-    for k in 0..=n {
-        let v = g(0.5 * k as f64 / n as f64);
-        if v > best.0 {
-            best = (v, k);
-        }
-    }
-    let h = 0.5 / n as f64;
-    let (mut lo, mut hi) = (
-        (best.1 as f64 * h - h).max(0.0),
-        (best.1 as f64 * h + h).min(0.5),
-    );
-    let ratio = 0.5 * (5f64.sqrt() - 1.0);
-    for _ in 0..24 {
-        let m1 = hi - ratio * (hi - lo);
-        let m2 = lo + ratio * (hi - lo);
-        if g(m1) < g(m2) {
-            lo = m1;
-        } else {
-            hi = m2;
-        }
-    }
-    best.0.max(g(0.5 * (lo + hi)))
+    sampled_maximum(|u| power.jerk_norm(m, u), 0.0, 0.5, JERK_SAMPLES)
 }
 
 /// The largest jerk norm per unit of the binding constraint of a shape at a

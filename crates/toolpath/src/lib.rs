@@ -25,6 +25,7 @@ pub mod feed_method;
 pub mod feed_optimal;
 pub mod limit_curve;
 pub mod lower_bound;
+mod maximum;
 pub mod merge;
 pub mod metrics;
 pub mod plan_check;
