@@ -180,13 +180,7 @@ pub struct CornerTransition {
 }
 
 /// The curve of a shape at a scale.
-pub(crate) fn curve(
-    v: [f64; 3],
-    t1: [f64; 3],
-    t2: [f64; 3],
-    shape: CornerShape,
-    s: f64,
-) -> QuinticBezier {
+fn curve(v: [f64; 3], t1: [f64; 3], t2: [f64; 3], shape: CornerShape, s: f64) -> QuinticBezier {
     let (a, b, c) = (s, shape.b * s, shape.c * s);
     QuinticBezier {
         control: [
@@ -372,18 +366,25 @@ pub fn corner_transition_with(
 /// The largest curvature per unit of the binding constraint of a shape at a
 /// turning angle: κ_max · δ (tolerance) or κ_max · L (length).
 pub fn normalized_curvature(turn: f64, shape: CornerShape, binding: Binding) -> f64 {
+    max_curvature(&unit_curve(turn, shape, binding))
+}
+
+/// The corner curve of a shape at a turning angle, in the plane z = 0 at
+/// the origin, scaled to a unit of its binding constraint: deviation 1
+/// (tolerance) or tangent length 1 (length). The curve behind the shape
+/// tables' normalized figures.
+pub(crate) fn unit_curve(turn: f64, shape: CornerShape, binding: Binding) -> QuinticBezier {
     let s = match binding {
         Binding::Tolerance => 32.0 / (turn.sin() * shape.deviation_weight()),
         Binding::Length => 1.0 / shape.length_weight(),
     };
-    let c = curve(
+    curve(
         [0.0; 3],
         [1.0, 0.0, 0.0],
         [turn.cos(), turn.sin(), 0.0],
         shape,
         s,
-    );
-    max_curvature(&c)
+    )
 }
 
 /// The grid search behind [`SHAPES`] ([`ShapeObjective::search_shape`] for

@@ -28,7 +28,7 @@
 //! times).
 
 use crate::bezier::QuinticBezier;
-use crate::corner::{curve, Binding, CornerShape};
+use crate::corner::{unit_curve, Binding, CornerShape};
 use crate::maximum::sampled_maximum;
 use crate::vec3::{cross, dot, norm, scale, sub};
 
@@ -173,18 +173,7 @@ pub fn max_jerk_norm(curve: &QuinticBezier) -> f64 {
 /// The largest jerk norm per unit of the binding constraint of a shape at a
 /// turning angle: g_max · δ² (tolerance) or g_max · L² (length).
 pub fn normalized_jerk(turn: f64, shape: CornerShape, binding: Binding) -> f64 {
-    let s = match binding {
-        Binding::Tolerance => 32.0 / (turn.sin() * shape.deviation_weight()),
-        Binding::Length => 1.0 / shape.length_weight(),
-    };
-    let c = curve(
-        [0.0; 3],
-        [1.0, 0.0, 0.0],
-        [turn.cos(), turn.sin(), 0.0],
-        shape,
-        s,
-    );
-    max_jerk_norm(&c)
+    max_jerk_norm(&unit_curve(turn, shape, binding))
 }
 
 /// The largest jerk norm g of any corner curve, sampled \[1/m²\]: κ at
