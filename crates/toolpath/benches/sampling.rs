@@ -18,8 +18,8 @@ mod support;
 
 use kerf_gcode::{read_points, PointUnit};
 use kerf_toolpath::{
-    bang_bang_under, check_plan, plan_feed_optimal, sample_path, sample_path_adaptive,
-    smooth_polyline, FeedConstraints, PathSample, SmoothedPath,
+    check_plan, plan_feed_optimal, sample_path, sample_path_adaptive, smooth_polyline,
+    FeedConstraints, PathSample, SmoothedPath,
 };
 
 /// How a path is sampled.
@@ -85,12 +85,7 @@ fn main() {
                     let smoothed = smooth_polyline(&points, *delta).unwrap();
                     let samples = sampler.run(&smoothed);
                     let plan = plan_feed_optimal(&samples, &constraints).unwrap();
-                    let curve: Vec<f64> = samples
-                        .iter()
-                        .map(|p| limits.curvature.speed(p.curvature))
-                        .collect();
-                    let lb =
-                        bang_bang_under(&samples, curve, limits.tangential_acceleration).unwrap();
+                    let lb = support::t_lb(&samples, limits);
                     (smoothed, samples, plan, lb)
                 };
                 let mut best = f64::INFINITY;
@@ -116,8 +111,8 @@ fn main() {
                     sampler.name(),
                     samples.len(),
                     plan.time,
-                    lb.time,
-                    plan.time / lb.time,
+                    lb,
+                    plan.time / lb,
                     worst.ratio,
                     best * 1e3
                 );

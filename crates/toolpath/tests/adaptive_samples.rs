@@ -5,12 +5,12 @@
 
 #[allow(dead_code)] // the tests' shared data; this file uses some of it
 mod support;
-use support::{feed_limits, outlines, program_polyline, seed_000_limits};
+use support::{feed_limits, outlines, program_polyline, seed_000_limits, t_lb};
 
 use kerf_toolpath::{
-    bang_bang_under, check_plan, plan_feed_optimal, sample_path, sample_path_adaptive,
-    smooth_polyline, smooth_polyline_with, AxisLimits, CornerMethod, FeedConstraints, FeedLimits,
-    PathSample, Piece, Sampling, SmoothedPath, ToolpathError,
+    check_plan, plan_feed_optimal, sample_path, sample_path_adaptive, smooth_polyline,
+    smooth_polyline_with, AxisLimits, CornerMethod, FeedConstraints, FeedLimits, PathSample, Piece,
+    Sampling, SmoothedPath, ToolpathError,
 };
 
 const STEP: f64 = 1e-3;
@@ -148,16 +148,6 @@ fn samples_bound_steps_and_hold_every_curvature_extremum() {
         worst.0 <= kerf_toolpath::adaptive::MONOTONE_SLACK,
         "{worst:?} exceeds the limit curve's slack"
     );
-}
-
-fn t_lb(samples: &[PathSample], limits: &FeedLimits) -> f64 {
-    let curve: Vec<f64> = samples
-        .iter()
-        .map(|p| limits.curvature.speed(p.curvature))
-        .collect();
-    bang_bang_under(samples, curve, limits.tangential_acceleration)
-        .unwrap()
-        .time
 }
 
 /// The near time-optimal plan on adaptive samples holds every limit on the output (`check_plan`

@@ -7,28 +7,16 @@
 
 #[allow(dead_code)] // each test file uses some of the shared data
 mod support;
-use support::{feed_limits, outlines, seed_000_limits, ZIG_ZAG};
+use support::{feed_limits, outlines, seed_000_limits, t_lb, ZIG_ZAG};
 
 use kerf_toolpath::scurve::{reachable, reachable_closed_form, scurve_distance};
 use kerf_toolpath::{
-    bang_bang_under, check_plan, plan_feed, plan_feed_optimal, point_at, sample_path,
-    smooth_polyline, AxisLimits, FeedConstraints, FeedLimits, FeedMethod, FeedPlan, PathSample,
-    Piece, SmoothedPath,
+    check_plan, plan_feed, plan_feed_optimal, point_at, sample_path, smooth_polyline, AxisLimits,
+    FeedConstraints, FeedMethod, FeedPlan, PathSample, Piece, SmoothedPath,
 };
 
 /// Rounding margin on every ratio of `check_plan`.
 const MARGIN: f64 = 1e-9;
-
-/// T_lb on the same samples under seed 003 eq. 22 (the bench's bound).
-fn t_lb(samples: &[PathSample], limits: &FeedLimits) -> f64 {
-    let curve: Vec<f64> = samples
-        .iter()
-        .map(|p| limits.curvature.speed(p.curvature))
-        .collect();
-    bang_bang_under(samples, curve, limits.tangential_acceleration)
-        .unwrap()
-        .time
-}
 
 /// The independent check: positions on the geometry at the plan's arc length every period,
 /// then finite differences. A central difference of order k over the period is a weighted mean

@@ -1,6 +1,6 @@
 //! Test data shared by the integration tests of `kerf_toolpath`.
 
-use kerf_toolpath::{CurvatureLimits, FeedLimits};
+use kerf_toolpath::{bang_bang_under, CurvatureLimits, FeedLimits, PathSample};
 
 /// A zig-zag of short and long segments with right-angle, acute and obtuse corners \[m\].
 pub const ZIG_ZAG: [[f64; 3]; 6] = [
@@ -84,4 +84,16 @@ pub fn program_polyline(name: &str) -> Vec<[f64; 3]> {
         }
     }
     polyline
+}
+
+/// T_lb \[s\] on `samples`: the bang-bang bound under seed 003 eq. 22's limit at every sample
+/// (the benches' and tests' bound).
+pub fn t_lb(samples: &[PathSample], limits: &FeedLimits) -> f64 {
+    let curve: Vec<f64> = samples
+        .iter()
+        .map(|p| limits.curvature.speed(p.curvature))
+        .collect();
+    bang_bang_under(samples, curve, limits.tangential_acceleration)
+        .unwrap()
+        .time
 }
