@@ -284,13 +284,15 @@ fn approach(v: f64, ta: f64, length: f64, t: f64) -> ((f64, f64, f64), f64) {
     (state, total)
 }
 
-#[test]
-fn head_driven_into_the_part_is_stopped_and_the_contact_named() {
-    // The cell file's start: the head above case 1's first CL point, tool axis vertical.
-    let start = [0.40, 0.70, 1.20, 0.0, 0.0, -0.07];
-    // q3 down 0.35 m at 50 mm/s: the tool-centre point C = (q1, q2, q3 + q6) would end 0.22 m
-    // below the part's surface (z about 0.9 there).
-    let (v, ta, length) = (0.05, 0.5, 0.35);
+/// A move of `joint` alone from `start` by `length` downwards (towards smaller values) at
+/// cruise speed `v` with raised-cosine ramps of `ta` ([`approach`]), sampled every 10 ms.
+fn approach_trajectory(
+    start: &[f64; 6],
+    joint: usize,
+    v: f64,
+    ta: f64,
+    length: f64,
+) -> JointTrajectory {
     let (_, total) = approach(v, ta, length, 0.0);
     let n = (total / 0.01).ceil() as usize;
     let points = (0..=n)
@@ -298,11 +300,11 @@ fn head_driven_into_the_part_is_stopped_and_the_contact_named() {
             let t = (k as f64 * 0.01).min(total);
             let ((p, dp, ddp), _) = approach(v, ta, length, t);
             let mut positions = start.to_vec();
-            positions[2] -= p;
+            positions[joint] -= p;
             let mut velocities = vec![0.0; 6];
-            velocities[2] = -dp;
+            velocities[joint] = -dp;
             let mut accelerations = vec![0.0; 6];
-            accelerations[2] = -ddp;
+            accelerations[joint] = -ddp;
             JointTrajectoryPoint {
                 positions,
                 velocities,
@@ -312,15 +314,31 @@ fn head_driven_into_the_part_is_stopped_and_the_contact_named() {
             }
         })
         .collect();
-    let trajectory = JointTrajectory {
+    JointTrajectory {
         joint_names: JOINTS.map(String::from).to_vec(),
         points,
         ..Default::default()
-    };
+    }
+}
+
+/// The executor's acceleration limit of the laser cutter's `joint` (its shipped URDF and
+/// limits file).
+fn laser_acceleration(joint: usize) -> f64 {
     let urdf = format!("{ROOT}/urdf/laser_cutter.urdf");
     let limits = format!("{ROOT}/urdf/laser_cutter_limits.yaml");
     let robot = kerf_robot::RobotModel::from_files(urdf.as_ref(), Some(limits.as_ref())).unwrap();
-    let a3 = robot.executor_limits().unwrap()[2].max_acceleration;
+    robot.executor_limits().unwrap()[joint].max_acceleration
+}
+
+#[test]
+fn head_driven_into_the_part_is_stopped_and_the_contact_named() {
+    // The cell file's start: the head above case 1's first CL point, tool axis vertical.
+    let start = [0.40, 0.70, 1.20, 0.0, 0.0, -0.07];
+    // q3 down 0.35 m at 50 mm/s: the tool-centre point C = (q1, q2, q3 + q6) would end 0.22 m
+    // below the part's surface (z about 0.9 there).
+    let (v, ta, length) = (0.05, 0.5, 0.35);
+    let trajectory = approach_trajectory(&start, 2, v, ta, length);
+    let a3 = laser_acceleration(2);
     // The stated depth: the head moves at most v * DT into the part in the period in which
     // the contact is found (the period before, the cell saw none), then the controlled stop
     // takes v² / (2 a) along q3 (only q3 moves; synchronized linear deceleration).
@@ -473,36 +491,8 @@ fn nozzle_driven_into_the_sheet_penetrates_less_than_the_stated_depth() {
     let length = (start[5] + 0.1 - 0.001).min(0.03);
     assert!(length > 0.015, "q6 starts at {}", start[5]);
     let ta = 0.2;
-    let (_, total) = approach(v, ta, length, 0.0);
-    let n = (total / 0.01).ceil() as usize;
-    let points = (0..=n)
-        .map(|k| {
-            let t = (k as f64 * 0.01).min(total);
-            let ((p, dp, ddp), _) = approach(v, ta, length, t);
-            let mut positions = start.to_vec();
-            positions[5] -= p;
-            let mut velocities = vec![0.0; 6];
-            velocities[5] = -dp;
-            let mut accelerations = vec![0.0; 6];
-            accelerations[5] = -ddp;
-            JointTrajectoryPoint {
-                positions,
-                velocities,
-                accelerations,
-                effort: vec![],
-                time_from_start: RosDuration::from_secs_f64(t).unwrap(),
-            }
-        })
-        .collect();
-    let trajectory = JointTrajectory {
-        joint_names: JOINTS.map(String::from).to_vec(),
-        points,
-        ..Default::default()
-    };
-    let urdf = format!("{ROOT}/urdf/laser_cutter.urdf");
-    let limits = format!("{ROOT}/urdf/laser_cutter_limits.yaml");
-    let robot = kerf_robot::RobotModel::from_files(urdf.as_ref(), Some(limits.as_ref())).unwrap();
-    let a6 = robot.executor_limits().unwrap()[5].max_acceleration;
+    let trajectory = approach_trajectory(&start, 5, v, ta, length);
+    let a6 = laser_acceleration(5);
     // The stated depth: at most v * DT in the period the contact is found (the period
     // before, the tip did not touch), then the controlled stop's v² / (2 a) along q6.
     let bound = v * DT + v * v / (2.0 * a6);
