@@ -5,10 +5,11 @@
 
 #[allow(dead_code)] // each test file uses some of the shared data
 mod support;
+use support::{corner_points, sampled_deviation};
 
 use kerf_gcode::{read_points, PointUnit};
 use kerf_toolpath::baseline::{ccr, icr, nurbs};
-use kerf_toolpath::vec3::{cross, distance_to_segment, dot, norm, sub};
+use kerf_toolpath::vec3::{cross, dot, norm, sub};
 use kerf_toolpath::{
     derivatives_at, plan_feed, point_at, sample_path, smooth_polyline, smooth_polyline_with,
     CornerMethod, CubicSpline, NurbsSettings, Piece, SmoothedPath, ToolpathError,
@@ -51,17 +52,6 @@ fn outlines() -> Vec<(String, Vec<[f64; 3]>)> {
             (p.file_stem().unwrap().to_string_lossy().to_string(), points)
         })
         .collect()
-}
-
-/// A corner turning by `deg` degrees in a tilted plane, segments of 10 mm.
-fn corner_points(deg: f64) -> [[f64; 3]; 3] {
-    let t = deg.to_radians();
-    let e1 = [1.0 / 2f64.sqrt(), 1.0 / 2f64.sqrt(), 0.0];
-    let e2 = [-0.6 / 2f64.sqrt(), 0.6 / 2f64.sqrt(), 0.8];
-    let v = [0.1, -0.2, 0.3];
-    let prev = std::array::from_fn(|d| v[d] - 0.010 * e1[d]);
-    let next = std::array::from_fn(|d| v[d] + 0.010 * (t.cos() * e1[d] + t.sin() * e2[d]));
-    [prev, v, next]
 }
 
 #[test]
@@ -119,12 +109,7 @@ fn every_corner_is_within_its_stated_deviation_and_the_tolerance() {
                     .unwrap()
                     .unwrap();
                 assert!(c.deviation <= delta * (1.0 + 1e-12), "{method:?} {deg}");
-                let mut worst: f64 = 0.0;
-                for k in 0..=4000 {
-                    let p = c.curve.point(k as f64 / 4000.0);
-                    worst =
-                        worst.max(distance_to_segment(p, a, v).min(distance_to_segment(p, v, b)));
-                }
+                let worst = sampled_deviation(&c.curve, a, v, b);
                 let name = method.name();
                 assert!(
                     worst <= c.deviation * (1.0 + 1e-9),

@@ -2,23 +2,15 @@
 //! the exact deviation bound, G2 joins, the shape table against its search, bad input.
 #![allow(clippy::unwrap_used, clippy::expect_used)] // tests report failures by panicking
 
+#[allow(dead_code)] // shared test data; this file uses some of it
+mod support;
+use support::{corner_points, sampled_deviation};
+
 use kerf_toolpath::corner::{
     corner_transition, normalized_curvature, search_shape, table_shape, Binding,
 };
-use kerf_toolpath::vec3::{cross, distance_to_segment, dot, norm, sub};
+use kerf_toolpath::vec3::{cross, dot, norm, sub};
 use kerf_toolpath::{smooth_polyline, Piece, ToolpathError};
-
-/// A corner turning by `deg` degrees in a tilted plane, segments of 10 mm.
-fn corner_points(deg: f64) -> [[f64; 3]; 3] {
-    let t = deg.to_radians();
-    // The plane spanned by e1 = (1, 1, 0)/√2 and e2 = (0, 0.6, 0.8) rotated... any orthonormal pair.
-    let e1 = [1.0 / 2f64.sqrt(), 1.0 / 2f64.sqrt(), 0.0];
-    let e2 = [-0.6 / 2f64.sqrt(), 0.6 / 2f64.sqrt(), 0.8];
-    let v = [0.1, -0.2, 0.3];
-    let prev = std::array::from_fn(|d| v[d] - 0.010 * e1[d]);
-    let next = std::array::from_fn(|d| v[d] + 0.010 * (t.cos() * e1[d] + t.sin() * e2[d]));
-    [prev, v, next]
-}
 
 #[test]
 fn the_deviation_is_exact_and_within_the_tolerance_at_every_angle() {
@@ -32,11 +24,7 @@ fn the_deviation_is_exact_and_within_the_tolerance_at_every_angle() {
             c.deviation
         );
         // Dense sampling: the largest distance to the two segments is the stated one.
-        let mut worst: f64 = 0.0;
-        for k in 0..=4000 {
-            let p = c.curve.point(k as f64 / 4000.0);
-            worst = worst.max(distance_to_segment(p, a, v).min(distance_to_segment(p, v, b)));
-        }
+        let worst = sampled_deviation(&c.curve, a, v, b);
         assert!(
             worst <= c.deviation * (1.0 + 1e-9),
             "{deg}: sampled {worst} > {}",

@@ -6,22 +6,12 @@
 
 #[allow(dead_code)] // shared test data; this file uses some of it
 mod support;
+use support::{corner_points, sampled_deviation};
 
 use kerf_toolpath::corner::{corner_transition_with, table_angles, Binding, ShapeObjective};
 use kerf_toolpath::corner_jerk::{curvature_and_rate, max_jerk_norm, sampled_max_jerk_norm};
-use kerf_toolpath::vec3::{cross, distance_to_segment, dot, norm, sub};
+use kerf_toolpath::vec3::{cross, dot, norm, sub};
 use kerf_toolpath::{smooth_polyline, smooth_polyline_with, CornerCurve, CornerMethod, Piece};
-
-/// A corner turning by `deg` degrees in a tilted plane, segments of 10 mm.
-fn corner_points(deg: f64) -> [[f64; 3]; 3] {
-    let t = deg.to_radians();
-    let e1 = [1.0 / 2f64.sqrt(), 1.0 / 2f64.sqrt(), 0.0];
-    let e2 = [-0.6 / 2f64.sqrt(), 0.6 / 2f64.sqrt(), 0.8];
-    let v = [0.1, -0.2, 0.3];
-    let prev = std::array::from_fn(|d| v[d] - 0.010 * e1[d]);
-    let next = std::array::from_fn(|d| v[d] + 0.010 * (t.cos() * e1[d] + t.sin() * e2[d]));
-    [prev, v, next]
-}
 
 fn quintic(c: &CornerCurve) -> &kerf_toolpath::QuinticBezier {
     match c {
@@ -45,11 +35,7 @@ fn the_jerk_shape_keeps_the_exact_deviation_and_g2_joins() {
                 "{deg}: {}",
                 c.deviation
             );
-            let mut worst: f64 = 0.0;
-            for k in 0..=4000 {
-                let p = c.curve.point(k as f64 / 4000.0);
-                worst = worst.max(distance_to_segment(p, a, v).min(distance_to_segment(p, v, b)));
-            }
+            let worst = sampled_deviation(&c.curve, a, v, b);
             assert!(
                 worst <= c.deviation * (1.0 + 1e-9),
                 "{deg}: {worst} > {}",

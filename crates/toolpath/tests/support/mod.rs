@@ -1,6 +1,7 @@
 //! Test data shared by the integration tests of `kerf_toolpath`.
 
-use kerf_toolpath::{bang_bang_under, CurvatureLimits, FeedLimits, PathSample};
+use kerf_toolpath::vec3::distance_to_segment;
+use kerf_toolpath::{bang_bang_under, CornerCurve, CurvatureLimits, FeedLimits, PathSample};
 
 /// A zig-zag of short and long segments with right-angle, acute and obtuse corners \[m\].
 pub const ZIG_ZAG: [[f64; 3]; 6] = [
@@ -96,4 +97,28 @@ pub fn t_lb(samples: &[PathSample], limits: &FeedLimits) -> f64 {
     bang_bang_under(samples, curve, limits.tangential_acceleration)
         .unwrap()
         .time
+}
+
+/// A corner turning by `deg` degrees in a tilted plane, segments of 10 mm: the points before,
+/// at and after the vertex \[m\].
+pub fn corner_points(deg: f64) -> [[f64; 3]; 3] {
+    let t = deg.to_radians();
+    // An orthonormal pair spanning a plane tilted against every axis.
+    let e1 = [1.0 / 2f64.sqrt(), 1.0 / 2f64.sqrt(), 0.0];
+    let e2 = [-0.6 / 2f64.sqrt(), 0.6 / 2f64.sqrt(), 0.8];
+    let v = [0.1, -0.2, 0.3];
+    let prev = std::array::from_fn(|d| v[d] - 0.010 * e1[d]);
+    let next = std::array::from_fn(|d| v[d] + 0.010 * (t.cos() * e1[d] + t.sin() * e2[d]));
+    [prev, v, next]
+}
+
+/// The largest distance \[m\] of a corner curve from the two segments a–v and v–b, on 4001
+/// equally spaced parameters.
+pub fn sampled_deviation(curve: &CornerCurve, a: [f64; 3], v: [f64; 3], b: [f64; 3]) -> f64 {
+    (0..=4000)
+        .map(|k| {
+            let p = curve.point(k as f64 / 4000.0);
+            distance_to_segment(p, a, v).min(distance_to_segment(p, v, b))
+        })
+        .fold(0.0, f64::max)
 }
