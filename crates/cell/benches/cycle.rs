@@ -80,27 +80,15 @@ fn command(path: &Path, t: f64) -> JointSample {
     let i = (x.floor() as usize).min(n - 1);
     let s = x - i as f64;
     let h = path.period;
-    let (s2, s3) = (s * s, s * s * s);
-    let (h00, h10, h01, h11) = (
-        2.0 * s3 - 3.0 * s2 + 1.0,
-        s3 - 2.0 * s2 + s,
-        -2.0 * s3 + 3.0 * s2,
-        s3 - s2,
-    );
-    let (d00, d10, d01, d11) = (
-        6.0 * s2 - 6.0 * s,
-        3.0 * s2 - 4.0 * s + 1.0,
-        -6.0 * s2 + 6.0 * s,
-        3.0 * s2 - 2.0 * s,
-    );
+    let basis = kerf_cell::hermite::Hermite::at(s);
     let (p0, p1, v0, v1) = (path.q[i], path.q[i + 1], path.qd[i], path.qd[i + 1]);
     let (a0, a1) = (path.qdd[i], path.qdd[i + 1]);
     JointSample {
         positions: (0..6)
-            .map(|j| h00 * p0[j] + h10 * h * v0[j] + h01 * p1[j] + h11 * h * v1[j])
+            .map(|j| basis.position(p0[j], v0[j], p1[j], v1[j], h))
             .collect(),
         velocities: (0..6)
-            .map(|j| dir * (d00 * p0[j] + d10 * h * v0[j] + d01 * p1[j] + d11 * h * v1[j]) / h)
+            .map(|j| dir * basis.velocity(p0[j], v0[j], p1[j], v1[j], h))
             .collect(),
         accelerations: (0..6).map(|j| a0[j] + s * (a1[j] - a0[j])).collect(),
     }

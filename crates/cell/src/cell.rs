@@ -12,6 +12,7 @@ use crate::config::{CellFile, GeometrySpec};
 use crate::contact::{Contact, ContactChecker};
 use crate::dynamics::{inverse_dynamics, Workspace};
 use crate::geometry::{primitive, to_pose, urdf_shape, RobotShape, SceneObject};
+use crate::hermite::Hermite;
 use crate::inertia::InertiaFile;
 use crate::settings::{CellSettings, Mode};
 use crate::world::World;
@@ -589,18 +590,10 @@ impl Cell {
         Ok(&self.state)
     }
 
-    /// The reference at fraction `s` of the period (cubic Hermite; e.g. Bartels, Beatty,
+    /// The reference at fraction `s` of the period ([`Hermite`]; e.g. Bartels, Beatty,
     /// Barsky, *An Introduction to Splines for Use in Computer Graphics*, 1987, section 3.6).
     fn interpolate(&mut self, end: &JointSample, s: f64, dt: f64) {
-        let (s2, s3) = (s * s, s * s * s);
-        let h00 = 2.0 * s3 - 3.0 * s2 + 1.0;
-        let h10 = s3 - 2.0 * s2 + s;
-        let h01 = -2.0 * s3 + 3.0 * s2;
-        let h11 = s3 - s2;
-        let d00 = 6.0 * s2 - 6.0 * s;
-        let d10 = 3.0 * s2 - 4.0 * s + 1.0;
-        let d01 = -6.0 * s2 + 6.0 * s;
-        let d11 = 3.0 * s2 - 2.0 * s;
+        let basis = Hermite::at(s);
         let p = &self.previous;
         for j in 0..end.positions.len() {
             let (p0, v0, p1, v1) = (
@@ -609,8 +602,8 @@ impl Cell {
                 end.positions[j],
                 end.velocities[j],
             );
-            self.reference.q[j] = h00 * p0 + h10 * dt * v0 + h01 * p1 + h11 * dt * v1;
-            self.reference.qd[j] = (d00 * p0 + d10 * dt * v0 + d01 * p1 + d11 * dt * v1) / dt;
+            self.reference.q[j] = basis.position(p0, v0, p1, v1, dt);
+            self.reference.qd[j] = basis.velocity(p0, v0, p1, v1, dt);
             let a0 = p.accelerations[j];
             self.reference.qdd[j] = a0 + s * (end.accelerations[j] - a0);
         }

@@ -25,6 +25,7 @@ pub mod contact;
 pub mod dynamics;
 pub mod error;
 pub mod geometry;
+pub mod hermite;
 pub mod inertia;
 pub mod settings;
 pub mod world;
