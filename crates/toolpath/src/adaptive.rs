@@ -4,6 +4,7 @@
 
 use crate::corner_curve::CornerCurve;
 use crate::error::ToolpathError;
+use crate::maximum::golden_argmax;
 use crate::samples::PathSample;
 use crate::smooth::{Piece, SmoothedPath};
 use crate::vec3::{dot, norm, scale, sub};
@@ -233,10 +234,12 @@ pub fn features(curve: &CornerCurve) -> Vec<f64> {
             let (before, after) = (kappa[j] - kappa[j - 1], kappa[j + 1] - kappa[j]);
             if before != 0.0 && after != 0.0 && (before > 0.0) != (after > 0.0) {
                 let sign = if before > 0.0 { 1.0 } else { -1.0 };
-                out.push(golden_max(a, b, |u| sign * curve.curvature(u)));
+                out.push(golden_argmax(a, b, EXTREMUM_STEPS, |u| {
+                    sign * curve.curvature(u)
+                }));
             }
             if slopes[j] > slopes[j - 1] && slopes[j] > slopes[j + 1] {
-                out.push(golden_max(a, b, |u| {
+                out.push(golden_argmax(a, b, EXTREMUM_STEPS, |u| {
                     slope(curve, u, curve.curvature(u), lo, hi)
                 }));
             }
@@ -246,13 +249,13 @@ pub fn features(curve: &CornerCurve) -> Vec<f64> {
         let n = FEATURE_SCAN;
         let slope_at = |u: f64| slope(curve, u, curve.curvature(u), lo, hi);
         if slopes[0] > slopes[1] {
-            let u = golden_max(grid[0], grid[1], slope_at);
+            let u = golden_argmax(grid[0], grid[1], EXTREMUM_STEPS, slope_at);
             if slope_at(u) > slopes[0] {
                 out.push(u);
             }
         }
         if slopes[n] > slopes[n - 1] {
-            let u = golden_max(grid[n - 1], grid[n], slope_at);
+            let u = golden_argmax(grid[n - 1], grid[n], EXTREMUM_STEPS, slope_at);
             if slope_at(u) > slopes[n] {
                 out.push(u);
             }
@@ -261,31 +264,6 @@ pub fn features(curve: &CornerCurve) -> Vec<f64> {
     out.sort_by(f64::total_cmp);
     out.dedup_by(|a, b| (*a - *b).abs() <= 1e-9);
     out
-}
-
-/// The maximum of a unimodal `f` on [lo, hi] by golden section
-/// ([`EXTREMUM_STEPS`] steps, one evaluation each).
-fn golden_max(mut lo: f64, mut hi: f64, f: impl Fn(f64) -> f64) -> f64 {
-    let g = 0.5 * (5f64.sqrt() - 1.0);
-    let mut m1 = hi - g * (hi - lo);
-    let mut m2 = lo + g * (hi - lo);
-    let (mut f1, mut f2) = (f(m1), f(m2));
-    for _ in 0..EXTREMUM_STEPS {
-        if f1 < f2 {
-            lo = m1;
-            m1 = m2;
-            f1 = f2;
-            m2 = lo + g * (hi - lo);
-            f2 = f(m2);
-        } else {
-            hi = m2;
-            m2 = m1;
-            f2 = f1;
-            m1 = hi - g * (hi - lo);
-            f1 = f(m1);
-        }
-    }
-    0.5 * (lo + hi)
 }
 
 /// Marches a corner curve from `first` (u = 0) to u = 1 in steps of at most

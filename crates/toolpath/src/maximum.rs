@@ -1,6 +1,8 @@
-//! The largest value of a function of one parameter on an interval, by a
-//! grid and a golden-section refinement: the search behind kerf's corner
-//! curvature, its jerk norm and a corner curve's largest curvature.
+//! Searches for the largest value of a function of one parameter on an
+//! interval: a grid and a golden-section refinement (kerf's corner
+//! curvature, its jerk norm, a corner curve's largest curvature), and the
+//! golden section alone on a unimodal function (the adaptive sampler's
+//! features, eq. 17's critical radius).
 
 /// Golden-section steps of the refinement: the bracket of two grid steps
 /// shrinks to 0.618²⁴ ≈ 10⁻⁵ of itself.
@@ -40,4 +42,33 @@ pub(crate) fn sampled_maximum(f: impl Fn(f64) -> f64, lo: f64, hi: f64, samples:
         }
     }
     best.0.max(f(0.5 * (a + b)))
+}
+
+/// Where a unimodal `f` is largest on [`lo`, `hi`], by `steps` steps of golden section, each
+/// reusing one of the previous step's two evaluations; the middle of the last bracket, whose
+/// width is 0.618^`steps` of the interval's.
+///
+/// # Performance
+/// `steps` + 2 evaluations of `f`.
+pub(crate) fn golden_argmax(mut lo: f64, mut hi: f64, steps: usize, f: impl Fn(f64) -> f64) -> f64 {
+    let g = 0.5 * (5f64.sqrt() - 1.0);
+    let mut m1 = hi - g * (hi - lo);
+    let mut m2 = lo + g * (hi - lo);
+    let (mut f1, mut f2) = (f(m1), f(m2));
+    for _ in 0..steps {
+        if f1 < f2 {
+            lo = m1;
+            m1 = m2;
+            f1 = f2;
+            m2 = lo + g * (hi - lo);
+            f2 = f(m2);
+        } else {
+            hi = m2;
+            m2 = m1;
+            f2 = f1;
+            m1 = hi - g * (hi - lo);
+            f1 = f(m1);
+        }
+    }
+    0.5 * (lo + hi)
 }

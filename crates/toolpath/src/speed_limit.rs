@@ -4,6 +4,7 @@
 //! normal acceleration and jerk, together with the programmed feed.
 
 use crate::error::{check_positive, ToolpathError};
+use crate::maximum::golden_argmax;
 
 /// A second-order position loop G(s) = ω_n² / (s² + 2ζω_n s + ω_n²) (seed
 /// 003 eq. 17's model: ω_n = √(K_p/J), ζ = B / (2√(J K_p))).
@@ -118,19 +119,10 @@ impl CurvatureLimits {
     pub fn contour_critical_radius(&self) -> Option<f64> {
         let servo = self.servo.as_ref()?;
         let e = servo.contour_error;
-        let v = |t: f64| self.contour_speed(e * (1.0 + t.exp()));
-        let (mut lo, mut hi) = (-20.0f64, 20.0f64);
-        let g = 0.5 * (5f64.sqrt() - 1.0);
-        for _ in 0..120 {
-            let m1 = hi - g * (hi - lo);
-            let m2 = lo + g * (hi - lo);
-            if v(m1) < v(m2) {
-                hi = m2;
-            } else {
-                lo = m1;
-            }
-        }
-        Some(e * (1.0 + (0.5 * (lo + hi)).exp()))
+        let t = golden_argmax(-20.0, 20.0, 120, |t| {
+            -self.contour_speed(e * (1.0 + t.exp()))
+        });
+        Some(e * (1.0 + t.exp()))
     }
 
     /// The least speed of eq. 17 over the curvatures [`kappa_lo`,
