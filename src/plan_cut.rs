@@ -148,6 +148,18 @@ fn summary(plan: &CutPlan) -> String {
         plan.iterations,
         plan.collision_queries
     );
+    let f = &plan.feed;
+    let _ = writeln!(
+        s,
+        "feed: {} law, cycle time {:.3} s (constant feed {:.3} s), peak feed {:.4} m/s",
+        f.law.as_str(),
+        f.cycle_time,
+        f.constant_feed_time,
+        f.peak_feed
+    );
+    for l in &f.limits {
+        let _ = writeln!(s, "  s {:.4}-{:.4} m: {}", l.s_start, l.s_end, l.limited_by);
+    }
     let _ = writeln!(s, "RTOs ({}):", plan.rtos.len());
     let _ = writeln!(
         s,
@@ -176,7 +188,7 @@ fn summary(plan: &CutPlan) -> String {
     let _ = writeln!(
         s,
         "stage times (s): setup {:.3}, hessian {:.3}, gfd {:.3}, selection {:.3}, rotary QP {:.3}, \
-         M-path QP {:.3}, collision {:.3}, evaluation {:.3}, total {:.3}",
+         M-path QP {:.3}, collision {:.3}, evaluation {:.3}, feed {:.3}, total {:.3}",
         t.setup,
         t.hessian,
         t.gfd,
@@ -185,6 +197,7 @@ fn summary(plan: &CutPlan) -> String {
         t.mpath_qp,
         t.collision,
         t.evaluation,
+        t.feed,
         t.total
     );
     s
@@ -237,6 +250,8 @@ fn metrics_table(m: &Metrics, qi: &Metrics) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use kerf_mjto::optimal_feed::{FeedLimit, FeedMode};
+    use kerf_mjto::plan::FeedReport;
     use kerf_mjto::{
         error::CollisionReport,
         plan::{RtoRecord, StageTimes},
@@ -267,6 +282,7 @@ mod tests {
             request_id: "case1".into(),
             joint_names: JOINT_NAMES.iter().map(|s| s.to_string()).collect(),
             times: vec![0.0, 0.01, 0.02],
+            path_positions: vec![0.0, 0.75, 1.5],
             positions: vec![[0.0; 6]; 3],
             velocities: vec![[0.0; 6]; 3],
             accelerations: vec![[0.0; 6]; 3],
@@ -294,6 +310,17 @@ mod tests {
             collision_queries: 99,
             control_points: 25,
             path_length: 1.5,
+            feed: FeedReport {
+                law: FeedMode::TimeOptimal,
+                cycle_time: 0.02,
+                constant_feed_time: 0.015,
+                peak_feed: 0.33,
+                limits: vec![FeedLimit {
+                    s_start: 0.25,
+                    s_end: 0.5,
+                    limited_by: "q5 jerk".into(),
+                }],
+            },
             times_per_stage: StageTimes {
                 total: 4.5,
                 ..Default::default()
@@ -305,6 +332,11 @@ mod tests {
             "{s}"
         );
         assert!(s.contains("RTOs (2):"), "{s}");
+        assert!(
+            s.contains("feed: time_optimal law, cycle time 0.020 s (constant feed 0.015 s)"),
+            "{s}"
+        );
+        assert!(s.contains("s 0.2500-0.5000 m: q5 jerk"), "{s}");
         assert!(
             s.contains("   12   0.5000    0.15000   -0.10000  -0.06000    iter 2"),
             "{s}"

@@ -110,6 +110,7 @@ fn msg_of(r: &CutRequest) -> msg::CutRequest {
         has_reference_standoff: true,
         reference_standoff: o.reference_standoff,
         clearance: o.clearance,
+        feed_law: o.feed_law.as_str().into(),
         time_budget: r.time_budget,
     }
 }
@@ -486,6 +487,7 @@ fn planned_trajectory_format_runs_on_the_executor() {
             .map(String::from)
             .to_vec(),
         times: Vec::new(),
+        path_positions: Vec::new(),
         positions: Vec::new(),
         velocities: Vec::new(),
         accelerations: Vec::new(),
@@ -496,6 +498,7 @@ fn planned_trajectory_format_runs_on_the_executor() {
         collision_queries: 0,
         control_points: 0,
         path_length: 0.0,
+        feed: Default::default(),
         times_per_stage: Default::default(),
     };
     for k in 0..=n {

@@ -183,16 +183,46 @@ pub fn quaternion_interpolation_within(
         ));
     }
     let times = law.checked_sample_times(dt, MAX_SAMPLES)?;
-    let mut positions = Vec::with_capacity(times.len());
+    let path: Vec<f64> = times.iter().map(|&t| law.eval(t)[0]).collect();
+    let positions = quaternion_interpolation_along(frames, rtos, &path, sigma, limits, budget)?;
+    Ok((times, positions))
+}
+
+/// The QI poses at the path positions `path` (m, one per sample, in [0, σ]): the baseline on
+/// any time law, e.g. the time-optimal one of a plan (`CutPlan::path_positions`), so that both
+/// methods are compared on the same s(t).
+///
+/// # Errors
+/// [`PlanError::InvalidRequest`] for bad RTOs or a position outside `[0, σ]`;
+/// [`PlanError::Unreachable`] when a sample leaves a stroke; [`PlanError::Interrupted`].
+///
+/// # Performance
+/// O(samples · log(N + RTOs)).
+pub fn quaternion_interpolation_along(
+    frames: &PathFrames,
+    rtos: &[Rto],
+    path: &[f64],
+    sigma: f64,
+    limits: &[AxisLimits; 6],
+    budget: &Budget,
+) -> Result<Vec<[f64; 6]>, PlanError> {
+    check_rtos(rtos)?;
+    let mut positions = Vec::with_capacity(path.len());
     let mut previous = rtos.first().map(|r| r.q4);
-    for (k, &t) in times.iter().enumerate() {
+    for (k, &s) in path.iter().enumerate() {
         if k.is_multiple_of(crate::planner::BUDGET_STRIDE) {
             budget.check("the QI baseline")?;
         }
-        let u = (law.eval(t)[0] / sigma).clamp(0.0, 1.0);
+        if !(s.is_finite() && (-1e-9 * sigma..=sigma * (1.0 + 1e-9)).contains(&s)) {
+            return Err(PlanError::invalid(
+                "path positions",
+                format!("{s} m at sample {k} is outside [0, {sigma}] m"),
+            ));
+        }
+        let u = (s / sigma).clamp(0.0, 1.0);
         let q = pose_unchecked(frames, rtos, u, previous, limits)?;
         previous = Some(q[3]);
         positions.push(q);
     }
-    Ok((times, positions))
+    Ok(positions)
 }

@@ -28,6 +28,7 @@ pub mod kinematics;
 pub mod machine;
 pub mod mesh;
 pub mod metrics;
+pub mod optimal_feed;
 pub mod orientation;
 pub mod plan;
 pub mod planner;

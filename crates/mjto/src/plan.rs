@@ -2,6 +2,24 @@
 
 use serde::{Deserialize, Serialize};
 
+use crate::optimal_feed::{FeedLimit, FeedMode};
+
+/// The feed of a plan (issue 16, item 1).
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+pub struct FeedReport {
+    /// The law the trajectory runs.
+    pub law: FeedMode,
+    /// Duration of the cut (s), rest to rest.
+    pub cycle_time: f64,
+    /// Duration of seed 001's constant-feed plan at the requested feedrate with the request's
+    /// ramps (s), for comparison ([`crate::timelaw::TimeLaw`]).
+    pub constant_feed_time: f64,
+    /// Largest feed reached (m/s).
+    pub peak_feed: f64,
+    /// Where the feed is limited and by what (time-optimal law; empty for the constant one).
+    pub limits: Vec<FeedLimit>,
+}
+
 /// One representative tool orientation of the final plan.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct RtoRecord {
@@ -59,6 +77,9 @@ pub struct StageTimes {
     pub gfd: f64,
     /// Initial RTO selection (eq. 56).
     pub selection: f64,
+    /// The time-optimal feed (TOPP3 solves, all iterations and margins).
+    #[serde(default)]
+    pub feed: f64,
     /// Rotary-axis QPs (all iterations).
     pub rotary_qp: f64,
     /// M-path QPs (all iterations).
@@ -80,6 +101,9 @@ pub struct CutPlan {
     pub joint_names: Vec<String>,
     /// Sample times from the start (s), every Δt, the last at the end.
     pub times: Vec<f64>,
+    /// Position along the CL path s (m) per sample: the time law s(t) the joints follow
+    /// (u = s/σ, eq. 1).
+    pub path_positions: Vec<f64>,
     /// Joint positions per sample.
     pub positions: Vec<[f64; 6]>,
     /// Joint velocities per sample (analytic, eq. 7).
@@ -100,6 +124,8 @@ pub struct CutPlan {
     pub control_points: usize,
     /// Path length σ (m).
     pub path_length: f64,
+    /// The feed: law, cycle time, the constant-feed time, where the feed is limited.
+    pub feed: FeedReport,
     /// Stage timings.
     pub times_per_stage: StageTimes,
 }

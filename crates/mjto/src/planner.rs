@@ -38,6 +38,7 @@ use crate::timelaw::TimeLaw;
 use crate::{CutPlan, CutRequest, LaserMachine, PlanError};
 
 mod dense_check;
+mod feed;
 mod iteration;
 mod setup;
 

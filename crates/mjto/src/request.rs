@@ -5,6 +5,7 @@
 //! form of the `~/cut_request_text` topic. SI units throughout: m, m/s,
 //! m/s², m/s³, s, rad.
 
+use crate::optimal_feed::FeedMode;
 use crate::timelaw::TimeLaw;
 use nalgebra::{Isometry3, Quaternion, Translation3, UnitQuaternion, Vector3};
 use serde::{Deserialize, Serialize};
@@ -160,6 +161,10 @@ pub struct CutOptions {
     /// Required clearance between head and workpiece (m, ≥ 0); 0 = contact
     /// is a collision.
     pub clearance: f64,
+    /// The time law: `time_optimal` (default: the fastest law under every limit, the
+    /// feedrate its cruise maximum; issue 16) or `constant` (seed 001's constant feedrate with
+    /// S-curve ramps).
+    pub feed_law: FeedMode,
 }
 
 impl Default for CutOptions {
@@ -174,6 +179,7 @@ impl Default for CutOptions {
             rto_angle: 20f64.to_radians(),
             reference_standoff: -0.07,
             clearance: 0.0,
+            feed_law: FeedMode::TimeOptimal,
         }
     }
 }

@@ -164,6 +164,31 @@ impl TimeLaw {
         self.t_cruise
     }
 
+    /// The stretches of the path and the limit each phase runs at: jerk phases at the path
+    /// jerk, the constant-acceleration phase at the path acceleration, the cruise at the
+    /// feedrate (only when it is reached), then the mirror image.
+    ///
+    /// # Returns
+    /// `(s_start, s_end, limit)` in path order; zero-length phases are left out.
+    pub fn phases(&self) -> Vec<(f64, f64, &'static str)> {
+        let mut ramp = vec![
+            (0.0, self.s1, "path jerk"),
+            (self.s1, self.s2, "path acceleration"),
+            (self.s2, self.d_ramp, "path jerk"),
+        ];
+        ramp.retain(|p| p.1 > p.0);
+        let mut out = ramp.clone();
+        if self.peak >= self.feed && self.sigma - self.d_ramp > self.d_ramp {
+            out.push((self.d_ramp, self.sigma - self.d_ramp, "feedrate"));
+        }
+        out.extend(
+            ramp.iter()
+                .rev()
+                .map(|&(a, b, name)| (self.sigma - b, self.sigma - a, name)),
+        );
+        out
+    }
+
     /// `[s, ṡ, s̈, s⃛]` at time `t` (m, m/s, m/s², m/s³), `t` clamped to
     /// `[0, T]`. At a phase boundary the jerk is that of the phase that
     /// starts there (the last phase at T). A NaN `t` gives NaN.
@@ -239,19 +264,7 @@ impl TimeLaw {
         if !(dt.is_finite() && dt > 0.0) {
             return vec![0.0, total];
         }
-        let count = (total / dt).floor().min(MAX_SAMPLES as f64);
-        let mut times = Vec::with_capacity(count as usize + 2);
-        let mut i = 0_u64;
-        loop {
-            let t = i as f64 * dt;
-            if t >= total - dt * 1e-6 {
-                break;
-            }
-            times.push(t);
-            i += 1;
-        }
-        times.push(total);
-        times
+        grid_times(total, dt, MAX_SAMPLES)
     }
 
     /// [`TimeLaw::sample_times`] with checks.
@@ -261,19 +274,48 @@ impl TimeLaw {
     /// not finite and positive or the trajectory would need more than
     /// `max_samples` samples.
     pub fn checked_sample_times(&self, dt: f64, max_samples: usize) -> Result<Vec<f64>, PlanError> {
-        let dt = positive("sample_period", dt)?;
-        let needed = (self.duration() / dt).ceil() + 1.0;
-        if needed > max_samples as f64 {
-            return Err(PlanError::invalid(
-                "sample_period",
-                format!(
-                    "{dt} s over a {:.3} s trajectory needs {needed} samples, more than {max_samples}",
-                    self.duration()
-                ),
-            ));
-        }
-        Ok(self.sample_times(dt))
+        checked_grid_times(self.duration(), dt, max_samples)
     }
+}
+
+/// Times `0, dt, 2dt, …` below `total` (at most `max_samples` of them) and `total` as the
+/// last; a grid time closer than `dt·1e-6` to `total` is dropped (`total` replaces it).
+fn grid_times(total: f64, dt: f64, max_samples: usize) -> Vec<f64> {
+    let count = (total / dt).floor().min(max_samples as f64);
+    let mut times = Vec::with_capacity(count as usize + 2);
+    let mut i = 0_u64;
+    loop {
+        let t = i as f64 * dt;
+        if t >= total - dt * 1e-6 || times.len() >= max_samples {
+            break;
+        }
+        times.push(t);
+        i += 1;
+    }
+    times.push(total);
+    times
+}
+
+/// The controller sample times of a trajectory of duration `total`: `0, dt, 2dt, …` and
+/// `total` as the last sample (a grid time closer than `dt·1e-6` to it is dropped).
+///
+/// # Errors
+/// [`PlanError::InvalidRequest`] (field `sample_period`) when `dt` is not finite and positive,
+/// `total` is not finite and positive, or the trajectory would need more than `max_samples`
+/// samples.
+pub fn checked_grid_times(total: f64, dt: f64, max_samples: usize) -> Result<Vec<f64>, PlanError> {
+    let dt = positive("sample_period", dt)?;
+    let total = positive("trajectory duration", total)?;
+    let needed = (total / dt).ceil() + 1.0;
+    if needed > max_samples as f64 {
+        return Err(PlanError::invalid(
+            "sample_period",
+            format!(
+                "{dt} s over a {total:.3} s trajectory needs {needed} samples, more than {max_samples}"
+            ),
+        ));
+    }
+    Ok(grid_times(total, dt, max_samples))
 }
 
 /// Chain rule of seed 001 eq. 6/7: from the geometric derivatives

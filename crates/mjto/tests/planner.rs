@@ -12,6 +12,7 @@ use kerf_mjto::error::status;
 use kerf_mjto::kinematics::{forward, tool_axis};
 use kerf_mjto::machine::JOINT_NAMES;
 use kerf_mjto::mesh::{load, write_obj, MeshData};
+use kerf_mjto::optimal_feed::FeedMode;
 use kerf_mjto::orientation::PathFrames;
 use kerf_mjto::planner::Planner;
 use kerf_mjto::timelaw::TimeLaw;
@@ -62,8 +63,9 @@ fn check_plan(name: &str, request: &CutRequest, plan: &CutPlan) {
     assert_eq!(plan.metrics.colliding_samples, 0);
 
     // Times: every sample period from 0, the last at the end T of the
-    // jerk-limited feed profile, less than one period after the one
-    // before.
+    // feed law, less than one period after the one before. The constant
+    // feed's S-curve is the fastest law under the process limits alone, so
+    // no law is faster; a plan that runs it is exactly it.
     let dt = request.sample_period;
     let law = TimeLaw::new(
         v.sigma,
@@ -72,7 +74,11 @@ fn check_plan(name: &str, request: &CutRequest, plan: &CutPlan) {
         request.feed_jerk,
     )
     .unwrap();
-    let total = law.duration();
+    assert_eq!(plan.feed.constant_feed_time, law.duration());
+    let total = plan.feed.cycle_time;
+    assert!(total >= law.duration() * (1.0 - 1e-9), "{name}: {total} s");
+    let on_s_curve = total == law.duration();
+    assert_eq!(plan.path_positions.len(), n);
     for (k, &t) in plan.times[..n - 1].iter().enumerate() {
         assert!((t - k as f64 * dt).abs() < 1e-9, "{name}: t[{k}] = {t}");
     }
@@ -177,7 +183,21 @@ fn check_plan(name: &str, request: &CutRequest, plan: &CutPlan) {
     let mut max_cl = 0.0f64;
     let mut previous_u = 0.0;
     for (k, (&t, q)) in plan.times.iter().zip(&plan.positions).enumerate() {
-        let u = (law.eval(t)[0] / v.sigma).clamp(0.0, 1.0);
+        let s = plan.path_positions[k];
+        if on_s_curve {
+            assert!((s - law.eval(t)[0]).abs() <= 1e-12, "{name}: s({t})");
+        }
+        // The feed of the executed samples: at most f on every step.
+        if k + 1 < n {
+            let step = plan.path_positions[k + 1] - s;
+            let h = plan.times[k + 1] - t;
+            assert!(
+                step <= request.feedrate * h * (1.0 + 1e-6),
+                "{name}: feed {} m/s over step {k}",
+                step / h
+            );
+        }
+        let u = (s / v.sigma).clamp(0.0, 1.0);
         assert!(u >= previous_u, "{name}: u decreases at {k}");
         previous_u = u;
         let (c, o) = forward(q);
@@ -263,6 +283,12 @@ fn check_plan(name: &str, request: &CutRequest, plan: &CutPlan) {
             peak_fd_jerk[j]
         );
     }
+}
+
+/// Seed 001's claim on its cases: MJTO's peak accelerations and jerks are below QI's on q1..q5
+/// (QI on the same RTOs and the same s(t)).
+fn check_smoother_than_qi(name: &str, plan: &CutPlan) {
+    let (m, qi) = (&plan.metrics, &plan.qi_metrics);
     for j in 0..5 {
         for (what, ours, theirs) in [
             (
@@ -295,9 +321,44 @@ fn case1_plans_within_limits_collision_free_and_smoother_than_qi() {
     let mut planner = Planner::new(machine()).unwrap();
     let plan = planner.plan(&request).unwrap();
     check_plan("case1", &request, &plan);
+    check_smoother_than_qi("case1", &plan);
     // Seed 001 section 3.1: one iteration suffices.
     assert_eq!(plan.iterations, 1);
     assert!(plan.rtos.iter().all(|r| r.inserted_at_iteration == 0));
+}
+
+#[test]
+fn case1_at_twice_its_feed_is_refused_at_constant_feed_and_planned_time_optimal() {
+    let mut request = case("case1");
+    request.feedrate *= 2.0;
+    let mut planner = Planner::new(machine()).unwrap();
+    // Seed 001's constant feed breaks a joint limit on its samples.
+    let mut constant = request.clone();
+    constant.options.feed_law = FeedMode::Constant;
+    match planner.plan(&constant) {
+        Err(e @ PlanError::LimitViolation { .. }) => {
+            assert_eq!(e.status(), status::LIMIT_VIOLATION);
+        }
+        other => panic!("expected LimitViolation, got {other:?}"),
+    }
+    // The time-optimal law slows down where q4 needs it.
+    let plan = planner.plan(&request).unwrap();
+    check_plan("case1 at 40 m/min", &request, &plan);
+    let feed = &plan.feed;
+    assert_eq!(feed.law, FeedMode::TimeOptimal);
+    assert!(feed.cycle_time > feed.constant_feed_time, "{feed:?}");
+    assert!(feed.peak_feed <= request.feedrate * (1.0 + 1e-9));
+    assert!(feed.peak_feed > 0.95 * request.feedrate, "{feed:?}");
+    let by: Vec<&str> = feed.limits.iter().map(|l| l.limited_by.as_str()).collect();
+    assert!(by.contains(&"feedrate"), "{by:?}");
+    assert!(by.iter().any(|b| b.starts_with("q4")), "{by:?}");
+    for l in &feed.limits {
+        assert!(l.s_start <= l.s_end && l.s_end <= plan.path_length, "{l:?}");
+    }
+    println!(
+        "case1 at 40 m/min: {:.4} s time-optimal, {:.4} s at constant feed (refused); limits {by:?}",
+        feed.cycle_time, feed.constant_feed_time
+    );
 }
 
 #[test]
@@ -306,6 +367,7 @@ fn case2_plans_within_limits_collision_free_and_inserts_rtos() {
     let mut planner = Planner::new(machine()).unwrap();
     let plan = planner.plan(&request).unwrap();
     check_plan("case2", &request, &plan);
+    check_smoother_than_qi("case2", &plan);
     // Seed 001 section 3.2: RTOs are inserted.
     assert!(plan.iterations >= 2, "{} iterations", plan.iterations);
     let inserted: Vec<_> = plan
@@ -421,8 +483,11 @@ fn bad_requests_give_the_right_error_and_the_planner_recovers() {
     }
 
     // Too fast: 5 m/s cannot meet the Table 2 limits of a rotary axis.
+    // Seed 001's constant feed: the rotary QP refuses it with the largest
+    // feedrate its constant-feed bounds allow (eq. 15).
     let mut r = base.clone();
     r.feedrate = 5.0;
+    r.options.feed_law = FeedMode::Constant;
     let f_max = match planner.plan(&r) {
         Err(
             e @ PlanError::Infeasible {
@@ -447,6 +512,40 @@ fn bad_requests_give_the_right_error_and_the_planner_recovers() {
         Err(e @ PlanError::Infeasible { .. }) => assert_eq!(e.status(), status::INFEASIBLE),
         other => panic!("expected Infeasible at 1.01 f*, got {other:?}"),
     }
+    // The time-optimal law (the default) slows down where the joints need
+    // it; 5 m/s is refused only because no point of the path allows it at
+    // steady state, with the largest feed some point allows and the joint
+    // that limits it there.
+    let mut r = base.clone();
+    r.feedrate = 5.0;
+    let f_max = match planner.plan(&r) {
+        Err(
+            e @ PlanError::Infeasible {
+                max_feasible_feedrate: Some(f),
+                ..
+            },
+        ) => {
+            assert_eq!(e.status(), status::INFEASIBLE);
+            let text = e.to_string();
+            assert!(
+                text.contains("steady state") && text.contains("limited by the q"),
+                "{e}"
+            );
+            assert!(f > 0.0 && f < 5.0, "{f}");
+            f
+        }
+        other => panic!("expected Infeasible with a feedrate, got {other:?}"),
+    };
+    // Just above it, refused again; just below it, planned within every
+    // limit, reaching nearly that feed.
+    r.feedrate = 1.01 * f_max;
+    match planner.plan(&r) {
+        Err(e @ PlanError::Infeasible { .. }) => assert_eq!(e.status(), status::INFEASIBLE),
+        other => panic!("expected Infeasible at 1.01 f*, got {other:?}"),
+    }
+    r.feedrate = 0.99 * f_max;
+    let fast = planner.plan(&r).unwrap();
+    check_plan("case1 at 0.99 f*", &r, &fast);
 
     // An unknown mesh.
     for mesh in [

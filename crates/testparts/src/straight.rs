@@ -1,7 +1,9 @@
 //! [`straight_cut`]: the smallest cut with a known quaternion-interpolation baseline, for the
 //! tests of the series and plots that draw a plan beside it.
 
-use kerf_mjto::{machine::JOINT_NAMES, plan::RtoRecord, CutPlan, CutRequest, PlanError};
+use kerf_mjto::optimal_feed::FeedMode;
+use kerf_mjto::plan::{FeedReport, RtoRecord};
+use kerf_mjto::{machine::JOINT_NAMES, CutPlan, CutRequest, PlanError};
 
 /// A straight cut along +x with the head vertical (a request and a hand-made plan of it): with
 /// both RTOs at q4 = q5 = 0, q6 = -0.05, the QI baseline is exactly M = C − q6·O (seed 001
@@ -27,6 +29,7 @@ pub fn straight_cut() -> Result<(CutRequest, CutPlan), PlanError> {
         request_id: "line".into(),
         joint_names: JOINT_NAMES.iter().map(|s| s.to_string()).collect(),
         times: vec![0.0, 0.5, 1.0],
+        path_positions: vec![0.0, 0.05, 0.1],
         positions: vec![[0.5, 0.7, 1.25, 0.0, 0.0, -0.05]; 3],
         velocities: vec![[0.0; 6]; 3],
         accelerations: vec![[0.0; 6]; 3],
@@ -37,6 +40,13 @@ pub fn straight_cut() -> Result<(CutRequest, CutPlan), PlanError> {
         collision_queries: 0,
         control_points: 3,
         path_length: 0.1,
+        feed: FeedReport {
+            law: FeedMode::Constant,
+            cycle_time: 1.0,
+            constant_feed_time: 1.0,
+            peak_feed: 0.2,
+            limits: Vec::new(),
+        },
         times_per_stage: Default::default(),
     };
     Ok((request, plan))

@@ -1,5 +1,5 @@
 //! kerf's own messages (`kerf_msgs/msg`, defined in `msgs/msg/`): the trajectory executor's
-//! [`TrajectoryStatus`], the MJTO planner's [`CutRequest`] / [`CutPlan`] (with [`CutRto`],
+//! [`TrajectoryStatus`], the MJTO planner's [`CutRequest`] / [`CutPlan`] (with [`CutRto`], [`CutFeedLimit`],
 //! [`CutMetrics`], [`CutCollision`]) and the milling planner's [`MillRequest`] / [`MillPlan`]
 //! (with [`MillSegment`]) and the G-code planner's [`GcodeRequest`] / [`GcodePlan`] (with
 //! [`GcodeToolEvent`]), and the simulated cell's [`CellContacts`] (with [`CellContact`]).
@@ -126,6 +126,8 @@ pub struct CutRequest {
     pub reference_standoff: f64,
     /// Required head–workpiece clearance (m, ≥ 0).
     pub clearance: f64,
+    /// The time law: "" or "time_optimal" (default), or "constant" (seed 001).
+    pub feed_law: String,
     /// Time budget of the plan (s): 0 = the node's `plan_timeout`; else in (0, plan_timeout].
     pub time_budget: f64,
 }
@@ -253,6 +255,16 @@ pub struct CutPlan {
     pub control_points: u32,
     /// CL path length (m).
     pub path_length: f64,
+    /// The time law run: "time_optimal" or "constant" (empty unless SUCCESS).
+    pub feed_law: String,
+    /// Duration of the cut (s).
+    pub cycle_time: f64,
+    /// Duration of seed 001's constant-feed plan (s), for comparison.
+    pub constant_feed_time: f64,
+    /// Largest feed reached (m/s).
+    pub peak_feed: f64,
+    /// Where the feed is held at a limit, and by which.
+    pub feed_limits: Vec<CutFeedLimit>,
     /// Validation and mesh loading (s).
     pub time_setup: f64,
     /// Jerk Hessian (s).
@@ -271,8 +283,23 @@ pub struct CutPlan {
     pub time_evaluation: f64,
     /// The whole plan (s).
     pub time_total: f64,
+    /// The time-optimal feed (s).
+    pub time_feed: f64,
 }
 impl_ros_type!(CutPlan, "kerf_msgs", msg, "CutPlan");
+
+/// `kerf_msgs/msg/CutFeedLimit`: one stretch of a [`CutPlan`]'s path where the feed is held at
+/// a limit.
+#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
+pub struct CutFeedLimit {
+    /// Start of the stretch along the CL path (m).
+    pub s_start: f64,
+    /// End of the stretch (m).
+    pub s_end: f64,
+    /// "feedrate", "path acceleration", "path jerk" or "<joint> velocity|acceleration|jerk".
+    pub limited_by: String,
+}
+impl_ros_type!(CutFeedLimit, "kerf_msgs", msg, "CutFeedLimit");
 
 impl CutPlan {
     /// The plan succeeded.

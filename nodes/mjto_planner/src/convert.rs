@@ -6,6 +6,7 @@
 //! names the field); the conversion only applies the defaults and refuses what cannot be
 //! expressed in the planner form (a zero quaternion, an index that does not fit `usize`).
 
+use kerf_mjto::optimal_feed::FeedMode;
 use kerf_mjto::{
     error::{status, CollisionReport},
     machine::JOINT_NAMES,
@@ -89,6 +90,16 @@ pub fn request_from_msg(m: &msg::CutRequest) -> Result<CutRequest, PlanError> {
             d.reference_standoff
         },
         clearance: m.clearance,
+        feed_law: match m.feed_law.as_str() {
+            "" | "time_optimal" => FeedMode::TimeOptimal,
+            "constant" => FeedMode::Constant,
+            other => {
+                return Err(PlanError::invalid(
+                    "feed_law",
+                    format!("{other:?} is neither \"time_optimal\" (or empty) nor \"constant\""),
+                ))
+            }
+        },
     };
     let p = &m.workpiece_pose.position;
     Ok(CutRequest {
@@ -227,10 +238,13 @@ pub fn trajectory_msg(plan: &kerf_mjto::CutPlan) -> Result<JointTrajectory, Stri
 pub fn success_message(plan: &kerf_mjto::CutPlan) -> String {
     let duration = plan.times.last().copied().unwrap_or(0.0);
     format!(
-        "planned {:.4} m of path in {:.3} s of motion: {} samples, {} RTOs, {} iteration(s), \
-         planning took {:.3} s",
+        "planned {:.4} m of path in {:.3} s of motion ({} feed; constant feed {:.3} s, peak feed \
+         {:.4} m/s): {} samples, {} RTOs, {} iteration(s), planning took {:.3} s",
         plan.path_length,
         duration,
+        plan.feed.law.as_str(),
+        plan.feed.constant_feed_time,
+        plan.feed.peak_feed,
         plan.times.len(),
         plan.rtos.len(),
         plan.iterations,
@@ -270,6 +284,20 @@ pub fn plan_to_msg(plan: &kerf_mjto::CutPlan) -> msg::CutPlan {
         collision_queries: to_u32(plan.collision_queries),
         control_points: to_u32(plan.control_points),
         path_length: plan.path_length,
+        feed_law: plan.feed.law.as_str().to_string(),
+        cycle_time: plan.feed.cycle_time,
+        constant_feed_time: plan.feed.constant_feed_time,
+        peak_feed: plan.feed.peak_feed,
+        feed_limits: plan
+            .feed
+            .limits
+            .iter()
+            .map(|l| msg::CutFeedLimit {
+                s_start: l.s_start,
+                s_end: l.s_end,
+                limited_by: l.limited_by.clone(),
+            })
+            .collect(),
         time_setup: t.setup,
         time_hessian: t.hessian,
         time_gfd: t.gfd,
@@ -279,6 +307,7 @@ pub fn plan_to_msg(plan: &kerf_mjto::CutPlan) -> msg::CutPlan {
         time_collision: t.collision,
         time_evaluation: t.evaluation,
         time_total: t.total,
+        time_feed: t.feed,
     }
 }
 
@@ -446,6 +475,33 @@ mod tests {
     }
 
     #[test]
+    fn feed_law_names_select_the_law_and_others_are_refused() {
+        let mut m = message();
+        for (name, law) in [
+            ("", FeedMode::TimeOptimal),
+            ("time_optimal", FeedMode::TimeOptimal),
+            ("constant", FeedMode::Constant),
+        ] {
+            m.feed_law = name.into();
+            assert_eq!(
+                request_from_msg(&m).unwrap().options.feed_law,
+                law,
+                "{name:?}"
+            );
+        }
+        for bad in ["Constant", "variable", " constant"] {
+            m.feed_law = bad.into();
+            match request_from_msg(&m) {
+                Err(e @ PlanError::InvalidRequest { .. }) => {
+                    assert_eq!(e.status(), status::INVALID_REQUEST);
+                    assert!(e.to_string().contains("feed_law"), "{e}");
+                }
+                other => panic!("{bad:?}: expected InvalidRequest, got {other:?}"),
+            }
+        }
+    }
+
+    #[test]
     fn bad_values_are_not_repaired() {
         // Negative and NaN values are passed on, and validation names the field.
         let mut m = message();
@@ -505,6 +561,7 @@ mod tests {
             request_id: "r9".into(),
             joint_names: JOINT_NAMES.iter().map(|s| s.to_string()).collect(),
             times,
+            path_positions: vec![0.0, 0.001, 0.002],
             positions,
             velocities: vec![[0.25, 0.0, 0.0, 2.5, 0.0, 0.0]; 3],
             accelerations: vec![[0.0, 0.0, 0.0, 0.0, 0.0, 1.0]; 3],
@@ -532,6 +589,17 @@ mod tests {
             collision_queries: 1234,
             control_points: 6,
             path_length: 0.002,
+            feed: kerf_mjto::plan::FeedReport {
+                law: FeedMode::TimeOptimal,
+                cycle_time: 0.008,
+                constant_feed_time: 0.007,
+                peak_feed: 0.25,
+                limits: vec![kerf_mjto::optimal_feed::FeedLimit {
+                    s_start: 0.0005,
+                    s_end: 0.0015,
+                    limited_by: "q4 velocity".into(),
+                }],
+            },
             times_per_stage: StageTimes {
                 setup: 0.1,
                 hessian: 0.2,
@@ -541,6 +609,7 @@ mod tests {
                 mpath_qp: 0.6,
                 collision: 0.7,
                 evaluation: 0.8,
+                feed: 0.9,
                 total: 3.6,
             },
         }
@@ -586,11 +655,20 @@ mod tests {
                 m.time_mpath_qp,
                 m.time_collision,
                 m.time_evaluation,
-                m.time_total
+                m.time_total,
+                m.time_feed
             ],
-            [0.1, 0.2, 0.3, 0.4, 0.5, 0.6, 0.7, 0.8, 3.6]
+            [0.1, 0.2, 0.3, 0.4, 0.5, 0.6, 0.7, 0.8, 3.6, 0.9]
         );
         assert!(m.collisions.is_empty());
+        assert_eq!(m.feed_law, "time_optimal");
+        assert_eq!(
+            (m.cycle_time, m.constant_feed_time, m.peak_feed),
+            (0.008, 0.007, 0.25)
+        );
+        assert_eq!(m.feed_limits.len(), 1);
+        assert_eq!(m.feed_limits[0].limited_by, "q4 velocity");
+        assert_eq!(m.feed_limits[0].s_end, 0.0015);
     }
 
     #[test]

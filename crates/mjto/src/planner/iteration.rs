@@ -7,7 +7,7 @@ use kerf_bspline::{BSpline, KnotVector};
 use nalgebra::Vector3;
 
 use super::{bspline_error, internal, Context, Iterate, RtoState, Samples, LIMIT_TOLERANCE};
-use crate::baseline::{quaternion_interpolation_within, Rto};
+use crate::baseline::{quaternion_interpolation_along, Rto};
 use crate::collision::CollisionWorld;
 use crate::gfd::Gfd;
 use crate::kinematics::tool_axis;
@@ -59,15 +59,25 @@ impl Context<'_> {
 
         // 2. The loop of Figure 6.
         let mut iteration = 0;
-        let (iterate, samples) = loop {
+        let (iterate, samples, feed) = loop {
             iteration += 1;
             let iterate = self.solve(knots, factor, &rtos, &mut times)?;
-            let samples = self.sample(&iterate)?;
+            // The geometry first, on the constant feed's samples (u every f·Δt at most);
+            // the time law only for a collision-free iterate, then its own samples again.
+            let constant = self.constant_samples(&iterate, &mut times)?;
             let t = Instant::now();
-            let violations = self.check(world, &samples)?;
+            let mut violations = self.check(world, &constant)?;
             times.collision += t.elapsed().as_secs_f64();
             if violations.is_empty() {
-                break (iterate, samples);
+                let timed = self.timed(&iterate, constant, &mut times)?;
+                if timed.resampled {
+                    let t = Instant::now();
+                    violations = self.check(world, &timed.samples)?;
+                    times.collision += t.elapsed().as_secs_f64();
+                }
+                if violations.is_empty() {
+                    break (iterate, timed.samples, timed.feed);
+                }
             }
             if iteration >= o.max_iterations {
                 return Err(PlanError::Collision {
@@ -128,21 +138,22 @@ impl Context<'_> {
                 q6: r.q[2],
             })
             .collect();
-        let dt = self.request.sample_period;
         self.budget.check("the QI baseline")?;
-        let (qi_times, qi_q) = quaternion_interpolation_within(
+        // QI on the plan's own time law s(t): the same samples, the same feed.
+        let qi_path: Vec<f64> = samples.u.iter().map(|u| u * self.v.sigma).collect();
+        let qi_q = quaternion_interpolation_along(
             &self.frames,
             &qi_rtos,
-            &self.law,
+            &qi_path,
             self.v.sigma,
-            dt,
             limits,
             &self.budget,
         )?;
+        let qi_times = samples.times.clone();
         self.budget.check("the QI baseline")?;
         let (qi_v, qi_a, qi_j) = finite_differences(&qi_times, &qi_q);
         let mut qi_metrics = kinematic_metrics(&qi_times, &qi_q, &qi_v, &qi_a, &qi_j, limits);
-        let qi_u: Vec<f64> = qi_times.iter().map(|&t| self.u_at(t)).collect();
+        let qi_u = samples.u.clone();
         self.budget.check("the QI baseline's geometry")?;
         self.fill_geometry(&mut qi_metrics, &qi_u, &qi_q, Some(world))?;
         times.evaluation += t.elapsed().as_secs_f64();
@@ -151,6 +162,7 @@ impl Context<'_> {
         Ok(CutPlan {
             request_id: self.request.request_id.clone(),
             joint_names: JOINT_NAMES.iter().map(|s| s.to_string()).collect(),
+            path_positions: samples.u.iter().map(|u| u * self.v.sigma).collect(),
             times: samples.times,
             positions: samples.q,
             velocities: samples.qd,
@@ -172,6 +184,7 @@ impl Context<'_> {
             collision_queries: world.queries(),
             control_points: knots.n_coeffs(),
             path_length: self.v.sigma,
+            feed,
             times_per_stage: times,
         })
     }
@@ -201,7 +214,7 @@ impl Context<'_> {
                 boundary: [0.0; 4],
                 via: &via,
             };
-            let (coeffs, _) = problem.solve()?;
+            let coeffs = super::feed::rotary_coefficients(&problem, self.request.options.feed_law)?;
             rotary.push(BSpline::new(knots.clone(), coeffs).map_err(bspline_error)?);
         }
         times.rotary_qp += t.elapsed().as_secs_f64();
@@ -249,19 +262,19 @@ impl Context<'_> {
         })
     }
 
-    /// u at time t of the feed profile (eq. 1).
-    pub(super) fn u_at(&self, t: f64) -> f64 {
-        (self.law.eval(t)[0] / self.v.sigma).clamp(0.0, 1.0)
-    }
-
-    /// Samples every Δt: q1..q3 from the M path (eq. 47: M = (q1, q2, q3)),
-    /// q4, q5 from eq. 5, q6 from its spline; derivatives by eq. 7.
+    /// Samples at `times` with the feed `states` (`[s, ṡ, s̈, s⃛]` per time): q1..q3 from the
+    /// M path (eq. 47: M = (q1, q2, q3)), q4, q5 from eq. 5, q6 from its spline; derivatives by
+    /// eq. 7.
     ///
     /// # Errors
     /// [`PlanError::Interrupted`] when the budget runs out (checked every
     /// [`super::BUDGET_STRIDE`] samples).
-    pub(super) fn sample(&self, it: &Iterate) -> Result<Samples, PlanError> {
-        let times = self.sample_times.clone();
+    pub(super) fn sample(
+        &self,
+        it: &Iterate,
+        times: Vec<f64>,
+        states: &[[f64; 4]],
+    ) -> Result<Samples, PlanError> {
         let n = times.len();
         let mut s = Samples {
             u: Vec::with_capacity(n),
@@ -272,11 +285,10 @@ impl Context<'_> {
             times,
         };
         let splines = [&it.m[0], &it.m[1], &it.m[2], &it.q4, &it.q5, &it.q6];
-        for (k, &t) in s.times.iter().enumerate() {
+        for (k, &law) in states.iter().enumerate() {
             if k.is_multiple_of(super::BUDGET_STRIDE) {
                 self.budget.check("trajectory sampling")?;
             }
-            let law = self.law.eval(t);
             let u = (law[0] / self.v.sigma).clamp(0.0, 1.0);
             let mut row = [[0.0; 6]; 4];
             for (j, spline) in splines.iter().enumerate() {

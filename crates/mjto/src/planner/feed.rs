@@ -1,0 +1,335 @@
+//! The time law of one iterate: the paper's constant feed, or the time-optimal variable feed
+//! (issue 16, item 1; [`crate::optimal_feed`]), sampled at the controller period Δt and checked
+//! against every Table 2 limit on those samples (what the executor runs).
+
+use std::time::Instant;
+
+use super::{Context, Iterate, Samples, LIMIT_TOLERANCE};
+use crate::error::{ConstraintFamily, LimitViolation};
+use crate::machine::JOINT_NAMES;
+use crate::metrics::limit_violations;
+use crate::optimal_feed::{steady_feed, FeedLimit, FeedMode, FeedProblem, OptimalFeed};
+use crate::plan::{FeedReport, StageTimes};
+use crate::rotary::RotaryQp;
+use crate::timelaw::{checked_grid_times, MAX_SAMPLES};
+use crate::PlanError;
+
+/// Stations of the time-optimal problem per knot span of the joint splines.
+pub const STATIONS_PER_SPAN: usize = 2;
+
+/// Fewest and most stations of the time-optimal problem.
+pub const STATION_RANGE: (usize, usize) = (64, 1500);
+
+/// Fraction of the joint limits first given to the time-optimal solver. Its constraints hold
+/// at its stations; the joint path's derivatives move between them, so the controller samples
+/// can exceed a limit slightly. Then the margin shrinks by the worst sample's excess (and
+/// [`MARGIN_STEP`] more) and the law is solved again, at most [`MARGIN_ATTEMPTS`] times.
+pub const FIRST_MARGIN: f64 = 0.98;
+
+/// Fraction of the process limits (feedrate, path acceleration and jerk) first given to the
+/// time-optimal solver; shrunk like the joints' margin when a sample exceeds one.
+pub const FIRST_PROCESS_MARGIN: f64 = 0.9999;
+
+/// Extra shrink factor of the margin after a violation.
+pub const MARGIN_STEP: f64 = 0.99;
+
+/// Most solves of the time-optimal law per iterate.
+pub const MARGIN_ATTEMPTS: usize = 4;
+
+/// A timed iterate: its samples and the report of its feed.
+pub(super) struct Timed {
+    pub samples: Samples,
+    pub feed: FeedReport,
+    /// Whether the samples are new (the time-optimal law), not the constant feed's.
+    pub resampled: bool,
+}
+
+impl Context<'_> {
+    /// The samples of `it` every Δt under the constant feed (seed 001 eq. 13 with the S-curve
+    /// ramps of [`crate::timelaw`]).
+    ///
+    /// # Errors
+    /// [`PlanError::Interrupted`].
+    pub(super) fn constant_samples(
+        &self,
+        it: &Iterate,
+        times: &mut StageTimes,
+    ) -> Result<Samples, PlanError> {
+        let t = Instant::now();
+        let states: Vec<[f64; 4]> = self
+            .sample_times
+            .iter()
+            .map(|&t| self.law.eval(t))
+            .collect();
+        let samples = self.sample(it, self.sample_times.clone(), &states)?;
+        times.evaluation += t.elapsed().as_secs_f64();
+        Ok(samples)
+    }
+
+    /// Times `it` under the request's feed law, given its constant-feed samples
+    /// ([`Self::constant_samples`]), and samples it every Δt.
+    ///
+    /// # Errors
+    /// [`PlanError::Infeasible`] (time-optimal law) when no station of the path allows the
+    /// requested feedrate at steady state, with the largest feed it allows and the joint that
+    /// limits it; [`PlanError::LimitViolation`] when no margin of [`MARGIN_ATTEMPTS` margins] keeps the
+    /// samples within the limits; [`PlanError::Solver`] and [`PlanError::Interrupted`].
+    pub(super) fn timed(
+        &self,
+        it: &Iterate,
+        samples: Samples,
+        times: &mut StageTimes,
+    ) -> Result<Timed, PlanError> {
+        let constant_time = self.law.duration();
+        let mode = self.request.options.feed_law;
+        // The constant feed's S-curve is the fastest rest-to-rest law under the feedrate, path
+        // acceleration and path jerk alone (bang-bang in jerk); joint limits can only slow it.
+        // So when every joint is inside its limits on its samples, it is the time-optimal law
+        // too, and the TOPP3 problem need not be solved.
+        if mode == FeedMode::Constant || self.within_limits(&samples) {
+            let limits = match mode {
+                FeedMode::Constant => Vec::new(),
+                FeedMode::TimeOptimal => self
+                    .law
+                    .phases()
+                    .into_iter()
+                    .map(|(s_start, s_end, by)| FeedLimit {
+                        s_start,
+                        s_end,
+                        limited_by: by.to_string(),
+                    })
+                    .collect(),
+            };
+            return Ok(Timed {
+                samples,
+                feed: FeedReport {
+                    law: mode,
+                    cycle_time: constant_time,
+                    constant_feed_time: constant_time,
+                    peak_feed: self.law.peak_feed(),
+                    limits,
+                },
+                resampled: false,
+            });
+        }
+        self.optimal(it, times, constant_time)
+    }
+
+    fn within_limits(&self, s: &Samples) -> bool {
+        limit_violations(
+            &s.times,
+            &s.q,
+            &s.qd,
+            &s.qdd,
+            &s.qddd,
+            self.limits(),
+            LIMIT_TOLERANCE,
+        )
+        .is_empty()
+    }
+
+    fn optimal(
+        &self,
+        it: &Iterate,
+        times: &mut StageTimes,
+        constant_time: f64,
+    ) -> Result<Timed, PlanError> {
+        let t0 = Instant::now();
+        let sigma = self.v.sigma;
+        let spans = it
+            .q4
+            .knots()
+            .n_coeffs()
+            .saturating_sub(super::DEGREE)
+            .max(1);
+        let n = (spans * STATIONS_PER_SPAN).clamp(STATION_RANGE.0, STATION_RANGE.1);
+        let stations: Vec<f64> = (0..=n).map(|k| sigma * k as f64 / n as f64).collect();
+        let splines = [&it.m[0], &it.m[1], &it.m[2], &it.q4, &it.q5, &it.q6];
+        let derivatives: Vec<[[f64; 6]; 4]> = stations
+            .iter()
+            .map(|&s| {
+                let mut d = [[0.0; 6]; 4];
+                for (j, spline) in splines.iter().enumerate() {
+                    let e = spline.eval((s / sigma).clamp(0.0, 1.0));
+                    let mut scale = 1.0;
+                    for (order, row) in d.iter_mut().enumerate() {
+                        row[j] = e[order] * scale;
+                        scale /= sigma;
+                    }
+                }
+                d
+            })
+            .collect();
+        let limits = self.limits();
+        let r = self.request;
+        self.reachable(&stations, &derivatives)?;
+        let mut problem = FeedProblem {
+            stations: &stations,
+            derivatives: &derivatives,
+            joints: limits,
+            feed: r.feedrate,
+            acc: r.feed_acceleration,
+            jerk: r.feed_jerk,
+            margin: FIRST_MARGIN,
+            process_margin: FIRST_PROCESS_MARGIN,
+        };
+        let mut last = Vec::new();
+        for _ in 0..MARGIN_ATTEMPTS {
+            self.budget.check("the time-optimal feed")?;
+            let margin = problem.margin;
+            let t = Instant::now();
+            let law = OptimalFeed::solve(&problem)?;
+            times.feed += t.elapsed().as_secs_f64();
+            let sample_times = checked_grid_times(law.duration(), r.sample_period, MAX_SAMPLES)?;
+            let states = law.eval_many(&sample_times)?;
+            let samples = self.sample(it, sample_times, &states)?;
+            let mut violations = limit_violations(
+                &samples.times,
+                &samples.q,
+                &samples.qd,
+                &samples.qdd,
+                &samples.qddd,
+                limits,
+                LIMIT_TOLERANCE,
+            );
+            let process = process_violations(&samples.times, &states, &problem);
+            if let Some(excess) = process
+                .iter()
+                .map(|v| v.value.abs() / v.limit)
+                .reduce(f64::max)
+            {
+                problem.process_margin = problem.process_margin / excess * MARGIN_STEP;
+            }
+            if violations.is_empty() && process.is_empty() {
+                let report = FeedReport {
+                    law: FeedMode::TimeOptimal,
+                    cycle_time: law.duration(),
+                    constant_feed_time: constant_time,
+                    peak_feed: law.peak_feed(),
+                    limits: law.limits(&problem),
+                };
+                log::debug!(
+                    "time-optimal feed: {} stations, margin {margin}, T = {:.4} s ({:.1} ms)",
+                    stations.len(),
+                    law.duration(),
+                    t0.elapsed().as_secs_f64() * 1e3
+                );
+                return Ok(Timed {
+                    samples,
+                    feed: report,
+                    resampled: true,
+                });
+            }
+            // A position limit is the geometry's: no time law mends it.
+            let mut excess = 1.0f64;
+            for v in &violations {
+                if v.quantity == "position" {
+                    return Err(PlanError::LimitViolation { violations });
+                }
+                excess = excess.max(v.value.abs() / v.limit);
+            }
+            if !violations.is_empty() {
+                problem.margin = margin / excess * MARGIN_STEP;
+            }
+            violations.extend(process);
+            last = violations;
+        }
+        Err(PlanError::LimitViolation { violations: last })
+    }
+
+    /// Refuses a feedrate that no station allows at steady state (issue 16, "bad input").
+    fn reachable(&self, stations: &[f64], derivatives: &[[[f64; 6]; 4]]) -> Result<(), PlanError> {
+        let limits = self.limits();
+        let mut best = (0.0f64, 0usize, None);
+        for (k, d) in derivatives.iter().enumerate() {
+            let (v, by) = steady_feed(d, limits);
+            if v > best.0 {
+                best = (v, k, by);
+            }
+        }
+        let f = self.request.feedrate;
+        if best.0 >= f {
+            return Ok(());
+        }
+        let (v, k, by) = best;
+        let (joint, family) = by.unwrap_or((0, ConstraintFamily::Velocity));
+        Err(PlanError::Infeasible {
+            problem: "time-optimal feed".into(),
+            family,
+            detail: format!(
+                "no point of the path allows f = {f:.6} m/s at steady state; the fastest, s = {:.4} m of {:.4} m, allows {v:.6} m/s, limited by the {} {} limit",
+                stations[k],
+                self.v.sigma,
+                JOINT_NAMES[joint],
+                crate::optimal_feed::family_word(family)
+            ),
+            max_feasible_feedrate: Some(v),
+        })
+    }
+}
+
+/// The coefficients of one rotary-axis QP under the request's feed law.
+///
+/// With the constant feed this is seed 001's QP (eq. 61) with its kinematic bounds at the
+/// requested feedrate (eq. 15, 40-42). With the time-optimal law those bounds are kept where
+/// they are feasible (the geometry then needs no slow-down at constant feed); where they are
+/// not, the QP is solved with the bounds at the largest feedrate that makes it feasible
+/// (bisection of [`RotaryQp::max_feasible_feedrate`]) and the time law slows the feed down
+/// where the joints need it, instead of refusing the cut (issue 16: the saddle cut).
+///
+/// # Errors
+/// As [`RotaryQp::solve`]: every error of the constant feed, and with the time-optimal law the
+/// kinematic infeasibility only when no feedrate makes the QP feasible.
+pub(super) fn rotary_coefficients(
+    problem: &RotaryQp,
+    mode: FeedMode,
+) -> Result<Vec<f64>, PlanError> {
+    match problem.solve() {
+        Ok((coeffs, _)) => Ok(coeffs),
+        Err(PlanError::Infeasible {
+            family:
+                ConstraintFamily::Velocity | ConstraintFamily::Acceleration | ConstraintFamily::Jerk,
+            max_feasible_feedrate: Some(feed),
+            ..
+        }) if mode == FeedMode::TimeOptimal => {
+            let relaxed = RotaryQp {
+                feedrate: feed,
+                ..*problem
+            };
+            relaxed.solve().map(|(coeffs, _)| coeffs)
+        }
+        Err(e) => Err(e),
+    }
+}
+
+/// The samples whose feed, path acceleration or path jerk exceeds the request's (relative
+/// tolerance [`LIMIT_TOLERANCE`]), at most one per quantity (the worst), as joint "path".
+fn process_violations(times: &[f64], states: &[[f64; 4]], p: &FeedProblem) -> Vec<LimitViolation> {
+    let mut out: Vec<LimitViolation> = Vec::new();
+    for (i, (quantity, limit)) in [
+        ("velocity", p.feed),
+        ("acceleration", p.acc),
+        ("jerk", p.jerk),
+    ]
+    .into_iter()
+    .enumerate()
+    {
+        let worst = times
+            .iter()
+            .zip(states)
+            .map(|(&t, s)| (t, s[i + 1]))
+            .max_by(|a, b| a.1.abs().total_cmp(&b.1.abs()));
+        if let Some((time, value)) = worst {
+            if value.abs() > limit * (1.0 + LIMIT_TOLERANCE) {
+                out.push(LimitViolation {
+                    joint: "path".into(),
+                    quantity,
+                    value,
+                    limit,
+                    time,
+                });
+            }
+        }
+    }
+    out
+}
