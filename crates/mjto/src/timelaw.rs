@@ -169,7 +169,8 @@ impl TimeLaw {
     /// feedrate (only when it is reached), then the mirror image.
     ///
     /// # Returns
-    /// `(s_start, s_end, limit)` in path order; zero-length phases are left out.
+    /// `(s_start, s_end, limit)` in path order; zero-length phases are left out and adjacent
+    /// phases at the same limit merged.
     pub fn phases(&self) -> Vec<(f64, f64, &'static str)> {
         let mut ramp = vec![
             (0.0, self.s1, "path jerk"),
@@ -186,7 +187,16 @@ impl TimeLaw {
                 .rev()
                 .map(|&(a, b, name)| (self.sigma - b, self.sigma - a, name)),
         );
-        out
+        // Adjacent phases at the same limit are one stretch (the two jerk phases of a ramp
+        // that does not reach the acceleration limit, the ramps of a path too short to cruise).
+        let mut merged: Vec<(f64, f64, &'static str)> = Vec::with_capacity(out.len());
+        for p in out {
+            match merged.last_mut() {
+                Some(last) if last.2 == p.2 => last.1 = p.1,
+                _ => merged.push(p),
+            }
+        }
+        merged
     }
 
     /// `[s, ṡ, s̈, s⃛]` at time `t` (m, m/s, m/s², m/s³), `t` clamped to

@@ -226,3 +226,44 @@ fn chain_rule_matches_finite_differences_of_q_of_u_of_t() {
     let d = chain_rule([1.0, 2.0, 3.0, 4.0], [0.0, 0.5, 0.0, 0.0], 2.0);
     assert_eq!(d, [1.0, 0.5, 3.0 * 0.0625, 4.0 * 0.015625]);
 }
+
+#[test]
+fn phases_cover_the_path_in_order_with_their_limits() {
+    // A long path at a feed above A²/J reaches the acceleration limit and cruises.
+    let sigma = 1.0;
+    let law = TimeLaw::new(sigma, 1.0, ACC, JERK).unwrap();
+    let phases = law.phases();
+    let names: Vec<&str> = phases.iter().map(|p| p.2).collect();
+    assert_eq!(
+        names,
+        [
+            "path jerk",
+            "path acceleration",
+            "path jerk",
+            "feedrate",
+            "path jerk",
+            "path acceleration",
+            "path jerk"
+        ]
+    );
+    assert_eq!(phases[0].0, 0.0);
+    assert!((phases[6].1 - sigma).abs() < 1e-12);
+    for w in phases.windows(2) {
+        assert!((w[1].0 - w[0].1).abs() < 1e-12, "{w:?}");
+    }
+    // The cruise starts where the law reaches the feedrate.
+    let t_cruise = (law.duration() - law.cruise_duration()) / 2.0;
+    assert!((law.eval(t_cruise)[0] - phases[3].0).abs() < 1e-9);
+    // Case 1's feed (20 m/min) stays below A²/J: the two jerk phases of each ramp are one
+    // stretch. A path too short to cruise is jerk-limited throughout.
+    let names: Vec<&str> = TimeLaw::new(0.8, 1.0 / 3.0, ACC, JERK)
+        .unwrap()
+        .phases()
+        .iter()
+        .map(|p| p.2)
+        .collect();
+    assert_eq!(names, ["path jerk", "feedrate", "path jerk"]);
+    let short = TimeLaw::new(0.001, 1.0 / 3.0, ACC, JERK).unwrap().phases();
+    assert_eq!(short.len(), 1, "{short:?}");
+    assert_eq!(short[0].2, "path jerk");
+}

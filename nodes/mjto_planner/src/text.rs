@@ -174,6 +174,7 @@ pub fn parse_lines(text: &str) -> Result<msg::CutRequest, PlanError> {
         match key {
             "request_id" => m.request_id = value.to_string(),
             "mesh" => m.mesh = value.to_string(),
+            "feed_law" => m.feed_law = value.to_string(),
             "feedrate" => m.feedrate = number(n, key, value)?,
             "feed_acceleration" => m.feed_acceleration = number(n, key, value)?,
             "feed_jerk" => m.feed_jerk = number(n, key, value)?,
@@ -286,6 +287,7 @@ mesh: package://kerf/meshes/plate.stl
 reference_standoff: 0
 rto_indices: 0, 2
 workpiece_pose: 1 2 3 0 0 0 1
+feed_law: constant
 ";
 
     #[test]
@@ -306,6 +308,10 @@ workpiece_pose: 1 2 3 0 0 0 1
         assert_eq!(r.options.reference_standoff, 0.0);
         assert_eq!(r.options.rto_indices, vec![0, 2]);
         assert_eq!(r.workpiece_pose.position, [1.0, 2.0, 3.0]);
+        assert_eq!(
+            r.options.feed_law,
+            kerf_mjto::optimal_feed::FeedMode::Constant
+        );
         r.validate().unwrap();
     }
 
