@@ -23,6 +23,7 @@
 pub mod baseline;
 pub mod collision;
 pub mod error;
+pub mod executed;
 pub mod gfd;
 pub mod kinematics;
 pub mod machine;

@@ -267,3 +267,42 @@ fn phases_cover_the_path_in_order_with_their_limits() {
     assert_eq!(short.len(), 1, "{short:?}");
     assert_eq!(short[0].2, "path jerk");
 }
+
+#[test]
+fn on_grid_puts_every_phase_on_the_sample_grid_within_the_limits() {
+    for (sigma, feed, dt) in [
+        (0.8, 1.0 / 3.0, 0.01),
+        (0.627, 0.25, 0.004),
+        (1.0, 1.0, 0.004),
+        (0.004, 1.0 / 3.0, 0.01),
+    ] {
+        let law = TimeLaw::new(sigma, feed, ACC, JERK).unwrap();
+        let grid = law.on_grid(dt).unwrap();
+        let jerk = grid.eval(0.0)[3];
+        assert!(jerk > 0.0 && jerk <= JERK, "{jerk}");
+        check_law(&grid, sigma, ACC, jerk);
+        assert!(
+            grid.peak_feed() <= feed * (1.0 + 1e-12),
+            "{sigma} {feed} {dt}"
+        );
+        assert!(grid.duration() >= law.duration() - 1e-12);
+        // Ramps rounded up by at most a period per phase, the cruise by one.
+        assert!(
+            grid.duration() <= law.duration() + 7.0 * dt,
+            "{sigma} {feed} {dt}"
+        );
+        // The whole law is a whole number of periods, and the jerk is constant within every
+        // step: at the two ends of a step's interior it is the same.
+        let steps = grid.duration() / dt;
+        assert!((steps - steps.round()).abs() < 1e-6, "{steps} steps");
+        for k in 0..steps.round() as usize {
+            let (a, b) = (k as f64 * dt, (k + 1) as f64 * dt);
+            let (ja, jb) = (grid.eval(a + 1e-9)[3], grid.eval(b - 1e-9)[3]);
+            assert_eq!(ja, jb, "jerk changes inside step {k} ({a} s)");
+        }
+    }
+    assert!(TimeLaw::new(0.8, 0.3, ACC, JERK)
+        .unwrap()
+        .on_grid(0.0)
+        .is_err());
+}

@@ -6,6 +6,7 @@ use std::time::Instant;
 
 use super::{Context, Iterate, Samples, LIMIT_TOLERANCE};
 use crate::error::{ConstraintFamily, LimitViolation};
+use crate::executed::executed_jerk_violations;
 use crate::machine::JOINT_NAMES;
 use crate::metrics::limit_violations;
 use crate::optimal_feed::{steady_feed, FeedLimit, FeedMode, FeedProblem, OptimalFeed};
@@ -116,16 +117,31 @@ impl Context<'_> {
     }
 
     fn within_limits(&self, s: &Samples) -> bool {
-        limit_violations(
+        self.violations(s).is_empty()
+    }
+
+    /// Every joint limit the samples break: Table 2 at the samples (eq. 7, analytic) and the
+    /// jerk the executor commands between them ([`crate::executed`]).
+    pub(super) fn violations(&self, s: &Samples) -> Vec<LimitViolation> {
+        let limits = self.limits();
+        let mut v = limit_violations(
             &s.times,
             &s.q,
             &s.qd,
             &s.qdd,
             &s.qddd,
-            self.limits(),
+            limits,
             LIMIT_TOLERANCE,
-        )
-        .is_empty()
+        );
+        v.extend(executed_jerk_violations(
+            &s.times,
+            &s.q,
+            &s.qd,
+            &s.qdd,
+            limits,
+            LIMIT_TOLERANCE,
+        ));
+        v
     }
 
     fn optimal(
@@ -183,15 +199,7 @@ impl Context<'_> {
             let sample_times = checked_grid_times(law.duration(), r.sample_period, MAX_SAMPLES)?;
             let states = law.eval_many(&sample_times)?;
             let samples = self.sample(it, sample_times, &states)?;
-            let mut violations = limit_violations(
-                &samples.times,
-                &samples.q,
-                &samples.qd,
-                &samples.qdd,
-                &samples.qddd,
-                limits,
-                LIMIT_TOLERANCE,
-            );
+            let mut violations = self.violations(&samples);
             let process = process_violations(&samples.times, &states, &problem);
             if let Some(excess) = process
                 .iter()

@@ -6,13 +6,13 @@ use std::time::Instant;
 use kerf_bspline::{BSpline, KnotVector};
 use nalgebra::Vector3;
 
-use super::{bspline_error, internal, Context, Iterate, RtoState, Samples, LIMIT_TOLERANCE};
+use super::{bspline_error, internal, Context, Iterate, RtoState, Samples};
 use crate::baseline::{quaternion_interpolation_along, Rto};
 use crate::collision::CollisionWorld;
 use crate::gfd::Gfd;
 use crate::kinematics::tool_axis;
 use crate::machine::JOINT_NAMES;
-use crate::metrics::{finite_differences, kinematic_metrics, limit_violations};
+use crate::metrics::{finite_differences, kinematic_metrics};
 use crate::plan::{RtoRecord, StageTimes};
 use crate::rotary::{JerkFactor, RotaryQp};
 use crate::selection::select_rtos;
@@ -101,19 +101,12 @@ impl Context<'_> {
             }
         };
 
-        // 3. Limits (analytic, eq. 7), metrics, QI baseline.
+        // 3. Limits (analytic, eq. 7, and the executor's segments between the samples),
+        // metrics, QI baseline.
         let t = Instant::now();
         self.budget.check("the limit check")?;
         let limits = self.limits();
-        let violations = limit_violations(
-            &samples.times,
-            &samples.q,
-            &samples.qd,
-            &samples.qdd,
-            &samples.qddd,
-            limits,
-            LIMIT_TOLERANCE,
-        );
+        let violations = self.violations(&samples);
         if !violations.is_empty() {
             return Err(PlanError::LimitViolation { violations });
         }

@@ -26,7 +26,8 @@ impl<'a> Context<'a> {
             request.feedrate,
             request.feed_acceleration,
             request.feed_jerk,
-        )?;
+        )?
+        .on_grid(request.sample_period)?;
         let sample_times = law.checked_sample_times(request.sample_period, MAX_SAMPLES)?;
         let limits = machine.limits();
         let standoff = request.options.reference_standoff;
