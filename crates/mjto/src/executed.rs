@@ -52,7 +52,7 @@ pub fn executed_jerk_violations(
         let mut worst = (0.0f64, 0.0f64);
         for k in 0..times.len().saturating_sub(1) {
             let h = times[k + 1] - times[k];
-            if !(h > 0.0) {
+            if h.is_nan() || h <= 0.0 {
                 continue;
             }
             let knot = |i: usize| Knot {
@@ -66,7 +66,7 @@ pub fn executed_jerk_violations(
                 worst = (peak, times[k]);
             }
         }
-        if !(worst.0 <= l.jerk * (1.0 + rel_tol)) {
+        if worst.0.is_nan() || worst.0 > l.jerk * (1.0 + rel_tol) {
             out.push(LimitViolation {
                 joint: JOINT_NAMES[j].to_string(),
                 quantity: EXECUTED_JERK,
