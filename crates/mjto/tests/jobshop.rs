@@ -62,8 +62,9 @@ const FEED_REL: f64 = 0.01;
 /// Returns `Err(message)` from the enclosing check unless the condition holds.
 macro_rules! ensure {
     ($cond:expr, $($msg:tt)+) => {
-        if !$cond {
-            return Err(format!($($msg)+));
+        match $cond {
+            true => {}
+            false => return Err(format!($($msg)+)),
         }
     };
 }
@@ -173,7 +174,10 @@ fn check_collision(name: &str, request: &CutRequest, result: Result<CutPlan, Pla
         PlanError::Collision { collisions, .. } => {
             let first = collisions.first().unwrap_or_else(|| panic!("{name}: {e}"));
             assert!(first.cl_index < n);
-            assert!(!first.links.is_empty() && !first.reason.is_empty(), "{first:?}");
+            assert!(
+                !first.links.is_empty() && !first.reason.is_empty(),
+                "{first:?}"
+            );
         }
         other => panic!("{name}: {other:?}"),
     }
@@ -251,7 +255,11 @@ fn check_differences(name: &str, plan: &CutPlan, limits: &[AxisLimits; 6]) -> Re
     for (j, l) in limits.iter().enumerate() {
         let mut dd: Vec<f64> = plan.positions.iter().map(|p| p[j]).collect();
         let mut peaks = [0.0f64; 3];
-        for (m, limit, what) in [(1, l.vel, "velocity"), (2, l.acc, "acceleration"), (3, l.jerk, "jerk")] {
+        for (m, limit, what) in [
+            (1, l.vel, "velocity"),
+            (2, l.acc, "acceleration"),
+            (3, l.jerk, "jerk"),
+        ] {
             dd = (0..dd.len() - 1)
                 .map(|k| (dd[k + 1] - dd[k]) / (t[k + m] - t[k]))
                 .collect();
@@ -309,11 +317,17 @@ fn check_segment_jerk(name: &str, plan: &CutPlan, limits: &[AxisLimits; 6]) -> R
             let (c, h) = segment(plan, k, j);
             let ratio = segment_peak_jerk(&c, h) / l.jerk;
             if ratio > worst.0 {
-                worst = (ratio, format!("{} in step {k} (t = {})", JOINT_NAMES[j], plan.times[k]));
+                worst = (
+                    ratio,
+                    format!("{} in step {k} (t = {})", JOINT_NAMES[j], plan.times[k]),
+                );
             }
         }
     }
-    println!("{name}: executed jerk peak / limit {:.3} ({})", worst.0, worst.1);
+    println!(
+        "{name}: executed jerk peak / limit {:.3} ({})",
+        worst.0, worst.1
+    );
     ensure!(
         worst.0 <= 1.0 + HERMITE_JERK_REL,
         "{name}: executed jerk {:.3} × its limit: {}",
@@ -355,7 +369,11 @@ fn states(plan: &CutPlan) -> Vec<([f64; 6], f64, bool)> {
     for k in 0..n {
         out.push((plan.positions[k], plan.times[k], true));
         if k + 1 < n {
-            out.push((midpoint(plan, k), 0.5 * (plan.times[k] + plan.times[k + 1]), false));
+            out.push((
+                midpoint(plan, k),
+                0.5 * (plan.times[k] + plan.times[k + 1]),
+                false,
+            ));
         }
     }
     out
@@ -527,17 +545,23 @@ fn check_distances(name: &str, request: &CutRequest, plan: &CutPlan) -> Result<(
 fn check_timing(name: &str, request: &CutRequest, plan: &CutPlan) -> Result<(), String> {
     let n = plan.times.len();
     let dt = request.sample_period;
-    ensure!(plan.joint_names == JOINT_NAMES, "{name}: joints {:?}", plan.joint_names);
+    ensure!(
+        plan.joint_names == JOINT_NAMES,
+        "{name}: joints {:?}",
+        plan.joint_names
+    );
     ensure!(n > 10 && plan.positions.len() == n, "{name}: {n} samples");
     ensure!(plan.times[0] == 0.0, "{name}: starts at {}", plan.times[0]);
     for w in plan.times.windows(2) {
-        ensure!(w[1] > w[0] && w[1] - w[0] <= dt * (1.0 + 1e-9), "{name}: step {w:?}");
+        ensure!(
+            w[1] > w[0] && w[1] - w[0] <= dt * (1.0 + 1e-9),
+            "{name}: step {w:?}"
+        );
     }
-    for j in 0..6 {
+    for (j, joint) in JOINT_NAMES.iter().enumerate() {
         ensure!(
             plan.velocities[0][j].abs() < 1e-9 && plan.velocities[n - 1][j].abs() < 1e-9,
-            "{name}: {} not at rest at an end",
-            JOINT_NAMES[j]
+            "{name}: {joint} not at rest at an end"
         );
     }
     Ok(())

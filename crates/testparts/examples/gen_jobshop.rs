@@ -39,7 +39,9 @@ fn main() -> ExitCode {
                 return ExitCode::SUCCESS;
             }
             other => {
-                eprintln!("unknown argument '{other}' (usage: gen_jobshop [--out <root>] [--plan])");
+                eprintln!(
+                    "unknown argument '{other}' (usage: gen_jobshop [--out <root>] [--plan])"
+                );
                 return ExitCode::from(2);
             }
         }

@@ -129,7 +129,11 @@ fn committed_files_equal_the_generator_output() {
 fn meshes_are_closed_outward_small_and_as_thick_as_stated() {
     for part in &shop().parts {
         let mesh = committed_mesh(part);
-        assert_eq!(mesh, part.mesh, "{}: the committed mesh loads as generated", part.name);
+        assert_eq!(
+            mesh, part.mesh,
+            "{}: the committed mesh loads as generated",
+            part.name
+        );
         assert!(
             mesh.triangles.len() <= jobshop::MAX_TRIANGLES,
             "{}: {} triangles",
@@ -140,7 +144,11 @@ fn meshes_are_closed_outward_small_and_as_thick_as_stated() {
         for t in &mesh.triangles {
             let abc = tri(&mesh, t);
             let area = 0.5 * (abc[1] - abc[0]).cross(&(abc[2] - abc[0])).norm();
-            assert!(area > 1e-8, "{}: degenerate triangle {t:?} ({area:e} m²)", part.name);
+            assert!(
+                area > 1e-8,
+                "{}: degenerate triangle {t:?} ({area:e} m²)",
+                part.name
+            );
             for k in 0..3 {
                 *directed.entry((t[k], t[(k + 1) % 3])).or_default() += 1;
             }
@@ -262,11 +270,19 @@ fn axes_are_the_surface_normals_and_contours_close() {
             // Points are rounded to 1 nm: on the 50 mm tube that turns the normal computed
             // from them by up to 2e-8 rad.
             let err = (v(a) - analytic_normal(case.part, &v(p))).norm();
-            assert!(err < 1e-7, "{} axis {i} is {err:e} off the normal", case.name);
+            assert!(
+                err < 1e-7,
+                "{} axis {i} is {err:e} off the normal",
+                case.name
+            );
         }
         let (first, last) = (req.points[0], *req.points.last().unwrap());
         if case.closed {
-            assert_eq!(first, last, "{}: a closed contour ends where it starts", case.name);
+            assert_eq!(
+                first, last,
+                "{}: a closed contour ends where it starts",
+                case.name
+            );
             assert_eq!(req.axes[0], *req.axes.last().unwrap(), "{}", case.name);
         } else {
             assert!((v(&first) - v(&last)).norm() > 0.05, "{}", case.name);
@@ -301,8 +317,14 @@ fn every_request_validates_with_job_shop_parameters() {
     assert!(shop.cases.len() >= 12);
     for case in &shop.cases {
         let req = committed(case);
-        let val = req.validate().unwrap_or_else(|e| panic!("{}: {e}", case.name));
-        assert_eq!(req, case.request, "{}: the file parses to the generated request", case.name);
+        let val = req
+            .validate()
+            .unwrap_or_else(|e| panic!("{}: {e}", case.name));
+        assert_eq!(
+            req, case.request,
+            "{}: the file parses to the generated request",
+            case.name
+        );
         assert_eq!(req.mesh, shop.part_of(case).unwrap().mesh_reference());
         let feed = req.feedrate * 60.0;
         match case.expect {
@@ -318,11 +340,15 @@ fn every_request_validates_with_job_shop_parameters() {
             req.points.len()
         );
         // The nominal M points are well inside the strokes.
-        let lim = LaserMachine::default_machine().unwrap().limits().clone();
+        let lim = *LaserMachine::default_machine().unwrap().limits();
         for (c, o) in val.points.iter().zip(&val.axes) {
             let m = c + o * 0.07;
             for k in 0..3 {
-                assert!(m[k] > lim[k].min + 0.1 && m[k] < lim[k].max - 0.1, "{}", case.name);
+                assert!(
+                    m[k] > lim[k].min + 0.1 && m[k] < lim[k].max - 0.1,
+                    "{}",
+                    case.name
+                );
             }
         }
     }
@@ -344,9 +370,18 @@ fn saddles_pass_the_tool_axis_through_the_vertical_twice() {
         // back to it at the end.
         assert_eq!(ys[0], 0.0, "{}", case.name);
         assert_eq!(crossings, 2, "{}: {crossings} crossings", case.name);
-        let ratio = req.points.iter().map(|p| p[0].hypot(p[1])).fold(0.0, f64::max) / r_main;
+        let ratio = req
+            .points
+            .iter()
+            .map(|p| p[0].hypot(p[1]))
+            .fold(0.0, f64::max)
+            / r_main;
         let tilt = ys.iter().map(|y| y.abs().asin()).fold(0.0, f64::max);
-        assert!((tilt - ratio.asin()).abs() < 1e-3, "{}: tilt {tilt}", case.name);
+        assert!(
+            (tilt - ratio.asin()).abs() < 1e-3,
+            "{}: tilt {tilt}",
+            case.name
+        );
         ratios.push((ratio * 100.0).round() / 100.0);
     }
     assert_eq!(ratios, [0.4, 0.7, 0.95]);
@@ -426,13 +461,18 @@ fn wall_cases_nominal_axis_collides_and_a_tilt_inside_the_allowance_clears() {
             );
             let nominal_free = (0..18).any(|k| {
                 let q4 = (k as f64 * 10.0).to_radians();
-                [-0.1, -0.085, -0.07, -0.055].iter().any(|&q6| scene.free(c, q4, 0.0, q6))
+                [-0.1, -0.085, -0.07, -0.055]
+                    .iter()
+                    .any(|&q6| scene.free(c, q4, 0.0, q6))
             });
             colliding += usize::from(!nominal_free);
         }
         let n = scene.points.len();
         if name == "angle_wall_trim" {
-            assert_eq!(colliding, n, "{name}: the nominal axis collides at every point");
+            assert_eq!(
+                colliding, n,
+                "{name}: the nominal axis collides at every point"
+            );
         } else {
             assert!(
                 colliding > n / 10 && colliding < n,
@@ -450,7 +490,10 @@ fn too_close_to_the_wall_no_orientation_inside_the_allowance_is_free() {
     let shop = shop();
     let scene = Scene::new(&shop, "angle_too_close");
     for (i, c) in scene.points.iter().enumerate().step_by(5) {
-        assert!(!scene.any_free(c, 10f64.to_radians()), "point {i} has a free orientation");
+        assert!(
+            !scene.any_free(c, 10f64.to_radians()),
+            "point {i} has a free orientation"
+        );
     }
     // The search finds free orientations where they exist: the wall trim 85 mm out.
     let wall = Scene::new(&shop, "angle_wall_trim");
@@ -475,7 +518,10 @@ fn channel_trims_clear_the_walls_only_with_the_forks_parallel_to_them() {
         }
         let (first, last) = (scene.points[0], *scene.points.last().unwrap());
         for c in [first, last] {
-            assert!(!scene.free(&c, 0.0, 0.0, -0.07), "{name}: forks towards a wall are free");
+            assert!(
+                !scene.free(&c, 0.0, 0.0, -0.07),
+                "{name}: forks towards a wall are free"
+            );
         }
     }
 }

@@ -61,7 +61,13 @@ impl ChannelParams {
             Vector2::new(w, h),
             Vector2::new(w + f, h),
         ];
-        profile_part("channel", &corners, self.bend_radius, self.thickness, self.length)
+        profile_part(
+            "channel",
+            &corners,
+            self.bend_radius,
+            self.thickness,
+            self.length,
+        )
     }
 }
 
@@ -104,7 +110,13 @@ impl AngleParams {
             Vector2::new(0.0, 0.0),
             Vector2::new(0.0, self.height),
         ];
-        profile_part("angle", &corners, self.bend_radius, self.thickness, self.length)
+        profile_part(
+            "angle",
+            &corners,
+            self.bend_radius,
+            self.thickness,
+            self.length,
+        )
     }
 }
 

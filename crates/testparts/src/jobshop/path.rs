@@ -75,7 +75,11 @@ pub fn sample_curve(
         ));
     }
     let steps = steps as usize;
-    let step = if closed { total / steps as f64 } else { spacing };
+    let step = if closed {
+        total / steps as f64
+    } else {
+        spacing
+    };
     let at = |s: f64| {
         let m = cum.partition_point(|&c| c <= s).clamp(1, TABLE_CHORDS) - 1;
         let span = cum[m + 1] - cum[m];

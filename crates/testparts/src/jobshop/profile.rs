@@ -73,7 +73,11 @@ pub fn bent_profile(
     let tangent = |k: usize| radius * (turn(k).abs() / 2.0).tan();
     for (k, w) in corners.windows(2).enumerate() {
         let used = if k > 0 { tangent(k) } else { 0.0 }
-            + if k + 2 < corners.len() { tangent(k + 1) } else { 0.0 };
+            + if k + 2 < corners.len() {
+                tangent(k + 1)
+            } else {
+                0.0
+            };
         if (w[1] - w[0]).norm() - used < MIN_STRAIGHT {
             return Err(TestPartError::invalid(
                 "profile",

@@ -43,33 +43,40 @@ pub fn saddle_curve(
 ///
 /// # Errors
 /// Only for inconsistent defaults.
-pub(super) fn saddle_cases(tube: &TubeParams, part: &Part) -> Result<Vec<JobShopCase>, TestPartError> {
+pub(super) fn saddle_cases(
+    tube: &TubeParams,
+    part: &Part,
+) -> Result<Vec<JobShopCase>, TestPartError> {
     let process = Process::shop(10.0, 4.0, 10.0, 10.0);
-    [("saddle_r040", 0.4), ("saddle_r070", 0.7), ("saddle_r095", 0.95)]
-        .into_iter()
-        .map(|(name, ratio)| {
-            let r = ratio * tube.radius;
-            let curve = saddle_curve(tube, r)?;
-            let path = sample_curve(&curve, true, process.spacing())?;
-            Ok(JobShopCase {
-                name,
-                title: format!(
-                    "saddle cut of a Ø{:.0} mm branch in the Ø{:.0} mm main tube (r/R = {ratio}), \
+    [
+        ("saddle_r040", 0.4),
+        ("saddle_r070", 0.7),
+        ("saddle_r095", 0.95),
+    ]
+    .into_iter()
+    .map(|(name, ratio)| {
+        let r = ratio * tube.radius;
+        let curve = saddle_curve(tube, r)?;
+        let path = sample_curve(&curve, true, process.spacing())?;
+        Ok(JobShopCase {
+            name,
+            title: format!(
+                "saddle cut of a Ø{:.0} mm branch in the Ø{:.0} mm main tube (r/R = {ratio}), \
                      tool axis the main tube's normal, vertical twice per loop; 10 m/min, 10°/10°",
-                    2e3 * r,
-                    2e3 * tube.radius
-                ),
-                part: part.name,
-                closed: true,
-                request: make_request(
-                    name,
-                    part.mesh_reference(),
-                    path,
-                    UnitQuaternion::identity(),
-                    process,
-                )?,
-                expect: Expectation::Plan,
-            })
+                2e3 * r,
+                2e3 * tube.radius
+            ),
+            part: part.name,
+            closed: true,
+            request: make_request(
+                name,
+                part.mesh_reference(),
+                path,
+                UnitQuaternion::identity(),
+                process,
+            )?,
+            expect: Expectation::Plan,
         })
-        .collect()
+    })
+    .collect()
 }

@@ -91,7 +91,10 @@ pub fn thick_sheet(grid: &SheetGrid, thickness: f64) -> Result<MeshData, TestPar
     if flips != 0 && flips != quads_u * (nv - 1) {
         return Err(TestPartError::invalid(
             "sheet grid",
-            format!("{flips} of {} quads wind against the others", quads_u * (nv - 1)),
+            format!(
+                "{flips} of {} quads wind against the others",
+                quads_u * (nv - 1)
+            ),
         ));
     }
     let mut triangles = outer.clone();
