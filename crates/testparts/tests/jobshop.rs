@@ -545,8 +545,9 @@ fn smoothstep(x: f64) -> (f64, f64) {
 /// that gives the requested feed where the curve is longest per radian (the feed never
 /// exceeds it and reaches it), with 0.5 s septic ramps. Checked every 1 ms: every joint's
 /// velocity, acceleration and jerk by finite differences within Table 2, the axis within 10°
-/// of the normal, the head collision-free. (r/R = 0.95 needs the jerk peak near the steepest
-/// tilt taken more slowly: only a variable feed makes it.)
+/// of the normal, the head collision-free. (Not shown for r/R = 0.95: at a constant 10 m/min its
+/// nominal tilt needs 2.5 times the q5 jerk limit, and the smallest fraction that keeps 10°
+/// still 2.2 times; it needs a slower feed near its steepest tilt.)
 #[test]
 fn saddles_r040_and_r070_have_a_hand_made_plan_at_10_m_min() {
     let shop = shop();
