@@ -10,7 +10,8 @@
 //! repository root (default `.`) and prints each mesh's size and each case's points, length
 //! and spacing. With `--plan` it also plans every case with `kerf_mjto::planner::Planner`
 //! (meshes read from the source tree) and prints the outcome: cycle time and wall-clock plan
-//! time, or the error.
+//! time (and the constant-feed time, the peak feed and where the feed is limited), or the
+//! error.
 
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -94,14 +95,24 @@ fn run(out: &std::path::Path, plan: bool) -> Result<(), Box<dyn std::error::Erro
             let result = planner.plan(r);
             let ms = t.elapsed().as_secs_f64() * 1e3;
             match result {
-                Ok(p) => println!(
-                    "  planned in {ms:.1} ms: cycle {:.3} s, {} samples, {} RTOs, {} iteration(s), max CL error {:.2e} m",
-                    p.times.last().copied().unwrap_or(0.0),
-                    p.times.len(),
-                    p.rtos.len(),
-                    p.iterations,
-                    p.metrics.max_cl_error
-                ),
+                Ok(p) => {
+                    println!(
+                        "  planned in {ms:.1} ms: cycle {:.3} s (constant feed {:.3} s), peak feed {:.2} m/min, {} samples, {} RTOs, {} iteration(s), max CL error {:.2e} m",
+                        p.feed.cycle_time,
+                        p.feed.constant_feed_time,
+                        p.feed.peak_feed * 60.0,
+                        p.times.len(),
+                        p.rtos.len(),
+                        p.iterations,
+                        p.metrics.max_cl_error
+                    );
+                    for l in &p.feed.limits {
+                        println!(
+                            "    feed limited by {} over s = {:.4}..{:.4} m",
+                            l.limited_by, l.s_start, l.s_end
+                        );
+                    }
+                }
                 Err(e) => println!("  refused in {ms:.1} ms (status {}): {e}", e.status()),
             }
         }
