@@ -7,11 +7,17 @@
 //! files with `cargo run -p kerf_testparts --example gen_bpillar -- --out .`
 //! from the repository root.
 //!
+//! [`jobshop`] generates the parts and cut requests of issue 16 item 4 (saddle cuts, holes
+//! and slots on curved sheet, trims near walls, closed contours, refusals):
+//! `urdf/meshes/jobshop_*.obj` and `crates/mjto/cases/jobshop/*.yaml`, regenerated with
+//! `cargo run -p kerf_testparts --example gen_jobshop -- --out .`.
+//!
 //! [`straight::straight_cut`] is a three-point cut with a hand-made plan whose QI baseline is
 //! known exactly.
 
 pub mod bpillar;
 pub mod error;
+pub mod jobshop;
 pub mod straight;
 
 pub use error::TestPartError;
