@@ -110,6 +110,7 @@ fn msg_of(r: &CutRequest) -> msg::CutRequest {
         has_reference_standoff: true,
         reference_standoff: o.reference_standoff,
         clearance: o.clearance,
+        cl_tolerance: o.cl_tolerance,
         feed_law: o.feed_law.as_str().into(),
         time_budget: r.time_budget,
     }

@@ -177,6 +177,7 @@ pub fn cut_request(u: &mut Unstructured) -> Result<msg::CutRequest> {
         has_reference_standoff: u.arbitrary()?,
         reference_standoff: float(u)?,
         clearance: if u.arbitrary()? { 0.0 } else { float(u)? },
+        cl_tolerance: if u.arbitrary()? { 0.0 } else { float(u)? },
         feed_law: string(u, &["", "time_optimal", "constant", "variable"])?,
         time_budget: if u.arbitrary()? { 0.0 } else { float(u)? },
     })

@@ -39,6 +39,7 @@ pub mod selection;
 pub mod series;
 pub mod standoff;
 pub mod timelaw;
+pub mod tip;
 pub mod trajectory;
 
 pub use error::PlanError;

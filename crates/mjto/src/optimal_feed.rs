@@ -101,6 +101,10 @@ pub struct FeedProblem<'a> {
     /// Fraction of the process limits (feedrate, path acceleration, path jerk) given to the
     /// solver, in (0, 1].
     pub process_margin: f64,
+    /// Per station `[g, g', g'']` with `g = |dC/ds|`, the tool tip's speed per unit ṡ
+    /// ([`crate::tip`]); the process limits apply to the tip, the virtual axis q₇ with
+    /// `q₇' = g`. Empty: `g = 1` (the tip moves at ṡ).
+    pub tip: &'a [[f64; 3]],
 }
 
 /// What limits the feed over a stretch of the path.
@@ -214,10 +218,17 @@ impl FeedProblem<'_> {
                 ));
             }
         }
+        if !self.tip.is_empty() && self.tip.len() != n {
+            return Err(PlanError::invalid(
+                "feed stations",
+                format!("{} tip rows for {n} stations", self.tip.len()),
+            ));
+        }
         if self
             .derivatives
             .iter()
             .any(|d| d.iter().flatten().any(|x| !x.is_finite()))
+            || self.tip.iter().flatten().any(|x| !x.is_finite())
         {
             return Err(PlanError::invalid(
                 "feed stations",
@@ -254,8 +265,11 @@ impl OptimalFeed {
                     m[(j, k)] = d[order][j];
                 }
             }
+            let g = p.tip.get(k).copied().unwrap_or([1.0, 0.0, 0.0]);
             q[0][(JOINTS, k)] = s;
-            q[1][(JOINTS, k)] = 1.0;
+            q[1][(JOINTS, k)] = g[0];
+            q[2][(JOINTS, k)] = g[1];
+            q[3][(JOINTS, k)] = g[2];
         }
         let m = p.margin;
         let upper = |f: &dyn Fn(&AxisLimits) -> f64, process: f64| -> Vec<f64> {
@@ -432,14 +446,22 @@ impl OptimalFeed {
             let (a, b) = (self.a[k].max(0.0), self.b[k]);
             let v = a.sqrt();
             let d = &p.derivatives[k];
-            let mut best = (v / p.feed, "feedrate".to_string());
+            let g = p.tip.get(k).copied().unwrap_or([1.0, 0.0, 0.0]);
+            let pm = p.process_margin;
+            let mut best = (g[0] * v / (pm * p.feed), "feedrate".to_string());
             let mut consider = |x: f64, name: String| {
                 if x > best.0 {
                     best = (x, name);
                 }
             };
-            consider(b.abs() / p.acc, "path acceleration".into());
-            consider((v * c).abs() / p.jerk, "path jerk".into());
+            consider(
+                (g[1] * a + g[0] * b).abs() / (pm * p.acc),
+                "path acceleration".into(),
+            );
+            consider(
+                (v * (g[2] * a + 3.0 * g[1] * b + g[0] * c)).abs() / (pm * p.jerk),
+                "path jerk".into(),
+            );
             // The joints against the limits the solver had (margin included).
             let m = p.margin;
             for (j, l) in p.joints.iter().enumerate() {

@@ -14,7 +14,7 @@ pub struct FeedReport {
     /// Duration of seed 001's constant-feed plan at the requested feedrate with the request's
     /// ramps (s), for comparison ([`crate::timelaw::TimeLaw`]).
     pub constant_feed_time: f64,
-    /// Largest feed reached (m/s).
+    /// Largest feed reached: the tool tip's peak speed over the samples (m/s).
     pub peak_feed: f64,
     /// Where the feed is limited and by what (time-optimal law; empty for the constant one).
     pub limits: Vec<FeedLimit>,

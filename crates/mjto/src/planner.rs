@@ -171,17 +171,59 @@ impl Planner {
         let ctx = Context::new(&self.machine, request, &v, budget)?;
         times.setup = start.elapsed().as_secs_f64();
 
-        let t = Instant::now();
-        let n_coeffs = match request.options.control_points {
+        let automatic = request.options.control_points == 0;
+        let mut n_coeffs = match request.options.control_points {
             0 => automatic_control_points(v.sigma, v.points.len()),
             c => c,
         };
-        let knots = KnotVector::for_parameters(DEGREE, n_coeffs, &v.u).map_err(bspline_error)?;
-        ctx.budget.check("the jerk Hessian")?;
-        let factor = JerkFactor::new(&knots)?;
-        times.hessian = t.elapsed().as_secs_f64();
-
-        let plan = ctx.run(&world, &knots, &factor, times, start)?;
+        let tolerance = request.options.cl_tolerance;
+        let plan = loop {
+            let t = Instant::now();
+            let knots =
+                KnotVector::for_parameters(DEGREE, n_coeffs, &v.u).map_err(bspline_error)?;
+            ctx.budget.check("the jerk Hessian")?;
+            let factor = JerkFactor::new(&knots)?;
+            times.hessian += t.elapsed().as_secs_f64();
+            let plan = ctx.run(&world, &knots, &factor, times.clone(), start)?;
+            let error = plan.metrics.max_cl_error;
+            let more = (2 * n_coeffs)
+                .min(MAX_AUTO_CONTROL_POINTS)
+                .min(v.points.len());
+            if error <= tolerance {
+                break plan;
+            }
+            // The path error is the M-path fit's (eq. 62): more coefficients follow tighter
+            // turns. Only the automatic choice is refined; a request's own count is kept.
+            if !automatic || more <= n_coeffs {
+                // The sample farthest from the path, for the message (the CL points between
+                // samples can be farther; `error` is the largest of both).
+                let time = plan
+                    .positions
+                    .iter()
+                    .zip(&plan.path_positions)
+                    .zip(&plan.times)
+                    .map(|((q, &s), &t)| {
+                        let c = crate::kinematics::forward(q).0;
+                        ((c - ctx.frames.cl_point(s / v.sigma)).norm(), t)
+                    })
+                    .max_by(|a, b| a.0.total_cmp(&b.0))
+                    .map_or(0.0, |w| w.1);
+                return Err(PlanError::LimitViolation {
+                    violations: vec![crate::error::LimitViolation {
+                        joint: "tool tip".into(),
+                        quantity: "distance from the CL path (m)",
+                        value: error,
+                        limit: tolerance,
+                        time,
+                    }],
+                });
+            }
+            log::debug!(
+                "CL error {error:.3e} m > {tolerance:.3e} m with {n_coeffs} coefficients: {more}"
+            );
+            times = plan.times_per_stage.clone();
+            n_coeffs = more;
+        };
         ctx.budget.check("the executability check")?;
         // Judged by what the executor runs: its own validation, from rest at the first point.
         let not_executable = |reason: String| PlanError::NotExecutable { reason };
@@ -195,6 +237,10 @@ impl Planner {
         Ok(plan)
     }
 }
+
+/// Most control coefficients the automatic choice refines to for the CL tolerance
+/// (`options.cl_tolerance`).
+pub const MAX_AUTO_CONTROL_POINTS: usize = 400;
 
 /// Path length per control coefficient of the automatic choice (m).
 pub const AUTO_SPACING: f64 = 0.01;

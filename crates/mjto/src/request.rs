@@ -161,6 +161,11 @@ pub struct CutOptions {
     /// Required clearance between head and workpiece (m, ≥ 0); 0 = contact
     /// is a collision.
     pub clearance: f64,
+    /// Largest distance of the tool tip (eq. 2) from the requested CL path at the samples and
+    /// CL points (m, > 0). With automatic control points the planner doubles them (up to
+    /// [`crate::planner::MAX_AUTO_CONTROL_POINTS`] and the CL count) until the plan is within
+    /// it; a plan that is not is refused (LIMIT_VIOLATION). Default 0.15 mm.
+    pub cl_tolerance: f64,
     /// The time law: `time_optimal` (default: the fastest law under every limit, the
     /// feedrate its cruise maximum; issue 16) or `constant` (seed 001's constant feedrate with
     /// S-curve ramps).
@@ -179,6 +184,7 @@ impl Default for CutOptions {
             rto_angle: 20f64.to_radians(),
             reference_standoff: -0.07,
             clearance: 0.0,
+            cl_tolerance: 1.5e-4,
             feed_law: FeedMode::TimeOptimal,
         }
     }
@@ -537,6 +543,7 @@ impl CutRequest {
         if o.clearance < 0.0 {
             return Err(PlanError::invalid("options.clearance", "must be ≥ 0"));
         }
+        positive("options.cl_tolerance", o.cl_tolerance)?;
         Ok(())
     }
 }

@@ -57,6 +57,7 @@ fn problem<'a>(
         jerk: JERK,
         margin: 1.0,
         process_margin: 1.0,
+        tip: &[],
     }
 }
 

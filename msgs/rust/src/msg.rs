@@ -126,6 +126,8 @@ pub struct CutRequest {
     pub reference_standoff: f64,
     /// Required head–workpiece clearance (m, ≥ 0).
     pub clearance: f64,
+    /// Largest tool-tip distance from the CL path (m); 0 = default 0.15 mm.
+    pub cl_tolerance: f64,
     /// The time law: "" or "time_optimal" (default), or "constant" (seed 001).
     pub feed_law: String,
     /// Time budget of the plan (s): 0 = the node's `plan_timeout`; else in (0, plan_timeout].

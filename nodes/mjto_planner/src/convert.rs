@@ -90,6 +90,7 @@ pub fn request_from_msg(m: &msg::CutRequest) -> Result<CutRequest, PlanError> {
             d.reference_standoff
         },
         clearance: m.clearance,
+        cl_tolerance: or_default(m.cl_tolerance, d.cl_tolerance),
         feed_law: match m.feed_law.as_str() {
             "" | "time_optimal" => FeedMode::TimeOptimal,
             "constant" => FeedMode::Constant,

@@ -186,6 +186,7 @@ pub fn parse_lines(text: &str) -> Result<msg::CutRequest, PlanError> {
             "rto_spacing" => m.rto_spacing = number(n, key, value)?,
             "rto_angle" => m.rto_angle = number(n, key, value)?,
             "clearance" => m.clearance = number(n, key, value)?,
+            "cl_tolerance" => m.cl_tolerance = number(n, key, value)?,
             "time_budget" => m.time_budget = number(n, key, value)?,
             "reference_standoff" => {
                 m.reference_standoff = number(n, key, value)?;

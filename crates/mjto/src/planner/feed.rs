@@ -13,6 +13,7 @@ use crate::optimal_feed::{steady_feed, FeedLimit, FeedMode, FeedProblem, Optimal
 use crate::plan::{FeedReport, StageTimes};
 use crate::rotary::RotaryQp;
 use crate::timelaw::{checked_grid_times, MAX_SAMPLES};
+use crate::tip::{tip_rate, tip_speed};
 use crate::PlanError;
 
 /// Stations of the time-optimal problem per knot span of the joint splines.
@@ -31,11 +32,18 @@ pub const FIRST_MARGIN: f64 = 0.98;
 /// time-optimal solver; shrunk like the joints' margin when a sample exceeds one.
 pub const FIRST_PROCESS_MARGIN: f64 = 0.9999;
 
+/// Extra shrink factor of the process margin after a violation (the process limits are
+/// smooth along the path: their excess between stations is small).
+pub const PROCESS_MARGIN_STEP: f64 = 0.9995;
+
 /// Extra shrink factor of the margin after a violation.
 pub const MARGIN_STEP: f64 = 0.99;
 
 /// Most solves of the time-optimal law per iterate.
 pub const MARGIN_ATTEMPTS: usize = 4;
+
+/// The "joint" of a limit violation of the tool tip's speed against the feedrate.
+pub const TOOL_TIP: &str = "tool tip";
 
 /// A timed iterate: its samples and the report of its feed.
 pub(super) struct Timed {
@@ -101,13 +109,14 @@ impl Context<'_> {
                     })
                     .collect(),
             };
+            let peak_feed = peak_tip_speed(&samples);
             return Ok(Timed {
                 samples,
                 feed: FeedReport {
                     law: mode,
                     cycle_time: constant_time,
                     constant_feed_time: constant_time,
-                    peak_feed: self.law.peak_feed(),
+                    peak_feed,
                     limits,
                 },
                 resampled: false,
@@ -120,8 +129,9 @@ impl Context<'_> {
         self.violations(s).is_empty()
     }
 
-    /// Every joint limit the samples break: Table 2 at the samples (eq. 7, analytic) and the
-    /// jerk the executor commands between them ([`crate::executed`]).
+    /// Every limit the samples break: Table 2 at the samples (eq. 7, analytic), the jerk the
+    /// executor commands between them ([`crate::executed`]) and the feedrate as the tool tip's
+    /// speed ([`crate::tip`], joint [`TOOL_TIP`]).
     pub(super) fn violations(&self, s: &Samples) -> Vec<LimitViolation> {
         let limits = self.limits();
         let mut v = limit_violations(
@@ -141,6 +151,24 @@ impl Context<'_> {
             limits,
             LIMIT_TOLERANCE,
         ));
+        let f = self.request.feedrate;
+        let worst =
+            s.q.iter()
+                .zip(&s.qd)
+                .zip(&s.times)
+                .map(|((q, qd), &t)| (tip_speed(q, qd), t))
+                .max_by(|a, b| a.0.total_cmp(&b.0));
+        if let Some((speed, time)) = worst {
+            if speed.is_nan() || speed > f * (1.0 + LIMIT_TOLERANCE) {
+                v.push(LimitViolation {
+                    joint: TOOL_TIP.into(),
+                    quantity: "velocity",
+                    value: speed,
+                    limit: f,
+                    time,
+                });
+            }
+        }
         v
     }
 
@@ -179,6 +207,7 @@ impl Context<'_> {
         let limits = self.limits();
         let r = self.request;
         self.reachable(&stations, &derivatives)?;
+        let tip = tip_factors(&stations, &derivatives);
         let mut problem = FeedProblem {
             stations: &stations,
             derivatives: &derivatives,
@@ -188,6 +217,7 @@ impl Context<'_> {
             jerk: r.feed_jerk,
             margin: FIRST_MARGIN,
             process_margin: FIRST_PROCESS_MARGIN,
+            tip: &tip,
         };
         let mut last = Vec::new();
         for _ in 0..MARGIN_ATTEMPTS {
@@ -199,21 +229,24 @@ impl Context<'_> {
             let sample_times = checked_grid_times(law.duration(), r.sample_period, MAX_SAMPLES)?;
             let states = law.eval_many(&sample_times)?;
             let samples = self.sample(it, sample_times, &states)?;
-            let mut violations = self.violations(&samples);
-            let process = process_violations(&samples.times, &states, &problem);
+            let (mut violations, mut process): (Vec<_>, Vec<_>) = self
+                .violations(&samples)
+                .into_iter()
+                .partition(|v| v.joint != TOOL_TIP);
+            process.extend(process_violations(&samples.times, &states, &problem));
             if let Some(excess) = process
                 .iter()
                 .map(|v| v.value.abs() / v.limit)
                 .reduce(f64::max)
             {
-                problem.process_margin = problem.process_margin / excess * MARGIN_STEP;
+                problem.process_margin = problem.process_margin / excess * PROCESS_MARGIN_STEP;
             }
             if violations.is_empty() && process.is_empty() {
                 let report = FeedReport {
                     law: FeedMode::TimeOptimal,
                     cycle_time: law.duration(),
                     constant_feed_time: constant_time,
-                    peak_feed: law.peak_feed(),
+                    peak_feed: peak_tip_speed(&samples),
                     limits: law.limits(&problem),
                 };
                 log::debug!(
@@ -310,9 +343,65 @@ pub(super) fn rotary_coefficients(
     }
 }
 
-/// The samples whose feed, path acceleration or path jerk exceeds the request's (relative
-/// tolerance [`LIMIT_TOLERANCE`]), at most one per quantity (the worst), as joint "path".
+/// The tool tip's largest speed over the samples (m/s): the feed as executed.
+fn peak_tip_speed(s: &Samples) -> f64 {
+    s.q.iter()
+        .zip(&s.qd)
+        .map(|(q, qd)| tip_speed(q, qd))
+        .fold(0.0, f64::max)
+}
+
+/// `[g, g', g'']` per station: `g = |dC/ds|` from the joint path's derivatives in s
+/// ([`crate::tip::tip_rate`]), its derivatives by central differences on the uniform stations
+/// (one-sided at the ends).
+fn tip_factors(stations: &[f64], derivatives: &[[[f64; 6]; 4]]) -> Vec<[f64; 3]> {
+    let g: Vec<f64> = derivatives
+        .iter()
+        .map(|d| tip_rate(&d[0], &d[1]).norm())
+        .collect();
+    let n = g.len();
+    let h = stations[1] - stations[0];
+    let diff = |v: &[f64], k: usize| {
+        if k == 0 {
+            (v[1] - v[0]) / h
+        } else if k == n - 1 {
+            (v[n - 1] - v[n - 2]) / h
+        } else {
+            (v[k + 1] - v[k - 1]) / (2.0 * h)
+        }
+    };
+    let g1: Vec<f64> = (0..n).map(|k| diff(&g, k)).collect();
+    (0..n).map(|k| [g[k], g1[k], diff(&g1, k)]).collect()
+}
+
+/// `[g, g', g'']` at path position `s`, linear between the stations.
+fn tip_at(p: &FeedProblem, s: f64) -> [f64; 3] {
+    let n = p.stations.len();
+    if p.tip.len() != n || n < 2 {
+        return [1.0, 0.0, 0.0];
+    }
+    let h = p.stations[1] - p.stations[0];
+    let x = (s / h).clamp(0.0, (n - 1) as f64);
+    let k = (x.floor() as usize).min(n - 2);
+    let w = x - k as f64;
+    std::array::from_fn(|i| p.tip[k][i] * (1.0 - w) + p.tip[k + 1][i] * w)
+}
+
+/// The samples whose tool-tip feed, path acceleration or path jerk (tangential, through
+/// [`tip_at`]: `g ṡ`, `g' ṡ² + g s̈`, `g'' ṡ³ + 3 g' ṡ s̈ + g s⃛`) exceeds the request's
+/// (relative tolerance [`LIMIT_TOLERANCE`]), at most one per quantity (the worst), as joint
+/// [`TOOL_TIP`].
 fn process_violations(times: &[f64], states: &[[f64; 4]], p: &FeedProblem) -> Vec<LimitViolation> {
+    let tangential = |st: &[f64; 4]| {
+        let [g, g1, g2] = tip_at(p, st[0]);
+        let (v, a, j) = (st[1], st[2], st[3]);
+        [
+            g * v,
+            g1 * v * v + g * a,
+            g2 * v * v * v + 3.0 * g1 * v * a + g * j,
+        ]
+    };
+    let rows: Vec<[f64; 3]> = states.iter().map(tangential).collect();
     let mut out: Vec<LimitViolation> = Vec::new();
     for (i, (quantity, limit)) in [
         ("velocity", p.feed),
@@ -324,13 +413,13 @@ fn process_violations(times: &[f64], states: &[[f64; 4]], p: &FeedProblem) -> Ve
     {
         let worst = times
             .iter()
-            .zip(states)
-            .map(|(&t, s)| (t, s[i + 1]))
+            .zip(&rows)
+            .map(|(&t, r)| (t, r[i]))
             .max_by(|a, b| a.1.abs().total_cmp(&b.1.abs()));
         if let Some((time, value)) = worst {
             if value.abs() > limit * (1.0 + LIMIT_TOLERANCE) {
                 out.push(LimitViolation {
-                    joint: "path".into(),
+                    joint: TOOL_TIP.into(),
                     quantity,
                     value,
                     limit,
