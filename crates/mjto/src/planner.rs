@@ -84,6 +84,8 @@ struct Iterate {
 struct Samples {
     times: Vec<f64>,
     u: Vec<f64>,
+    /// ṡ (m/s) of the feed law.
+    sd: Vec<f64>,
     q: Vec<[f64; 6]>,
     qd: Vec<[f64; 6]>,
     qdd: Vec<[f64; 6]>,

@@ -12,7 +12,7 @@ use crate::metrics::limit_violations;
 use crate::optimal_feed::{steady_feed, FeedLimit, FeedMode, FeedProblem, OptimalFeed};
 use crate::plan::{FeedReport, StageTimes};
 use crate::rotary::RotaryQp;
-use crate::timelaw::{checked_grid_times, MAX_SAMPLES};
+use crate::timelaw::{checked_grid_times, TimeLaw, MAX_SAMPLES};
 use crate::tip::{tip_rate, tip_speed};
 use crate::PlanError;
 
@@ -91,15 +91,44 @@ impl Context<'_> {
     ) -> Result<Timed, PlanError> {
         let constant_time = self.law.duration();
         let mode = self.request.options.feed_law;
-        // The constant feed's S-curve is the fastest rest-to-rest law under the feedrate, path
-        // acceleration and path jerk alone (bang-bang in jerk); joint limits can only slow it.
-        // So when every joint is inside its limits on its samples, it is the time-optimal law
-        // too, and the TOPP3 problem need not be solved.
+        // The feed is the tool tip's speed g ṡ, g = |dC/ds| (crate::tip): where the M-path fit
+        // makes g > 1 the S-curve at f would move the tip faster than f. The S-curve at
+        // f / max g keeps it (g is 1 to 1e-3 on cases 1 and 2).
+        let g_max = samples
+            .q
+            .iter()
+            .zip(&samples.qd)
+            .zip(&samples.sd)
+            .filter(|(_, &sd)| sd > 1e-9)
+            .map(|((q, qd), &sd)| tip_speed(q, qd) / sd)
+            .fold(1.0f64, f64::max);
+        let (law, samples) = if g_max > 1.0 + LIMIT_TOLERANCE {
+            let r = self.request;
+            let law = TimeLaw::new(
+                self.v.sigma,
+                r.feedrate / g_max,
+                r.feed_acceleration,
+                r.feed_jerk,
+            )?
+            .on_grid(r.sample_period)?;
+            let t = Instant::now();
+            let sample_times = law.checked_sample_times(r.sample_period, MAX_SAMPLES)?;
+            let states: Vec<[f64; 4]> = sample_times.iter().map(|&t| law.eval(t)).collect();
+            let samples = self.sample(it, sample_times, &states)?;
+            times.evaluation += t.elapsed().as_secs_f64();
+            (law, samples)
+        } else {
+            (self.law, samples)
+        };
+        // The S-curve is the fastest rest-to-rest law under the feedrate, path acceleration and
+        // path jerk alone (bang-bang in jerk); joint limits can only slow it. So when every
+        // joint is inside its limits on its samples, it is the time-optimal law too (to the
+        // rounding of its phases to the sample grid, and f / max g above), and the TOPP3
+        // problem need not be solved.
         if mode == FeedMode::Constant || self.within_limits(&samples) {
             let limits = match mode {
                 FeedMode::Constant => Vec::new(),
-                FeedMode::TimeOptimal => self
-                    .law
+                FeedMode::TimeOptimal => law
                     .phases()
                     .into_iter()
                     .map(|(s_start, s_end, by)| FeedLimit {
@@ -114,12 +143,12 @@ impl Context<'_> {
                 samples,
                 feed: FeedReport {
                     law: mode,
-                    cycle_time: constant_time,
+                    cycle_time: law.duration(),
                     constant_feed_time: constant_time,
                     peak_feed,
                     limits,
                 },
-                resampled: false,
+                resampled: g_max > 1.0 + LIMIT_TOLERANCE,
             });
         }
         self.optimal(it, times, constant_time)

@@ -271,6 +271,7 @@ impl Context<'_> {
         let n = times.len();
         let mut s = Samples {
             u: Vec::with_capacity(n),
+            sd: Vec::with_capacity(n),
             q: Vec::with_capacity(n),
             qd: Vec::with_capacity(n),
             qdd: Vec::with_capacity(n),
@@ -291,6 +292,7 @@ impl Context<'_> {
                 }
             }
             s.u.push(u);
+            s.sd.push(law[1]);
             s.q.push(row[0]);
             s.qd.push(row[1]);
             s.qdd.push(row[2]);
