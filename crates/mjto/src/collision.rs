@@ -32,7 +32,9 @@
 //!   centre of the workpiece bounding box.
 
 mod head;
+mod separation;
 mod world;
 
 pub use head::{HeadLink, HeadModel, HeadShape, Primitive};
+pub use separation::SEPARATION_MARGIN;
 pub use world::CollisionWorld;
