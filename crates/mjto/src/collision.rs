@@ -33,8 +33,10 @@
 
 mod head;
 mod separation;
+mod sweep;
 mod world;
 
 pub use head::{HeadLink, HeadModel, HeadShape, Primitive};
 pub use separation::SEPARATION_MARGIN;
+pub use sweep::{MAX_BACKOFF, MAX_EXPAND, MAX_WINDOW};
 pub use world::CollisionWorld;

@@ -11,26 +11,42 @@ use parry3d_f64::query::{intersection_test, DefaultQueryDispatcher, QueryDispatc
 use parry3d_f64::shape::{Ball, Cuboid, Cylinder, RoundShape, Shape, TriMesh, TriMeshFlags};
 
 use super::head::{machine_err, HeadLink, HeadModel, Primitive};
-use super::separation::{LocalPrimitive, TriangleAxes};
+use super::separation::{LocalPrimitive, TriangleAxes, SEPARATION_MARGIN};
 use crate::mesh::MeshData;
 use crate::PlanError;
 
 /// One head primitive as a parry shape (inflated by the clearance).
-struct WorldShape {
+pub(super) struct WorldShape {
     /// Shape frame in the link frame (parry cylinders are along y: the
     /// URDF z-cylinder is turned by Rx(π/2)).
-    local: Pose,
+    pub(super) local: Pose,
     shape: Box<dyn Shape>,
     /// The primitive (not inflated) in the same frame, for the
-    /// separating-axis first stage.
-    primitive: LocalPrimitive,
+    /// separating-axis first stage and the motion bounds.
+    pub(super) primitive: LocalPrimitive,
+}
+
+/// What [`CollisionWorld::shape_query`] found for one placed shape.
+#[derive(Debug, Clone, Copy)]
+pub(super) struct ShapeVerdict {
+    /// Within the clearance of the workpiece (parry's exact verdict).
+    pub(super) hit: bool,
+    /// When not `hit`: the shape is at least `clearance + clear_by` (m)
+    /// from the workpiece; 0 when nothing more is known.
+    pub(super) clear_by: f64,
+}
+
+/// Euclidean distance between two boxes (0 when they overlap).
+fn aabb_gap(a: &Aabb, b: &Aabb) -> f64 {
+    let lo = (b.mins - a.maxs).max(a.mins - b.maxs).max(Vector::ZERO);
+    lo.length()
 }
 
 /// The shapes of one link and their joint bounding box in the link frame.
-struct WorldLink {
-    link: HeadLink,
+pub(super) struct WorldLink {
+    pub(super) link: HeadLink,
     local_aabb: Aabb,
-    shapes: Vec<WorldShape>,
+    pub(super) shapes: Vec<WorldShape>,
 }
 
 /// The head and the workpiece, ready for configuration queries.
@@ -39,15 +55,15 @@ struct WorldLink {
 /// can be checked from several threads.
 pub struct CollisionWorld {
     head: HeadModel,
-    links: Vec<WorldLink>,
+    pub(super) links: Vec<WorldLink>,
     mesh: TriMesh,
     /// The mesh's triangles with their normals, by triangle index.
     triangles: Vec<TriangleAxes>,
     mesh_aabb: Aabb,
-    /// Machine-frame point subtracted before the f32 conversion.
-    origin: Vector3<f64>,
+    /// Machine-frame point subtracted from every coordinate.
+    pub(super) origin: Vector3<f64>,
     clearance: f64,
-    queries: AtomicUsize,
+    pub(super) queries: AtomicUsize,
 }
 
 impl std::fmt::Debug for CollisionWorld {
@@ -63,8 +79,8 @@ impl std::fmt::Debug for CollisionWorld {
 }
 
 /// nalgebra isometry (machine frame, f64) to a parry pose relative to
-/// `origin` (f32).
-fn to_pose(iso: &Isometry3<f64>, origin: &Vector3<f64>) -> Pose {
+/// `origin`.
+pub(super) fn to_pose(iso: &Isometry3<f64>, origin: &Vector3<f64>) -> Pose {
     let t = iso.translation.vector - origin;
     let q = iso.rotation.quaternion();
     Pose::from_parts(
@@ -287,29 +303,77 @@ impl CollisionWorld {
     /// shape's box, then the exact triangle-vs-shape test), with the
     /// separating axes of [`super::separation`] as a rigorous first stage
     /// before each exact triangle test.
-    fn shape_hits(&self, p: &Pose, s: &WorldShape) -> bool {
+    pub(super) fn shape_hits(&self, p: &Pose, s: &WorldShape) -> bool {
+        self.shape_query(p, s, 0.0).hit
+    }
+
+    /// [`Self::shape_hits`], and a certified bound on how far the shape is
+    /// from the workpiece when it does not hit: the triangles are searched
+    /// in the shape's box widened by `expand` (m, ≥ 0), each separated
+    /// by the axes of [`super::separation`] or, failing them, tested by
+    /// parry's exact test.
+    ///
+    /// # Returns
+    /// `hit` exactly as parry's composite test decides it (the widened
+    /// search only adds triangles outside the shape's box, which cannot
+    /// touch it, and the first stage only skips the exact test where an
+    /// axis proves separation); when not `hit`, `clear_by` ≥ 0 with
+    /// `distance(shape, workpiece) ≥ clearance + clear_by`: `expand` for the
+    /// triangles outside the widened box, each separating gap for the
+    /// others, 0 as soon as a triangle needed the exact test, minus
+    /// [`SEPARATION_MARGIN`] each time.
+    pub(super) fn shape_query(&self, p: &Pose, s: &WorldShape, expand: f64) -> ShapeVerdict {
         // The pose as parry's `intersection_test(IDENTITY, mesh, p, shape)`
         // hands it to the composite test.
         let pos12 = Pose::IDENTITY.inv_mul(p);
         let aabb = s.shape.compute_aabb(&pos12);
-        if !aabb.intersects(&self.mesh_aabb) {
-            return false;
+        let wide = if expand > 0.0 {
+            aabb.loosened(expand)
+        } else {
+            aabb
+        };
+        let clear = |by: f64| ShapeVerdict {
+            hit: false,
+            clear_by: (by - SEPARATION_MARGIN).max(0.0),
+        };
+        if !wide.intersects(&self.mesh_aabb) {
+            // Every triangle lies in the mesh's box.
+            return clear(aabb_gap(&aabb, &self.mesh_aabb));
         }
+        // parry's test looks no further than the shape's own box.
+        let may_hit = aabb.intersects(&self.mesh_aabb);
         let placed = s.primitive.placed(&pos12);
-        self.mesh
+        let need = self.clearance + SEPARATION_MARGIN;
+        // Triangles outside the widened box are more than `expand` beyond
+        // the inflated shape.
+        let mut bound = expand;
+        for i in self
+            .mesh
             .bvh()
-            .leaves(|node: &BvhNode| node.aabb().intersects(&aabb))
-            .any(|i| {
-                let separated = self
-                    .triangles
-                    .get(i as usize)
-                    .is_some_and(|t| placed.separated(t, self.clearance));
-                !separated
-                    && DefaultQueryDispatcher
-                        .intersection_test(&pos12, &self.mesh.triangle(i), s.shape.as_ref())
-                        // Unsupported pairs were excluded in new(); be conservative.
-                        .map_or(true, |r| r.intersecting)
-            })
+            .leaves(|node: &BvhNode| node.aabb().intersects(&wide))
+        {
+            let gap = self
+                .triangles
+                .get(i as usize)
+                .map_or(f64::NEG_INFINITY, |t| placed.gap(t, need + bound));
+            if gap > need {
+                bound = bound.min(gap - self.clearance);
+                continue;
+            }
+            bound = 0.0;
+            if may_hit
+                && DefaultQueryDispatcher
+                    .intersection_test(&pos12, &self.mesh.triangle(i), s.shape.as_ref())
+                    // Unsupported pairs were excluded in new(); be conservative.
+                    .map_or(true, |r| r.intersecting)
+            {
+                return ShapeVerdict {
+                    hit: true,
+                    clear_by: 0.0,
+                };
+            }
+        }
+        clear(bound)
     }
 
     /// [`Self::shape_hits`] without the first stage: parry's composite test.
