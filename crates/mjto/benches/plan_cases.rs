@@ -9,13 +9,21 @@
 //! Prints markdown tables (the ones in BENCHMARKS.md). Timings are medians
 //! over `KERF_PLAN_RUNS` runs (default 20) after one warm-up run, which also
 //! loads the mesh into the planner's cache (a node plans with a warm cache).
+//! The last table times the three collision paths on each final plan's
+//! samples (one thread): parry's composite test per sample
+//! (`colliding_links_exhaustive`), with the separating-axis first stage
+//! (`colliding_links`), and conservative advancement in the planner's runs
+//! of 256 samples (`colliding_links_along`); it also checks that the three
+//! agree.
 #![allow(clippy::unwrap_used, clippy::expect_used)] // tests report failures by panicking
 
 use std::path::Path;
 use std::time::Instant;
 
+use kerf_mjto::collision::{CollisionWorld, HeadModel};
+use kerf_mjto::mesh::MeshCache;
 use kerf_mjto::plan::{CutPlan, StageTimes};
-use kerf_mjto::planner::Planner;
+use kerf_mjto::planner::{Planner, BUDGET_STRIDE};
 use kerf_mjto::{CutRequest, LaserMachine};
 
 fn median(mut v: Vec<f64>) -> f64 {
@@ -118,5 +126,39 @@ fn main() {
             );
         }
         println!();
+    }
+    println!("| case | samples | exhaustive (µs/sample) | first stage (µs/sample) | advancement (µs/sample) | verdicts equal |");
+    println!("|---|---|---|---|---|---|");
+    for (name, plan) in &plans {
+        let text = std::fs::read_to_string(cases.join(format!("{name}.yaml"))).expect("case file");
+        let request = CutRequest::from_yaml(&text).expect("request");
+        let v = request.validate().expect("valid");
+        let mesh = MeshCache::new().get(&request.mesh).expect("mesh");
+        let head = HeadModel::from_urdf(planner.machine().robot().urdf()).expect("head");
+        let w = CollisionWorld::new(head, &mesh, &v.workpiece_pose, request.options.clearance)
+            .expect("world");
+        let qs = &plan.positions;
+        let per_sample = |f: &dyn Fn() -> Vec<Vec<&'static str>>| {
+            let mut t = Vec::new();
+            let mut out = Vec::new();
+            for _ in 0..runs {
+                let start = Instant::now();
+                out = f();
+                t.push(start.elapsed().as_secs_f64() / qs.len() as f64 * 1e6);
+            }
+            (median(t), out)
+        };
+        let (te, e) = per_sample(&|| qs.iter().map(|q| w.colliding_links_exhaustive(q)).collect());
+        let (tf, f) = per_sample(&|| qs.iter().map(|q| w.colliding_links(q)).collect());
+        let (ta, a) = per_sample(&|| {
+            qs.chunks(BUDGET_STRIDE)
+                .flat_map(|c| w.colliding_links_along(c))
+                .collect()
+        });
+        println!(
+            "| {name} | {} | {te:.2} | {tf:.2} | {ta:.2} | {} |",
+            qs.len(),
+            e == f && e == a
+        );
     }
 }

@@ -22,7 +22,17 @@
 //!   housing (`a_axis`), the fork and C-axis motor (`c_axis`), the ram; a
 //!   link whose bounding box misses the workpiece bounding box is skipped
 //!   without any triangle test, then every shape's own box is matched
-//!   against the mesh BVH by parry.
+//!   against the mesh BVH, as parry's composite test does. Each candidate
+//!   triangle first meets a few separating axes (`separation`: a gap
+//!   beyond the clearance + [`SEPARATION_MARGIN`] proves it clear); only
+//!   the others get parry's exact triangle test. The verdicts are parry's
+//!   ([`CollisionWorld::colliding_links_exhaustive`] is the path without
+//!   the first stage, for tests and benches).
+//! * A sampled trajectory is checked by conservative advancement
+//!   ([`CollisionWorld::colliding_links_along`], `sweep`): a query at an
+//!   anchor sample certifies a distance, and the following samples that the
+//!   shape provably cannot cross it in need no query; same verdicts as one
+//!   query per sample.
 //! * The geometry runs on `parry3d-f64` (the f64 build of parry3d 0.31).
 //!   The f32 build's GJK test of a cylinder against a large triangle
 //!   reports contact across a 1 mm gap (the nozzle above a flange at 3°
@@ -32,7 +42,11 @@
 //!   centre of the workpiece bounding box.
 
 mod head;
+mod separation;
+mod sweep;
 mod world;
 
 pub use head::{HeadLink, HeadModel, HeadShape, Primitive};
+pub use separation::SEPARATION_MARGIN;
+pub use sweep::{MAX_BACKOFF, MAX_EXPAND, MAX_WINDOW};
 pub use world::CollisionWorld;

@@ -6,26 +6,47 @@ use std::sync::atomic::{AtomicUsize, Ordering};
 use nalgebra::{Isometry3, Translation3, UnitQuaternion, Vector3};
 use parry3d_f64::bounding_volume::{Aabb, BoundingVolume};
 use parry3d_f64::math::{Pose, Rotation, Vector};
-use parry3d_f64::query::intersection_test;
+use parry3d_f64::partitioning::BvhNode;
+use parry3d_f64::query::{intersection_test, DefaultQueryDispatcher, QueryDispatcher};
 use parry3d_f64::shape::{Ball, Cuboid, Cylinder, RoundShape, Shape, TriMesh, TriMeshFlags};
 
 use super::head::{machine_err, HeadLink, HeadModel, Primitive};
+use super::separation::{LocalPrimitive, TriangleAxes, SEPARATION_MARGIN};
 use crate::mesh::MeshData;
 use crate::PlanError;
 
 /// One head primitive as a parry shape (inflated by the clearance).
-struct WorldShape {
+pub(super) struct WorldShape {
     /// Shape frame in the link frame (parry cylinders are along y: the
     /// URDF z-cylinder is turned by Rx(π/2)).
-    local: Pose,
+    pub(super) local: Pose,
     shape: Box<dyn Shape>,
+    /// The primitive (not inflated) in the same frame, for the
+    /// separating-axis first stage and the motion bounds.
+    pub(super) primitive: LocalPrimitive,
+}
+
+/// What [`CollisionWorld::shape_query`] found for one placed shape.
+#[derive(Debug, Clone, Copy)]
+pub(super) struct ShapeVerdict {
+    /// Within the clearance of the workpiece (parry's exact verdict).
+    pub(super) hit: bool,
+    /// When not `hit`: the shape is at least `clearance + clear_by` (m)
+    /// from the workpiece; 0 when nothing more is known.
+    pub(super) clear_by: f64,
+}
+
+/// Euclidean distance between two boxes (0 when they overlap).
+fn aabb_gap(a: &Aabb, b: &Aabb) -> f64 {
+    let lo = (b.mins - a.maxs).max(a.mins - b.maxs).max(Vector::ZERO);
+    lo.length()
 }
 
 /// The shapes of one link and their joint bounding box in the link frame.
-struct WorldLink {
-    link: HeadLink,
+pub(super) struct WorldLink {
+    pub(super) link: HeadLink,
     local_aabb: Aabb,
-    shapes: Vec<WorldShape>,
+    pub(super) shapes: Vec<WorldShape>,
 }
 
 /// The head and the workpiece, ready for configuration queries.
@@ -34,13 +55,15 @@ struct WorldLink {
 /// can be checked from several threads.
 pub struct CollisionWorld {
     head: HeadModel,
-    links: Vec<WorldLink>,
+    pub(super) links: Vec<WorldLink>,
     mesh: TriMesh,
+    /// The mesh's triangles with their normals, by triangle index.
+    triangles: Vec<TriangleAxes>,
     mesh_aabb: Aabb,
-    /// Machine-frame point subtracted before the f32 conversion.
-    origin: Vector3<f64>,
+    /// Machine-frame point subtracted from every coordinate.
+    pub(super) origin: Vector3<f64>,
     clearance: f64,
-    queries: AtomicUsize,
+    pub(super) queries: AtomicUsize,
 }
 
 impl std::fmt::Debug for CollisionWorld {
@@ -56,8 +79,8 @@ impl std::fmt::Debug for CollisionWorld {
 }
 
 /// nalgebra isometry (machine frame, f64) to a parry pose relative to
-/// `origin` (f32).
-fn to_pose(iso: &Isometry3<f64>, origin: &Vector3<f64>) -> Pose {
+/// `origin`.
+pub(super) fn to_pose(iso: &Isometry3<f64>, origin: &Vector3<f64>) -> Pose {
     let t = iso.translation.vector - origin;
     let q = iso.rotation.quaternion();
     Pose::from_parts(
@@ -68,7 +91,7 @@ fn to_pose(iso: &Isometry3<f64>, origin: &Vector3<f64>) -> Pose {
 
 /// The parry shape of a primitive inflated by `clearance` (m, ≥ 0), and
 /// its pose correction (cylinder axis z → y).
-fn parry_shape(p: &Primitive, clearance: f64) -> (Box<dyn Shape>, Isometry3<f64>) {
+fn parry_shape(p: &Primitive, clearance: f64) -> (Box<dyn Shape>, LocalPrimitive, Isometry3<f64>) {
     let z_to_y = Isometry3::from_parts(
         Translation3::identity(),
         UnitQuaternion::from_axis_angle(&Vector3::x_axis(), std::f64::consts::FRAC_PI_2),
@@ -84,7 +107,7 @@ fn parry_shape(p: &Primitive, clearance: f64) -> (Box<dyn Shape>, Isometry3<f64>
             } else {
                 Box::new(c)
             };
-            (s, Isometry3::identity())
+            (s, LocalPrimitive::Cuboid { half: h }, Isometry3::identity())
         }
         Primitive::Cylinder {
             radius,
@@ -99,10 +122,18 @@ fn parry_shape(p: &Primitive, clearance: f64) -> (Box<dyn Shape>, Isometry3<f64>
             } else {
                 Box::new(c)
             };
-            (s, z_to_y)
+            (
+                s,
+                LocalPrimitive::Cylinder {
+                    radius,
+                    half_length,
+                },
+                z_to_y,
+            )
         }
         Primitive::Sphere { radius } => (
             Box::new(Ball::new(radius + clearance)),
+            LocalPrimitive::Ball { radius },
             Isometry3::identity(),
         ),
     }
@@ -171,10 +202,13 @@ impl CollisionWorld {
         let trimesh = TriMesh::with_flags(vertices, mesh.triangles, TriMeshFlags::empty())
             .map_err(|e| mesh_err(format!("cannot build the collision mesh: {e:?}")))?;
         let mesh_aabb = trimesh.local_aabb();
+        let triangles = (0..trimesh.num_triangles() as u32)
+            .map(|i| TriangleAxes::new(&trimesh.triangle(i)))
+            .collect();
 
         let mut links: Vec<WorldLink> = Vec::new();
         for s in &head.shapes {
-            let (shape, fix) = parry_shape(&s.primitive, clearance);
+            let (shape, primitive, fix) = parry_shape(&s.primitive, clearance);
             let local = to_pose(&(s.origin * fix), &Vector3::zeros());
             let aabb = shape.compute_aabb(&local);
             // Every pair must be supported by parry's dispatcher: probe once.
@@ -184,7 +218,11 @@ impl CollisionWorld {
                     s.primitive
                 ))
             })?;
-            let ws = WorldShape { local, shape };
+            let ws = WorldShape {
+                local,
+                shape,
+                primitive,
+            };
             match links.last_mut() {
                 Some(l) if l.link == s.link => {
                     l.local_aabb = l.local_aabb.merged(&aabb);
@@ -201,6 +239,7 @@ impl CollisionWorld {
             head,
             links,
             mesh: trimesh,
+            triangles,
             mesh_aabb,
             origin,
             clearance,
@@ -225,7 +264,7 @@ impl CollisionWorld {
 
     /// Tests the links of the head at `q`; `all = false` stops at the
     /// first colliding link.
-    fn check(&self, q: &[f64; 6], all: bool) -> Vec<&'static str> {
+    fn check(&self, q: &[f64; 6], all: bool, exhaustive: bool) -> Vec<&'static str> {
         self.queries.fetch_add(1, Ordering::Relaxed);
         if q.iter().any(|v| !v.is_finite()) {
             // A configuration that cannot be placed is never free.
@@ -242,11 +281,11 @@ impl CollisionWorld {
                 continue;
             }
             let hit = link.shapes.iter().any(|s| {
-                let p = pose * s.local;
-                s.shape.compute_aabb(&p).intersects(&self.mesh_aabb)
-                    && intersection_test(&Pose::IDENTITY, &self.mesh, &p, s.shape.as_ref())
-                        // Unsupported pairs were excluded in new(); be conservative.
-                        .map_or(true, |r| r.intersecting)
+                if exhaustive {
+                    self.shape_hits_exhaustive(&(pose * s.local), s)
+                } else {
+                    self.shape_hits(&(pose * s.local), s)
+                }
             });
             if hit {
                 hits.push(link.link.name());
@@ -256,6 +295,93 @@ impl CollisionWorld {
             }
         }
         hits
+    }
+
+    /// Whether one placed head shape (pose `p` in the mesh frame) is within
+    /// the clearance of the workpiece: parry's composite test
+    /// (`intersects_shape`: every triangle whose BVH leaf box meets the
+    /// shape's box, then the exact triangle-vs-shape test), with the
+    /// separating axes of [`super::separation`] as a rigorous first stage
+    /// before each exact triangle test.
+    pub(super) fn shape_hits(&self, p: &Pose, s: &WorldShape) -> bool {
+        self.shape_query(p, s, 0.0).hit
+    }
+
+    /// [`Self::shape_hits`], and a certified bound on how far the shape is
+    /// from the workpiece when it does not hit: the triangles are searched
+    /// in the shape's box widened by `expand` (m, ≥ 0), each separated
+    /// by the axes of [`super::separation`] or, failing them, tested by
+    /// parry's exact test.
+    ///
+    /// # Returns
+    /// `hit` exactly as parry's composite test decides it (the widened
+    /// search only adds triangles outside the shape's box, which cannot
+    /// touch it, and the first stage only skips the exact test where an
+    /// axis proves separation); when not `hit`, `clear_by` ≥ 0 with
+    /// `distance(shape, workpiece) ≥ clearance + clear_by`: `expand` for the
+    /// triangles outside the widened box, each separating gap for the
+    /// others, 0 as soon as a triangle needed the exact test, minus
+    /// [`SEPARATION_MARGIN`] each time.
+    pub(super) fn shape_query(&self, p: &Pose, s: &WorldShape, expand: f64) -> ShapeVerdict {
+        // The pose as parry's `intersection_test(IDENTITY, mesh, p, shape)`
+        // hands it to the composite test.
+        let pos12 = Pose::IDENTITY.inv_mul(p);
+        let aabb = s.shape.compute_aabb(&pos12);
+        let wide = if expand > 0.0 {
+            aabb.loosened(expand)
+        } else {
+            aabb
+        };
+        let clear = |by: f64| ShapeVerdict {
+            hit: false,
+            clear_by: (by - SEPARATION_MARGIN).max(0.0),
+        };
+        if !wide.intersects(&self.mesh_aabb) {
+            // Every triangle lies in the mesh's box.
+            return clear(aabb_gap(&aabb, &self.mesh_aabb));
+        }
+        // parry's test looks no further than the shape's own box.
+        let may_hit = aabb.intersects(&self.mesh_aabb);
+        let placed = s.primitive.placed(&pos12);
+        let need = self.clearance + SEPARATION_MARGIN;
+        // Triangles outside the widened box are more than `expand` beyond
+        // the inflated shape.
+        let mut bound = expand;
+        for i in self
+            .mesh
+            .bvh()
+            .leaves(|node: &BvhNode| node.aabb().intersects(&wide))
+        {
+            let gap = self
+                .triangles
+                .get(i as usize)
+                .map_or(f64::NEG_INFINITY, |t| placed.gap(t, need + bound));
+            if gap > need {
+                bound = bound.min(gap - self.clearance);
+                continue;
+            }
+            bound = 0.0;
+            if may_hit
+                && DefaultQueryDispatcher
+                    .intersection_test(&pos12, &self.mesh.triangle(i), s.shape.as_ref())
+                    // Unsupported pairs were excluded in new(); be conservative.
+                    .map_or(true, |r| r.intersecting)
+            {
+                return ShapeVerdict {
+                    hit: true,
+                    clear_by: 0.0,
+                };
+            }
+        }
+        clear(bound)
+    }
+
+    /// [`Self::shape_hits`] without the first stage: parry's composite test.
+    fn shape_hits_exhaustive(&self, p: &Pose, s: &WorldShape) -> bool {
+        s.shape.compute_aabb(p).intersects(&self.mesh_aabb)
+            && intersection_test(&Pose::IDENTITY, &self.mesh, p, s.shape.as_ref())
+                // Unsupported pairs were excluded in new(); be conservative.
+                .map_or(true, |r| r.intersecting)
     }
 
     /// Names of the head links within the clearance of the workpiece at
@@ -268,7 +394,16 @@ impl CollisionWorld {
     /// Tests every link (no early exit); use [`CollisionWorld::is_free`]
     /// when the names are not needed.
     pub fn colliding_links(&self, q: &[f64; 6]) -> Vec<&'static str> {
-        self.check(q, true)
+        self.check(q, true, false)
+    }
+
+    /// [`CollisionWorld::colliding_links`] by parry's composite test alone
+    /// (`intersection_test` of every shape against the whole mesh, the
+    /// exact test of every candidate triangle), without the
+    /// separating-axis first stage: the reference the faster paths are
+    /// tested against. Counts one query.
+    pub fn colliding_links_exhaustive(&self, q: &[f64; 6]) -> Vec<&'static str> {
+        self.check(q, true, true)
     }
 
     /// True when no head shape is within the clearance of the workpiece at
@@ -278,7 +413,7 @@ impl CollisionWorld {
     /// Stops at the first colliding link; links whose bounding box misses
     /// the workpiece's cost a box test only.
     pub fn is_free(&self, q: &[f64; 6]) -> bool {
-        self.check(q, false).is_empty()
+        self.check(q, false, false).is_empty()
     }
 
     /// Number of configuration queries so far.

@@ -14,6 +14,12 @@ use crate::PlanError;
 impl Context<'_> {
     /// Collision and lead/tilt check of every sample, on two threads.
     ///
+    /// The collision verdicts come in runs of [`BUDGET_STRIDE`] samples from
+    /// [`CollisionWorld::colliding_links_along`] (conservative advancement:
+    /// the same verdicts as one [`CollisionWorld::colliding_links`] per
+    /// sample, with one query per head shape covering the samples it cannot
+    /// reach the workpiece in).
+    ///
     /// # Errors
     /// [`PlanError::Interrupted`] when the budget runs out (checked every
     /// [`super::BUDGET_STRIDE`] samples on each thread).
@@ -27,11 +33,15 @@ impl Context<'_> {
         let check_range =
             |range: std::ops::Range<usize>| -> Result<Vec<CollisionReport>, Interrupt> {
                 let mut found = Vec::new();
-                for k in range {
-                    if k.is_multiple_of(BUDGET_STRIDE) {
-                        self.budget.check("the dense collision check")?;
+                let mut start = range.start;
+                while start < range.end {
+                    self.budget.check("the dense collision check")?;
+                    let end = (start + BUDGET_STRIDE).min(range.end);
+                    let links = world.colliding_links_along(&s.q[start..end]);
+                    for (k, links) in (start..end).zip(links) {
+                        found.extend(self.check_sample(s.times[k], s.u[k], &s.q[k], &links));
                     }
-                    found.extend(self.check_sample(world, s.times[k], s.u[k], &s.q[k]));
+                    start = end;
                 }
                 Ok(found)
             };
@@ -56,21 +66,26 @@ impl Context<'_> {
         Ok(first)
     }
 
+    /// The report of one sample at `time`, path parameter `u` and joints
+    /// `q`, given the head links within the clearance there (from the
+    /// collision check), or `None` when it is clear and inside the
+    /// lead/tilt limits.
     pub(super) fn check_sample(
         &self,
-        world: &CollisionWorld,
         time: f64,
         u: f64,
         q: &[f64; 6],
+        colliding: &[&str],
     ) -> Option<CollisionReport> {
-        let links: Vec<String> = world
-            .colliding_links(q)
-            .into_iter()
-            .map(|l| l.to_string())
-            .collect();
         let axis = tool_axis(q[3], q[4]);
         let (lead, tilt) = self.frames.lead_tilt(u, &axis);
         let r = self.request;
+        let lead_bad = lead.abs() > r.max_lead_angle * (1.0 + ANGLE_TOLERANCE);
+        let tilt_bad = tilt.abs() > r.max_tilt_angle * (1.0 + ANGLE_TOLERANCE);
+        if colliding.is_empty() && !lead_bad && !tilt_bad {
+            return None;
+        }
+        let links: Vec<String> = colliding.iter().map(|l| l.to_string()).collect();
         let mut reasons = Vec::new();
         if !links.is_empty() {
             reasons.push(format!(
@@ -78,22 +93,19 @@ impl Context<'_> {
                 links.join(", ")
             ));
         }
-        if lead.abs() > r.max_lead_angle * (1.0 + ANGLE_TOLERANCE) {
+        if lead_bad {
             reasons.push(format!(
                 "lead angle {:.2}° exceeds {:.2}°",
                 lead.to_degrees(),
                 r.max_lead_angle.to_degrees()
             ));
         }
-        if tilt.abs() > r.max_tilt_angle * (1.0 + ANGLE_TOLERANCE) {
+        if tilt_bad {
             reasons.push(format!(
                 "tilt angle {:.2}° exceeds {:.2}°",
                 tilt.to_degrees(),
                 r.max_tilt_angle.to_degrees()
             ));
-        }
-        if reasons.is_empty() {
-            return None;
         }
         Some(CollisionReport {
             u,
@@ -244,11 +256,17 @@ impl Context<'_> {
         if let Some(w) = world {
             // Two threads, as the dense check of the plan itself.
             let half = q.len() / 2;
+            // Conservative advancement, as the dense check of the plan: the
+            // same count as one query per sample.
             let count = |part: &[[f64; 6]]| -> Result<usize, Interrupt> {
                 let mut n = 0;
                 for chunk in part.chunks(BUDGET_STRIDE) {
                     self.budget.check("the QI baseline's collision count")?;
-                    n += chunk.iter().filter(|q| !w.is_free(q)).count();
+                    n += w
+                        .colliding_links_along(chunk)
+                        .iter()
+                        .filter(|links| !links.is_empty())
+                        .count();
                 }
                 Ok(n)
             };
