@@ -3,6 +3,7 @@
 //! ```text
 //! cargo bench -p kerf_mjto --bench feed_cases
 //! KERF_PLAN_RUNS=10 cargo bench -p kerf_mjto --bench feed_cases
+//! KERF_CASES=saddle,slot cargo bench -p kerf_mjto --bench feed_cases
 //! ```
 //!
 //! Per case: the constant feed's outcome (seed 001 eq. 13 with kerf's S-curve ramps on the
@@ -79,6 +80,14 @@ fn main() {
         .collect();
     jobshop.sort();
     files.extend(jobshop);
+    // KERF_CASES=saddle,slot plans only the cases whose name contains one of the words.
+    if let Ok(filter) = std::env::var("KERF_CASES") {
+        let words: Vec<String> = filter.split(',').map(str::to_string).collect();
+        files.retain(|f| {
+            let name = f.file_stem().unwrap().to_string_lossy();
+            words.iter().any(|w| name.contains(w.as_str()))
+        });
+    }
     let mut planner =
         Planner::new(LaserMachine::default_machine().expect("machine")).expect("planner");
     println!("| case | σ (m) | f (m/min) | constant feed (seed 001) | time-optimal | peak tip feed (m/min) | feed held by | planning (median of {runs}) |");
