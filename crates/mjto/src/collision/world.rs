@@ -420,4 +420,9 @@ impl CollisionWorld {
     pub fn queries(&self) -> usize {
         self.queries.load(Ordering::Relaxed)
     }
+
+    /// Restarts the query count (a world kept for the next plan of the same part).
+    pub fn reset_queries(&self) {
+        self.queries.store(0, Ordering::Relaxed);
+    }
 }

@@ -20,7 +20,7 @@ use crate::PlanError;
 pub const STATIONS_PER_SPAN: usize = 2;
 
 /// Fewest and most stations of the time-optimal problem.
-pub const STATION_RANGE: (usize, usize) = (64, 1500);
+pub const STATION_RANGE: (usize, usize) = (64, 600);
 
 /// Fraction of the joint limits first given to the time-optimal solver. Its constraints hold
 /// at its stations; the joint path's derivatives move between them, so the controller samples
