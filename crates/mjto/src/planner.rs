@@ -39,6 +39,7 @@ use crate::{CutPlan, CutRequest, LaserMachine, PlanError};
 
 mod dense_check;
 mod iteration;
+mod rto_box;
 mod setup;
 
 /// Degree of the B-splines: quintic, C³ (seed 001 section 2.1).
@@ -67,6 +68,9 @@ struct RtoState {
     u: f64,
     q: [f64; 3],
     inserted_at: usize,
+    /// The box of free, feasible GFD samples around `q` the QPs may choose
+    /// in (`options.rto_constraint: box`); `None`: equality at `q`.
+    bounds: Option<crate::gfd::GridBox>,
 }
 
 /// The splines of one iteration and their dense samples.

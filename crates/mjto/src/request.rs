@@ -131,6 +131,50 @@ impl Default for Weights {
     }
 }
 
+/// How the RTO orientations enter the QPs (kerf, issue 16 item 3).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum RtoConstraint {
+    /// Seed 001 eq. 57-60 and 62-64: the joint splines pass exactly through
+    /// the selected GFD candidate (q4, q5, q6) at each RTO.
+    Equality,
+    /// kerf: at each RTO, q4, q5 and q6 may take any value inside the
+    /// largest box of collision-free, lead/tilt-feasible GFD grid samples
+    /// grown around the selected candidate (`gfd::Gfd::free_box`); the QPs
+    /// choose the values of least jerk. Measured smoother than `equality`
+    /// on the committed cases and a tube saddle (BENCHMARKS.md).
+    #[default]
+    Box,
+}
+
+impl RtoConstraint {
+    /// The option from its request spelling: `"equality"` or `"box"`; the
+    /// empty string is the default ([`RtoConstraint::Box`]).
+    ///
+    /// # Errors
+    /// [`PlanError::InvalidRequest`] (field `options.rto_constraint`) for any
+    /// other text.
+    pub fn parse(text: &str) -> Result<Self, PlanError> {
+        match text {
+            "" => Ok(Self::default()),
+            "equality" => Ok(Self::Equality),
+            "box" => Ok(Self::Box),
+            other => Err(PlanError::invalid(
+                "options.rto_constraint",
+                format!("{other:?} must be \"equality\" or \"box\""),
+            )),
+        }
+    }
+
+    /// The request spelling.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            Self::Equality => "equality",
+            Self::Box => "box",
+        }
+    }
+}
+
 /// Planner options.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
@@ -160,6 +204,11 @@ pub struct CutOptions {
     /// Required clearance between head and workpiece (m, ≥ 0); 0 = contact
     /// is a collision.
     pub clearance: f64,
+    /// RTOs as equalities (seed 001) or boxes inside the feasible domain
+    /// (kerf, the default): `"equality"` or `"box"`. Written only when not
+    /// the default (request files written before the option read the same).
+    #[serde(skip_serializing_if = "is_default_rto_constraint")]
+    pub rto_constraint: RtoConstraint,
 }
 
 impl Default for CutOptions {
@@ -174,6 +223,7 @@ impl Default for CutOptions {
             rto_angle: 20f64.to_radians(),
             reference_standoff: -0.07,
             clearance: 0.0,
+            rto_constraint: RtoConstraint::Box,
         }
     }
 }
@@ -225,6 +275,10 @@ pub struct CutRequest {
     /// A plan that runs out of it ends with [`PlanError::Interrupted`] (status TIMEOUT).
     #[serde(default, skip_serializing_if = "is_zero")]
     pub time_budget: f64,
+}
+
+fn is_default_rto_constraint(v: &RtoConstraint) -> bool {
+    *v == RtoConstraint::default()
 }
 
 fn is_zero(v: &f64) -> bool {

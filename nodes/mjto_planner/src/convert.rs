@@ -89,6 +89,7 @@ pub fn request_from_msg(m: &msg::CutRequest) -> Result<CutRequest, PlanError> {
             d.reference_standoff
         },
         clearance: m.clearance,
+        rto_constraint: d.rto_constraint,
     };
     let p = &m.workpiece_pose.position;
     Ok(CutRequest {
