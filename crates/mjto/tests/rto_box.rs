@@ -2,7 +2,8 @@
 //! free, lead/tilt-feasible GFD samples (`Gfd::free_box`), the QPs'
 //! interval constraints, and whole plans with `options.rto_constraint`
 //! `box` against the paper's `equality` on case 1, case 2 and a tube saddle
-//! beside a rib.
+//! (`common::saddle`: collisions of the head's fork with the main tube and
+//! a 30° turn of the nominal axis force RTO insertions in the paper's loop).
 #![allow(clippy::unwrap_used, clippy::expect_used)] // tests report failures by panicking
 
 use std::path::Path;
@@ -72,7 +73,8 @@ fn gfd_at(request: &CutRequest, i: usize) -> (Gfd, PathFrames) {
 /// Every sample of the box is a candidate, free in a fresh world, inside
 /// lead/tilt, joint ranges and strokes; the box's corners are grid values;
 /// and every face that could still grow is blocked by a rejected or
-/// colliding sample.
+/// colliding sample. Returns the number of faces a colliding sample blocks.
+#[allow(clippy::too_many_arguments)]
 fn check_box(
     name: &str,
     g: &Gfd,
@@ -82,7 +84,7 @@ fn check_box(
     world: &CollisionWorld,
     max_steps: [usize; 3],
     start: [usize; 3],
-) {
+) -> usize {
     let limits = *machine().limits();
     let axes = g.grid_axes();
     for k in 0..3 {
@@ -110,6 +112,7 @@ fn check_box(
     }
     // Maximal: each face is at the grid's end, at max_steps, or its next
     // layer holds a rejected or colliding sample.
+    let mut by_collision = 0;
     for k in 0..3 {
         for up in [false, true] {
             let next = if up {
@@ -128,13 +131,16 @@ fn check_box(
                 hi_index: hi,
                 ..*b
             };
-            let blocked = g
-                .box_candidates(&layer_box)
+            let layer = g.box_candidates(&layer_box);
+            let collides = layer
                 .iter()
-                .any(|c| c.is_none_or(|c| !world.is_free(&g.joint_vector(c))));
+                .any(|c| c.is_some_and(|c| !world.is_free(&g.joint_vector(c))));
+            let blocked = collides || layer.iter().any(Option::is_none);
             assert!(blocked, "{name}: face {k} {up} could grow");
+            by_collision += usize::from(collides);
         }
     }
+    by_collision
 }
 
 #[test]
@@ -145,6 +151,7 @@ fn the_box_holds_only_free_feasible_samples_and_is_maximal() {
     let world = world_of(&request);
     let budget = Budget::unlimited();
     let mut limited = 0;
+    let mut by_collision = 0;
     // Every tenth CL point of the loop: beside the rib, on the flanks and
     // through the vertical.
     for i in (0..request.points.len()).step_by(10) {
@@ -161,7 +168,7 @@ fn the_box_holds_only_free_feasible_samples_and_is_maximal() {
                 .free_box(p, steps, None, &world, &budget)
                 .unwrap()
                 .unwrap();
-            check_box(
+            by_collision += check_box(
                 &format!("CL {i}"),
                 &g,
                 &b,
@@ -193,8 +200,10 @@ fn the_box_holds_only_free_feasible_samples_and_is_maximal() {
         assert_eq!(b.hi[0], q[0]);
         assert_eq!(b.lo[1], q[1]);
     }
-    // Not trivial: on some points the rib or the lead/tilt limits stop a box.
+    // Not trivial: on some points the lead/tilt limits or collisions (the
+    // rib, the tube) stop a box.
     assert!(limited > 0);
+    assert!(by_collision > 0);
 }
 
 #[test]
@@ -375,9 +384,9 @@ fn check_plan(name: &str, request: &CutRequest, plan: &CutPlan) {
             assert!(plan.accelerations[k][j].abs() <= l.acc * (1.0 + 1e-6));
         }
     }
-    for j in 0..6 {
+    for (j, l) in limits.iter().enumerate() {
         assert!(
-            plan.metrics.peak_jerk[j] <= limits[j].jerk * (1.0 + 1e-6),
+            plan.metrics.peak_jerk[j] <= l.jerk * (1.0 + 1e-6),
             "{name}: q{} jerk",
             j + 1
         );

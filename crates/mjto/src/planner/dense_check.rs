@@ -8,6 +8,7 @@ use super::rto_box::{jerk_proxy, INSERT_CHOICES};
 use super::{Context, Iterate, RtoState, Samples, ANGLE_TOLERANCE, BUDGET_STRIDE};
 use crate::collision::CollisionWorld;
 use crate::error::CollisionReport;
+use crate::gfd::weighted_distance;
 use crate::kinematics::{forward, tool_axis};
 use crate::plan::Metrics;
 use crate::request::RtoConstraint;
@@ -199,8 +200,23 @@ impl Context<'_> {
                 .iter()
                 .map(|r| (r.u, value(r)))
                 .collect();
+            // First order, one more point constraint at ũ_i raises each
+            // rotary QP's jerk cost by (Δq)² / g_ii with g_ii the same for q4
+            // and q5 (same knots, same objective): the nearest candidate
+            // (eq. 55, k4 = k5) is the least-jerk one. The discrete jerk proxy
+            // only breaks ties among equally near ones (measured: letting it
+            // choose among all six nearest raised case 2's q5 RMS jerk from
+            // 20.7 to 23.7 rad/s³).
+            let nearest = choices
+                .first()
+                .map(|&p| weighted_distance(&gfd.candidates[p].q, &target, weights))
+                .unwrap_or(f64::INFINITY);
+            let tied = |p: usize| {
+                weighted_distance(&gfd.candidates[p].q, &target, weights)
+                    <= nearest * (1.0 + 1e-9) + 1e-12
+            };
             let mut best: Option<(f64, usize)> = None;
-            for &p in &choices {
+            for &p in choices.iter().filter(|&&p| tied(p)) {
                 let q = gfd.candidates[p].q;
                 let score = jerk_proxy(&before, &after, u, [q[0], q[1]]);
                 if best.is_none_or(|(s, _)| score < s) {

@@ -22,8 +22,9 @@ use super::{Context, RtoState};
 /// collision queries per RTO.
 pub const BOX_STEPS: [usize; 3] = [2, 2, 1];
 
-/// Free candidates scored by [`jerk_proxy`] when inserting an RTO (kerf): the
-/// nearest ones (eq. 55) to the trajectory, so the choice stays local.
+/// Free candidates looked at when inserting an RTO (kerf): the nearest ones
+/// (eq. 55) to the trajectory; those as near as the nearest are told apart
+/// by [`jerk_proxy`].
 pub const INSERT_CHOICES: usize = 6;
 
 /// Third divided difference of four points `(u, q)` (kerf's discrete jerk
