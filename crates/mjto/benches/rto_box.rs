@@ -48,8 +48,8 @@ fn main() {
     ));
     let mut planner =
         Planner::new(LaserMachine::default_machine().expect("machine")).expect("planner");
-    println!("| case | RTOs | RMS jerk q4 (rad/s³) | RMS jerk q5 | peak jerk q4 | peak jerk q5 | RTOs (inserted) | iterations | collision queries | planning time (median of {runs}) |");
-    println!("|---|---|---|---|---|---|---|---|---|---|");
+    println!("| case | RTO constraint | RMS jerk q4 (rad/s³) | RMS jerk q5 | peak jerk q4 | peak jerk q5 | RTOs (inserted) | iterations | collision queries | GFD + selection + boxes | rotary QPs | M-path QP | dense checks | planning time (median of {runs}) |");
+    println!("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|");
     for (name, request) in &requests {
         for constraint in [RtoConstraint::Equality, RtoConstraint::Box] {
             let mut r = request.clone();
@@ -62,14 +62,19 @@ fn main() {
                 }
             };
             let mut wall = Vec::new();
+            let mut stages = Vec::new();
             for _ in 0..runs {
                 let t = Instant::now();
-                planner.plan(&r).expect("plan");
+                let p = planner.plan(&r).expect("plan");
                 wall.push(t.elapsed().as_secs_f64());
+                stages.push(p.times_per_stage);
             }
+            let stage = |f: &dyn Fn(&kerf_mjto::plan::StageTimes) -> f64| {
+                median(stages.iter().map(f).collect()) * 1e3
+            };
             let m = &plan.metrics;
             println!(
-                "| {name} | {} | {:.2} | {:.2} | {:.2} | {:.2} | {} ({}) | {} | {} | {:.1} ms |",
+                "| {name} | {} | {:.2} | {:.2} | {:.2} | {:.2} | {} ({}) | {} | {} | {:.1} ms | {:.1} ms | {:.1} ms | {:.1} ms | {:.1} ms |",
                 constraint.as_str(),
                 m.rms_jerk[3],
                 m.rms_jerk[4],
@@ -82,6 +87,10 @@ fn main() {
                     .count(),
                 plan.iterations,
                 plan.collision_queries,
+                stage(&|s| s.gfd + s.selection),
+                stage(&|s| s.rotary_qp),
+                stage(&|s| s.mpath_qp),
+                stage(&|s| s.collision),
                 median(wall) * 1e3
             );
         }

@@ -19,8 +19,13 @@
 //!   checked analytically (eq. 7) against every Table 2 limit on the dense
 //!   samples; a violation is an error, never clamped;
 //! * an inserted RTO is the free GFD candidate nearest (eq. 55) to the
-//!   current trajectory at that CL point (the GFD is centred there), so the
-//!   smooth solution is perturbed as little as possible.
+//!   current trajectory at that CL point (the GFD is centred there, or on
+//!   the nominal axis when none is free there), so the smooth solution is
+//!   perturbed as little as possible;
+//! * with `options.rto_constraint: box` (the default; issue 16 item 3) an
+//!   RTO is a box of free, lead/tilt-feasible GFD samples around its pick
+//!   and the QPs choose inside it (`planner/rto_box.rs`); `equality` is the
+//!   paper's.
 
 use kerf_budget::Budget;
 use kerf_executor::{check_executable, ExecutorConfig};

@@ -456,3 +456,37 @@ fn a_saddle_beside_a_rib_loses_its_q5_zig_zags_with_boxes() {
         eq.metrics.rms_jerk[4]
     );
 }
+
+#[test]
+fn the_option_parses_defaults_to_box_and_refuses_other_text() {
+    let base = "points: [[0, 0, 0], [0.1, 0, 0]]\naxes: [[0, 0, 1], [0, 0, 1]]\n\
+                feedrate: 0.3\nsample_period: 0.01\nmax_lead_angle: 0.1\n\
+                max_tilt_angle: 0.1\nmesh: m.stl\n";
+    let r = CutRequest::from_yaml(base).unwrap();
+    assert_eq!(r.options.rto_constraint, RtoConstraint::Box);
+    for (text, want) in [
+        ("equality", RtoConstraint::Equality),
+        ("box", RtoConstraint::Box),
+    ] {
+        let r =
+            CutRequest::from_yaml(&format!("{base}options: {{rto_constraint: {text}}}\n")).unwrap();
+        assert_eq!(r.options.rto_constraint, want);
+        assert_eq!(RtoConstraint::parse(text).unwrap(), want);
+        assert_eq!(want.as_str(), text);
+    }
+    // The default is not written, so request files written before the
+    // option read and write the same.
+    let base_request = CutRequest::from_yaml(base).unwrap();
+    assert!(!serde_yaml_ng::to_string(&base_request)
+        .unwrap()
+        .contains("rto_constraint"));
+    for bad in ["Box", "boxes", "1"] {
+        let e = CutRequest::from_yaml(&format!("{base}options: {{rto_constraint: {bad}}}\n"))
+            .unwrap_err();
+        assert!(matches!(e, PlanError::InvalidRequest { .. }), "{e}");
+        assert!(e.to_string().contains("rto_constraint"), "{bad}: {e}");
+        let e = RtoConstraint::parse(bad).unwrap_err();
+        assert!(e.to_string().contains("options.rto_constraint"), "{e}");
+    }
+    assert_eq!(RtoConstraint::parse("").unwrap(), RtoConstraint::Box);
+}
