@@ -54,6 +54,7 @@ def main(path):
         "has_reference_standoff": "reference_standoff" in o,
         "reference_standoff": o.get("reference_standoff", 0.0),
         "clearance": o.get("clearance", 0.0),
+        "rto_constraint": o.get("rto_constraint", ""),
         "time_budget": r.get("time_budget", 0.0),
     }
     # JSON is valid YAML, and ros2 topic pub reads it on one line.

@@ -110,6 +110,7 @@ fn msg_of(r: &CutRequest) -> msg::CutRequest {
         has_reference_standoff: true,
         reference_standoff: o.reference_standoff,
         clearance: o.clearance,
+        rto_constraint: o.rto_constraint.as_str().into(),
         time_budget: r.time_budget,
     }
 }

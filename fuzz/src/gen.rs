@@ -177,6 +177,7 @@ pub fn cut_request(u: &mut Unstructured) -> Result<msg::CutRequest> {
         has_reference_standoff: u.arbitrary()?,
         reference_standoff: float(u)?,
         clearance: if u.arbitrary()? { 0.0 } else { float(u)? },
+        rto_constraint: string(u, &["box", "equality"])?,
         time_budget: if u.arbitrary()? { 0.0 } else { float(u)? },
     })
 }

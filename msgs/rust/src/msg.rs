@@ -126,6 +126,8 @@ pub struct CutRequest {
     pub reference_standoff: f64,
     /// Required head–workpiece clearance (m, ≥ 0).
     pub clearance: f64,
+    /// RTOs as `"box"` or `"equality"` constraints of the QPs; empty = default `"box"`.
+    pub rto_constraint: String,
     /// Time budget of the plan (s): 0 = the node's `plan_timeout`; else in (0, plan_timeout].
     pub time_budget: f64,
 }
