@@ -1,6 +1,6 @@
 //! Bench binary: RTOs as equalities (seed 001) against boxes inside the
 //! feasible domain (kerf, issue 16 item 3) on case 1, case 2 and a tube
-//! saddle beside a rib: RMS and peak jerk per rotary axis, RTOs,
+//! saddle beside a rib (6 and 10 m/min): RMS and peak jerk per rotary axis, RTOs,
 //! iterations, and the planning time.
 //!
 //! ```text
@@ -45,6 +45,11 @@ fn main() {
     requests.push((
         "saddle (rib)".into(),
         geometry.request(&mesh.reference(), 0.1),
+    ));
+    // The issue's feed, 10 m/min.
+    requests.push((
+        "saddle (rib), 10 m/min".into(),
+        geometry.request(&mesh.reference(), 10.0 / 60.0),
     ));
     let mut planner =
         Planner::new(LaserMachine::default_machine().expect("machine")).expect("planner");
