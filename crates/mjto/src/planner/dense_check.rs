@@ -114,11 +114,12 @@ impl Context<'_> {
     /// * `options.rto_constraint: equality` (seed 001): the inserted value is
     ///   the free GFD candidate nearest (eq. 55) to the current trajectory
     ///   there.
-    /// * `box` (kerf, issue 16 item 3): of the [`super::rto_box::INSERT_CHOICES`]
-    ///   free candidates nearest (eq. 55) to the trajectory, the one of least
-    ///   discrete jerk against its neighbouring RTOs
-    ///   ([`super::rto_box::jerk_proxy`]; ties to the nearer), with its box of
-    ///   free samples grown away from the trajectory's (failing) value; and a
+    /// * `box` (kerf, issue 16 item 3): the free candidate nearest (eq. 55) to
+    ///   the trajectory too (the least jerk to first order, see the body);
+    ///   among the [`super::rto_box::INSERT_CHOICES`] nearest, those as near
+    ///   are told apart by the discrete jerk against the neighbouring RTOs
+    ///   ([`super::rto_box::jerk_proxy`]); its box of free samples is grown
+    ///   away from the trajectory's (failing) value; and a
     ///   boxed RTO within one CL point of the run falls back to the equality
     ///   at its pick, so every round narrows the choice and the loop
     ///   terminates as the paper's does.
