@@ -56,6 +56,7 @@ def main(path):
         "clearance": o.get("clearance", 0.0),
         "cl_tolerance": o.get("cl_tolerance", 0.0),
         "feed_law": o.get("feed_law", ""),
+        "rto_constraint": o.get("rto_constraint", ""),
         "time_budget": r.get("time_budget", 0.0),
     }
     # JSON is valid YAML, and ros2 topic pub reads it on one line.

@@ -179,6 +179,7 @@ pub fn cut_request(u: &mut Unstructured) -> Result<msg::CutRequest> {
         clearance: if u.arbitrary()? { 0.0 } else { float(u)? },
         cl_tolerance: if u.arbitrary()? { 0.0 } else { float(u)? },
         feed_law: string(u, &["", "time_optimal", "constant", "variable"])?,
+        rto_constraint: string(u, &["box", "equality"])?,
         time_budget: if u.arbitrary()? { 0.0 } else { float(u)? },
     })
 }

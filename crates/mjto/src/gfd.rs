@@ -61,6 +61,36 @@ pub struct Gfd {
     pub total: usize,
     /// Lazy collision status per candidate: `Some(true)` free.
     free: Vec<Option<bool>>,
+    /// The sample values of the tensor grid per axis (q4, q5, q6), each
+    /// non-decreasing.
+    axes: [Vec<f64>; 3],
+    /// Grid index (i4, i5, i6) of each candidate.
+    grid_index: Vec<[usize; 3]>,
+    /// Candidate index of each grid sample (`None`: rejected), at
+    /// `(i4 · n5 + i5) · n6 + i6`.
+    cell: Vec<Option<usize>>,
+}
+
+/// An axis-aligned box of GFD grid samples around a candidate (kerf, issue
+/// 16: the interval constraints of the RTOs, see [`Gfd::free_box`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct GridBox {
+    /// Lowest grid index per axis (q4, q5, q6).
+    pub lo_index: [usize; 3],
+    /// Highest grid index per axis (inclusive).
+    pub hi_index: [usize; 3],
+    /// Lower corner (q4, q5, q6) (rad, rad, m).
+    pub lo: [f64; 3],
+    /// Upper corner (q4, q5, q6) (rad, rad, m).
+    pub hi: [f64; 3],
+}
+
+impl GridBox {
+    /// Whether `q` = (q4, q5, q6) lies in the box, each coordinate within
+    /// `tol` of its interval.
+    pub fn contains(&self, q: &[f64; 3], tol: f64) -> bool {
+        (0..3).all(|k| q[k] >= self.lo[k] - tol && q[k] <= self.hi[k] + tol)
+    }
 }
 
 /// Unit tool axis O(q4, q5) of seed 001 eq. 2.
@@ -214,6 +244,9 @@ impl Gfd {
         if !q6s.iter().any(|&v| (v - reference[2]).abs() <= 1e-12) {
             q6s.push(reference[2]);
         }
+        // Grid order along q6 (the reference may have been appended), so
+        // that neighbouring indices are neighbouring standoffs.
+        q6s.sort_by(f64::total_cmp);
         let mut gfd = Gfd {
             cl_index,
             u,
@@ -225,9 +258,13 @@ impl Gfd {
             stroke_rejected: 0,
             total: q4s.len() * q5s.len() * q6s.len(),
             free: Vec::new(),
+            axes: [Vec::new(), Vec::new(), Vec::new()],
+            grid_index: Vec::new(),
+            cell: Vec::new(),
         };
-        for &q4 in &q4s {
-            for &q5 in &q5s {
+        let mut index = Vec::new();
+        for (i4, &q4) in q4s.iter().enumerate() {
+            for (i5, &q5) in q5s.iter().enumerate() {
                 if !within(q4, l4) || !within(q5, l5) {
                     gfd.range_rejected += q6s.len();
                     continue;
@@ -239,7 +276,7 @@ impl Gfd {
                     gfd.angle_rejected += q6s.len();
                     continue;
                 }
-                for &q6 in &q6s {
+                for (i6, &q6) in q6s.iter().enumerate() {
                     if !within(q6, l6) {
                         gfd.range_rejected += 1;
                         continue;
@@ -251,6 +288,7 @@ impl Gfd {
                         continue;
                     }
                     let q = [q4, q5, q6];
+                    index.push([i4, i5, i6]);
                     gfd.candidates.push(Candidate {
                         q,
                         distance: weighted_distance(&q, &reference, &reference_weights),
@@ -261,10 +299,187 @@ impl Gfd {
             }
         }
         // Stable: equal distances keep grid order.
-        gfd.candidates
-            .sort_by(|a, b| a.distance.total_cmp(&b.distance));
+        let mut order: Vec<usize> = (0..gfd.candidates.len()).collect();
+        order.sort_by(|&a, &b| {
+            gfd.candidates[a]
+                .distance
+                .total_cmp(&gfd.candidates[b].distance)
+        });
+        let (n5, n6) = (q5s.len(), q6s.len());
+        gfd.cell = vec![None; gfd.total];
+        let mut sorted = Vec::with_capacity(order.len());
+        for (p, &k) in order.iter().enumerate() {
+            let [i4, i5, i6] = index[k];
+            gfd.cell[(i4 * n5 + i5) * n6 + i6] = Some(p);
+            gfd.grid_index.push(index[k]);
+            sorted.push(gfd.candidates[k]);
+        }
+        gfd.candidates = sorted;
         gfd.free = vec![None; gfd.candidates.len()];
+        gfd.axes = [q4s, q5s, q6s];
         gfd
+    }
+
+    /// The grid sample values per axis (q4, q5, q6), each non-decreasing.
+    pub fn grid_axes(&self) -> &[Vec<f64>; 3] {
+        &self.axes
+    }
+
+    /// Grid index (i4, i5, i6) of candidate `p`, `None` if out of range.
+    pub fn grid_index(&self, p: usize) -> Option<[usize; 3]> {
+        self.grid_index.get(p).copied()
+    }
+
+    /// The candidate at grid index `g`, `None` when that sample was
+    /// rejected (lead/tilt, range, stroke) or `g` is outside the grid.
+    pub fn candidate_at(&self, g: [usize; 3]) -> Option<usize> {
+        let [n4, n5, n6] = self.axes.each_ref().map(Vec::len);
+        if g[0] >= n4 || g[1] >= n5 || g[2] >= n6 {
+            return None;
+        }
+        self.cell
+            .get((g[0] * n5 + g[1]) * n6 + g[2])
+            .copied()
+            .flatten()
+    }
+
+    /// The candidates inside a box (every grid sample of it, when the box
+    /// came from [`Self::free_box`]).
+    pub fn box_candidates(&self, b: &GridBox) -> Vec<Option<usize>> {
+        let mut out = Vec::new();
+        for i4 in b.lo_index[0]..=b.hi_index[0] {
+            for i5 in b.lo_index[1]..=b.hi_index[1] {
+                for i6 in b.lo_index[2]..=b.hi_index[2] {
+                    out.push(self.candidate_at([i4, i5, i6]));
+                }
+            }
+        }
+        out
+    }
+
+    /// The largest box of collision-free candidates grown around candidate
+    /// `p` (kerf, issue 16 item 3; not in seed 001, whose RTOs are single
+    /// grid picks, eq. 57-60 and 62-64).
+    ///
+    /// The box is a block of the tensor grid, `[lo_index, hi_index]` per
+    /// axis, every sample of which is a candidate (inside the lead/tilt
+    /// limits, the joint ranges and the q1..q3 stroke, see [`Self::build`])
+    /// and collision-free (checked lazily here, memoised). It starts as the
+    /// single sample of `p` and grows one grid layer at a time, the six
+    /// faces in turn (−q4, +q4, −q5, +q5, −q6, +q6), a face only when
+    /// every sample of the new layer qualifies, until no face can grow:
+    /// maximal, not necessarily maximum, in volume.
+    ///
+    /// # Arguments
+    /// * `p` - the candidate the box grows from (it should be free).
+    /// * `max_steps` - largest number of grid steps per axis on each side of
+    ///   `p`.
+    /// * `away_from` - when given (q4, q5, q6), a face never grows towards
+    ///   it along an axis where `p` differs from it (so the box excludes a
+    ///   configuration known to fail, e.g. a colliding trajectory).
+    /// * `world`, `budget` - collision world; the budget is checked before
+    ///   each query.
+    ///
+    /// # Returns
+    /// The box, or `None` if `p` is out of range or itself collides.
+    ///
+    /// # Errors
+    /// The budget's [`Interrupt`].
+    ///
+    /// # Performance
+    /// At most one collision query per sample of the final box plus one
+    /// per rejected layer (early exit on the first failing sample);
+    /// ≤ Π (2 max_steps + 1) samples.
+    pub fn free_box(
+        &mut self,
+        p: usize,
+        max_steps: [usize; 3],
+        away_from: Option<[f64; 3]>,
+        world: &CollisionWorld,
+        budget: &Budget,
+    ) -> Result<Option<GridBox>, Interrupt> {
+        let Some(start) = self.grid_index(p) else {
+            return Ok(None);
+        };
+        budget.check("the RTO box")?;
+        if !self.is_free(p, world) {
+            return Ok(None);
+        }
+        let n = self.axes.each_ref().map(Vec::len);
+        let q = self.candidates[p].q;
+        let (mut lo, mut hi) = (start, start);
+        loop {
+            let mut grew = false;
+            for face in 0..6 {
+                let (k, up) = (face / 2, face % 2 == 1);
+                let blocked_by_target = away_from.is_some_and(|t| {
+                    let d = t[k] - q[k];
+                    d != 0.0 && (d > 0.0) == up
+                });
+                let next = if up {
+                    (hi[k] + 1 < n[k] && hi[k] - start[k] < max_steps[k]).then(|| hi[k] + 1)
+                } else {
+                    (lo[k] > 0 && start[k] - lo[k] < max_steps[k]).then(|| lo[k] - 1)
+                };
+                let Some(layer) = next.filter(|_| !blocked_by_target) else {
+                    continue;
+                };
+                let (mut llo, mut lhi) = (lo, hi);
+                llo[k] = layer;
+                lhi[k] = layer;
+                if self.layer_free(llo, lhi, world, budget)? {
+                    if up {
+                        hi[k] = layer;
+                    } else {
+                        lo[k] = layer;
+                    }
+                    grew = true;
+                }
+            }
+            if !grew {
+                break;
+            }
+        }
+        let value = |k: usize, i: usize| self.axes[k][i];
+        Ok(Some(GridBox {
+            lo_index: lo,
+            hi_index: hi,
+            lo: [0, 1, 2].map(|k| value(k, lo[k])),
+            hi: [0, 1, 2].map(|k| value(k, hi[k])),
+        }))
+    }
+
+    /// Whether every grid sample of the block `[lo, hi]` is a collision-free
+    /// candidate (known colliding or rejected samples are tested first).
+    fn layer_free(
+        &mut self,
+        lo: [usize; 3],
+        hi: [usize; 3],
+        world: &CollisionWorld,
+        budget: &Budget,
+    ) -> Result<bool, Interrupt> {
+        let mut unknown = Vec::new();
+        for i4 in lo[0]..=hi[0] {
+            for i5 in lo[1]..=hi[1] {
+                for i6 in lo[2]..=hi[2] {
+                    match self.candidate_at([i4, i5, i6]) {
+                        None => return Ok(false),
+                        Some(c) => match self.known_status(c) {
+                            Some(false) => return Ok(false),
+                            Some(true) => {}
+                            None => unknown.push(c),
+                        },
+                    }
+                }
+            }
+        }
+        for c in unknown {
+            budget.check("the RTO box")?;
+            if !self.is_free(c, world) {
+                return Ok(false);
+            }
+        }
+        Ok(true)
     }
 
     /// Full joint vector of candidate `p` at this CL point: q1..q3 = C −
@@ -319,6 +534,33 @@ impl Gfd {
         world: &CollisionWorld,
         budget: &Budget,
     ) -> Result<Option<usize>, Interrupt> {
+        Ok(self
+            .nearest_free_k(target, weights, world, budget, 1)?
+            .first()
+            .copied())
+    }
+
+    /// The first `k` free candidates in order of the eq. 55 distance to
+    /// `target` (ties in candidate order), as [`Self::nearest_free`].
+    ///
+    /// # Returns
+    /// Up to `k` candidate indices, nearest first (fewer when fewer are
+    /// free).
+    ///
+    /// # Errors
+    /// The budget's [`Interrupt`], checked before each collision query.
+    ///
+    /// # Performance
+    /// O(n log n) sort plus a collision query per unchecked candidate nearer
+    /// than the k-th free one.
+    pub fn nearest_free_k(
+        &mut self,
+        target: [f64; 3],
+        weights: &Weights,
+        world: &CollisionWorld,
+        budget: &Budget,
+        k: usize,
+    ) -> Result<Vec<usize>, Interrupt> {
         let mut order: Vec<(f64, usize)> = self
             .candidates
             .iter()
@@ -326,13 +568,17 @@ impl Gfd {
             .map(|(p, c)| (weighted_distance(&c.q, &target, weights), p))
             .collect();
         order.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+        let mut found = Vec::new();
         for (_, p) in order {
+            if found.len() >= k {
+                break;
+            }
             budget.check("the search for a free GFD candidate")?;
             if self.is_free(p, world) {
-                return Ok(Some(p));
+                found.push(p);
             }
         }
-        Ok(None)
+        Ok(found)
     }
 
     /// Number of candidates whose collision status has been evaluated.

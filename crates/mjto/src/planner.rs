@@ -19,8 +19,13 @@
 //!   checked analytically (eq. 7) against every Table 2 limit on the dense
 //!   samples; a violation is an error, never clamped;
 //! * an inserted RTO is the free GFD candidate nearest (eq. 55) to the
-//!   current trajectory at that CL point (the GFD is centred there), so the
-//!   smooth solution is perturbed as little as possible.
+//!   current trajectory at that CL point (the GFD is centred there, or on
+//!   the nominal axis when none is free there), so the smooth solution is
+//!   perturbed as little as possible;
+//! * with `options.rto_constraint: box` (the default; issue 16 item 3) an
+//!   RTO is a box of free, lead/tilt-feasible GFD samples around its pick
+//!   and the QPs choose inside it (`planner/rto_box.rs`); `equality` is the
+//!   paper's.
 
 use kerf_budget::Budget;
 use kerf_executor::{check_executable, ExecutorConfig};
@@ -40,6 +45,7 @@ use crate::{CutPlan, CutRequest, LaserMachine, PlanError};
 mod dense_check;
 mod feed;
 mod iteration;
+mod rto_box;
 mod setup;
 
 /// Degree of the B-splines: quintic, C³ (seed 001 section 2.1).
@@ -88,6 +94,9 @@ struct RtoState {
     u: f64,
     q: [f64; 3],
     inserted_at: usize,
+    /// The box of free, feasible GFD samples around `q` the QPs may choose
+    /// in (`options.rto_constraint: box`); `None`: equality at `q`.
+    bounds: Option<crate::gfd::GridBox>,
 }
 
 /// The splines of one iteration and their dense samples.

@@ -132,6 +132,50 @@ impl Default for Weights {
     }
 }
 
+/// How the RTO orientations enter the QPs (kerf, issue 16 item 3).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum RtoConstraint {
+    /// Seed 001 eq. 57-60 and 62-64: the joint splines pass exactly through
+    /// the selected GFD candidate (q4, q5, q6) at each RTO.
+    Equality,
+    /// kerf: at each RTO, q4, q5 and q6 may take any value inside the
+    /// largest box of collision-free, lead/tilt-feasible GFD grid samples
+    /// grown around the selected candidate (`gfd::Gfd::free_box`); the QPs
+    /// choose the values of least jerk. Measured smoother than `equality`
+    /// on the committed cases and a tube saddle (BENCHMARKS.md).
+    #[default]
+    Box,
+}
+
+impl RtoConstraint {
+    /// The option from its request spelling: `"equality"` or `"box"`; the
+    /// empty string is the default ([`RtoConstraint::Box`]).
+    ///
+    /// # Errors
+    /// [`PlanError::InvalidRequest`] (field `options.rto_constraint`) for any
+    /// other text.
+    pub fn parse(text: &str) -> Result<Self, PlanError> {
+        match text {
+            "" => Ok(Self::default()),
+            "equality" => Ok(Self::Equality),
+            "box" => Ok(Self::Box),
+            other => Err(PlanError::invalid(
+                "options.rto_constraint",
+                format!("{other:?} must be \"equality\" or \"box\""),
+            )),
+        }
+    }
+
+    /// The request spelling.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            Self::Equality => "equality",
+            Self::Box => "box",
+        }
+    }
+}
+
 /// Planner options.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
@@ -164,12 +208,31 @@ pub struct CutOptions {
     /// Largest distance of the tool tip (eq. 2) from the requested CL path at the samples and
     /// CL points (m, > 0). With automatic control points the planner doubles them (up to
     /// [`crate::planner::MAX_AUTO_CONTROL_POINTS`] and the CL count) until the plan is within
-    /// it; a plan that is not is refused (LIMIT_VIOLATION). Default 0.15 mm.
+    /// it; a plan that is not is refused (LIMIT_VIOLATION). Default 0.15 mm. Written only when
+    /// not the default (request files written before the option read the same).
+    #[serde(skip_serializing_if = "is_default_cl_tolerance")]
     pub cl_tolerance: f64,
     /// The time law: `time_optimal` (default: the fastest law under every limit, the
     /// feedrate its cruise maximum; issue 16) or `constant` (seed 001's constant feedrate with
-    /// S-curve ramps).
+    /// S-curve ramps). Written only when not the default.
+    #[serde(skip_serializing_if = "is_default_feed_law")]
     pub feed_law: FeedMode,
+    /// RTOs as equalities (seed 001) or boxes inside the feasible domain
+    /// (kerf, the default): `"equality"` or `"box"`. Written only when not
+    /// the default (request files written before the option read the same).
+    #[serde(skip_serializing_if = "is_default_rto_constraint")]
+    pub rto_constraint: RtoConstraint,
+}
+
+/// The default of `options.cl_tolerance` (m).
+pub const DEFAULT_CL_TOLERANCE: f64 = 1.5e-4;
+
+fn is_default_cl_tolerance(v: &f64) -> bool {
+    *v == DEFAULT_CL_TOLERANCE
+}
+
+fn is_default_feed_law(v: &FeedMode) -> bool {
+    *v == FeedMode::default()
 }
 
 impl Default for CutOptions {
@@ -184,8 +247,9 @@ impl Default for CutOptions {
             rto_angle: 20f64.to_radians(),
             reference_standoff: -0.07,
             clearance: 0.0,
-            cl_tolerance: 1.5e-4,
+            cl_tolerance: DEFAULT_CL_TOLERANCE,
             feed_law: FeedMode::TimeOptimal,
+            rto_constraint: RtoConstraint::Box,
         }
     }
 }
@@ -237,6 +301,10 @@ pub struct CutRequest {
     /// A plan that runs out of it ends with [`PlanError::Interrupted`] (status TIMEOUT).
     #[serde(default, skip_serializing_if = "is_zero")]
     pub time_budget: f64,
+}
+
+fn is_default_rto_constraint(v: &RtoConstraint) -> bool {
+    *v == RtoConstraint::default()
 }
 
 fn is_zero(v: &f64) -> bool {

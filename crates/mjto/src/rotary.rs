@@ -14,9 +14,14 @@
 //!               |D₁Θ| ≤ ω_max σ/f, |D₂Θ| ≤ α_max σ²/f², |D₃Θ| ≤ J_max σ³/f³   (eq. 15, 40-42)
 //!               q_u(0), q_u(1), q_uu(0), q_uu(1) given      (eq. 45)
 //!               q(ũ_i) = q_i                                (eq. 57-60)
+//!               lo_i ≤ q(ũ_i) ≤ hi_i                        (kerf, RTO boxes)
 //! ```
 //!
-//! which has the minimiser of eq. 61. A cone over `Lᵀ D₃` carries the
+//! which has the minimiser of eq. 61. The interval rows are kerf's
+//! (issue 16 item 3), not seed 001's: an RTO given as a box of free,
+//! lead/tilt-feasible GFD samples ([`crate::gfd::Gfd::free_box`]) lets the
+//! QP choose the orientation of least jerk inside it instead of one grid
+//! pick; with `lo_i = hi_i` the row is the equality of eq. 57-60. A cone over `Lᵀ D₃` carries the
 //! conditioning of that matrix (~n³ on [0, 1]) instead of H's (~n⁶,
 //! 10¹⁷ for the paper's 628 coefficients), every row is banded (the whole
 //! problem is sparse), and each constraint row is scaled to unit largest
@@ -72,6 +77,10 @@ pub struct RotaryQp<'a> {
     pub boundary: [f64; 4],
     /// RTO equalities `(ũ_i, q_i)` (eq. 57-60).
     pub via: &'a [(f64, f64)],
+    /// RTO intervals `(ũ_i, lo_i, hi_i)`, `lo_i ≤ q(ũ_i) ≤ hi_i` (kerf, issue
+    /// 16 item 3: the box of an RTO, see the module documentation); in the
+    /// constraint family `Rto` with the equalities.
+    pub via_box: &'a [(f64, f64, f64)],
 }
 
 /// One sparse row: `(column, coefficient)` pairs.
@@ -294,6 +303,22 @@ impl RotaryQp<'_> {
                 .map(|(i, &v)| (row.start + i, v))
                 .collect();
             rto.push((coeffs, q, q));
+        }
+        for &(u, lo, hi) in self.via_box {
+            if !(lo.is_finite() && hi.is_finite() && lo <= hi) {
+                return Err(PlanError::invalid(
+                    self.axis_name,
+                    format!("RTO interval [{lo}, {hi}] at u = {u} is empty or not finite"),
+                ));
+            }
+            let row = basis_row(self.knots, u, 0).map_err(err)?;
+            let coeffs = row
+                .values
+                .iter()
+                .enumerate()
+                .map(|(i, &v)| (row.start + i, v))
+                .collect();
+            rto.push((coeffs, lo, hi));
         }
         fams.push(Family {
             family: ConstraintFamily::Rto,

@@ -35,7 +35,12 @@
 //!               q6_min ≤ s_j ≤ q6_max          (eq. 54 on the coefficients: by the
 //!                                              convex hull, the whole q6 curve)
 //!               (N s)_i = q6(ũ_i)              (RTO equalities, eq. 62-64)
+//!               lo_i ≤ (N s)_i ≤ hi_i          (kerf: RTO boxes, issue 16 item 3)
 //! ```
+//!
+//! The interval rows are kerf's, not seed 001's: an RTO given as a box of
+//! free, feasible GFD samples ([`crate::gfd::Gfd::free_box`]) leaves the
+//! standoff there free within the box's q6 range.
 //!
 //! The small Tikhonov term `τ‖N s − w_ref‖²` (relative weight
 //! [`TIKHONOV`]) makes the minimiser unique: D is only positive
@@ -71,6 +76,9 @@ pub struct MPathProblem<'a> {
     pub stroke: (f64, f64),
     /// RTO equalities `(CL index, q6)` (eq. 62-64).
     pub via: &'a [(usize, f64)],
+    /// RTO intervals `(CL index, lo, hi)`: `lo ≤ q6 ≤ hi` there (kerf, issue
+    /// 16 item 3, the q6 range of an RTO box).
+    pub via_box: &'a [(usize, f64, f64)],
     /// Reference standoff w_ref of the Tikhonov term (m).
     pub reference: f64,
 }
@@ -224,6 +232,24 @@ pub fn solve_standoff(p: &MPathProblem) -> Result<MPathSolution, PlanError> {
             });
         }
     }
+    for &(i, a, b) in p.via_box {
+        if i >= p.params.len() || !(a.is_finite() && b.is_finite() && a <= b) {
+            return Err(PlanError::invalid(
+                "M path",
+                format!("RTO interval ({i}, [{a}, {b}]) invalid"),
+            ));
+        }
+        if b < lo - CHECK_TOL || a > hi + CHECK_TOL {
+            return Err(PlanError::Infeasible {
+                problem: PROBLEM.into(),
+                family: ConstraintFamily::Rto,
+                detail: format!(
+                    "RTO at CL point {i} asks q6 in [{a}, {b}] m, outside the stroke [{lo}, {hi}] m"
+                ),
+                max_feasible_feedrate: None,
+            });
+        }
+    }
     let pc = pieces(p)?;
     let (m, nc) = pc.n.shape();
     // R = [R_x; R_y; R_z], r likewise, scaled to unit largest entry.
@@ -292,6 +318,19 @@ pub fn solve_standoff(p: &MPathProblem) -> Result<MPathSolution, PlanError> {
             row += 1;
         }
         cones.push(SupportedConeT::ZeroConeT(p.via.len()));
+        for &(i, a, bh) in p.via_box {
+            let c: Vec<(usize, f64)> = (0..nc).map(|j| (j, pc.n[(i, j)])).collect();
+            let neg: Vec<(usize, f64)> = c.iter().map(|&(j, v)| (j, -v)).collect();
+            push_row(&mut ii, &mut jj, &mut vv, row, &c);
+            b.push(bh);
+            row += 1;
+            push_row(&mut ii, &mut jj, &mut vv, row, &neg);
+            b.push(-a);
+            row += 1;
+        }
+        if !p.via_box.is_empty() {
+            cones.push(SupportedConeT::NonnegativeConeT(2 * p.via_box.len()));
+        }
         if with_stroke {
             // Convex hull (as eq. 15 for the rotary axes): bounds on the
             // coefficients of q6(u) keep the whole curve, not only the CL
@@ -336,7 +375,10 @@ pub fn solve_standoff(p: &MPathProblem) -> Result<MPathSolution, PlanError> {
                 let ok_via = p
                     .via
                     .iter()
-                    .all(|&(i, v)| (w[i] - v).abs() <= CHECK_TOL.max(1e-6 * v.abs()));
+                    .all(|&(i, v)| (w[i] - v).abs() <= CHECK_TOL.max(1e-6 * v.abs()))
+                    && p.via_box
+                        .iter()
+                        .all(|&(i, a, bh)| w[i] >= a - CHECK_TOL && w[i] <= bh + CHECK_TOL);
                 let ok_stroke = !with_stroke
                     || w.iter()
                         .all(|&v| v >= lo - CHECK_TOL && v <= hi + CHECK_TOL);
@@ -368,8 +410,9 @@ pub fn solve_standoff(p: &MPathProblem) -> Result<MPathSolution, PlanError> {
                 problem: PROBLEM.into(),
                 family,
                 detail: format!(
-                    "no standoff within [{lo}, {hi}] m meets the {} RTO values",
-                    p.via.len()
+                    "no standoff within [{lo}, {hi}] m meets the {} RTO values and {} RTO intervals",
+                    p.via.len(),
+                    p.via_box.len()
                 ),
                 max_feasible_feedrate: None,
             });

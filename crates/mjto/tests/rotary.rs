@@ -51,6 +51,7 @@ fn problem<'a>(
         feedrate,
         boundary: [0.0; 4],
         via,
+        via_box: &[],
     }
 }
 
@@ -571,6 +572,7 @@ fn paper_size_628_coefficients_with_the_table2_q5_limits() {
         feedrate: feed,
         boundary: [0.0; 4],
         via: &via,
+        via_box: &[],
     };
     let (theta, _) = qp.solve().unwrap();
     assert_eq!(theta.len(), 628);

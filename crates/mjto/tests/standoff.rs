@@ -66,6 +66,7 @@ impl Path {
             axes: &self.axes,
             stroke,
             via,
+            via_box: &[],
             reference: REFERENCE,
         }
     }

@@ -130,6 +130,8 @@ pub struct CutRequest {
     pub cl_tolerance: f64,
     /// The time law: "" or "time_optimal" (default), or "constant" (seed 001).
     pub feed_law: String,
+    /// RTOs as `"box"` or `"equality"` constraints of the QPs; empty = default `"box"`.
+    pub rto_constraint: String,
     /// Time budget of the plan (s): 0 = the node's `plan_timeout`; else in (0, plan_timeout].
     pub time_budget: f64,
 }

@@ -11,7 +11,7 @@ use kerf_mjto::{
     error::{status, CollisionReport},
     machine::JOINT_NAMES,
     plan::{Metrics, RtoRecord},
-    request::{CutOptions, PoseSpec},
+    request::{CutOptions, PoseSpec, RtoConstraint},
     CutRequest, PlanError,
 };
 use kerf_msgs::{msg, trajectory_msgs::JointTrajectory};
@@ -52,11 +52,12 @@ fn to_u32(v: usize) -> u32 {
 /// `.msg` file: 0 means the [`CutOptions`] default for `control_points`, `max_iterations`, the
 /// GFD grid, `rto_spacing` and `rto_angle`; 0 means [`DEFAULT_FEED_ACCELERATION`] /
 /// [`DEFAULT_FEED_JERK`] for the feed ramps; `has_reference_standoff == false` means the default
-/// standoff. Every other value is passed on unchanged for [`CutRequest::validate`] to check.
+/// standoff; an empty `rto_constraint` means the default ([`RtoConstraint::Box`]). Every other
+/// value is passed on unchanged for [`CutRequest::validate`] to check.
 ///
 /// # Errors
 /// [`PlanError::InvalidRequest`] for an all-zero `workpiece_pose.orientation` (the identity is
-/// w = 1).
+/// w = 1) and for an `rto_constraint` other than `""`, `"equality"` and `"box"`.
 pub fn request_from_msg(m: &msg::CutRequest) -> Result<CutRequest, PlanError> {
     let q = &m.workpiece_pose.orientation;
     if q.x == 0.0 && q.y == 0.0 && q.z == 0.0 && q.w == 0.0 {
@@ -101,6 +102,7 @@ pub fn request_from_msg(m: &msg::CutRequest) -> Result<CutRequest, PlanError> {
                 ))
             }
         },
+        rto_constraint: RtoConstraint::parse(&m.rto_constraint)?,
     };
     let p = &m.workpiece_pose.position;
     Ok(CutRequest {
@@ -461,6 +463,7 @@ mod tests {
         m.has_reference_standoff = true;
         m.reference_standoff = 0.0;
         m.clearance = 0.002;
+        m.rto_constraint = "equality".into();
         let r = request_from_msg(&m).unwrap();
         assert_eq!((r.feed_acceleration, r.feed_jerk), (5.0, 50.0));
         let o = &r.options;
@@ -472,6 +475,7 @@ mod tests {
         // q6 = 0 is a valid standoff: the flag, not the value, selects the default.
         assert_eq!(o.reference_standoff, 0.0);
         assert_eq!(o.clearance, 0.002);
+        assert_eq!(o.rto_constraint, RtoConstraint::Equality);
         assert_eq!(o.weights, CutOptions::default().weights);
     }
 
@@ -500,6 +504,24 @@ mod tests {
                 other => panic!("{bad:?}: expected InvalidRequest, got {other:?}"),
             }
         }
+    }
+
+    #[test]
+    fn rto_constraint_takes_its_default_and_refuses_other_text() {
+        let mut m = message();
+        assert_eq!(
+            request_from_msg(&m).unwrap().options.rto_constraint,
+            RtoConstraint::Box
+        );
+        m.rto_constraint = "box".into();
+        assert_eq!(
+            request_from_msg(&m).unwrap().options.rto_constraint,
+            RtoConstraint::Box
+        );
+        m.rto_constraint = "Box ".into();
+        let e = request_from_msg(&m).unwrap_err();
+        assert_eq!(e.status(), status::INVALID_REQUEST);
+        assert!(e.to_string().contains("options.rto_constraint"), "{e}");
     }
 
     #[test]

@@ -4,11 +4,14 @@
 
 use kerf_budget::Interrupt;
 
+use super::rto_box::{jerk_proxy, INSERT_CHOICES};
 use super::{Context, Iterate, RtoState, Samples, ANGLE_TOLERANCE, BUDGET_STRIDE};
 use crate::collision::CollisionWorld;
 use crate::error::CollisionReport;
+use crate::gfd::weighted_distance;
 use crate::kinematics::{forward, tool_axis};
 use crate::plan::Metrics;
+use crate::request::RtoConstraint;
 use crate::PlanError;
 
 impl Context<'_> {
@@ -118,8 +121,20 @@ impl Context<'_> {
 
     /// Inserts one RTO per run of consecutive violating samples, at the CL
     /// point nearest to the run's worst (middle) sample that is not yet an
-    /// RTO; its value is the free GFD candidate nearest (eq. 55) to the
-    /// current trajectory there. Returns how many were inserted.
+    /// RTO. Returns how many RTOs were inserted or changed.
+    ///
+    /// * `options.rto_constraint: equality` (seed 001): the inserted value is
+    ///   the free GFD candidate nearest (eq. 55) to the current trajectory
+    ///   there.
+    /// * `box` (kerf, issue 16 item 3): the free candidate nearest (eq. 55) to
+    ///   the trajectory too (the least jerk to first order, see the body);
+    ///   among the [`super::rto_box::INSERT_CHOICES`] nearest, those as near
+    ///   are told apart by the discrete jerk against the neighbouring RTOs
+    ///   ([`super::rto_box::jerk_proxy`]); its box of free samples is grown
+    ///   away from the trajectory's (failing) value; and a
+    ///   boxed RTO within one CL point of the run falls back to the equality
+    ///   at its pick, so every round narrows the choice and the loop
+    ///   terminates as the paper's does.
     pub(super) fn insert_rtos(
         &self,
         world: &CollisionWorld,
@@ -128,6 +143,7 @@ impl Context<'_> {
         rtos: &mut Vec<RtoState>,
         iteration: usize,
     ) -> Result<usize, PlanError> {
+        let boxes = self.request.options.rto_constraint == RtoConstraint::Box;
         let mut runs: Vec<(usize, usize)> = Vec::new();
         let mut start = 0;
         for k in 1..=violations.len() {
@@ -142,6 +158,13 @@ impl Context<'_> {
         for (a, b) in runs {
             self.budget.check("RTO insertion")?;
             let mid = &violations[(a + b) / 2];
+            let near = violations[a].cl_index.saturating_sub(1)..=violations[b].cl_index + 1;
+            for r in rtos.iter_mut() {
+                if r.bounds.is_some() && near.contains(&r.cl_index) {
+                    r.bounds = None;
+                    added += 1;
+                }
+            }
             let Some(i) = self.free_cl_index(
                 mid.cl_index,
                 violations[a].cl_index,
@@ -154,8 +177,7 @@ impl Context<'_> {
             let target = [it.q4.eval(u)[0], it.q5.eval(u)[0], it.w[i]];
             // The grid is centred on the trajectory's orientation and spans
             // the usual q6 range around the preferred standoff (a q6 at a
-            // stroke end would leave no q6 span); the candidate taken is the
-            // free one nearest (eq. 55) to the trajectory's (q4, q5, q6).
+            // stroke end would leave no q6 span).
             let centre = [
                 target[0],
                 target[1],
@@ -163,19 +185,70 @@ impl Context<'_> {
             ];
             let mut gfd = self.build_gfd(i, centre);
             let weights = &self.request.options.weights;
-            let Some(p) = gfd.nearest_free(target, weights, world, &self.budget)? else {
+            let k = if boxes { INSERT_CHOICES } else { 1 };
+            let mut choices = gfd.nearest_free_k(target, weights, world, &self.budget, k)?;
+            if choices.is_empty() {
+                // kerf: a trajectory far outside the lead/tilt cone (RTOs
+                // too sparse for the turn of the nominal axis) leaves no
+                // candidate in a grid centred on it; the grid centred on the
+                // nominal orientation (as the initial GFDs) has them. The
+                // candidate is still the one nearest (eq. 55) to the
+                // trajectory.
+                gfd = self.build_gfd(i, self.reference(i));
+                choices = gfd.nearest_free_k(target, weights, world, &self.budget, k)?;
+            }
+            let pos = rtos.partition_point(|r| r.cl_index < i);
+            let value = |r: &RtoState| {
+                if r.inserted_at == iteration {
+                    [r.q[0], r.q[1]]
+                } else {
+                    [it.q4.eval(r.u)[0], it.q5.eval(r.u)[0]]
+                }
+            };
+            let before: Vec<(f64, [f64; 2])> = rtos[pos.saturating_sub(2)..pos]
+                .iter()
+                .map(|r| (r.u, value(r)))
+                .collect();
+            let after: Vec<(f64, [f64; 2])> = rtos[pos..(pos + 2).min(rtos.len())]
+                .iter()
+                .map(|r| (r.u, value(r)))
+                .collect();
+            // First order, one more point constraint at ũ_i raises each
+            // rotary QP's jerk cost by (Δq)² / g_ii with g_ii the same for q4
+            // and q5 (same knots, same objective): the nearest candidate
+            // (eq. 55, k4 = k5) is the least-jerk one. The discrete jerk proxy
+            // only breaks ties among equally near ones (measured: letting it
+            // choose among all six nearest raised case 2's q5 RMS jerk from
+            // 20.7 to 23.7 rad/s³).
+            let nearest = choices
+                .first()
+                .map(|&p| weighted_distance(&gfd.candidates[p].q, &target, weights))
+                .unwrap_or(f64::INFINITY);
+            let tied = |p: usize| {
+                weighted_distance(&gfd.candidates[p].q, &target, weights)
+                    <= nearest * (1.0 + 1e-9) + 1e-12
+            };
+            let mut best: Option<(f64, usize)> = None;
+            for &p in choices.iter().filter(|&&p| tied(p)) {
+                let q = gfd.candidates[p].q;
+                let score = jerk_proxy(&before, &after, u, [q[0], q[1]]);
+                if best.is_none_or(|(s, _)| score < s) {
+                    best = Some((score, p));
+                }
+            }
+            let Some((_, p)) = best else {
                 return Err(PlanError::NoFeasibleOrientation {
                     index: i,
                     u,
                     reason: format!(
-                        "inserting an RTO against: {}; none of the {} GFD candidates around the trajectory is free ({} outside the lead/tilt limits or stroke)",
+                        "inserting an RTO against: {}; none of the {} GFD candidates around the trajectory or the nominal axis is free ({} outside the lead/tilt limits or stroke)",
                         mid.reason,
                         gfd.total,
                         gfd.total - gfd.candidates.len()
                     ),
                 });
             };
-            let pos = rtos.partition_point(|r| r.cl_index < i);
+            let bounds = self.rto_box(&mut gfd, p, Some(target), world)?;
             rtos.insert(
                 pos,
                 RtoState {
@@ -183,6 +256,7 @@ impl Context<'_> {
                     u,
                     q: gfd.candidates[p].q,
                     inserted_at: iteration,
+                    bounds,
                 },
             );
             added += 1;

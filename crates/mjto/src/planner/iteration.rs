@@ -54,8 +54,12 @@ impl Context<'_> {
                 u: g.u,
                 q: g.candidates[p].q,
                 inserted_at: 0,
+                bounds: None,
             })
             .collect();
+        let t = Instant::now();
+        self.initial_boxes(&mut gfds, &chosen, &mut rtos, world)?;
+        times.selection += t.elapsed().as_secs_f64();
 
         // 2. The loop of Figure 6.
         let mut iteration = 0;
@@ -183,7 +187,10 @@ impl Context<'_> {
     }
 
     /// Both QPs for the current RTOs (eq. 61, then eq. 62 with the
-    /// optimized orientation).
+    /// optimized orientation). An RTO with a box (kerf,
+    /// `options.rto_constraint: box`) gives each QP the interval
+    /// `lo ≤ q(ũ_i) ≤ hi` of its axis instead of the equality of eq. 57-60
+    /// and 62-64.
     pub(super) fn solve(
         &self,
         knots: &KnotVector,
@@ -196,7 +203,16 @@ impl Context<'_> {
         let mut rotary = Vec::with_capacity(2);
         for (k, name) in [(3usize, "q4"), (4usize, "q5")] {
             self.budget.check("the rotary-axis QPs")?;
-            let via: Vec<(f64, f64)> = rtos.iter().map(|r| (r.u, r.q[k - 3])).collect();
+            let a = k - 3;
+            let via: Vec<(f64, f64)> = rtos
+                .iter()
+                .filter(|r| r.bounds.is_none())
+                .map(|r| (r.u, r.q[a]))
+                .collect();
+            let via_box: Vec<(f64, f64, f64)> = rtos
+                .iter()
+                .filter_map(|r| r.bounds.map(|b| (r.u, b.lo[a], b.hi[a])))
+                .collect();
             let problem = RotaryQp {
                 axis_name: name,
                 knots,
@@ -206,6 +222,7 @@ impl Context<'_> {
                 feedrate: self.request.feedrate,
                 boundary: [0.0; 4],
                 via: &via,
+                via_box: &via_box,
             };
             let coeffs = super::feed::rotary_coefficients(&problem, self.request.options.feed_law)?;
             rotary.push(BSpline::new(knots.clone(), coeffs).map_err(bspline_error)?);
@@ -225,7 +242,15 @@ impl Context<'_> {
             .iter()
             .map(|&u| tool_axis(q4.eval(u)[0], q5.eval(u)[0]))
             .collect();
-        let via: Vec<(usize, f64)> = rtos.iter().map(|r| (r.cl_index, r.q[2])).collect();
+        let via: Vec<(usize, f64)> = rtos
+            .iter()
+            .filter(|r| r.bounds.is_none())
+            .map(|r| (r.cl_index, r.q[2]))
+            .collect();
+        let via_box: Vec<(usize, f64, f64)> = rtos
+            .iter()
+            .filter_map(|r| r.bounds.map(|b| (r.cl_index, b.lo[2], b.hi[2])))
+            .collect();
         self.budget.check("the M-path QP")?;
         let problem = MPathProblem {
             knots,
@@ -235,6 +260,7 @@ impl Context<'_> {
             axes: &axes,
             stroke: (limits[5].min, limits[5].max),
             via: &via,
+            via_box: &via_box,
             reference: self.request.options.reference_standoff,
         };
         let sol = solve_standoff(&problem)?;

@@ -23,3 +23,5 @@ impl Rng {
         2.0 * self.next() - 1.0
     }
 }
+
+pub mod saddle;
