@@ -40,7 +40,7 @@ pub const PROCESS_MARGIN_STEP: f64 = 0.9995;
 pub const MARGIN_STEP: f64 = 0.99;
 
 /// Most solves of the time-optimal law per iterate.
-pub const MARGIN_ATTEMPTS: usize = 4;
+pub const MARGIN_ATTEMPTS: usize = 8;
 
 /// The "joint" of a limit violation of the tool tip's speed against the feedrate.
 pub const TOOL_TIP: &str = "tool tip";
@@ -218,25 +218,24 @@ impl Context<'_> {
         let n = (spans * STATIONS_PER_SPAN).clamp(STATION_RANGE.0, STATION_RANGE.1);
         let stations: Vec<f64> = (0..=n).map(|k| sigma * k as f64 / n as f64).collect();
         let splines = [&it.m[0], &it.m[1], &it.m[2], &it.q4, &it.q5, &it.q6];
-        let derivatives: Vec<[[f64; 6]; 4]> = stations
-            .iter()
-            .map(|&s| {
-                let mut d = [[0.0; 6]; 4];
-                for (j, spline) in splines.iter().enumerate() {
-                    let e = spline.eval((s / sigma).clamp(0.0, 1.0));
-                    let mut scale = 1.0;
-                    for (order, row) in d.iter_mut().enumerate() {
-                        row[j] = e[order] * scale;
-                        scale /= sigma;
-                    }
+        // [q, q', q'', q'''] per joint in arc length at s (q' = q_u/σ, ...).
+        let at = |s: f64| {
+            let mut d = [[0.0; 6]; 4];
+            for (j, spline) in splines.iter().enumerate() {
+                let e = spline.eval((s / sigma).clamp(0.0, 1.0));
+                let mut scale = 1.0;
+                for (order, row) in d.iter_mut().enumerate() {
+                    row[j] = e[order] * scale;
+                    scale /= sigma;
                 }
-                d
-            })
-            .collect();
+            }
+            d
+        };
+        let derivatives: Vec<[[f64; 6]; 4]> = stations.iter().map(|&s| at(s)).collect();
         let limits = self.limits();
         let r = self.request;
         self.reachable(&stations, &derivatives)?;
-        let tip = tip_factors(&stations, &derivatives);
+        let tip = tip_factors(&stations, &at);
         let mut problem = FeedProblem {
             stations: &stations,
             derivatives: &derivatives,
@@ -381,27 +380,30 @@ fn peak_tip_speed(s: &Samples) -> f64 {
 }
 
 /// `[g, g', g'']` per station: `g = |dC/ds|` from the joint path's derivatives in s
-/// ([`crate::tip::tip_rate`]), its derivatives by central differences on the uniform stations
-/// (one-sided at the ends).
-fn tip_factors(stations: &[f64], derivatives: &[[[f64; 6]; 4]]) -> Vec<[f64; 3]> {
-    let g: Vec<f64> = derivatives
-        .iter()
-        .map(|d| tip_rate(&d[0], &d[1]).norm())
-        .collect();
-    let n = g.len();
-    let h = stations[1] - stations[0];
-    let diff = |v: &[f64], k: usize| {
-        if k == 0 {
-            (v[1] - v[0]) / h
-        } else if k == n - 1 {
-            (v[n - 1] - v[n - 2]) / h
-        } else {
-            (v[k + 1] - v[k - 1]) / (2.0 * h)
-        }
+/// ([`crate::tip::tip_rate`], `at(s)` as in [`FeedProblem::derivatives`]), its derivatives by
+/// central differences over ±[`TIP_STEP`] of the path (one-sided at the ends).
+fn tip_factors(stations: &[f64], at: &dyn Fn(f64) -> [[f64; 6]; 4]) -> Vec<[f64; 3]> {
+    let sigma = stations.last().copied().unwrap_or(0.0);
+    let h = TIP_STEP * sigma.max(f64::MIN_POSITIVE);
+    let g = |s: f64| {
+        let d = at(s.clamp(0.0, sigma));
+        tip_rate(&d[0], &d[1]).norm()
     };
-    let g1: Vec<f64> = (0..n).map(|k| diff(&g, k)).collect();
-    (0..n).map(|k| [g[k], g1[k], diff(&g1, k)]).collect()
+    stations
+        .iter()
+        .map(|&s| {
+            // Keep the three points inside [0, σ].
+            let c = s.clamp(h, sigma - h);
+            let (gm, g0, gp) = (g(c - h), g(c), g(c + h));
+            let g1 = (gp - gm) / (2.0 * h);
+            let g2 = (gp - 2.0 * g0 + gm) / (h * h);
+            [g(s), g1 + g2 * (s - c), g2]
+        })
+        .collect()
 }
+
+/// Step of the differences of [`tip_factors`], as a fraction of the path length.
+pub const TIP_STEP: f64 = 1e-4;
 
 /// `[g, g', g'']` at path position `s`, linear between the stations.
 fn tip_at(p: &FeedProblem, s: f64) -> [f64; 3] {
