@@ -38,6 +38,18 @@ pub struct Rto {
     pub q6: f64,
 }
 
+impl From<&crate::plan::RtoRecord> for Rto {
+    /// The RTO of a plan's record (its u and joint values).
+    fn from(r: &crate::plan::RtoRecord) -> Self {
+        Self {
+            u: r.u,
+            q4: r.q4,
+            q5: r.q5,
+            q6: r.q6,
+        }
+    }
+}
+
 /// Checks that the RTOs are usable: at least one, finite, `u` strictly
 /// increasing.
 fn check_rtos(rtos: &[Rto]) -> Result<(), PlanError> {

@@ -79,16 +79,7 @@ impl JointSeries {
             request.feed_acceleration,
             request.feed_jerk,
         )?;
-        let rtos: Vec<Rto> = plan
-            .rtos
-            .iter()
-            .map(|r| Rto {
-                u: r.u,
-                q4: r.q4,
-                q5: r.q5,
-                q6: r.q6,
-            })
-            .collect();
+        let rtos: Vec<Rto> = plan.rtos.iter().map(Rto::from).collect();
         let (times, positions) =
             quaternion_interpolation(&frames, &rtos, &law, v.sigma, request.sample_period, limits)?;
         let (velocities, accelerations, jerks) = finite_differences(&times, &positions);

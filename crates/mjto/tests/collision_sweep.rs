@@ -47,16 +47,7 @@ fn qi_samples(machine: &LaserMachine, request: &CutRequest, plan: &CutPlan) -> V
         request.feed_jerk,
     )
     .unwrap();
-    let rtos: Vec<Rto> = plan
-        .rtos
-        .iter()
-        .map(|r| Rto {
-            u: r.u,
-            q4: r.q4,
-            q5: r.q5,
-            q6: r.q6,
-        })
-        .collect();
+    let rtos: Vec<Rto> = plan.rtos.iter().map(Rto::from).collect();
     quaternion_interpolation(
         &frames,
         &rtos,

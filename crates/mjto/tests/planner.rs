@@ -332,16 +332,7 @@ fn check_plan(name: &str, request: &CutRequest, plan: &CutPlan) {
 fn check_smoother_than_qi(name: &str, request: &CutRequest, plan: &CutPlan) {
     let v = request.validate().unwrap();
     let frames = PathFrames::new(&v.points, &v.axes, &v.u);
-    let rtos: Vec<Rto> = plan
-        .rtos
-        .iter()
-        .map(|r| Rto {
-            u: r.u,
-            q4: r.q4,
-            q5: r.q5,
-            q6: r.q6,
-        })
-        .collect();
+    let rtos: Vec<Rto> = plan.rtos.iter().map(Rto::from).collect();
     let qi = quaternion_interpolation_along(
         &frames,
         &rtos,
