@@ -20,7 +20,9 @@ pub struct FeedReport {
     pub limits: Vec<FeedLimit>,
 }
 
-/// One representative tool orientation of the final plan.
+/// One representative tool orientation of the final plan: the selected GFD candidate. With
+/// `rto_constraint: equality` the trajectory passes through it; with `box` (the default) within
+/// the box of free, lead/tilt-feasible candidates around it (`Gfd::free_box`).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct RtoRecord {
     /// Normalized arc length ũ_i.
