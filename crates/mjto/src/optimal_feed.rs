@@ -44,6 +44,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::error::ConstraintFamily;
 use crate::machine::{AxisLimits, JOINT_NAMES};
+use crate::timelaw::chain_rule;
 use crate::PlanError;
 
 /// Which time law a plan runs (`options.feed_law` of the request).
@@ -323,32 +324,34 @@ impl OptimalFeed {
             .allow_almost_solved(true)
             .build()
             .map_err(|e| copp_error("SOCP options", e))?;
-        let mut profile: Option<Topp3Profile> = None;
-        let mut duration = f64::INFINITY;
+        // The last pass's profile and its times t(s).
+        let mut solved: Option<(Topp3Profile, Vec<f64>)> = None;
         // Sequential convex passes: each relinearizes the jerk rows around the previous
         // solution (copp's SCP refinement) until the time gains less than SCP_GAIN.
         for _ in 0..SCP_PASSES {
-            let reference = profile.as_ref().map_or(a_ra.as_slice(), |p| p.a.as_slice());
+            let reference = solved
+                .as_ref()
+                .map_or(a_ra.as_slice(), |(p, _)| p.a.as_slice());
             let problem =
                 Topp3ProblemBuilder::new(&mut robot, 0, reference, (0.0, 0.0), (0.0, 0.0))
                     .build_with_linearization()
                     .map_err(|e| copp_error("TOPP3 problem", e))?;
-            let solved = topp3_socp(&problem, &options).map_err(|e| copp_error("TOPP3-SOCP", e))?;
-            let (t, _) = s_to_t_topp3(p.stations, solved.as_parts(), 0.0)
+            let profile =
+                topp3_socp(&problem, &options).map_err(|e| copp_error("TOPP3-SOCP", e))?;
+            let (duration, t) = s_to_t_topp3(p.stations, profile.as_parts(), 0.0)
                 .map_err(|e| copp_error("t(s)", e))?;
-            let gain = (duration - t) / t;
-            profile = Some(solved);
-            duration = t;
-            if gain < SCP_GAIN {
+            let before = solved.as_ref().map_or(f64::INFINITY, |(_, t)| {
+                t.last().copied().unwrap_or(f64::INFINITY)
+            });
+            solved = Some((profile, t));
+            if (before - duration) / duration < SCP_GAIN {
                 break;
             }
         }
-        let profile = profile.ok_or_else(|| PlanError::Solver {
+        let (profile, t) = solved.ok_or_else(|| PlanError::Solver {
             problem: "time-optimal feed (TOPP3)".into(),
             detail: "no SOCP pass ran".into(),
         })?;
-        let (_, t) =
-            s_to_t_topp3(p.stations, profile.as_parts(), 0.0).map_err(|e| copp_error("t(s)", e))?;
         let (a, b, stationary) = profile.into_parts();
         Ok(Self {
             s: p.stations.to_vec(),
@@ -367,11 +370,6 @@ impl OptimalFeed {
     /// The largest feed reached (m/s).
     pub fn peak_feed(&self) -> f64 {
         self.a.iter().fold(0.0f64, |m, &a| m.max(a.max(0.0).sqrt()))
-    }
-
-    /// Stations, `a = ṡ²`, `b = s̈` and times of the law.
-    pub fn nodes(&self) -> (&[f64], &[f64], &[f64], &[f64]) {
-        (&self.s, &self.a, &self.b, &self.t)
     }
 
     /// `[s, ṡ, s̈, s⃛]` at each of `times` (increasing, within `[0, T]`).
@@ -416,18 +414,19 @@ impl OptimalFeed {
     fn state(&self, k: usize, time: f64, s: f64) -> [f64; 4] {
         let n = self.s.len() - 1;
         let (head, tail) = self.stationary;
-        if k < head {
-            // Constant jerk from rest (copp's stationary block): s − s₀ = D τ³.
-            let (am, sm) = (self.a[head], self.s[head] - self.s[0]);
+        // Constant jerk from (or to) rest, copp's stationary blocks: s − s_end = D τ³ with
+        // τ = t − t_end, D = a_m^{3/2} / (27 (s_m − s_end)²) from the block's inner node m.
+        let rest = |m: usize, end: usize| {
+            let (am, sm) = (self.a[m], self.s[m] - self.s[end]);
             let d = am * am.sqrt() / (27.0 * sm * sm);
-            let tau = time - self.t[0];
-            return [s, 3.0 * d * tau * tau, 6.0 * d * tau, 6.0 * d];
+            let tau = time - self.t[end];
+            [s, 3.0 * d * tau * tau, 6.0 * d * tau, 6.0 * d]
+        };
+        if k < head {
+            return rest(head, 0);
         }
         if k >= n - tail {
-            let (am, sm) = (self.a[n - tail], self.s[n] - self.s[n - tail]);
-            let d = am * am.sqrt() / (27.0 * sm * sm);
-            let tau = time - self.t[n];
-            return [s, 3.0 * d * tau * tau, 6.0 * d * tau, 6.0 * d];
+            return rest(n - tail, n);
         }
         let h = self.s[k + 1] - self.s[k];
         let c = (self.b[k + 1] - self.b[k]) / h;
@@ -455,41 +454,31 @@ impl OptimalFeed {
         for k in 0..n {
             let kk = k.min(n - 2);
             let c = (self.b[kk + 1] - self.b[kk]) / (self.s[kk + 1] - self.s[kk]);
-            let (a, b) = (self.a[k].max(0.0), self.b[k]);
-            let v = a.sqrt();
-            let d = &p.derivatives[k];
+            // The law at the station: [s, ṡ, s̈, s⃛] with s⃛ = c ṡ.
+            let v = self.a[k].max(0.0).sqrt();
+            let law = [self.s[k], v, self.b[k], c * v];
+            // Seed 001 eq. 7 with derivatives in arc length (σ = 1): [·, rate, acc, jerk].
+            let motion = |d: [f64; 4]| chain_rule(d, law, 1.0);
             let g = p.tip.get(k).copied().unwrap_or([1.0, 0.0, 0.0]);
+            let tip = motion([0.0, g[0], g[1], g[2]]);
             let pm = p.process_margin;
-            let mut best = (g[0] * v / (pm * p.feed), "feedrate".to_string());
+            let mut best = (tip[1] / (pm * p.feed), "feedrate".to_string());
             let mut consider = |x: f64, name: String| {
                 if x > best.0 {
                     best = (x, name);
                 }
             };
-            consider(
-                (g[1] * a + g[0] * b).abs() / (pm * p.acc),
-                "path acceleration".into(),
-            );
-            consider(
-                (v * (g[2] * a + 3.0 * g[1] * b + g[0] * c)).abs() / (pm * p.jerk),
-                "path jerk".into(),
-            );
+            consider(tip[2].abs() / (pm * p.acc), "path acceleration".into());
+            consider(tip[3].abs() / (pm * p.jerk), "path jerk".into());
             // The joints against the limits the solver had (margin included).
             let m = p.margin;
+            let d = &p.derivatives[k];
             for (j, l) in p.joints.iter().enumerate() {
                 let name = JOINT_NAMES[j];
-                consider(
-                    (d[1][j] * v).abs() / (m * l.vel),
-                    format!("{name} velocity"),
-                );
-                consider(
-                    (d[2][j] * a + d[1][j] * b).abs() / (m * l.acc),
-                    format!("{name} acceleration"),
-                );
-                consider(
-                    (v * (d[3][j] * a + 3.0 * d[2][j] * b + d[1][j] * c)).abs() / (m * l.jerk),
-                    format!("{name} jerk"),
-                );
+                let q = motion([d[0][j], d[1][j], d[2][j], d[3][j]]);
+                consider(q[1].abs() / (m * l.vel), format!("{name} velocity"));
+                consider(q[2].abs() / (m * l.acc), format!("{name} acceleration"));
+                consider(q[3].abs() / (m * l.jerk), format!("{name} jerk"));
             }
             if best.0 < ACTIVE_FRACTION {
                 continue;

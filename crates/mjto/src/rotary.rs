@@ -86,6 +86,21 @@ pub struct RotaryQp<'a> {
 /// One sparse row: `(column, coefficient)` pairs.
 type SparseRow = Vec<(usize, f64)>;
 
+/// The `deriv`-th derivative of the basis at `u` as a sparse row over the coefficients (eq. 12).
+fn sparse_basis(
+    knots: &KnotVector,
+    u: f64,
+    deriv: usize,
+) -> Result<SparseRow, kerf_bspline::BsplineError> {
+    let row = basis_row(knots, u, deriv)?;
+    Ok(row
+        .values
+        .iter()
+        .enumerate()
+        .map(|(i, &v)| (row.start + i, v))
+        .collect())
+}
+
 /// Which families a solve keeps.
 type Keep<'a> = &'a dyn Fn(ConstraintFamily) -> bool;
 
@@ -280,13 +295,7 @@ impl RotaryQp<'_> {
             .into_iter()
             .enumerate()
         {
-            let row = basis_row(self.knots, u, deriv).map_err(err)?;
-            let coeffs = row
-                .values
-                .iter()
-                .enumerate()
-                .map(|(i, &v)| (row.start + i, v))
-                .collect();
+            let coeffs = sparse_basis(self.knots, u, deriv).map_err(err)?;
             boundary.push((coeffs, self.boundary[k], self.boundary[k]));
         }
         fams.push(Family {
@@ -295,13 +304,7 @@ impl RotaryQp<'_> {
         });
         let mut rto = Vec::new();
         for &(u, q) in self.via {
-            let row = basis_row(self.knots, u, 0).map_err(err)?;
-            let coeffs = row
-                .values
-                .iter()
-                .enumerate()
-                .map(|(i, &v)| (row.start + i, v))
-                .collect();
+            let coeffs = sparse_basis(self.knots, u, 0).map_err(err)?;
             rto.push((coeffs, q, q));
         }
         for &(u, lo, hi) in self.via_box {
@@ -311,13 +314,7 @@ impl RotaryQp<'_> {
                     format!("RTO interval [{lo}, {hi}] at u = {u} is empty or not finite"),
                 ));
             }
-            let row = basis_row(self.knots, u, 0).map_err(err)?;
-            let coeffs = row
-                .values
-                .iter()
-                .enumerate()
-                .map(|(i, &v)| (row.start + i, v))
-                .collect();
+            let coeffs = sparse_basis(self.knots, u, 0).map_err(err)?;
             rto.push((coeffs, lo, hi));
         }
         fams.push(Family {

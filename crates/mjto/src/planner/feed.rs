@@ -12,7 +12,7 @@ use crate::metrics::limit_violations;
 use crate::optimal_feed::{steady_feed, FeedLimit, FeedMode, FeedProblem, OptimalFeed};
 use crate::plan::{FeedReport, StageTimes};
 use crate::rotary::RotaryQp;
-use crate::timelaw::{checked_grid_times, TimeLaw, MAX_SAMPLES};
+use crate::timelaw::{chain_rule, checked_grid_times, TimeLaw, MAX_SAMPLES};
 use crate::tip::{tip_rate, tip_speed};
 use crate::PlanError;
 
@@ -64,13 +64,20 @@ impl Context<'_> {
         it: &Iterate,
         times: &mut StageTimes,
     ) -> Result<Samples, PlanError> {
+        self.law_samples(it, &self.law, self.sample_times.clone(), times)
+    }
+
+    /// The samples of `it` at `sample_times` under the S-curve `law`.
+    fn law_samples(
+        &self,
+        it: &Iterate,
+        law: &TimeLaw,
+        sample_times: Vec<f64>,
+        times: &mut StageTimes,
+    ) -> Result<Samples, PlanError> {
         let t = Instant::now();
-        let states: Vec<[f64; 4]> = self
-            .sample_times
-            .iter()
-            .map(|&t| self.law.eval(t))
-            .collect();
-        let samples = self.sample(it, self.sample_times.clone(), &states)?;
+        let states: Vec<[f64; 4]> = sample_times.iter().map(|&t| law.eval(t)).collect();
+        let samples = self.sample(it, sample_times, &states)?;
         times.evaluation += t.elapsed().as_secs_f64();
         Ok(samples)
     }
@@ -102,7 +109,8 @@ impl Context<'_> {
             .filter(|(_, &sd)| sd > 1e-9)
             .map(|((q, qd), &sd)| tip_speed(q, qd) / sd)
             .fold(1.0f64, f64::max);
-        let (law, samples) = if g_max > 1.0 + LIMIT_TOLERANCE {
+        let resampled = g_max > 1.0 + LIMIT_TOLERANCE;
+        let (law, samples) = if resampled {
             let r = self.request;
             let law = TimeLaw::new(
                 self.v.sigma,
@@ -111,11 +119,8 @@ impl Context<'_> {
                 r.feed_jerk,
             )?
             .on_grid(r.sample_period)?;
-            let t = Instant::now();
             let sample_times = law.checked_sample_times(r.sample_period, MAX_SAMPLES)?;
-            let states: Vec<[f64; 4]> = sample_times.iter().map(|&t| law.eval(t)).collect();
-            let samples = self.sample(it, sample_times, &states)?;
-            times.evaluation += t.elapsed().as_secs_f64();
+            let samples = self.law_samples(it, &law, sample_times, times)?;
             (law, samples)
         } else {
             (self.law, samples)
@@ -148,7 +153,7 @@ impl Context<'_> {
                     peak_feed,
                     limits,
                 },
-                resampled: g_max > 1.0 + LIMIT_TOLERANCE,
+                resampled,
             });
         }
         self.optimal(it, times, constant_time)
@@ -181,13 +186,7 @@ impl Context<'_> {
             LIMIT_TOLERANCE,
         ));
         let f = self.request.feedrate;
-        let worst =
-            s.q.iter()
-                .zip(&s.qd)
-                .zip(&s.times)
-                .map(|((q, qd), &t)| (tip_speed(q, qd), t))
-                .max_by(|a, b| a.0.total_cmp(&b.0));
-        if let Some((speed, time)) = worst {
+        if let Some((speed, time)) = worst_tip_speed(s) {
             if speed.is_nan() || speed > f * (1.0 + LIMIT_TOLERANCE) {
                 v.push(LimitViolation {
                     joint: TOOL_TIP.into(),
@@ -371,12 +370,19 @@ pub(super) fn rotary_coefficients(
     }
 }
 
-/// The tool tip's largest speed over the samples (m/s): the feed as executed.
-fn peak_tip_speed(s: &Samples) -> f64 {
+/// The tool tip's largest speed over the samples (m/s) and its time: the feed as executed (a NaN
+/// speed counts as the largest).
+fn worst_tip_speed(s: &Samples) -> Option<(f64, f64)> {
     s.q.iter()
         .zip(&s.qd)
-        .map(|(q, qd)| tip_speed(q, qd))
-        .fold(0.0, f64::max)
+        .zip(&s.times)
+        .map(|((q, qd), &t)| (tip_speed(q, qd), t))
+        .max_by(|a, b| a.0.total_cmp(&b.0))
+}
+
+/// The tool tip's largest speed over the samples (m/s), for the report.
+fn peak_tip_speed(s: &Samples) -> f64 {
+    worst_tip_speed(s).map_or(0.0, |w| w.0)
 }
 
 /// `[g, g', g'']` per station: `g = |dC/ds|` from the joint path's derivatives in s
@@ -418,30 +424,21 @@ fn tip_at(p: &FeedProblem, s: f64) -> [f64; 3] {
     std::array::from_fn(|i| p.tip[k][i] * (1.0 - w) + p.tip[k + 1][i] * w)
 }
 
-/// The samples whose tool-tip feed, path acceleration or path jerk (tangential, through
-/// [`tip_at`]: `g ṡ`, `g' ṡ² + g s̈`, `g'' ṡ³ + 3 g' ṡ s̈ + g s⃛`) exceeds the request's
-/// (relative tolerance [`LIMIT_TOLERANCE`]), at most one per quantity (the worst), as joint
-/// [`TOOL_TIP`].
+/// The samples whose tool tip's tangential acceleration or jerk (through [`tip_at`] and seed
+/// 001 eq. 7 in arc length: `g' ṡ² + g s̈`, `g'' ṡ³ + 3 g' ṡ s̈ + g s⃛`) exceeds the request's
+/// path acceleration or jerk (relative tolerance [`LIMIT_TOLERANCE`]), at most one per
+/// quantity (the worst), as joint [`TOOL_TIP`]. The tip's speed against the feedrate is checked
+/// exactly, by [`Context::violations`].
 fn process_violations(times: &[f64], states: &[[f64; 4]], p: &FeedProblem) -> Vec<LimitViolation> {
-    let tangential = |st: &[f64; 4]| {
-        let [g, g1, g2] = tip_at(p, st[0]);
-        let (v, a, j) = (st[1], st[2], st[3]);
-        [
-            g * v,
-            g1 * v * v + g * a,
-            g2 * v * v * v + 3.0 * g1 * v * a + g * j,
-        ]
-    };
-    let rows: Vec<[f64; 3]> = states.iter().map(tangential).collect();
+    let rows: Vec<[f64; 4]> = states
+        .iter()
+        .map(|st| {
+            let [g, g1, g2] = tip_at(p, st[0]);
+            chain_rule([0.0, g, g1, g2], *st, 1.0)
+        })
+        .collect();
     let mut out: Vec<LimitViolation> = Vec::new();
-    for (i, (quantity, limit)) in [
-        ("velocity", p.feed),
-        ("acceleration", p.acc),
-        ("jerk", p.jerk),
-    ]
-    .into_iter()
-    .enumerate()
-    {
+    for (i, quantity, limit) in [(2, "acceleration", p.acc), (3, "jerk", p.jerk)] {
         let worst = times
             .iter()
             .zip(&rows)
