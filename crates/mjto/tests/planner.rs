@@ -537,6 +537,16 @@ fn bad_requests_give_the_right_error_and_the_planner_recovers() {
     let mut r = base.clone();
     r.feedrate = f64::NAN;
     expect_invalid(&mut planner, &r, "feedrate", "finite");
+    for (bad, reason) in [
+        (0.0, "must be > 0"),
+        (-1e-4, "must be > 0"),
+        (f64::NAN, "finite"),
+        (f64::INFINITY, "finite"),
+    ] {
+        let mut r = base.clone();
+        r.options.cl_tolerance = bad;
+        expect_invalid(&mut planner, &r, "options.cl_tolerance", reason);
+    }
     let mut r = base.clone();
     r.points[10] = r.points[9];
     expect_invalid(&mut planner, &r, "points[10]", "repeats");
