@@ -18,6 +18,8 @@
 pub mod bpillar;
 pub mod error;
 pub mod jobshop;
+mod placement;
+mod rounding;
 pub mod straight;
 
 pub use error::TestPartError;

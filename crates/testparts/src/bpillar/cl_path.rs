@@ -4,10 +4,10 @@
 use nalgebra::Vector3;
 
 use super::part::BPillar;
-use super::rounding::round_vec;
 use super::section::LEFT_FLANGE_FILLET_START;
 use super::surface::SurfaceVertex;
 use super::{AXIS_SCALE, COORD_SCALE};
+use crate::rounding::round_vec;
 use crate::TestPartError;
 
 /// A CL path: points on the outer surface and their nominal tool axes.

@@ -52,7 +52,6 @@ mod files;
 mod params;
 mod part;
 mod request;
-mod rounding;
 mod section;
 mod spine;
 mod surface;

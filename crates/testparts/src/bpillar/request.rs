@@ -2,11 +2,12 @@
 //! parameters, the YAML form and the tool-axis changes between RTOs.
 
 use kerf_mjto::request::{CutOptions, CutRequest, PoseSpec};
-use nalgebra::{Point3, UnitQuaternion, Vector3};
+use nalgebra::{UnitQuaternion, Vector3};
 
 use super::cl_path::ClPath;
-use super::rounding::round_to;
 use super::{AXIS_SCALE, MESH_REFERENCE, REGENERATE_COMMAND};
+use crate::placement::nominal_m_centre;
+use crate::rounding::round_to;
 use crate::TestPartError;
 
 /// The CL point spacing `f Δt` of a feedrate and a sample period.
@@ -61,17 +62,7 @@ pub(super) fn make_request(
             ));
         }
     }
-    let q6 = CutOptions::default().reference_standoff;
-    let mut lo = Vector3::repeat(f64::INFINITY);
-    let mut hi = Vector3::repeat(f64::NEG_INFINITY);
-    for (c, o) in path.points.iter().zip(&path.axes) {
-        let c = rotation * Point3::new(c[0], c[1], c[2]);
-        let o = rotation * Vector3::new(o[0], o[1], o[2]);
-        let m = c.coords - o * q6;
-        lo = lo.inf(&m);
-        hi = hi.sup(&m);
-    }
-    let centre = (lo + hi) * 0.5;
+    let centre = nominal_m_centre(&path.points, &path.axes, &rotation);
     let mm = |v: f64| round_to(v, 1e3);
     let position = [
         mm(m_center[0] - centre.x),

@@ -4,9 +4,9 @@ use kerf_mjto::mesh::MeshData;
 use nalgebra::Vector3;
 
 use super::params::BPillarParams;
-use super::rounding::round_vec;
 use super::spine::Spine;
 use super::{COORD_SCALE, SECTION_FD_STEP};
+use crate::rounding::round_vec;
 use crate::TestPartError;
 
 /// A point of the outer surface with its unit outward (head-side) normal.

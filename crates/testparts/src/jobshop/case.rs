@@ -2,11 +2,12 @@
 //! demands of a planner.
 
 use kerf_mjto::request::{CutOptions, CutRequest, PoseSpec};
-use nalgebra::{Point3, UnitQuaternion, Vector3};
+use nalgebra::UnitQuaternion;
 
 use super::path::ClPath;
-use super::rounding::round_to;
 use super::AXIS_SCALE;
+use crate::placement::nominal_m_centre;
+use crate::rounding::round_to;
 use crate::TestPartError;
 
 /// What a planner must answer (issue 16: planned at the requested feed where a machine can
@@ -98,17 +99,7 @@ pub(super) fn make_request(
     rotation: UnitQuaternion<f64>,
     process: Process,
 ) -> Result<CutRequest, TestPartError> {
-    let q6 = CutOptions::default().reference_standoff;
-    let mut lo = Vector3::repeat(f64::INFINITY);
-    let mut hi = Vector3::repeat(f64::NEG_INFINITY);
-    for (c, o) in path.points.iter().zip(&path.axes) {
-        let c = rotation * Point3::new(c[0], c[1], c[2]);
-        let o = rotation * Vector3::new(o[0], o[1], o[2]);
-        let m = c.coords - o * q6;
-        lo = lo.inf(&m);
-        hi = hi.sup(&m);
-    }
-    let centre = (lo + hi) * 0.5;
+    let centre = nominal_m_centre(&path.points, &path.axes, &rotation);
     if !centre.iter().all(|v| v.is_finite()) {
         return Err(TestPartError::invalid(id, "empty or non-finite path"));
     }

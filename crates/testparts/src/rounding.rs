@@ -1,10 +1,10 @@
-//! Rounding of generated coordinates to short decimals.
+//! Rounding of generated coordinates to short decimals (deterministic files), for every part.
 
 use nalgebra::Vector3;
 
 /// `x` rounded to a multiple of `1 / scale` (`scale` a power of ten, so
 /// the result prints as a short decimal); negative zero becomes zero.
-pub(super) fn round_to(x: f64, scale: f64) -> f64 {
+pub(crate) fn round_to(x: f64, scale: f64) -> f64 {
     let y = (x * scale).round() / scale;
     if y == 0.0 {
         0.0
@@ -14,7 +14,7 @@ pub(super) fn round_to(x: f64, scale: f64) -> f64 {
 }
 
 /// `v` rounded componentwise with [`round_to`].
-pub(super) fn round_vec(v: &Vector3<f64>, scale: f64) -> [f64; 3] {
+pub(crate) fn round_vec(v: &Vector3<f64>, scale: f64) -> [f64; 3] {
     [
         round_to(v.x, scale),
         round_to(v.y, scale),
