@@ -6,7 +6,8 @@
 //! 99th percentile and worst CPU time of the calling thread (`CLOCK_THREAD_CPUTIME_ID`) in
 //! `Cell::step` over 5 000 cycles (after 200 warm-up cycles), the worst wall-clock time, and
 //! the contacts seen. CPU time excludes the time the thread waits for a core on a loaded
-//! machine; the wall-clock worst case includes it.
+//! machine; the wall-clock worst case includes it. `KERF_CELL_SCENARIOS` selects scenarios
+//! (see [`selected`]).
 #![allow(clippy::unwrap_used, clippy::expect_used)] // a bench reports failures by panicking
 
 use std::path::PathBuf;
@@ -112,7 +113,22 @@ fn physics_rate() -> f64 {
         .unwrap_or(CellSettings::default().physics_rate_hz)
 }
 
+/// Whether the scenario runs: `KERF_CELL_SCENARIOS` is a comma-separated list of substrings
+/// of "<name> <mode>" (e.g. `into,Dynamic`: every scenario containing either); unset: all.
+fn selected(name: &str, mode: Mode) -> bool {
+    match std::env::var("KERF_CELL_SCENARIOS") {
+        Ok(list) => {
+            let label = format!("{name} {mode:?}");
+            list.split(',').any(|f| !f.is_empty() && label.contains(f))
+        }
+        Err(_) => true,
+    }
+}
+
 fn run(name: &str, cell_name: &str, mode: Mode, path: &Path) {
+    if !selected(name, mode) {
+        return;
+    }
     let settings = CellSettings {
         mode,
         physics_rate_hz: physics_rate(),
@@ -158,13 +174,15 @@ fn run(name: &str, cell_name: &str, mode: Mode, path: &Path) {
             }
         }
     }
+    let counts = cell.checker().counts();
+    let per_cycle = |n: u64| n as f64 / (warm + cycles) as f64;
     times.sort_by(f64::total_cmp);
     let mean = times.iter().sum::<f64>() / times.len() as f64;
     let median = times[times.len() / 2];
     let p99 = times[times.len() * 99 / 100];
     let max = times[times.len() - 1];
     println!(
-        "{name:<34} {mode:<9} CPU mean {:>6.1} us  median {:>6.1} us  p99 {:>6.1} us  max {:>7.1} us | wall max {:>7.1} us | contact in {with_contact}/{cycles} cycles, deepest {:.2} mm | max tracking error {:.1e}",
+        "{name:<34} {mode:<9} CPU mean {:>6.1} us  median {:>6.1} us  p99 {:>6.1} us  max {:>7.1} us | wall max {:>7.1} us | contact in {with_contact}/{cycles} cycles, deepest {:.2} mm | max tracking error {:.1e} | per cycle: {:.2} queries, {:.2} box tests, {:.2} skipped, {:.1} triangles, {:.2} tested",
         mean * 1e6,
         median * 1e6,
         p99 * 1e6,
@@ -172,6 +190,11 @@ fn run(name: &str, cell_name: &str, mode: Mode, path: &Path) {
         wall_max * 1e6,
         deepest * 1e3,
         tracking,
+        per_cycle(counts.queries),
+        per_cycle(counts.boxes),
+        per_cycle(counts.skipped),
+        per_cycle(counts.triangles),
+        per_cycle(counts.tested),
         mode = format!("{mode:?}"),
     );
 }

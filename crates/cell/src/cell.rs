@@ -10,7 +10,7 @@ use parry3d_f64::math::Pose;
 use crate::chain::{urdf_origin, Chain, MassProps};
 use crate::config::{CellFile, GeometrySpec};
 use crate::contact::{Contact, ContactChecker};
-use crate::dynamics::{inverse_dynamics, Workspace};
+use crate::dynamics::{inverse_dynamics, mass_diagonal, Workspace};
 use crate::geometry::{primitive, to_pose, urdf_shape, RobotShape, SceneObject};
 use crate::hermite::Hermite;
 use crate::inertia::InertiaFile;
@@ -84,6 +84,10 @@ pub struct Cell {
     poses: Vec<Pose>,
     reference: Reference,
     scratch: Vec<f64>,
+    /// Joint positions of the multibody at the start of a physics step (dynamic mode).
+    state_q: Vec<f64>,
+    /// Feed-forward efforts of a physics step (dynamic mode).
+    tau_ff: Vec<f64>,
     kp: Vec<f64>,
     kd: Vec<f64>,
 }
@@ -301,6 +305,8 @@ impl Cell {
                 qdd: vec![0.0; n],
             },
             scratch: vec![0.0; n],
+            state_q: vec![0.0; n],
+            tau_ff: vec![0.0; n],
             kp: vec![0.0; n],
             kd: vec![0.0; n],
         };
@@ -478,9 +484,10 @@ impl Cell {
     /// the cell is then unchanged.
     ///
     /// # Performance
-    /// Kinematic: per sub-step a forward kinematics and the contact queries. Dynamic: per
-    /// sub-step one inverse dynamics (O(joints)), one rapier step and the contact queries;
-    /// per period `joints` more inverse dynamics for the gains. BENCHMARKS.md, "Simulated cell
+    /// Kinematic: per sub-step a forward kinematics and the contact checks (a displacement
+    /// bound per pair; queries only for pairs near the scene). Dynamic: per sub-step one
+    /// inverse dynamics (O(joints)), one rapier step (most of the cost) and the contact checks;
+    /// per period one mass-matrix diagonal for the gains. BENCHMARKS.md, "Simulated cell
     /// (issue 15)".
     pub fn step(&mut self, command: &JointSample, dt: f64) -> Result<&CellState, CellError> {
         if !(dt.is_finite() && (dt - self.dt_control).abs() <= 1e-9 * self.dt_control) {
@@ -612,28 +619,12 @@ impl Cell {
     /// Servo gains at `q`: `Kp = M_jj ω²`, `Kd = 2 ζ M_jj ω` (a critically damped second
     /// order loop per joint when ζ = 1; e.g. Siciliano et al., *Robotics: Modelling,
     /// Planning and Control*, 2009, section 8.5.2, independent joint control), `M_jj` the
-    /// mass-matrix diagonal from the inverse dynamics with a unit acceleration and no
-    /// gravity (Walker, Orin, "Efficient dynamic computer simulation of robotic mechanisms",
-    /// ASME J. Dyn. Sys. 104:205-211, 1982, method 1), plus the armature.
+    /// mass-matrix diagonal ([`crate::dynamics::mass_diagonal`]) plus the armature.
     fn update_gains(&mut self, q: &[f64]) {
-        let n = q.len();
         let w = 2.0 * std::f64::consts::PI * self.settings.bandwidth_hz;
-        let zeros = vec![0.0; n];
-        let mut unit = vec![0.0; n];
-        let mut tau = vec![0.0; n];
-        for j in 0..n {
-            unit.iter_mut().for_each(|u| *u = 0.0);
-            unit[j] = 1.0;
-            inverse_dynamics(
-                &self.chain,
-                q,
-                &zeros,
-                &unit,
-                &Vector3::zeros(),
-                &mut self.ws,
-                &mut tau,
-            );
-            let m = tau[j] + self.chain.joints[j].drive.armature;
+        mass_diagonal(&self.chain, q, &mut self.ws, &mut self.scratch);
+        for (j, joint) in self.chain.joints.iter().enumerate() {
+            let m = self.scratch[j] + joint.drive.armature;
             self.kp[j] = m * w * w;
             self.kd[j] = 2.0 * self.settings.damping_ratio * m * w;
         }
@@ -641,16 +632,14 @@ impl Cell {
 
     /// Computes and applies the drive efforts of one physics step (dynamic mode).
     fn drive(&mut self, efforts: &mut [f64], saturated: &mut [bool], v_before: &mut [f64]) {
-        let n = efforts.len();
-        let mut q = vec![0.0; n];
-        self.world.positions(&self.chain, &mut q);
-        self.world.velocities(v_before);
         let Reference {
             q: qr,
             qd: qdr,
             qdd: qddr,
         } = &self.reference;
-        let mut tau_ff = vec![0.0; n];
+        let (q, tau_ff) = (&mut self.state_q, &mut self.tau_ff);
+        self.world.positions(&self.chain, q);
+        self.world.velocities(v_before);
         inverse_dynamics(
             &self.chain,
             qr,
@@ -658,7 +647,7 @@ impl Cell {
             qddr,
             &self.gravity,
             &mut self.ws,
-            &mut tau_ff,
+            tau_ff,
         );
         for (j, joint) in self.chain.joints.iter().enumerate() {
             // Viscous friction is rapier's implicit damping on the end-of-step velocity.

@@ -2,16 +2,41 @@
 //!
 //! rapier's own contact events are not used: with speculative contacts they start about 2 cm
 //! before the shapes touch. Each (robot shape, scene object) pair is tested with parry's
-//! `contact` query with the pair's threshold as prediction distance, after a bounding-box
-//! test; the reported distance is signed (negative = penetration depth).
+//! `contact` query, after a bounding-box test; the reported distance is signed (negative =
+//! penetration depth).
+//!
+//! Every test leaves a lower bound on the pair's distance (the box gap, the query's distance,
+//! or its prediction distance when it finds nothing). Until the shape has moved far enough to
+//! close that margin ([`crate::motion`]), the pair cannot be a contact and is not tested again:
+//! the contacts found are those of testing every pair at every call.
 
-use parry3d_f64::bounding_volume::BoundingVolume;
+use parry3d_f64::bounding_volume::Aabb;
 use parry3d_f64::math::Pose;
 use parry3d_f64::query;
 
 use crate::config::{Allow, CellFile, ObjectKind};
 use crate::geometry::{to_vector3, RobotShape, SceneObject};
+use crate::mesh_contact::{mesh_contact, Candidates};
+use crate::motion::{aabb_gap, ShapeBound};
 use crate::CellError;
+
+/// How much farther than its threshold a pair's query looks (m): the query then returns the
+/// pair's distance (or that it is beyond `threshold + MARGIN`), a clearance the shape may use
+/// up by moving before the pair is tested again. Larger margins test more triangles per query
+/// and fewer queries; BENCHMARKS.md, "Simulated cell", compares 0.5 to 8 mm.
+pub const MARGIN: f64 = 0.001;
+
+/// Allowance for the queries' own error (m) when a clearance decides to skip a test (GJK
+/// converges to about 1e-10 m at these scales; this keeps the skip conservative).
+const SLACK: f64 = 1e-6;
+
+/// What the last test of a pair proved: its distance was at least `lower` with the shape at
+/// `pose`.
+#[derive(Debug, Clone, Copy)]
+struct Clearance {
+    lower: f64,
+    pose: Pose,
+}
 
 /// One contact between a robot shape and a scene object.
 #[derive(Debug, Clone, PartialEq)]
@@ -43,11 +68,39 @@ struct Pair {
 }
 
 /// The pairs to test and their thresholds (allowances applied).
+#[derive(Clone)]
 pub struct ContactChecker {
     shapes: Vec<RobotShape>,
     objects: Vec<SceneObject>,
     pairs: Vec<Pair>,
     threshold: f64,
+    /// Per shape: its bounding box in its own frame.
+    local_aabbs: Vec<Aabb>,
+    /// Per shape: the data of its displacement bound.
+    bounds: Vec<ShapeBound>,
+    /// Per pair: what its last test proved (`None` before the first).
+    clearance: Vec<Option<Clearance>>,
+    /// Queries run and skipped by [`ContactChecker::check`] since the checker was built.
+    counts: QueryCounts,
+    /// Scratch of the mesh queries.
+    candidates: Candidates,
+}
+
+/// How many pair tests [`ContactChecker::check`] ran as parry queries, settled by bounding
+/// boxes, or skipped by a clearance.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct QueryCounts {
+    /// Parry `contact` queries.
+    pub queries: u64,
+    /// Pairs settled by their bounding-box gap.
+    pub boxes: u64,
+    /// Pairs skipped: the shape had not moved enough since the last test.
+    pub skipped: u64,
+    /// Mesh triangles in the grown boxes of the queried shapes.
+    pub triangles: u64,
+    /// Mesh triangles tested with GJK (and EPA) after the plane bounds
+    /// ([`crate::mesh_contact`]).
+    pub tested: u64,
 }
 
 impl std::fmt::Debug for ContactChecker {
@@ -145,11 +198,25 @@ impl ContactChecker {
                 }
             }
         }
+        let local_aabbs = shapes
+            .iter()
+            .map(|s| s.shape.compute_local_aabb())
+            .collect();
+        let bounds = shapes
+            .iter()
+            .map(|s| ShapeBound::new(s.shape.as_ref()))
+            .collect();
+        let clearance = vec![None; pairs.len()];
         Ok(Self {
             shapes,
             objects,
             pairs,
             threshold,
+            local_aabbs,
+            bounds,
+            clearance,
+            counts: QueryCounts::default(),
+            candidates: Candidates::default(),
         })
     }
 
@@ -168,6 +235,15 @@ impl ContactChecker {
         self.threshold
     }
 
+    /// How many pair tests ran as queries, were settled by boxes, or were skipped.
+    pub fn counts(&self) -> QueryCounts {
+        QueryCounts {
+            triangles: self.candidates.candidates,
+            tested: self.candidates.tested,
+            ..self.counts
+        }
+    }
+
     /// Tests every pair at the given body poses and merges the contacts into `out`: per
     /// (shape, object) pair, the nearest over the calls is kept.
     ///
@@ -177,32 +253,86 @@ impl ContactChecker {
     /// * `out` - contacts so far in this control cycle.
     ///
     /// # Performance
-    /// One bounding-box test per pair; a parry `contact` query (BVH traversal for meshes)
-    /// only for pairs whose boxes, grown by the threshold, overlap.
-    pub fn check(&self, bodies: &[Pose], time: f64, out: &mut Vec<Contact>) {
-        for pair in &self.pairs {
-            let s = &self.shapes[pair.shape];
-            let o = &self.objects[pair.object];
+    /// Per pair one displacement bound; when the shape has moved less than the clearance the
+    /// last test left, nothing more. Otherwise a bounding-box gap, and a parry `contact` query
+    /// (BVH traversal for meshes) with prediction `threshold + MARGIN` only when the gap is
+    /// below the threshold.
+    pub fn check(&mut self, bodies: &[Pose], time: f64, out: &mut Vec<Contact>) {
+        let Self {
+            shapes,
+            objects,
+            pairs,
+            local_aabbs,
+            bounds,
+            clearance,
+            counts,
+            candidates,
+            ..
+        } = self;
+        for (pair, known) in pairs.iter().zip(clearance.iter_mut()) {
+            let s = &shapes[pair.shape];
+            let o = &objects[pair.object];
             let pose = match s.body {
                 Some(b) => bodies[b] * s.local,
                 None => s.local,
             };
-            let aabb = s.shape.compute_aabb(&pose).loosened(pair.threshold);
-            if !aabb.intersects(&o.aabb) {
+            if let Some(k) = known {
+                let moved = bounds[pair.shape].displacement(&k.pose, &pose);
+                if k.lower - moved - SLACK >= pair.threshold {
+                    counts.skipped += 1;
+                    continue;
+                }
+            }
+            let gap = aabb_gap(&local_aabbs[pair.shape].transform_by(&pose), &o.aabb);
+            if gap - SLACK >= pair.threshold {
+                counts.boxes += 1;
+                *known = Some(Clearance { lower: gap, pose });
                 continue;
             }
-            let c = match query::contact(
-                &pose,
-                s.shape.as_ref(),
-                &o.pose,
-                o.shape.as_ref(),
-                pair.threshold,
-            ) {
-                Ok(Some(c)) if c.dist < pair.threshold => c,
-                Ok(_) => continue,
+            counts.queries += 1;
+            // A pair found within its threshold is likely to stay there: the margin would only
+            // add triangles to the query (10 % of the cycle with the nozzle in the part).
+            let near = known.is_some_and(|k| k.lower < pair.threshold);
+            let prediction = pair.threshold + if near { 0.0 } else { MARGIN };
+            let result = match o.shape.as_trimesh() {
+                Some(mesh) => mesh_contact(
+                    mesh,
+                    &o.pose,
+                    s.shape.as_ref(),
+                    &pose,
+                    prediction,
+                    candidates,
+                ),
+                None => query::contact(
+                    &pose,
+                    s.shape.as_ref(),
+                    &o.pose,
+                    o.shape.as_ref(),
+                    prediction,
+                ),
+            };
+            let c = match result {
+                Ok(Some(c)) => {
+                    *known = Some(Clearance {
+                        lower: c.dist,
+                        pose,
+                    });
+                    if c.dist >= pair.threshold {
+                        continue;
+                    }
+                    c
+                }
+                Ok(None) => {
+                    *known = Some(Clearance {
+                        lower: prediction,
+                        pose,
+                    });
+                    continue;
+                }
                 Err(_) => {
                     // Every pair's support was checked when the cell was built.
                     log::error!("parry cannot test {} against {}", s.name, o.name);
+                    *known = None;
                     continue;
                 }
             };

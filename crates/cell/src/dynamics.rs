@@ -120,3 +120,49 @@ pub fn inverse_dynamics(
         }
     }
 }
+
+/// Diagonal of the joint-space mass matrix `M(q)` of the rigid bodies (without armature), in
+/// kg or kg m².
+///
+/// From the kinetic energy, `M(q) = Σ_b (m_b J_v,bᵀ J_v,b + J_ω,bᵀ I_b J_ω,b)` (Siciliano,
+/// Sciavicco, Villani, Oriolo, *Robotics: Modelling, Planning and Control*, 2009, eq. 7.32),
+/// with the geometric Jacobian columns of joint `j` at body `b`'s centre of mass
+/// (ibid., eq. 3.30): `J_v = a_j × (c_b − o_j)`, `J_ω = a_j` for a revolute joint and
+/// `J_v = a_j`, `J_ω = 0` for a prismatic one, for every body `b` that joint `j` moves. The
+/// diagonal entry is `Σ_b m_b |J_v|² + J_ωᵀ I_b J_ω`: the same numbers as
+/// [`inverse_dynamics`] with a unit acceleration of joint `j` and no velocity or gravity
+/// (Walker and Orin's method 1), in one pass instead of one per joint.
+///
+/// # Arguments
+/// * `chain` - the bodies.
+/// * `q` - joint positions (model order).
+/// * `ws` - scratch buffers.
+/// * `out` - output, one entry per joint.
+///
+/// # Performance
+/// O(joints × depth), no allocation once `ws` has grown.
+pub fn mass_diagonal(chain: &Chain, q: &[f64], ws: &mut Workspace, out: &mut [f64]) {
+    chain.body_poses(q, &mut ws.poses);
+    out.iter_mut().for_each(|m| *m = 0.0);
+    for (b, body) in chain.joints.iter().enumerate() {
+        let pose = &ws.poses[b];
+        let m = &body.mass;
+        let centre = pose * nalgebra::Point3::from(m.com);
+        let r = pose.rotation.to_rotation_matrix();
+        let inertia = r * m.inertia * r.transpose();
+        let mut j = Some(b);
+        while let Some(k) = j {
+            let joint = &chain.joints[k];
+            let frame = &ws.poses[k];
+            let axis = frame.rotation * joint.axis.into_inner();
+            out[k] += match joint.kind {
+                JointKind::Revolute => {
+                    let v = axis.cross(&(centre.coords - frame.translation.vector));
+                    m.mass * v.norm_squared() + axis.dot(&(inertia * axis))
+                }
+                JointKind::Prismatic => m.mass * axis.norm_squared(),
+            };
+            j = joint.parent;
+        }
+    }
+}

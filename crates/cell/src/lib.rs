@@ -12,9 +12,11 @@
 //! | [`inertia`] | the mass sidecar of a URDF without `<inertial>` |
 //! | [`chain`] | URDF links merged into rigid bodies (the converter to rapier) |
 //! | [`world`] | the rapier multibody |
-//! | [`dynamics`] | recursive Newton-Euler inverse dynamics (feed-forward, gains) |
+//! | [`dynamics`] | recursive Newton-Euler inverse dynamics (feed-forward), mass-matrix diagonal (gains) |
 //! | [`geometry`] | parry shapes of robot and scene |
 //! | [`contact`] | contacts by distance threshold, allowances for standoff and engagement |
+//! | [`motion`] | how far a shape can have moved: pairs skipped while their clearance holds |
+//! | [`mesh_contact`] | a shape against a triangle mesh, triangles deepest-first, pruned by plane |
 //! | [`settings`] | mode, rates, servo bandwidth |
 //! | [`cell`] | [`Cell`], the lock-step of control and physics |
 
@@ -27,11 +29,13 @@ pub mod error;
 pub mod geometry;
 pub mod hermite;
 pub mod inertia;
+pub mod mesh_contact;
+pub mod motion;
 pub mod settings;
 pub mod world;
 
 pub use cell::{load_robot, Cell, CellState};
 pub use config::CellFile;
-pub use contact::Contact;
+pub use contact::{Contact, QueryCounts};
 pub use error::CellError;
 pub use settings::{CellSettings, Mode};
