@@ -163,13 +163,7 @@ impl SimCell {
 
 impl Drop for SimCell {
     fn drop(&mut self) {
-        self.stop.stop();
-        if let Some(h) = self.executor.take() {
-            let r = h.join().expect("executor thread");
-            if !std::thread::panicking() {
-                r.expect("executor ended cleanly");
-            }
-        }
+        support::stop_and_join(&self.stop, &mut self.executor);
     }
 }
 

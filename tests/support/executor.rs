@@ -49,3 +49,18 @@ pub fn initial_positions(q: &[f64]) -> String {
     let q: Vec<String> = q.iter().map(|v| format!("{v:?}")).collect();
     format!("initial_positions:=[{}]", q.join(", "))
 }
+
+/// Stops an executor started by [`spawn_robot_executor`] and joins its thread: for the `Drop`
+/// of a test's cell, whose nodes must still be dropped before their Contexts afterwards (the
+/// fields keep their order). Panics if the executor ended with an error, unless the test is
+/// already panicking.
+#[allow(dead_code)] // not every crate including this module needs it
+pub fn stop_and_join(stop: &StopToken, executor: &mut Option<JoinHandle<Result<(), String>>>) {
+    stop.stop();
+    if let Some(h) = executor.take() {
+        let r = h.join().expect("executor thread");
+        if !std::thread::panicking() {
+            r.expect("executor ended cleanly");
+        }
+    }
+}

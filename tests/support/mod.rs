@@ -28,7 +28,7 @@ mod take;
 
 #[allow(unused_imports)] // not every crate including this module needs all of them
 pub use {
-    executor::{initial_positions, spawn_executor, spawn_robot_executor},
+    executor::{initial_positions, spawn_executor, spawn_robot_executor, stop_and_join},
     motion::{
         assert_rests_at, assert_starts_at, drain_statuses, executor_input, largest_step, off_plan,
         watch_cell, watch_executor,
