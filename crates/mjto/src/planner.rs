@@ -42,6 +42,7 @@ use crate::rotary::JerkFactor;
 use crate::timelaw::TimeLaw;
 use crate::{CutPlan, CutRequest, LaserMachine, PlanError};
 
+mod corridor;
 mod dense_check;
 mod feed;
 mod iteration;

@@ -200,7 +200,7 @@ impl Context<'_> {
     ) -> Result<Iterate, PlanError> {
         let limits = self.limits();
         let t = Instant::now();
-        let mut rotary = Vec::with_capacity(2);
+        let mut rotary: Vec<BSpline> = Vec::with_capacity(2);
         for (k, name) in [(3usize, "q4"), (4usize, "q5")] {
             self.budget.check("the rotary-axis QPs")?;
             let a = k - 3;
@@ -213,6 +213,11 @@ impl Context<'_> {
                 .iter()
                 .filter_map(|r| r.bounds.map(|b| (r.u, b.lo[a], b.hi[a])))
                 .collect();
+            // q5's corridor follows the q4 just chosen (kerf, planner/corridor.rs).
+            let corridor = match (k, rotary.first()) {
+                (4, Some(q4)) if self.corridor_on() => self.q5_corridor(q4, rtos),
+                _ => Vec::new(),
+            };
             let problem = RotaryQp {
                 axis_name: name,
                 knots,
@@ -223,8 +228,10 @@ impl Context<'_> {
                 boundary: [0.0; 4],
                 via: &via,
                 via_box: &via_box,
+                corridor: &corridor,
+                free_end_slopes: false,
             };
-            let coeffs = super::feed::rotary_coefficients(&problem, self.request.options.feed_law)?;
+            let coeffs = self.allowance_coefficients(&problem)?;
             rotary.push(BSpline::new(knots.clone(), coeffs).map_err(bspline_error)?);
         }
         times.rotary_qp += t.elapsed().as_secs_f64();
@@ -327,3 +334,4 @@ impl Context<'_> {
         Ok(s)
     }
 }
+

@@ -1,0 +1,226 @@
+//! The lead/tilt allowance as a corridor of the q5 QP along the whole cut (kerf, issue 16
+//! item 3; `options.orientation_corridor: allowance`).
+//!
+//! Seed 001 constrains the rotary splines only at the RTOs (eq. 57-60); between them the
+//! jerk-minimal spline is free, and the lead/tilt tolerance of Table 1 is checked on the
+//! dense samples afterwards. Where the nominal axis turns fast (a tube saddle through the
+//! vertical) the free spline cuts the corner outside the allowance, the dense check inserts
+//! RTOs there, and the inserted grid picks pin q5 to the nominal tilt, whose jerk then holds
+//! the feed (saddle r/R 0.4: 8.95 of 10 m/min, BENCHMARKS.md). With the corridor, the q5 QP
+//! gets, at every CL point that is not an RTO, the interval of q5 whose tool axis (with the
+//! q4 the q4 QP chose) is inside the allowance: the QP itself then chooses the least-jerk
+//! tilt inside the lead/tilt-feasible set along the whole cut, e.g. a fraction of the nominal
+//! tilt, as a hand-made plan does.
+//!
+//! # The interval
+//!
+//! With q4 fixed, `O(q5) = cos q5 ẑ + sin q5 e`, `e = (cos q4, sin q4, 0)` (eq. 2): a great
+//! circle. The allowance `|lead| ≤ φ_max, |tilt| ≤ ϕ_max` is the intersection of four
+//! half-spaces through the origin (`O·t ≤ tan φ_max O·n`, ...), a convex spherical polygon
+//! around the nominal axis n; its intersection with a great circle is one arc. So the
+//! interval is found by bisection outward from the point of the circle nearest to n,
+//! `q5* = atan2(n·e, n·ẑ)`, each side to [`BISECTION_TOLERANCE`].
+
+use kerf_bspline::BSpline;
+use nalgebra::Vector3;
+
+use super::feed::rotary_coefficients;
+use super::{Context, RtoState};
+use crate::kinematics::tool_axis;
+use crate::optimal_feed::FeedMode;
+use crate::request::OrientationCorridor;
+use crate::rotary::RotaryQp;
+use crate::PlanError;
+
+/// Fraction of the lead/tilt allowance the corridor gives the q5 QP (kerf). The corridor
+/// holds at the CL points only; the spline between them moves by O(h²·q5'') more, and the
+/// dense check of every Δt sample stays the arbiter (a sample outside the allowance still
+/// inserts an RTO there).
+pub const CORRIDOR_FRACTION: f64 = 0.98;
+
+/// Width of the bracket at which the bisection of an interval end stops (rad).
+pub const BISECTION_TOLERANCE: f64 = 1e-9;
+
+/// The interval of q5 whose tool axis `tool_axis(q4, q5)` is inside the allowance.
+///
+/// # Arguments
+/// * `q4` - the C-axis angle (rad).
+/// * `n` - the nominal unit tool axis.
+/// * `inside` - whether a tool axis is inside the allowance (convex around `n`, see the
+///   module documentation).
+/// * `stroke` - the q5 stroke `(min, max)` (rad).
+///
+/// # Returns
+/// `Some((lo, hi))` inside the stroke, or `None` when no q5 with this q4 is inside the
+/// allowance (or within the stroke).
+pub fn tilt_interval(
+    q4: f64,
+    n: &Vector3<f64>,
+    inside: &dyn Fn(&Vector3<f64>) -> bool,
+    stroke: (f64, f64),
+) -> Option<(f64, f64)> {
+    let e = Vector3::new(q4.cos(), q4.sin(), 0.0);
+    let centre = n.dot(&e).atan2(n.z);
+    let ok = |q5: f64| inside(&tool_axis(q4, q5));
+    if !centre.is_finite() || !ok(centre) {
+        return None;
+    }
+    // Past a quarter turn from the centre O·n ≤ 0: outside any allowance below π/2.
+    let end = |direction: f64| {
+        let (mut good, mut bad) = (centre, centre + direction * std::f64::consts::FRAC_PI_2);
+        if ok(bad) {
+            return bad;
+        }
+        while (bad - good).abs() > BISECTION_TOLERANCE {
+            let mid = 0.5 * (good + bad);
+            if ok(mid) {
+                good = mid;
+            } else {
+                bad = mid;
+            }
+        }
+        good
+    };
+    let (lo, hi) = (end(-1.0).max(stroke.0), end(1.0).min(stroke.1));
+    (lo <= hi).then_some((lo, hi))
+}
+
+impl Context<'_> {
+    /// Whether the request asks for the allowance corridor (`options.orientation_corridor`).
+    pub(super) fn corridor_on(&self) -> bool {
+        self.request.options.orientation_corridor == OrientationCorridor::Allowance
+    }
+
+    /// The coefficients of one rotary QP under `options.orientation_corridor`.
+    ///
+    /// * `none` (seed 001): [`rotary_coefficients`] of `problem` as given.
+    /// * `allowance` (kerf): with the time-optimal law, the problem with seed 001's zero end
+    ///   slopes (eq. 45) when it is feasible at the requested feedrate, else with free end
+    ///   slopes ([`RotaryQp::free_end_slopes`]; still infeasible: the feedrate bisection of
+    ///   [`rotary_coefficients`]). A problem whose corridor makes it infeasible for another
+    ///   reason than its kinematic bounds (the corridor against an RTO's box or pick next to
+    ///   it: both are inside the allowance, the corridor inside [`CORRIDOR_FRACTION`] of it
+    ///   with the q4 of the spline) is solved again without the corridor, as seed 001's; the
+    ///   dense check then inserts RTOs where the allowance is left.
+    ///
+    /// # Errors
+    /// As [`rotary_coefficients`].
+    pub(super) fn allowance_coefficients(&self, problem: &RotaryQp) -> Result<Vec<f64>, PlanError> {
+        let mode = self.request.options.feed_law;
+        if !self.corridor_on() {
+            return rotary_coefficients(problem, mode);
+        }
+        match end_slopes_as_needed(problem, mode) {
+            Err(PlanError::Infeasible { family, detail, .. }) if !problem.corridor.is_empty() => {
+                log::debug!(
+                    "{} QP infeasible with the allowance corridor ({family}: {detail}); solved without it",
+                    problem.axis_name
+                );
+                let free = RotaryQp {
+                    corridor: &[],
+                    ..*problem
+                };
+                end_slopes_as_needed(&free, mode)
+            }
+            other => other,
+        }
+    }
+
+    /// The q5 corridor `(u_i, lo_i, hi_i)` at every CL point that is not an RTO, given the
+    /// q4 spline: [`tilt_interval`] inside [`CORRIDOR_FRACTION`] of the lead and tilt
+    /// allowance. A CL point with no such q5 (q4 far from the nominal there) has no row;
+    /// the dense check covers it.
+    pub(super) fn q5_corridor(&self, q4: &BSpline, rtos: &[RtoState]) -> Vec<(f64, f64, f64)> {
+        let r = self.request;
+        let (max_lead, max_tilt) = (
+            r.max_lead_angle * CORRIDOR_FRACTION,
+            r.max_tilt_angle * CORRIDOR_FRACTION,
+        );
+        let stroke = {
+            let l = self.limits()[4];
+            (l.min, l.max)
+        };
+        let mut out = Vec::with_capacity(self.v.u.len());
+        for (i, &u) in self.v.u.iter().enumerate() {
+            if rtos.iter().any(|rto| rto.cl_index == i) {
+                continue;
+            }
+            let inside = |o: &Vector3<f64>| {
+                let (lead, tilt) = self.frames.lead_tilt_at(i, o);
+                lead.abs() <= max_lead && tilt.abs() <= max_tilt
+            };
+            if let Some((lo, hi)) = tilt_interval(q4.eval(u)[0], &self.v.axes[i], &inside, stroke)
+            {
+                out.push((u, lo, hi));
+            }
+        }
+        out
+    }
+}
+
+/// With the time-optimal law: zero end slopes (seed 001 eq. 45) when the problem is feasible
+/// so at the requested feedrate, else free ones (see [`Context::allowance_coefficients`]).
+/// With the constant law the end slopes stay zero: its S-curve ramps run at the request's path
+/// jerk, which a nonzero `q_u` would turn into joint jerk (`q_u s⃛ / σ`, eq. 7).
+fn end_slopes_as_needed(problem: &RotaryQp, mode: FeedMode) -> Result<Vec<f64>, PlanError> {
+    if mode == FeedMode::Constant {
+        return rotary_coefficients(problem, mode);
+    }
+    if let Some(coeffs) = problem.try_solve()? {
+        return Ok(coeffs);
+    }
+    let free = RotaryQp {
+        free_end_slopes: true,
+        ..*problem
+    };
+    rotary_coefficients(&free, mode)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A lead/tilt box around n = ẑ with t = x̂, b = ŷ.
+    fn around_z(max_lead: f64, max_tilt: f64) -> impl Fn(&Vector3<f64>) -> bool {
+        move |o: &Vector3<f64>| {
+            o.x.atan2(o.z).abs() <= max_lead && o.y.atan2(o.z).abs() <= max_tilt
+        }
+    }
+
+    #[test]
+    fn interval_in_the_lead_plane_is_the_lead_allowance() {
+        // q4 = 0: q5 tilts the axis toward x̂ = t, the lead plane.
+        let (lo, hi) = tilt_interval(0.0, &Vector3::z(), &around_z(0.2, 0.1), (-1.0, 1.0)).unwrap();
+        assert!((lo + 0.2).abs() < 1e-8 && (hi - 0.2).abs() < 1e-8, "{lo} {hi}");
+        // q4 = π/2: toward ŷ = b, the tilt plane.
+        let (lo, hi) = tilt_interval(
+            std::f64::consts::FRAC_PI_2,
+            &Vector3::z(),
+            &around_z(0.2, 0.1),
+            (-1.0, 1.0),
+        )
+        .unwrap();
+        assert!((lo + 0.1).abs() < 1e-8 && (hi - 0.1).abs() < 1e-8, "{lo} {hi}");
+    }
+
+    #[test]
+    fn interval_is_centred_on_the_nearest_point_and_cut_by_the_stroke() {
+        // n tilted by 0.5 rad toward x̂; lead measured from n: the interval is 0.5 ± 0.2.
+        let n = tool_axis(0.0, 0.5);
+        let t = tool_axis(0.0, 0.5 + std::f64::consts::FRAC_PI_2);
+        let inside = move |o: &Vector3<f64>| o.dot(&t).atan2(o.dot(&n)).abs() <= 0.2;
+        let (lo, hi) = tilt_interval(0.0, &n, &inside, (-1.0, 1.0)).unwrap();
+        assert!((lo - 0.3).abs() < 1e-8 && (hi - 0.7).abs() < 1e-8, "{lo} {hi}");
+        let (lo, hi) = tilt_interval(0.0, &n, &inside, (-1.0, 0.6)).unwrap();
+        assert!((lo - 0.3).abs() < 1e-8 && hi == 0.6, "{lo} {hi}");
+        assert!(tilt_interval(0.0, &n, &inside, (-1.0, 0.2)).is_none());
+    }
+
+    #[test]
+    fn no_interval_when_q4_leaves_no_q5_inside() {
+        // n tilted 0.5 rad toward x̂, q4 a quarter turn off: the circle passes 0.5 rad away.
+        let n = tool_axis(0.0, 0.5);
+        let inside = move |o: &Vector3<f64>| o.angle(&n) <= 0.2;
+        assert!(tilt_interval(std::f64::consts::FRAC_PI_2, &n, &inside, (-1.0, 1.0)).is_none());
+    }
+}
