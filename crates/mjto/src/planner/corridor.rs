@@ -38,6 +38,13 @@ use crate::PlanError;
 /// inserts an RTO there).
 pub const CORRIDOR_FRACTION: f64 = 0.98;
 
+/// Most active-set rounds of the q5 corridor per QP ([`Context::rotary_in_allowance`]).
+pub const CORRIDOR_ROUNDS: usize = 6;
+
+/// CL points on each side of a point outside the allowance that get a corridor row with it
+/// (the solution moves its excess to the neighbours otherwise, one round each).
+pub const CORRIDOR_PAD: usize = 3;
+
 /// Width of the bracket at which the bisection of an interval end stops (rad).
 pub const BISECTION_TOLERANCE: f64 = 1e-9;
 
@@ -93,73 +100,113 @@ impl Context<'_> {
 
     /// The coefficients of one rotary QP under `options.orientation_corridor`.
     ///
-    /// * `none` (seed 001): [`rotary_coefficients`] of `problem` as given.
-    /// * `allowance` (kerf): with the time-optimal law, the problem with seed 001's zero end
-    ///   slopes (eq. 45) when it is feasible at the requested feedrate, else with free end
-    ///   slopes ([`RotaryQp::free_end_slopes`]; still infeasible: the feedrate bisection of
-    ///   [`rotary_coefficients`]). A problem whose corridor makes it infeasible for another
-    ///   reason than its kinematic bounds (the corridor against an RTO's box or pick next to
-    ///   it: both are inside the allowance, the corridor inside [`CORRIDOR_FRACTION`] of it
-    ///   with the q4 of the spline) is solved again without the corridor, as seed 001's; the
-    ///   dense check then inserts RTOs where the allowance is left.
+    /// # Arguments
+    /// * `problem` - the QP of seed 001 (eq. 61, with kerf's RTO boxes), without corridor.
+    /// * `q4` - for the q5 QP, the q4 spline just chosen; `None` for the q4 QP.
+    /// * `rtos` - the RTOs (their CL points get no corridor row: their box or pick is there).
+    ///
+    /// # Returns
+    /// * `none` (seed 001): [`rotary_coefficients`] of `problem`.
+    /// * `allowance` (kerf): with the time-optimal law, zero end slopes (eq. 45) when the
+    ///   problem is feasible so at the requested feedrate, else free ones
+    ///   ([`RotaryQp::free_end_slopes`]; still infeasible: the feedrate bisection of
+    ///   [`rotary_coefficients`]). For q5, the corridor is added by active sets: the CL points
+    ///   whose axis is outside [`CORRIDOR_FRACTION`] of the allowance get their interval
+    ///   ([`tilt_interval`]) as a row, [`CORRIDOR_PAD`] points on each side of each run too, and
+    ///   the QP is solved again, at most [`CORRIDOR_ROUNDS`] times. A solution inside every
+    ///   interval is the optimum of the QP with the whole corridor (a convex problem whose
+    ///   relaxation's optimum is feasible), at the cost of the rows that bind, not of one row
+    ///   per CL point (case 2: 628). A corridor that makes the QP infeasible for another reason
+    ///   than its kinematic bounds (against an RTO's box or pick next to it: both inside the
+    ///   allowance, the corridor inside [`CORRIDOR_FRACTION`] of it with the q4 of the spline)
+    ///   is dropped, as seed 001; the dense check then inserts RTOs where the allowance is left.
     ///
     /// # Errors
     /// As [`rotary_coefficients`].
-    pub(super) fn allowance_coefficients(&self, problem: &RotaryQp) -> Result<Vec<f64>, PlanError> {
+    pub(super) fn rotary_in_allowance(
+        &self,
+        problem: &RotaryQp,
+        q4: Option<&BSpline>,
+        rtos: &[RtoState],
+    ) -> Result<Vec<f64>, PlanError> {
         let mode = self.request.options.feed_law;
         if !self.corridor_on() {
             return rotary_coefficients(problem, mode);
         }
-        match end_slopes_as_needed(problem, mode) {
-            Err(PlanError::Infeasible { family, detail, .. }) if !problem.corridor.is_empty() => {
-                log::debug!(
-                    "{} QP infeasible with the allowance corridor ({family}: {detail}); solved without it",
-                    problem.axis_name
-                );
-                let free = RotaryQp {
-                    corridor: &[],
-                    ..*problem
-                };
-                end_slopes_as_needed(&free, mode)
-            }
-            other => other,
-        }
-    }
-
-    /// The q5 corridor `(u_i, lo_i, hi_i)` at every CL point that is not an RTO, given the
-    /// q4 spline: [`tilt_interval`] inside [`CORRIDOR_FRACTION`] of the lead and tilt
-    /// allowance. A CL point with no such q5 (q4 far from the nominal there) has no row;
-    /// the dense check covers it.
-    pub(super) fn q5_corridor(&self, q4: &BSpline, rtos: &[RtoState]) -> Vec<(f64, f64, f64)> {
+        let mut coeffs = end_slopes_as_needed(problem, mode)?;
+        let Some(q4) = q4 else {
+            return Ok(coeffs);
+        };
         let r = self.request;
         let (max_lead, max_tilt) = (
             r.max_lead_angle * CORRIDOR_FRACTION,
             r.max_tilt_angle * CORRIDOR_FRACTION,
         );
+        let inside = |i: usize, o: &Vector3<f64>| {
+            let (lead, tilt) = self.frames.lead_tilt_at(i, o);
+            lead.abs() <= max_lead && tilt.abs() <= max_tilt
+        };
         let stroke = {
             let l = self.limits()[4];
             (l.min, l.max)
         };
-        let mut out = Vec::with_capacity(self.v.u.len());
-        for (i, &u) in self.v.u.iter().enumerate() {
-            if rtos.iter().any(|rto| rto.cl_index == i) {
-                continue;
+        let n = self.v.u.len();
+        let q4_at: Vec<f64> = self.v.u.iter().map(|&u| q4.eval(u)[0]).collect();
+        let mut free: Vec<bool> = (0..n)
+            .map(|i| !rtos.iter().any(|rto| rto.cl_index == i))
+            .collect();
+        let mut rows: Vec<(f64, f64, f64)> = Vec::new();
+        for _ in 0..CORRIDOR_ROUNDS {
+            let q5 = BSpline::new(problem.knots.clone(), coeffs.clone())
+                .map_err(super::bspline_error)?;
+            let outside: Vec<usize> = (0..n)
+                .filter(|&i| {
+                    free[i] && !inside(i, &tool_axis(q4_at[i], q5.eval(self.v.u[i])[0]))
+                })
+                .collect();
+            let mut added = 0;
+            for &i in &outside {
+                for k in i.saturating_sub(CORRIDOR_PAD)..=(i + CORRIDOR_PAD).min(n - 1) {
+                    if !free[k] {
+                        continue;
+                    }
+                    free[k] = false;
+                    let inside_k = |o: &Vector3<f64>| inside(k, o);
+                    if let Some((lo, hi)) =
+                        tilt_interval(q4_at[k], &self.v.axes[k], &inside_k, stroke)
+                    {
+                        rows.push((self.v.u[k], lo, hi));
+                        added += 1;
+                    }
+                }
             }
-            let inside = |o: &Vector3<f64>| {
-                let (lead, tilt) = self.frames.lead_tilt_at(i, o);
-                lead.abs() <= max_lead && tilt.abs() <= max_tilt
+            if added == 0 {
+                break;
+            }
+            rows.sort_by(|a, b| a.0.total_cmp(&b.0));
+            let with = RotaryQp {
+                corridor: &rows,
+                ..*problem
             };
-            if let Some((lo, hi)) = tilt_interval(q4.eval(u)[0], &self.v.axes[i], &inside, stroke)
-            {
-                out.push((u, lo, hi));
+            self.budget.check("the rotary-axis QPs")?;
+            match end_slopes_as_needed(&with, mode) {
+                Ok(c) => coeffs = c,
+                Err(PlanError::Infeasible { family, detail, .. }) => {
+                    log::debug!(
+                        "{} QP infeasible with the allowance corridor ({family}: {detail}); solved without it",
+                        problem.axis_name
+                    );
+                    return end_slopes_as_needed(problem, mode);
+                }
+                Err(e) => return Err(e),
             }
         }
-        out
+        Ok(coeffs)
     }
 }
 
 /// With the time-optimal law: zero end slopes (seed 001 eq. 45) when the problem is feasible
-/// so at the requested feedrate, else free ones (see [`Context::allowance_coefficients`]).
+/// so at the requested feedrate, else free ones (see [`Context::rotary_in_allowance`]).
 /// With the constant law the end slopes stay zero: its S-curve ramps run at the request's path
 /// jerk, which a nonzero `q_u` would turn into joint jerk (`q_u s⃛ / σ`, eq. 7).
 fn end_slopes_as_needed(problem: &RotaryQp, mode: FeedMode) -> Result<Vec<f64>, PlanError> {

@@ -213,11 +213,6 @@ impl Context<'_> {
                 .iter()
                 .filter_map(|r| r.bounds.map(|b| (r.u, b.lo[a], b.hi[a])))
                 .collect();
-            // q5's corridor follows the q4 just chosen (kerf, planner/corridor.rs).
-            let corridor = match (k, rotary.first()) {
-                (4, Some(q4)) if self.corridor_on() => self.q5_corridor(q4, rtos),
-                _ => Vec::new(),
-            };
             let problem = RotaryQp {
                 axis_name: name,
                 knots,
@@ -228,10 +223,11 @@ impl Context<'_> {
                 boundary: [0.0; 4],
                 via: &via,
                 via_box: &via_box,
-                corridor: &corridor,
+                corridor: &[],
                 free_end_slopes: false,
             };
-            let coeffs = self.allowance_coefficients(&problem)?;
+            // q5's corridor follows the q4 just chosen (kerf, planner/corridor.rs).
+            let coeffs = self.rotary_in_allowance(&problem, rotary.first(), rtos)?;
             rotary.push(BSpline::new(knots.clone(), coeffs).map_err(bspline_error)?);
         }
         times.rotary_qp += t.elapsed().as_secs_f64();
