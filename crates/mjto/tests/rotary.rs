@@ -746,7 +746,10 @@ fn corridor_rows_hold_at_their_points_and_zero_end_slopes_cost_jerk() {
         let spline = BSpline::new(knots.clone(), theta).unwrap();
         for &(u, lo, hi) in &corridor {
             let q = spline.eval(u)[0];
-            assert!(q >= lo - 1e-7 && q <= hi + 1e-7, "q({u}) = {q} outside [{lo}, {hi}]");
+            assert!(
+                q >= lo - 1e-7 && q <= hi + 1e-7,
+                "q({u}) = {q} outside [{lo}, {hi}]"
+            );
         }
         let d0 = spline.eval(0.0);
         let d1 = spline.eval(1.0);
@@ -779,7 +782,10 @@ fn corridor_rows_hold_at_their_points_and_zero_end_slopes_cost_jerk() {
         free_end_slopes: true,
         ..fast
     };
-    let theta = fast_free.try_solve().unwrap().expect("feasible with free end slopes");
+    let theta = fast_free
+        .try_solve()
+        .unwrap()
+        .expect("feasible with free end slopes");
     assert!(peak_jerk(theta, &fast_free) <= q5.jerk * (1.0 + 1e-6));
 }
 

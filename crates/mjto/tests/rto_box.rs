@@ -506,13 +506,18 @@ fn the_corridor_option_parses_defaults_to_allowance_and_refuses_other_text() {
                 feedrate: 0.3\nsample_period: 0.01\nmax_lead_angle: 0.1\n\
                 max_tilt_angle: 0.1\nmesh: m.stl\n";
     let r = CutRequest::from_yaml(base).unwrap();
-    assert_eq!(r.options.orientation_corridor, OrientationCorridor::Allowance);
+    assert_eq!(
+        r.options.orientation_corridor,
+        OrientationCorridor::Allowance
+    );
     for (text, want) in [
         ("none", OrientationCorridor::None),
         ("allowance", OrientationCorridor::Allowance),
     ] {
-        let r = CutRequest::from_yaml(&format!("{base}options: {{orientation_corridor: {text}}}\n"))
-            .unwrap();
+        let r = CutRequest::from_yaml(&format!(
+            "{base}options: {{orientation_corridor: {text}}}\n"
+        ))
+        .unwrap();
         assert_eq!(r.options.orientation_corridor, want);
         assert_eq!(OrientationCorridor::parse(text).unwrap(), want);
         assert_eq!(want.as_str(), text);
@@ -526,7 +531,13 @@ fn the_corridor_option_parses_defaults_to_allowance_and_refuses_other_text() {
             .unwrap_err();
         assert!(e.to_string().contains("orientation_corridor"), "{bad}: {e}");
         let e = OrientationCorridor::parse(bad).unwrap_err();
-        assert!(e.to_string().contains("options.orientation_corridor"), "{e}");
+        assert!(
+            e.to_string().contains("options.orientation_corridor"),
+            "{e}"
+        );
     }
-    assert_eq!(OrientationCorridor::parse("").unwrap(), OrientationCorridor::Allowance);
+    assert_eq!(
+        OrientationCorridor::parse("").unwrap(),
+        OrientationCorridor::Allowance
+    );
 }

@@ -524,7 +524,10 @@ mod tests {
         m.orientation_corridor = "off".into();
         let e = request_from_msg(&m).unwrap_err();
         assert_eq!(e.status(), status::INVALID_REQUEST);
-        assert!(e.to_string().contains("options.orientation_corridor"), "{e}");
+        assert!(
+            e.to_string().contains("options.orientation_corridor"),
+            "{e}"
+        );
     }
 
     #[test]

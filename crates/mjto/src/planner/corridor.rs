@@ -160,9 +160,7 @@ impl Context<'_> {
             let q5 = BSpline::new(problem.knots.clone(), coeffs.clone())
                 .map_err(super::bspline_error)?;
             let outside: Vec<usize> = (0..n)
-                .filter(|&i| {
-                    free[i] && !inside(i, &tool_axis(q4_at[i], q5.eval(self.v.u[i])[0]))
-                })
+                .filter(|&i| free[i] && !inside(i, &tool_axis(q4_at[i], q5.eval(self.v.u[i])[0])))
                 .collect();
             let mut added = 0;
             for &i in &outside {
@@ -229,16 +227,17 @@ mod tests {
 
     /// A lead/tilt box around n = ẑ with t = x̂, b = ŷ.
     fn around_z(max_lead: f64, max_tilt: f64) -> impl Fn(&Vector3<f64>) -> bool {
-        move |o: &Vector3<f64>| {
-            o.x.atan2(o.z).abs() <= max_lead && o.y.atan2(o.z).abs() <= max_tilt
-        }
+        move |o: &Vector3<f64>| o.x.atan2(o.z).abs() <= max_lead && o.y.atan2(o.z).abs() <= max_tilt
     }
 
     #[test]
     fn interval_in_the_lead_plane_is_the_lead_allowance() {
         // q4 = 0: q5 tilts the axis toward x̂ = t, the lead plane.
         let (lo, hi) = tilt_interval(0.0, &Vector3::z(), &around_z(0.2, 0.1), (-1.0, 1.0)).unwrap();
-        assert!((lo + 0.2).abs() < 1e-8 && (hi - 0.2).abs() < 1e-8, "{lo} {hi}");
+        assert!(
+            (lo + 0.2).abs() < 1e-8 && (hi - 0.2).abs() < 1e-8,
+            "{lo} {hi}"
+        );
         // q4 = π/2: toward ŷ = b, the tilt plane.
         let (lo, hi) = tilt_interval(
             std::f64::consts::FRAC_PI_2,
@@ -247,7 +246,10 @@ mod tests {
             (-1.0, 1.0),
         )
         .unwrap();
-        assert!((lo + 0.1).abs() < 1e-8 && (hi - 0.1).abs() < 1e-8, "{lo} {hi}");
+        assert!(
+            (lo + 0.1).abs() < 1e-8 && (hi - 0.1).abs() < 1e-8,
+            "{lo} {hi}"
+        );
     }
 
     #[test]
@@ -257,7 +259,10 @@ mod tests {
         let t = tool_axis(0.0, 0.5 + std::f64::consts::FRAC_PI_2);
         let inside = move |o: &Vector3<f64>| o.dot(&t).atan2(o.dot(&n)).abs() <= 0.2;
         let (lo, hi) = tilt_interval(0.0, &n, &inside, (-1.0, 1.0)).unwrap();
-        assert!((lo - 0.3).abs() < 1e-8 && (hi - 0.7).abs() < 1e-8, "{lo} {hi}");
+        assert!(
+            (lo - 0.3).abs() < 1e-8 && (hi - 0.7).abs() < 1e-8,
+            "{lo} {hi}"
+        );
         let (lo, hi) = tilt_interval(0.0, &n, &inside, (-1.0, 0.6)).unwrap();
         assert!((lo - 0.3).abs() < 1e-8 && hi == 0.6, "{lo} {hi}");
         assert!(tilt_interval(0.0, &n, &inside, (-1.0, 0.2)).is_none());

@@ -330,4 +330,3 @@ impl Context<'_> {
         Ok(s)
     }
 }
-
