@@ -1,16 +1,24 @@
 //! The lead/tilt allowance as a corridor of the q5 QP along the whole cut (kerf, issue 16
 //! item 3; `options.orientation_corridor: allowance`).
 //!
-//! Seed 001 constrains the rotary splines only at the RTOs (eq. 57-60); between them the
-//! jerk-minimal spline is free, and the lead/tilt tolerance of Table 1 is checked on the
-//! dense samples afterwards. Where the nominal axis turns fast (a tube saddle through the
-//! vertical) the free spline cuts the corner outside the allowance, the dense check inserts
-//! RTOs there, and the inserted grid picks pin q5 to the nominal tilt, whose jerk then holds
-//! the feed (saddle r/R 0.4: 8.95 of 10 m/min, BENCHMARKS.md). With the corridor, the q5 QP
-//! gets, at every CL point that is not an RTO, the interval of q5 whose tool axis (with the
-//! q4 the q4 QP chose) is inside the allowance: the QP itself then chooses the least-jerk
-//! tilt inside the lead/tilt-feasible set along the whole cut, e.g. a fraction of the nominal
-//! tilt, as a hand-made plan does.
+//! Measured on the tube saddle r/R 0.4 at 10 m/min (a closed loop that starts and ends where
+//! the tool axis passes the vertical, dq5/ds ≈ 20 rad/m there), seed 001's q5 QP peaked at
+//! 8.95 of 10 m/min (BENCHMARKS.md) because of two constraints:
+//! * eq. 45's zero end slopes `q_u(0) = q_u(1) = 0`: q5 starts flat and must catch up with
+//!   the tilt, 323 rad/s³ of jerk at both ends at the constant-feed bounds (Table 2: 200), so
+//!   the QP is infeasible at f and its bounds are relaxed to ~8.5 m/min;
+//! * the allowance is only seen at the RTOs (eq. 57-60): between them the spline left the 10°
+//!   tilt allowance, the dense check inserted an RTO, and the next QP relaxed to 7.15 m/min.
+//!
+//! So, with `allowance`:
+//! * with the time-optimal law a rotary QP infeasible at f with zero end slopes gets free ones
+//!   ([`RotaryQp::free_end_slopes`]): from rest the joint velocity is zero whatever `q_u` is,
+//!   and TOPP3 limits the ramps by the joint jerk `q_u s⃛ / σ` (eq. 7);
+//! * the q5 QP gets, at the CL points between the RTOs where it would leave the allowance, the
+//!   interval of q5 whose tool axis (with the q4 the q4 QP chose) is inside it (active sets,
+//!   [`Context::rotary_in_allowance`]): the QP itself chooses the least-jerk tilt inside the
+//!   lead/tilt-feasible set along the whole cut, e.g. a fraction of the nominal tilt, as a
+//!   hand-made plan does.
 //!
 //! # The interval
 //!
