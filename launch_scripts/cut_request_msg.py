@@ -57,6 +57,7 @@ def main(path):
         "cl_tolerance": o.get("cl_tolerance", 0.0),
         "feed_law": o.get("feed_law", ""),
         "rto_constraint": o.get("rto_constraint", ""),
+        "orientation_corridor": o.get("orientation_corridor", ""),
         "time_budget": r.get("time_budget", 0.0),
     }
     # JSON is valid YAML, and ros2 topic pub reads it on one line.

@@ -4,7 +4,11 @@
 //! cargo bench -p kerf_mjto --bench feed_cases
 //! KERF_PLAN_RUNS=10 cargo bench -p kerf_mjto --bench feed_cases
 //! KERF_CASES=saddle,slot cargo bench -p kerf_mjto --bench feed_cases
+//! KERF_ORIENTATION_CORRIDOR=none cargo bench -p kerf_mjto --bench feed_cases
 //! ```
+//!
+//! `KERF_ORIENTATION_CORRIDOR` (`none` or `allowance`, default the request's default) sets
+//! `options.orientation_corridor` of every request: `none` is seed 001's rotary QPs.
 //!
 //! Per case: the constant feed's outcome (seed 001 eq. 13 with kerf's S-curve ramps on the
 //! sample grid) and its time, the time-optimal law's outcome, cycle time, peak tool-tip feed and
@@ -18,6 +22,7 @@ use std::time::Instant;
 
 use kerf_mjto::optimal_feed::FeedMode;
 use kerf_mjto::planner::Planner;
+use kerf_mjto::request::OrientationCorridor;
 use kerf_mjto::{CutPlan, CutRequest, LaserMachine, PlanError};
 
 fn median(mut v: Vec<f64>) -> f64 {
@@ -88,15 +93,21 @@ fn main() {
             words.iter().any(|w| name.contains(w.as_str()))
         });
     }
+    let corridor = std::env::var("KERF_ORIENTATION_CORRIDOR")
+        .map(|v| OrientationCorridor::parse(&v).expect("KERF_ORIENTATION_CORRIDOR"))
+        .unwrap_or_default();
+    println!("options.orientation_corridor: {}", corridor.as_str());
+    println!();
     let mut planner =
         Planner::new(LaserMachine::default_machine().expect("machine")).expect("planner");
-    println!("| case | σ (m) | f (m/min) | constant feed (seed 001) | time-optimal | peak tip feed (m/min) | feed held by | planning (median of {runs}) |");
-    println!("|---|---|---|---|---|---|---|---|");
+    println!("| case | σ (m) | f (m/min) | constant feed (seed 001) | time-optimal | peak tip feed (m/min) | feed held by | q5 RMS / peak jerk (rad/s³) | iterations | planning (median of {runs}) |");
+    println!("|---|---|---|---|---|---|---|---|---|---|");
     let mut peaks: Vec<(String, CutPlan)> = Vec::new();
     for file in &files {
         let name = file.file_stem().unwrap().to_string_lossy().to_string();
         let text = std::fs::read_to_string(file).expect("case file");
         let mut request = CutRequest::from_yaml(&text).expect("request");
+        request.options.orientation_corridor = corridor;
         let sigma = request.validate().map(|v| v.sigma).unwrap_or(f64::NAN);
         request.options.feed_law = FeedMode::Constant;
         let constant = planner.plan(&request);
@@ -113,7 +124,7 @@ fn main() {
             .map(|p| p.feed.constant_feed_time)
             .unwrap_or(f64::NAN);
         println!(
-            "| {name} | {sigma:.3} | {:.1} | {} (S-curve {constant_time:.3} s) | {} | {} | {} | {:.1} ms |",
+            "| {name} | {sigma:.3} | {:.1} | {} (S-curve {constant_time:.3} s) | {} | {} | {} | {} | {} | {:.1} ms |",
             request.feedrate * 60.0,
             outcome(&constant),
             outcome(&first),
@@ -122,6 +133,17 @@ fn main() {
                 .map(|p| format!("{:.2}", p.feed.peak_feed * 60.0))
                 .unwrap_or_default(),
             first.as_ref().map(held_by).unwrap_or_default(),
+            first
+                .as_ref()
+                .map(|p| format!(
+                    "{:.2} / {:.2}",
+                    p.metrics.rms_jerk[4], p.metrics.peak_jerk[4]
+                ))
+                .unwrap_or_default(),
+            first
+                .as_ref()
+                .map(|p| p.iterations.to_string())
+                .unwrap_or_default(),
             median(wall) * 1e3
         );
         if let Ok(plan) = first {

@@ -6,7 +6,11 @@
 //! ```text
 //! cargo bench -p kerf_mjto --bench rto_box
 //! KERF_PLAN_RUNS=20 cargo bench -p kerf_mjto --bench rto_box
+//! KERF_ORIENTATION_CORRIDOR=none cargo bench -p kerf_mjto --bench rto_box
 //! ```
+//!
+//! `KERF_ORIENTATION_CORRIDOR` (`none` or `allowance`, default the request's default) sets
+//! `options.orientation_corridor` of every request: `none` is seed 001's rotary QPs.
 //!
 //! Prints a markdown table (the one in BENCHMARKS.md). Planning times are
 //! medians over `KERF_PLAN_RUNS` runs (default 10) after one warm-up run.
@@ -16,7 +20,7 @@ use std::path::Path;
 use std::time::Instant;
 
 use kerf_mjto::planner::Planner;
-use kerf_mjto::request::RtoConstraint;
+use kerf_mjto::request::{OrientationCorridor, RtoConstraint};
 use kerf_mjto::{CutRequest, LaserMachine};
 
 #[path = "../tests/common/saddle.rs"]
@@ -51,6 +55,14 @@ fn main() {
         "saddle (rib), 10 m/min".into(),
         geometry.request(&mesh.reference(), 10.0 / 60.0),
     ));
+    let corridor = std::env::var("KERF_ORIENTATION_CORRIDOR")
+        .map(|v| OrientationCorridor::parse(&v).expect("KERF_ORIENTATION_CORRIDOR"))
+        .unwrap_or_default();
+    for (_, r) in &mut requests {
+        r.options.orientation_corridor = corridor;
+    }
+    println!("options.orientation_corridor: {}", corridor.as_str());
+    println!();
     let mut planner =
         Planner::new(LaserMachine::default_machine().expect("machine")).expect("planner");
     println!("| case | RTO constraint | RMS jerk q4 (rad/s³) | RMS jerk q5 | peak jerk q4 | peak jerk q5 | RTOs (inserted) | iterations | collision queries | GFD + selection + boxes | rotary QPs | M-path QP | dense checks | planning time (median of {runs}) |");

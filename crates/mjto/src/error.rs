@@ -23,6 +23,9 @@ pub enum ConstraintFamily {
     Rto,
     /// The standoff stroke of the M-path QP (eq. 54, 62).
     Stroke,
+    /// The lead/tilt allowance corridor of the q5 QP at the CL points (kerf, issue 16 item 3;
+    /// `options.orientation_corridor: allowance`).
+    Allowance,
 }
 
 impl std::fmt::Display for ConstraintFamily {
@@ -35,6 +38,7 @@ impl std::fmt::Display for ConstraintFamily {
             ConstraintFamily::Boundary => "boundary equalities",
             ConstraintFamily::Rto => "RTO equalities",
             ConstraintFamily::Stroke => "standoff stroke",
+            ConstraintFamily::Allowance => "lead/tilt allowance corridor",
         };
         f.write_str(s)
     }

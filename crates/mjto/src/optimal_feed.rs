@@ -182,6 +182,7 @@ pub fn family_word(family: ConstraintFamily) -> &'static str {
         ConstraintFamily::Rto => "RTO",
         ConstraintFamily::Boundary => "boundary",
         ConstraintFamily::Stroke => "stroke",
+        ConstraintFamily::Allowance => "lead/tilt allowance",
     }
 }
 

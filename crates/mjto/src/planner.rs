@@ -26,6 +26,16 @@
 //!   RTO is a box of free, lead/tilt-feasible GFD samples around its pick
 //!   and the QPs choose inside it (`planner/rto_box.rs`); `equality` is the
 //!   paper's.
+//! * with `options.orientation_corridor: allowance` (the default; issue 16
+//!   item 3) the q5 QP also keeps q5 inside the lead/tilt allowance at every
+//!   CL point between the RTOs (with the q4 just chosen), so it minimizes the
+//!   jerk over the feasible orientations of the whole cut, not only at the
+//!   RTOs; and with the time-optimal feed, a rotary QP that is infeasible at
+//!   the requested feedrate with eq. 45's zero end slopes is solved with free
+//!   end slopes (a closed cut that starts where the tool axis passes the
+//!   vertical; the feed ramps then adapt to the joint jerk, item 2)
+//!   (`planner/corridor.rs`). `none` is the paper's. Measured on saddle r/R
+//!   0.4 at 10 m/min: 8.95 → 9.98 m/min peak, 1.111 → 0.966 s (BENCHMARKS.md).
 
 use kerf_budget::Budget;
 use kerf_executor::{check_executable, ExecutorConfig};
@@ -42,6 +52,7 @@ use crate::rotary::JerkFactor;
 use crate::timelaw::TimeLaw;
 use crate::{CutPlan, CutRequest, LaserMachine, PlanError};
 
+mod corridor;
 mod dense_check;
 mod feed;
 mod iteration;

@@ -176,6 +176,51 @@ impl RtoConstraint {
     }
 }
 
+/// Where the rotary QPs see the lead/tilt allowance (kerf, issue 16 item 3).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum OrientationCorridor {
+    /// Seed 001 (eq. 57-61): the rotary splines are constrained only at the RTOs and free
+    /// between them; the allowance is checked on the dense samples afterwards and a sample
+    /// outside it inserts an RTO.
+    None,
+    /// kerf: the q5 QP also keeps q5, at every CL point between the RTOs, inside the
+    /// interval whose tool axis (with the q4 of the q4 QP) is within the lead/tilt
+    /// allowance, so it minimizes the jerk over the feasible orientations of the whole cut
+    /// (`planner/corridor.rs`). Measured: the tube saddle r/R 0.4 at its requested 10 m/min
+    /// instead of 8.95 (BENCHMARKS.md).
+    #[default]
+    Allowance,
+}
+
+impl OrientationCorridor {
+    /// The option from its request spelling: `"none"` or `"allowance"`; the empty string is
+    /// the default ([`OrientationCorridor::Allowance`]).
+    ///
+    /// # Errors
+    /// [`PlanError::InvalidRequest`] (field `options.orientation_corridor`) for any other
+    /// text.
+    pub fn parse(text: &str) -> Result<Self, PlanError> {
+        match text {
+            "" => Ok(Self::default()),
+            "none" => Ok(Self::None),
+            "allowance" => Ok(Self::Allowance),
+            other => Err(PlanError::invalid(
+                "options.orientation_corridor",
+                format!("{other:?} must be \"none\" or \"allowance\""),
+            )),
+        }
+    }
+
+    /// The request spelling.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            Self::None => "none",
+            Self::Allowance => "allowance",
+        }
+    }
+}
+
 /// Planner options.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
@@ -222,6 +267,16 @@ pub struct CutOptions {
     /// the default (request files written before the option read the same).
     #[serde(skip_serializing_if = "is_default_rto_constraint")]
     pub rto_constraint: RtoConstraint,
+    /// The lead/tilt allowance as a corridor of the q5 QP along the whole cut (kerf, the
+    /// default: `"allowance"`) or only checked on the dense samples (seed 001: `"none"`).
+    /// Written only when not the default (request files written before the option read the
+    /// same).
+    #[serde(skip_serializing_if = "is_default_orientation_corridor")]
+    pub orientation_corridor: OrientationCorridor,
+}
+
+fn is_default_orientation_corridor(v: &OrientationCorridor) -> bool {
+    *v == OrientationCorridor::default()
 }
 
 /// The default of `options.cl_tolerance` (m).
@@ -250,6 +305,7 @@ impl Default for CutOptions {
             cl_tolerance: DEFAULT_CL_TOLERANCE,
             feed_law: FeedMode::TimeOptimal,
             rto_constraint: RtoConstraint::Box,
+            orientation_corridor: OrientationCorridor::Allowance,
         }
     }
 }

@@ -12,16 +12,20 @@
 //! min t   s.t.  ‖Lᵀ D₃ Θ‖ ≤ t
 //!               q_min ≤ Θ_j ≤ q_max                        (eq. 15, 39)
 //!               |D₁Θ| ≤ ω_max σ/f, |D₂Θ| ≤ α_max σ²/f², |D₃Θ| ≤ J_max σ³/f³   (eq. 15, 40-42)
-//!               q_u(0), q_u(1), q_uu(0), q_uu(1) given      (eq. 45)
+//!               q_u(0), q_u(1), q_uu(0), q_uu(1) given      (eq. 45; q_u free: kerf option)
 //!               q(ũ_i) = q_i                                (eq. 57-60)
 //!               lo_i ≤ q(ũ_i) ≤ hi_i                        (kerf, RTO boxes)
+//!               a_i ≤ q(u_i) ≤ b_i                          (kerf, allowance corridor)
 //! ```
 //!
 //! which has the minimiser of eq. 61. The interval rows are kerf's
 //! (issue 16 item 3), not seed 001's: an RTO given as a box of free,
 //! lead/tilt-feasible GFD samples ([`crate::gfd::Gfd::free_box`]) lets the
 //! QP choose the orientation of least jerk inside it instead of one grid
-//! pick; with `lo_i = hi_i` the row is the equality of eq. 57-60. A cone over `Lᵀ D₃` carries the
+//! pick; with `lo_i = hi_i` the row is the equality of eq. 57-60. The corridor rows (kerf, issue
+//! 16 item 3, [`RotaryQp::corridor`]) bound q at CL points between the RTOs to the lead/tilt
+//! allowance, so the jerk is minimized inside the feasible orientations along the whole cut,
+//! not only at the RTOs (seed 001 has no such rows: its spline is free between RTOs). A cone over `Lᵀ D₃` carries the
 //! conditioning of that matrix (~n³ on [0, 1]) instead of H's (~n⁶,
 //! 10¹⁷ for the paper's 628 coefficients), every row is banded (the whole
 //! problem is sparse), and each constraint row is scaled to unit largest
@@ -75,12 +79,23 @@ pub struct RotaryQp<'a> {
     pub feedrate: f64,
     /// `[q_u(0), q_u(1), q_uu(0), q_uu(1)]` (eq. 45).
     pub boundary: [f64; 4],
+    /// Leave `q_u(0)` and `q_u(1)` free (kerf, issue 16 item 3): only the `q_uu` rows of
+    /// eq. 45 are kept. A cut that starts where the tool axis tilts fastest (a closed saddle
+    /// starting at the vertical) cannot follow its allowance with zero end slopes; a trajectory
+    /// from rest has zero joint velocity whatever `q_u` is, and the time-optimal feed limits
+    /// the start and stop ramps by the joint jerk `q_u s⃛ / σ` (eq. 7). `false` is seed 001.
+    pub free_end_slopes: bool,
     /// RTO equalities `(ũ_i, q_i)` (eq. 57-60).
     pub via: &'a [(f64, f64)],
     /// RTO intervals `(ũ_i, lo_i, hi_i)`, `lo_i ≤ q(ũ_i) ≤ hi_i` (kerf, issue
     /// 16 item 3: the box of an RTO, see the module documentation); in the
     /// constraint family `Rto` with the equalities.
     pub via_box: &'a [(f64, f64, f64)],
+    /// Corridor intervals `(u_i, a_i, b_i)`, `a_i ≤ q(u_i) ≤ b_i` at CL points between the
+    /// RTOs (kerf, issue 16 item 3: the q values whose tool axis is inside the lead/tilt
+    /// allowance there; `options.orientation_corridor`); empty in seed 001's problem. Their
+    /// own constraint family, [`ConstraintFamily::Allowance`].
+    pub corridor: &'a [(f64, f64, f64)],
 }
 
 /// One sparse row: `(column, coefficient)` pairs.
@@ -295,6 +310,9 @@ impl RotaryQp<'_> {
             .into_iter()
             .enumerate()
         {
+            if deriv == 1 && self.free_end_slopes {
+                continue;
+            }
             let coeffs = sparse_basis(self.knots, u, deriv).map_err(err)?;
             boundary.push((coeffs, self.boundary[k], self.boundary[k]));
         }
@@ -320,6 +338,21 @@ impl RotaryQp<'_> {
         fams.push(Family {
             family: ConstraintFamily::Rto,
             rows: rto,
+        });
+        let mut corridor = Vec::with_capacity(self.corridor.len());
+        for &(u, lo, hi) in self.corridor {
+            if !(lo.is_finite() && hi.is_finite() && lo <= hi) {
+                return Err(PlanError::invalid(
+                    self.axis_name,
+                    format!("corridor interval [{lo}, {hi}] at u = {u} is empty or not finite"),
+                ));
+            }
+            let coeffs = sparse_basis(self.knots, u, 0).map_err(err)?;
+            corridor.push((coeffs, lo, hi));
+        }
+        fams.push(Family {
+            family: ConstraintFamily::Allowance,
+            rows: corridor,
         });
         Ok(fams)
     }
@@ -469,13 +502,14 @@ impl RotaryQp<'_> {
         }
         use ConstraintFamily::*;
         let kinematic = |f: ConstraintFamily| matches!(f, Velocity | Acceleration | Jerk);
-        let drops: [(&str, Keep, Option<ConstraintFamily>); 7] = [
+        let drops: [(&str, Keep, Option<ConstraintFamily>); 8] = [
             ("jerk", &|f| f != Jerk, Some(Jerk)),
             ("acceleration", &|f| f != Acceleration, Some(Acceleration)),
             ("velocity", &|f| f != Velocity, Some(Velocity)),
             ("kinematic", &|f| !kinematic(f), None),
             ("position", &|f| f != Position, Some(Position)),
             ("RTO", &|f| f != Rto, Some(Rto)),
+            ("allowance corridor", &|f| f != Allowance, Some(Allowance)),
             ("boundary", &|f| f != Boundary, Some(Boundary)),
         ];
         for (name, keep, family) in drops {
@@ -509,6 +543,17 @@ impl RotaryQp<'_> {
             detail: "infeasible even with any single constraint family removed".into(),
             max_feasible_feedrate: None,
         })
+    }
+
+    /// One solve at the requested feedrate with every constraint: `Ok(Some(Θ))`, or
+    /// `Ok(None)` when it is infeasible (without the diagnosis and the feedrate bisection of
+    /// [`Self::solve`]).
+    ///
+    /// # Errors
+    /// [`PlanError::Solver`] when Clarabel fails, [`PlanError::InvalidRequest`] for an empty
+    /// or non-finite interval.
+    pub fn try_solve(&self) -> Result<Option<Vec<f64>>, PlanError> {
+        Ok(self.attempt(self.feedrate, &|_| true)?.map(|(x, _)| x))
     }
 
     /// Largest feasible feedrate below the requested one, to 0.1 %, by

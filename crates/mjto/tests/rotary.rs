@@ -52,6 +52,8 @@ fn problem<'a>(
         boundary: [0.0; 4],
         via,
         via_box: &[],
+        corridor: &[],
+        free_end_slopes: false,
     }
 }
 
@@ -573,6 +575,8 @@ fn paper_size_628_coefficients_with_the_table2_q5_limits() {
         boundary: [0.0; 4],
         via: &via,
         via_box: &[],
+        corridor: &[],
+        free_end_slopes: false,
     };
     let (theta, _) = qp.solve().unwrap();
     assert_eq!(theta.len(), 628);
@@ -704,4 +708,110 @@ fn invalid_inputs_are_errors_not_panics() {
     // Knots below degree 3 cannot carry a jerk Hessian.
     let quadratic = KnotVector::clamped_uniform(2, 8).unwrap();
     assert!(JerkFactor::new(&quadratic).is_err());
+}
+
+/// Table 2's q5 with a sine of amplitude `a` over u ∈ [0, 1] to follow (the tilt of a closed
+/// saddle that starts where the tool axis passes the vertical): the knots, factor and the
+/// corridor `a sin(2πu) ± w` at `m` interior points.
+fn sine_corridor(a: f64, w: f64, m: usize) -> Vec<(f64, f64, f64)> {
+    (1..m)
+        .map(|i| {
+            let u = i as f64 / m as f64;
+            let c = a * (std::f64::consts::TAU * u).sin();
+            (u, c - w, c + w)
+        })
+        .collect()
+}
+
+#[test]
+fn corridor_rows_hold_at_their_points_and_zero_end_slopes_cost_jerk() {
+    let knots = KnotVector::clamped_uniform(K, 40).unwrap();
+    let factor = JerkFactor::new(&knots).unwrap();
+    let q5 = LaserMachine::default_machine().unwrap().limits()[4];
+    let corridor = sine_corridor(0.4, 0.17, 100);
+    let qp = RotaryQp {
+        axis_name: "q5",
+        knots: &knots,
+        factor: &factor,
+        limits: q5,
+        sigma: 0.127,
+        feedrate: 0.05,
+        boundary: [0.0; 4],
+        via: &[(0.0, 0.0), (1.0, 0.0)],
+        via_box: &[],
+        corridor: &corridor,
+        free_end_slopes: false,
+    };
+    let peak_jerk = |theta: Vec<f64>, qp: &RotaryQp| {
+        let spline = BSpline::new(knots.clone(), theta).unwrap();
+        for &(u, lo, hi) in &corridor {
+            let q = spline.eval(u)[0];
+            assert!(
+                q >= lo - 1e-7 && q <= hi + 1e-7,
+                "q({u}) = {q} outside [{lo}, {hi}]"
+            );
+        }
+        let d0 = spline.eval(0.0);
+        let d1 = spline.eval(1.0);
+        // q_uu(0) = q_uu(1) = 0 always (eq. 45); q_u only with fixed end slopes.
+        assert!(d0[2].abs() < 1e-6 && d1[2].abs() < 1e-6, "{d0:?} {d1:?}");
+        if !qp.free_end_slopes {
+            assert!(d0[1].abs() < 1e-6 && d1[1].abs() < 1e-6, "{d0:?} {d1:?}");
+        }
+        let s = qp.feedrate / qp.sigma;
+        (0..=4000)
+            .map(|i| spline.eval(i as f64 / 4000.0)[3].abs() * s.powi(3))
+            .fold(0.0, f64::max)
+    };
+    let fixed = peak_jerk(qp.solve().unwrap().0, &qp);
+    let free_qp = RotaryQp {
+        free_end_slopes: true,
+        ..qp
+    };
+    let free = peak_jerk(free_qp.solve().unwrap().0, &free_qp);
+    println!("peak q5 jerk at 3 m/min: zero end slopes {fixed:.1}, free {free:.1} rad/s³");
+    assert!(free < 0.8 * fixed, "free end slopes {free} vs zero {fixed}");
+    // At 10 m/min: infeasible with zero end slopes (try_solve says so without diagnosing),
+    // feasible with free ones.
+    let fast = RotaryQp {
+        feedrate: 10.0 / 60.0,
+        ..qp
+    };
+    assert!(fast.try_solve().unwrap().is_none());
+    let fast_free = RotaryQp {
+        free_end_slopes: true,
+        ..fast
+    };
+    let theta = fast_free
+        .try_solve()
+        .unwrap()
+        .expect("feasible with free end slopes");
+    assert!(peak_jerk(theta, &fast_free) <= q5.jerk * (1.0 + 1e-6));
+}
+
+#[test]
+fn a_corridor_that_cannot_be_followed_is_reported_as_the_allowance() {
+    let knots = KnotVector::clamped_uniform(K, 16).unwrap();
+    let factor = JerkFactor::new(&knots).unwrap();
+    // q must be near 1 at u = 0.5 and near −1 just after: no spline of 16 coefficients does it.
+    let corridor = [(0.5, 1.0, 1.1), (0.5001, -1.1, -1.0)];
+    let qp = RotaryQp {
+        corridor: &corridor,
+        ..problem(&knots, &factor, loose(), SIGMA, FEED, &[])
+    };
+    assert!(qp.try_solve().unwrap().is_none());
+    match qp.solve() {
+        Err(PlanError::Infeasible { family, .. }) => {
+            assert_eq!(family, ConstraintFamily::Allowance)
+        }
+        other => panic!("{other:?}"),
+    }
+    // An empty or non-finite interval is refused by name.
+    for bad in [[(0.5, 1.0, 0.9)], [(0.5, f64::NAN, 1.0)]] {
+        let qp = RotaryQp {
+            corridor: &bad,
+            ..problem(&knots, &factor, loose(), SIGMA, FEED, &[])
+        };
+        assert!(matches!(qp.solve(), Err(PlanError::InvalidRequest { .. })));
+    }
 }

@@ -240,6 +240,8 @@ fn the_rotary_qp_stays_inside_its_boxes_and_no_jerkier_than_equality() {
         boundary: [0.0; 4],
         via: &picks,
         via_box: &[],
+        corridor: &[],
+        free_end_slopes: false,
     };
     let (eq, _) = base.solve().unwrap();
     let (bx, _) = RotaryQp {
@@ -495,4 +497,47 @@ fn the_option_parses_defaults_to_box_and_refuses_other_text() {
         assert!(e.to_string().contains("options.rto_constraint"), "{e}");
     }
     assert_eq!(RtoConstraint::parse("").unwrap(), RtoConstraint::Box);
+}
+
+#[test]
+fn the_corridor_option_parses_defaults_to_allowance_and_refuses_other_text() {
+    use kerf_mjto::request::OrientationCorridor;
+    let base = "points: [[0, 0, 0], [0.1, 0, 0]]\naxes: [[0, 0, 1], [0, 0, 1]]\n\
+                feedrate: 0.3\nsample_period: 0.01\nmax_lead_angle: 0.1\n\
+                max_tilt_angle: 0.1\nmesh: m.stl\n";
+    let r = CutRequest::from_yaml(base).unwrap();
+    assert_eq!(
+        r.options.orientation_corridor,
+        OrientationCorridor::Allowance
+    );
+    for (text, want) in [
+        ("none", OrientationCorridor::None),
+        ("allowance", OrientationCorridor::Allowance),
+    ] {
+        let r = CutRequest::from_yaml(&format!(
+            "{base}options: {{orientation_corridor: {text}}}\n"
+        ))
+        .unwrap();
+        assert_eq!(r.options.orientation_corridor, want);
+        assert_eq!(OrientationCorridor::parse(text).unwrap(), want);
+        assert_eq!(want.as_str(), text);
+    }
+    // The default is not written: request files written before the option read the same.
+    assert!(!serde_yaml_ng::to_string(&r)
+        .unwrap()
+        .contains("orientation_corridor"));
+    for bad in ["Allowance", "off", "1"] {
+        let e = CutRequest::from_yaml(&format!("{base}options: {{orientation_corridor: {bad}}}\n"))
+            .unwrap_err();
+        assert!(e.to_string().contains("orientation_corridor"), "{bad}: {e}");
+        let e = OrientationCorridor::parse(bad).unwrap_err();
+        assert!(
+            e.to_string().contains("options.orientation_corridor"),
+            "{e}"
+        );
+    }
+    assert_eq!(
+        OrientationCorridor::parse("").unwrap(),
+        OrientationCorridor::Allowance
+    );
 }

@@ -132,6 +132,9 @@ pub struct CutRequest {
     pub feed_law: String,
     /// RTOs as `"box"` or `"equality"` constraints of the QPs; empty = default `"box"`.
     pub rto_constraint: String,
+    /// The q5 QP's lead/tilt allowance corridor: `"allowance"` or `"none"` (seed 001); empty =
+    /// default `"allowance"`.
+    pub orientation_corridor: String,
     /// Time budget of the plan (s): 0 = the node's `plan_timeout`; else in (0, plan_timeout].
     pub time_budget: f64,
 }

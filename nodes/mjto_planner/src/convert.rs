@@ -11,7 +11,7 @@ use kerf_mjto::{
     error::{status, CollisionReport},
     machine::JOINT_NAMES,
     plan::{Metrics, RtoRecord},
-    request::{CutOptions, PoseSpec, RtoConstraint},
+    request::{CutOptions, OrientationCorridor, PoseSpec, RtoConstraint},
     CutRequest, PlanError,
 };
 use kerf_msgs::{msg, trajectory_msgs::JointTrajectory};
@@ -52,12 +52,14 @@ fn to_u32(v: usize) -> u32 {
 /// `.msg` file: 0 means the [`CutOptions`] default for `control_points`, `max_iterations`, the
 /// GFD grid, `rto_spacing` and `rto_angle`; 0 means [`DEFAULT_FEED_ACCELERATION`] /
 /// [`DEFAULT_FEED_JERK`] for the feed ramps; `has_reference_standoff == false` means the default
-/// standoff; an empty `rto_constraint` means the default ([`RtoConstraint::Box`]). Every other
+/// standoff; an empty `rto_constraint` means the default ([`RtoConstraint::Box`]), an empty
+/// `orientation_corridor` the default ([`OrientationCorridor::Allowance`]). Every other
 /// value is passed on unchanged for [`CutRequest::validate`] to check.
 ///
 /// # Errors
 /// [`PlanError::InvalidRequest`] for an all-zero `workpiece_pose.orientation` (the identity is
-/// w = 1) and for an `rto_constraint` other than `""`, `"equality"` and `"box"`.
+/// w = 1), for an `rto_constraint` other than `""`, `"equality"` and `"box"` and for an
+/// `orientation_corridor` other than `""`, `"allowance"` and `"none"`.
 pub fn request_from_msg(m: &msg::CutRequest) -> Result<CutRequest, PlanError> {
     let q = &m.workpiece_pose.orientation;
     if q.x == 0.0 && q.y == 0.0 && q.z == 0.0 && q.w == 0.0 {
@@ -103,6 +105,7 @@ pub fn request_from_msg(m: &msg::CutRequest) -> Result<CutRequest, PlanError> {
             }
         },
         rto_constraint: RtoConstraint::parse(&m.rto_constraint)?,
+        orientation_corridor: OrientationCorridor::parse(&m.orientation_corridor)?,
     };
     let p = &m.workpiece_pose.position;
     Ok(CutRequest {
@@ -504,6 +507,27 @@ mod tests {
                 other => panic!("{bad:?}: expected InvalidRequest, got {other:?}"),
             }
         }
+    }
+
+    #[test]
+    fn orientation_corridor_takes_its_default_and_refuses_other_text() {
+        let mut m = message();
+        assert_eq!(
+            request_from_msg(&m).unwrap().options.orientation_corridor,
+            OrientationCorridor::Allowance
+        );
+        m.orientation_corridor = "none".into();
+        assert_eq!(
+            request_from_msg(&m).unwrap().options.orientation_corridor,
+            OrientationCorridor::None
+        );
+        m.orientation_corridor = "off".into();
+        let e = request_from_msg(&m).unwrap_err();
+        assert_eq!(e.status(), status::INVALID_REQUEST);
+        assert!(
+            e.to_string().contains("options.orientation_corridor"),
+            "{e}"
+        );
     }
 
     #[test]

@@ -15,8 +15,8 @@
 //!   `x y z qx qy qz qw`), `control_points`, `max_iterations`, `gfd_q4_steps`, `gfd_q5_steps`,
 //!   `gfd_q6_steps`, `gfd_q4_half_range`, `gfd_q5_half_range`, `rto_indices` (integers
 //!   separated by spaces or commas), `rto_spacing`, `rto_angle`, `reference_standoff` (giving
-//!   it sets `has_reference_standoff`), `clearance`, `rto_constraint` (`box` or `equality`) and
-//!   `time_budget`. `feedrate`, `sample_period`,
+//!   it sets `has_reference_standoff`), `clearance`, `rto_constraint` (`box` or `equality`),
+//!   `orientation_corridor` (`allowance` or `none`) and `time_budget`. `feedrate`, `sample_period`,
 //!   `max_lead_angle`, `max_tilt_angle` and `mesh` are required; every key may appear once.
 //!   Blank lines and lines starting with `#` are ignored (comments are whole lines: a value
 //!   is never cut at `#`); points keep their order even when key lines come between them.
@@ -175,6 +175,7 @@ pub fn parse_lines(text: &str) -> Result<msg::CutRequest, PlanError> {
         match key {
             "request_id" => m.request_id = value.to_string(),
             "rto_constraint" => m.rto_constraint = value.to_string(),
+            "orientation_corridor" => m.orientation_corridor = value.to_string(),
             "mesh" => m.mesh = value.to_string(),
             "feed_law" => m.feed_law = value.to_string(),
             "feedrate" => m.feedrate = number(n, key, value)?,

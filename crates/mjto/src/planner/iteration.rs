@@ -200,7 +200,7 @@ impl Context<'_> {
     ) -> Result<Iterate, PlanError> {
         let limits = self.limits();
         let t = Instant::now();
-        let mut rotary = Vec::with_capacity(2);
+        let mut rotary: Vec<BSpline> = Vec::with_capacity(2);
         for (k, name) in [(3usize, "q4"), (4usize, "q5")] {
             self.budget.check("the rotary-axis QPs")?;
             let a = k - 3;
@@ -223,8 +223,11 @@ impl Context<'_> {
                 boundary: [0.0; 4],
                 via: &via,
                 via_box: &via_box,
+                corridor: &[],
+                free_end_slopes: false,
             };
-            let coeffs = super::feed::rotary_coefficients(&problem, self.request.options.feed_law)?;
+            // q5's corridor follows the q4 just chosen (kerf, planner/corridor.rs).
+            let coeffs = self.rotary_in_allowance(&problem, rotary.first(), rtos)?;
             rotary.push(BSpline::new(knots.clone(), coeffs).map_err(bspline_error)?);
         }
         times.rotary_qp += t.elapsed().as_secs_f64();
