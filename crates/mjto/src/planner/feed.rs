@@ -216,12 +216,15 @@ impl Context<'_> {
             .max(1);
         let n = (spans * STATIONS_PER_SPAN).clamp(STATION_RANGE.0, STATION_RANGE.1);
         let stations: Vec<f64> = (0..=n).map(|k| sigma * k as f64 / n as f64).collect();
-        let splines = [&it.m[0], &it.m[1], &it.m[2], &it.q4, &it.q5, &it.q6];
-        // [q, q', q'', q'''] per joint in arc length at s (q' = q_u/σ, ...).
+        // [q, q', q'', q'''] per joint in arc length at s (q' = q_u/σ, ...). u is clamped to
+        // [0, 1]: the evaluation cannot fail (a failure leaves NaN, which the limit checks
+        // refuse).
         let at = |s: f64| {
             let mut d = [[0.0; 6]; 4];
-            for (j, spline) in splines.iter().enumerate() {
-                let e = spline.eval((s / sigma).clamp(0.0, 1.0));
+            let joints = it
+                .joints((s / sigma).clamp(0.0, 1.0), 3)
+                .unwrap_or([[f64::NAN; 4]; 6]);
+            for (j, e) in joints.iter().enumerate() {
                 let mut scale = 1.0;
                 for (order, row) in d.iter_mut().enumerate() {
                     row[j] = e[order] * scale;

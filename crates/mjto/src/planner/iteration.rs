@@ -124,7 +124,7 @@ impl Context<'_> {
             limits,
         );
         self.fill_geometry(&mut metrics, &samples.u, &samples.q, None)?;
-        metrics.max_cl_error = metrics.max_cl_error.max(self.cl_error_at_points(&iterate));
+        metrics.max_cl_error = metrics.max_cl_error.max(self.cl_error_at_points(&iterate)?);
 
         let qi_rtos: Vec<Rto> = rtos
             .iter()
@@ -240,8 +240,13 @@ impl Context<'_> {
             .v
             .u
             .iter()
-            .map(|&u| tool_axis(q4.eval(u)[0], q5.eval(u)[0]))
-            .collect();
+            .map(|&u| {
+                let [a, b] = q4
+                    .eval_shared([q4.coeffs(), q5.coeffs()], u, 0)
+                    .map_err(bspline_error)?;
+                Ok(tool_axis(a[0], b[0]))
+            })
+            .collect::<Result<_, PlanError>>()?;
         let via: Vec<(usize, f64)> = rtos
             .iter()
             .filter(|r| r.bounds.is_none())
@@ -304,15 +309,14 @@ impl Context<'_> {
             qddd: Vec::with_capacity(n),
             times,
         };
-        let splines = [&it.m[0], &it.m[1], &it.m[2], &it.q4, &it.q5, &it.q6];
         for (k, &law) in states.iter().enumerate() {
             if k.is_multiple_of(super::BUDGET_STRIDE) {
                 self.budget.check("trajectory sampling")?;
             }
             let u = (law[0] / self.v.sigma).clamp(0.0, 1.0);
             let mut row = [[0.0; 6]; 4];
-            for (j, spline) in splines.iter().enumerate() {
-                let d = chain_rule(spline.eval(u), law, self.v.sigma);
+            for (j, e) in it.joints(u, 3)?.into_iter().enumerate() {
+                let d = chain_rule(e, law, self.v.sigma);
                 for (r, value) in d.iter().enumerate() {
                     row[r][j] = *value;
                 }
