@@ -6,7 +6,7 @@ use std::time::Instant;
 use kerf_bspline::{BSpline, KnotVector};
 use nalgebra::Vector3;
 
-use super::{bspline_error, internal, Context, Iterate, RtoState, Samples};
+use super::{bspline_error, Context, Iterate, RtoState, Samples};
 use crate::baseline::{quaternion_interpolation_along, Rto};
 use crate::collision::CollisionWorld;
 use crate::gfd::Gfd;
@@ -200,40 +200,34 @@ impl Context<'_> {
     ) -> Result<Iterate, PlanError> {
         let limits = self.limits();
         let t = Instant::now();
-        let mut rotary = Vec::with_capacity(2);
-        for (k, name) in [(3usize, "q4"), (4usize, "q5")] {
-            self.budget.check("the rotary-axis QPs")?;
-            let a = k - 3;
-            let via: Vec<(f64, f64)> = rtos
+        self.budget.check("the rotary-axis QPs")?;
+        let vias: [(Vec<(f64, f64)>, Vec<(f64, f64, f64)>); 2] = [0, 1].map(|a| {
+            let via = rtos
                 .iter()
                 .filter(|r| r.bounds.is_none())
                 .map(|r| (r.u, r.q[a]))
                 .collect();
-            let via_box: Vec<(f64, f64, f64)> = rtos
+            let via_box = rtos
                 .iter()
                 .filter_map(|r| r.bounds.map(|b| (r.u, b.lo[a], b.hi[a])))
                 .collect();
-            let problem = RotaryQp {
-                axis_name: name,
-                knots,
-                factor,
-                limits: limits[k],
-                sigma: self.v.sigma,
-                feedrate: self.request.feedrate,
-                boundary: [0.0; 4],
-                via: &via,
-                via_box: &via_box,
-            };
-            let coeffs = super::feed::rotary_coefficients(&problem, self.request.options.feed_law)?;
-            rotary.push(BSpline::new(knots.clone(), coeffs).map_err(bspline_error)?);
-        }
+            (via, via_box)
+        });
+        let problems = [(3usize, "q4"), (4usize, "q5")].map(|(k, name)| RotaryQp {
+            axis_name: name,
+            knots,
+            factor,
+            limits: limits[k],
+            sigma: self.v.sigma,
+            feedrate: self.request.feedrate,
+            boundary: [0.0; 4],
+            via: &vias[k - 3].0,
+            via_box: &vias[k - 3].1,
+        });
+        let [c4, c5] = super::feed::rotary_pair(&problems, self.request.options.feed_law)?;
+        let q4 = BSpline::new(knots.clone(), c4).map_err(bspline_error)?;
+        let q5 = BSpline::new(knots.clone(), c5).map_err(bspline_error)?;
         times.rotary_qp += t.elapsed().as_secs_f64();
-        let q5 = rotary
-            .pop()
-            .ok_or_else(|| internal("rotary QP result missing"))?;
-        let q4 = rotary
-            .pop()
-            .ok_or_else(|| internal("rotary QP result missing"))?;
 
         let t = Instant::now();
         let axes: Vec<Vector3<f64>> = self
