@@ -7,6 +7,7 @@
 //! KERF_PLAN_RUNS=40 cargo bench -p kerf_mjto --bench plan_time
 //! KERF_PLAN_CASES=case1 KERF_PLAN_COLD=0 cargo bench -p kerf_mjto --bench plan_time
 //! KERF_PLAN_DUMP=/tmp/plans.txt cargo bench -p kerf_mjto --bench plan_time
+//! KERF_PLAN_SEQUENCE=rto_box cargo bench -p kerf_mjto --bench plan_time
 //! ```
 //!
 //! * **warm**: one [`Planner`] plans the same request again and again, as a planner node does
@@ -25,6 +26,11 @@
 //! its outcome written to `<file>`: every sample's time and joint positions, velocities and
 //! accelerations, the RTOs, the cycle time and the metrics, with every float in its exact
 //! shortest round-trip form (or the error's text); no timing.
+//!
+//! With `KERF_PLAN_SEQUENCE=plan_cases` or `rto_box`, case 1 is timed after the plans that
+//! precede it in that bench (issue 16 item 5: the two benches disagreed by 5 ms on case 1);
+//! under `valgrind --tool=callgrind --toggle-collect=plan_time::timed` the two sequences'
+//! instruction counts compare the work done.
 #![allow(clippy::unwrap_used, clippy::expect_used)] // a bench reports failures by panicking
 
 use std::fmt::Write as _;
@@ -36,6 +42,9 @@ use kerf_mjto::plan::StageTimes;
 use kerf_mjto::planner::Planner;
 use kerf_mjto::request::RtoConstraint;
 use kerf_mjto::{CutRequest, LaserMachine};
+
+#[path = "../tests/common/saddle.rs"]
+mod saddle;
 
 fn median(mut v: Vec<f64>) -> f64 {
     v.sort_by(|a, b| a.total_cmp(b));
@@ -224,6 +233,42 @@ fn dump(path: &Path) {
     std::fs::write(path, out).expect("write the dump");
 }
 
+/// Case 1 (RTO boxes) timed after the work that precedes it in `benches/plan_cases.rs`
+/// (`plan_cases`: a new planner, one warm-up plan) or in `benches/rto_box.rs` (`rto_box`: the
+/// saddle's mesh written, a new planner, case 1 with equalities planned 1 + `runs` times, then
+/// one warm-up plan with boxes): `runs` plans of each sequence, median wall and CPU time.
+fn sequence(which: &str, runs: usize) {
+    let r = request(&cases_dir().join("case1.yaml"));
+    let mut p = planner();
+    let geometry = saddle::Saddle::default();
+    let mesh = saddle::TempMesh::new("plan_time", &geometry.mesh());
+    let _saddle = geometry.request(&mesh.reference(), 0.1);
+    match which {
+        "plan_cases" => {}
+        "rto_box" => {
+            let mut e = r.clone();
+            e.options.rto_constraint = RtoConstraint::Equality;
+            for _ in 0..=runs {
+                p.plan(&e).expect("plan");
+            }
+        }
+        other => panic!("KERF_PLAN_SEQUENCE={other}: plan_cases or rto_box"),
+    }
+    let mut b = r.clone();
+    b.options.rto_constraint = RtoConstraint::Box;
+    p.plan(&b).expect("warm-up plan");
+    let mut s = Series::default();
+    for _ in 0..runs {
+        s.push(timed(&mut p, &b));
+    }
+    println!(
+        "case1 after the {which} sequence: wall {:.2} ms, CPU {:.2} ms (medians of {runs}; load {})",
+        median(s.wall) * 1e3,
+        median(s.cpu) * 1e3,
+        load_average()
+    );
+}
+
 fn main() {
     if let Ok(path) = std::env::var("KERF_PLAN_DUMP") {
         dump(Path::new(&path));
@@ -234,5 +279,9 @@ fn main() {
         .and_then(|v| v.parse().ok())
         .unwrap_or(20)
         .max(1);
+    if let Ok(which) = std::env::var("KERF_PLAN_SEQUENCE") {
+        sequence(&which, runs);
+        return;
+    }
     time_cases(runs);
 }

@@ -201,7 +201,9 @@ impl Context<'_> {
         let limits = self.limits();
         let t = Instant::now();
         self.budget.check("the rotary-axis QPs")?;
-        let vias: [(Vec<(f64, f64)>, Vec<(f64, f64, f64)>); 2] = [0, 1].map(|a| {
+        // Per axis: the RTO equalities (u, q) and boxes (u, lo, hi).
+        type Vias = (Vec<(f64, f64)>, Vec<(f64, f64, f64)>);
+        let vias: [Vias; 2] = [0, 1].map(|a| {
             let via = rtos
                 .iter()
                 .filter(|r| r.bounds.is_none())
