@@ -118,8 +118,8 @@ impl Iterate {
     /// [`PlanError::Solver`] for u outside [0, 1] or not finite.
     ///
     /// # Performance
-    /// One basis evaluation instead of six: sampling a case-2 plan evaluated the basis ~40 000
-    /// times, 16 % of its instructions.
+    /// One basis evaluation instead of six: six separate evaluations were 16 % of a case-2
+    /// plan's instructions (BENCHMARKS.md).
     fn joints(&self, u: f64, nderiv: usize) -> Result<[[f64; 4]; 6], PlanError> {
         let [m0, m1, m2] = &self.m;
         self.q4
