@@ -8,7 +8,12 @@
 //!
 //! Prints markdown tables (the ones in BENCHMARKS.md). Timings are medians
 //! over `KERF_PLAN_RUNS` runs (default 20) after one warm-up run, which also
-//! loads the mesh into the planner's cache (a node plans with a warm cache).
+//! loads the mesh into the planner's cache and builds its collision world (a
+//! node plans with a warm planner). The planning time is that of
+//! `benches/plan_time.rs` and `benches/rto_box.rs`: one `Planner::plan` of a
+//! warm planner, wall clock; "total" is the plan's own `StageTimes::total`
+//! (the executability check included), "wall" the bench's clock around the
+//! call. `plan_time` also gives CPU time and the cold planner.
 //! The last table times the three collision paths on each final plan's
 //! samples (one thread): parry's composite test per sample
 //! (`colliding_links_exhaustive`), with the separating-axis first stage

@@ -13,7 +13,9 @@
 //! `options.orientation_corridor` of every request: `none` is seed 001's rotary QPs.
 //!
 //! Prints a markdown table (the one in BENCHMARKS.md). Planning times are
-//! medians over `KERF_PLAN_RUNS` runs (default 10) after one warm-up run.
+//! medians over `KERF_PLAN_RUNS` runs (default 10) after one warm-up run: one
+//! `Planner::plan` of a warm planner (mesh cached, collision world kept),
+//! wall clock, as in `benches/plan_cases.rs` and `benches/plan_time.rs`.
 #![allow(clippy::unwrap_used, clippy::expect_used)] // a bench reports failures by panicking
 
 use std::path::Path;

@@ -16,7 +16,7 @@
 //!   and TOPP3 limits the ramps by the joint jerk `q_u s⃛ / σ` (eq. 7);
 //! * the q5 QP gets, at the CL points between the RTOs where it would leave the allowance, the
 //!   interval of q5 whose tool axis (with the q4 the q4 QP chose) is inside it (active sets,
-//!   [`Context::rotary_in_allowance`]): the QP itself chooses the least-jerk tilt inside the
+//!   [`Context::q5_in_allowance`]): the QP itself chooses the least-jerk tilt inside the
 //!   lead/tilt-feasible set along the whole cut, e.g. a fraction of the nominal tilt, as a
 //!   hand-made plan does.
 //!
@@ -46,7 +46,7 @@ use crate::PlanError;
 /// inserts an RTO there).
 pub const CORRIDOR_FRACTION: f64 = 0.98;
 
-/// Most active-set rounds of the q5 corridor per QP ([`Context::rotary_in_allowance`]).
+/// Most active-set rounds of the q5 corridor per QP ([`Context::q5_in_allowance`]).
 pub const CORRIDOR_ROUNDS: usize = 6;
 
 /// CL points on each side of a point outside the allowance that get a corridor row with it
@@ -106,45 +106,67 @@ impl Context<'_> {
         self.request.options.orientation_corridor == OrientationCorridor::Allowance
     }
 
-    /// The coefficients of one rotary QP under `options.orientation_corridor`.
-    ///
-    /// # Arguments
-    /// * `problem` - the QP of seed 001 (eq. 61, with kerf's RTO boxes), without corridor.
-    /// * `q4` - for the q5 QP, the q4 spline just chosen; `None` for the q4 QP.
-    /// * `rtos` - the RTOs (their CL points get no corridor row: their box or pick is there).
+    /// The first solve of one rotary QP under `options.orientation_corridor`: independent of
+    /// the other axis, so q4's and q5's run side by side ([`super::feed::rotary_pair`]).
     ///
     /// # Returns
     /// * `none` (seed 001): [`rotary_coefficients`] of `problem`.
     /// * `allowance` (kerf): with the time-optimal law, zero end slopes (eq. 45) when the
     ///   problem is feasible so at the requested feedrate, else free ones
     ///   ([`RotaryQp::free_end_slopes`]; still infeasible: the feedrate bisection of
-    ///   [`rotary_coefficients`]). For q5, the corridor is added by active sets: the CL points
-    ///   whose axis is outside [`CORRIDOR_FRACTION`] of the allowance get their interval
-    ///   ([`tilt_interval`]) as a row, [`CORRIDOR_PAD`] points on each side of each run too, and
-    ///   the QP is solved again, at most [`CORRIDOR_ROUNDS`] times. A solution inside every
-    ///   interval is the optimum of the QP with the whole corridor (a convex problem whose
-    ///   relaxation's optimum is feasible), at the cost of the rows that bind, not of one row
-    ///   per CL point (case 2: 628). A corridor that makes the QP infeasible for another reason
-    ///   than its kinematic bounds (against an RTO's box or pick next to it: both inside the
-    ///   allowance, the corridor inside [`CORRIDOR_FRACTION`] of it with the q4 of the spline)
-    ///   is dropped, as seed 001; the dense check then inserts RTOs where the allowance is left.
+    ///   [`rotary_coefficients`]).
     ///
     /// # Errors
     /// As [`rotary_coefficients`].
-    pub(super) fn rotary_in_allowance(
+    pub(super) fn rotary_first(
+        corridor: bool,
+        mode: FeedMode,
+    ) -> impl Fn(&RotaryQp) -> Result<Vec<f64>, PlanError> + Sync {
+        move |problem| {
+            if corridor {
+                end_slopes_as_needed(problem, mode)
+            } else {
+                rotary_coefficients(problem, mode)
+            }
+        }
+    }
+
+    /// The q5 QP's coefficients inside the allowance, from its first solve
+    /// ([`Context::rotary_first`]) and the q4 spline chosen.
+    ///
+    /// # Arguments
+    /// * `problem` - the q5 QP of seed 001 (eq. 61, with kerf's RTO boxes), without corridor.
+    /// * `first` - its first solve.
+    /// * `q4` - the q4 spline.
+    /// * `rtos` - the RTOs (their CL points get no corridor row: their box or pick is there).
+    ///
+    /// # Returns
+    /// * `none` (seed 001): `first`.
+    /// * `allowance` (kerf): the corridor is added by active sets: the CL points whose axis is
+    ///   outside [`CORRIDOR_FRACTION`] of the allowance get their interval ([`tilt_interval`])
+    ///   as a row, [`CORRIDOR_PAD`] points on each side of each run too, and the QP is solved
+    ///   again, at most [`CORRIDOR_ROUNDS`] times. A solution inside every interval is the
+    ///   optimum of the QP with the whole corridor (a convex problem whose relaxation's optimum
+    ///   is feasible), at the cost of the rows that bind, not of one row per CL point (case 2:
+    ///   628). A corridor that makes the QP infeasible for another reason than its kinematic
+    ///   bounds (against an RTO's box or pick next to it: both inside the allowance, the
+    ///   corridor inside [`CORRIDOR_FRACTION`] of it with the q4 of the spline) is dropped, as
+    ///   seed 001; the dense check then inserts RTOs where the allowance is left.
+    ///
+    /// # Errors
+    /// As [`rotary_coefficients`].
+    pub(super) fn q5_in_allowance(
         &self,
         problem: &RotaryQp,
-        q4: Option<&BSpline>,
+        first: Vec<f64>,
+        q4: &BSpline,
         rtos: &[RtoState],
     ) -> Result<Vec<f64>, PlanError> {
         let mode = self.request.options.feed_law;
         if !self.corridor_on() {
-            return rotary_coefficients(problem, mode);
+            return Ok(first);
         }
-        let mut coeffs = end_slopes_as_needed(problem, mode)?;
-        let Some(q4) = q4 else {
-            return Ok(coeffs);
-        };
+        let mut coeffs = first;
         let r = self.request;
         let (max_lead, max_tilt) = (
             r.max_lead_angle * CORRIDOR_FRACTION,
@@ -212,7 +234,7 @@ impl Context<'_> {
 }
 
 /// With the time-optimal law: zero end slopes (seed 001 eq. 45) when the problem is feasible
-/// so at the requested feedrate, else free ones (see [`Context::rotary_in_allowance`]).
+/// so at the requested feedrate, else free ones (see [`Context::rotary_first`]).
 /// With the constant law the end slopes stay zero: its S-curve ramps run at the request's path
 /// jerk, which a nonzero `q_u` would turn into joint jerk (`q_u s⃛ / σ`, eq. 7).
 fn end_slopes_as_needed(problem: &RotaryQp, mode: FeedMode) -> Result<Vec<f64>, PlanError> {

@@ -285,23 +285,16 @@ impl Context<'_> {
 
     /// Largest distance between FK (eq. 2) of the splines at the CL
     /// parameters u_i and the CL points C_i.
-    pub(super) fn cl_error_at_points(&self, it: &Iterate) -> f64 {
-        self.v
-            .u
-            .iter()
-            .zip(&self.v.points)
-            .map(|(&u, c)| {
-                let q = [
-                    it.m[0].eval(u)[0],
-                    it.m[1].eval(u)[0],
-                    it.m[2].eval(u)[0],
-                    it.q4.eval(u)[0],
-                    it.q5.eval(u)[0],
-                    it.q6.eval(u)[0],
-                ];
-                (forward(&q).0 - c).norm()
-            })
-            .fold(0.0, f64::max)
+    ///
+    /// # Errors
+    /// [`PlanError::Solver`] for a CL parameter outside [0, 1] (validated requests have none).
+    pub(super) fn cl_error_at_points(&self, it: &Iterate) -> Result<f64, PlanError> {
+        let mut worst = 0.0f64;
+        for (&u, c) in self.v.u.iter().zip(&self.v.points) {
+            let q = it.joints(u, 0)?.map(|d| d[0]);
+            worst = worst.max((forward(&q).0 - c).norm());
+        }
+        Ok(worst)
     }
 
     /// CL error against the reference path, lead/tilt extremes and (when a

@@ -6,7 +6,7 @@ use std::time::Instant;
 use kerf_bspline::{BSpline, KnotVector};
 use nalgebra::Vector3;
 
-use super::{bspline_error, internal, Context, Iterate, RtoState, Samples};
+use super::{bspline_error, Context, Iterate, RtoState, Samples};
 use crate::baseline::{quaternion_interpolation_along, Rto};
 use crate::collision::CollisionWorld;
 use crate::gfd::Gfd;
@@ -124,7 +124,7 @@ impl Context<'_> {
             limits,
         );
         self.fill_geometry(&mut metrics, &samples.u, &samples.q, None)?;
-        metrics.max_cl_error = metrics.max_cl_error.max(self.cl_error_at_points(&iterate));
+        metrics.max_cl_error = metrics.max_cl_error.max(self.cl_error_at_points(&iterate)?);
 
         let qi_rtos: Vec<Rto> = rtos
             .iter()
@@ -200,51 +200,56 @@ impl Context<'_> {
     ) -> Result<Iterate, PlanError> {
         let limits = self.limits();
         let t = Instant::now();
-        let mut rotary: Vec<BSpline> = Vec::with_capacity(2);
-        for (k, name) in [(3usize, "q4"), (4usize, "q5")] {
-            self.budget.check("the rotary-axis QPs")?;
-            let a = k - 3;
-            let via: Vec<(f64, f64)> = rtos
+        self.budget.check("the rotary-axis QPs")?;
+        // Per axis: the RTO equalities (u, q) and boxes (u, lo, hi).
+        type Vias = (Vec<(f64, f64)>, Vec<(f64, f64, f64)>);
+        let vias: [Vias; 2] = [0, 1].map(|a| {
+            let via = rtos
                 .iter()
                 .filter(|r| r.bounds.is_none())
                 .map(|r| (r.u, r.q[a]))
                 .collect();
-            let via_box: Vec<(f64, f64, f64)> = rtos
+            let via_box = rtos
                 .iter()
                 .filter_map(|r| r.bounds.map(|b| (r.u, b.lo[a], b.hi[a])))
                 .collect();
-            let problem = RotaryQp {
-                axis_name: name,
-                knots,
-                factor,
-                limits: limits[k],
-                sigma: self.v.sigma,
-                feedrate: self.request.feedrate,
-                boundary: [0.0; 4],
-                via: &via,
-                via_box: &via_box,
-                corridor: &[],
-                free_end_slopes: false,
-            };
-            // q5's corridor follows the q4 just chosen (kerf, planner/corridor.rs).
-            let coeffs = self.rotary_in_allowance(&problem, rotary.first(), rtos)?;
-            rotary.push(BSpline::new(knots.clone(), coeffs).map_err(bspline_error)?);
-        }
+            (via, via_box)
+        });
+        let problems = [(3usize, "q4"), (4usize, "q5")].map(|(k, name)| RotaryQp {
+            axis_name: name,
+            knots,
+            factor,
+            limits: limits[k],
+            sigma: self.v.sigma,
+            feedrate: self.request.feedrate,
+            boundary: [0.0; 4],
+            via: &vias[k - 3].0,
+            via_box: &vias[k - 3].1,
+            corridor: &[],
+            free_end_slopes: false,
+        });
+        // q4 and q5's first solves side by side; q5's corridor then follows the q4 chosen
+        // (kerf, planner/corridor.rs).
+        let first = Self::rotary_first(self.corridor_on(), self.request.options.feed_law);
+        let [c4, c5] = super::feed::rotary_pair(&problems, &first)?;
+        let q4 = BSpline::new(knots.clone(), c4).map_err(bspline_error)?;
+        self.budget.check("the rotary-axis QPs")?;
+        let c5 = self.q5_in_allowance(&problems[1], c5, &q4, rtos)?;
+        let q5 = BSpline::new(knots.clone(), c5).map_err(bspline_error)?;
         times.rotary_qp += t.elapsed().as_secs_f64();
-        let q5 = rotary
-            .pop()
-            .ok_or_else(|| internal("rotary QP result missing"))?;
-        let q4 = rotary
-            .pop()
-            .ok_or_else(|| internal("rotary QP result missing"))?;
 
         let t = Instant::now();
         let axes: Vec<Vector3<f64>> = self
             .v
             .u
             .iter()
-            .map(|&u| tool_axis(q4.eval(u)[0], q5.eval(u)[0]))
-            .collect();
+            .map(|&u| {
+                let [a, b] = q4
+                    .eval_shared([q4.coeffs(), q5.coeffs()], u, 0)
+                    .map_err(bspline_error)?;
+                Ok(tool_axis(a[0], b[0]))
+            })
+            .collect::<Result<_, PlanError>>()?;
         let via: Vec<(usize, f64)> = rtos
             .iter()
             .filter(|r| r.bounds.is_none())
@@ -307,15 +312,14 @@ impl Context<'_> {
             qddd: Vec::with_capacity(n),
             times,
         };
-        let splines = [&it.m[0], &it.m[1], &it.m[2], &it.q4, &it.q5, &it.q6];
         for (k, &law) in states.iter().enumerate() {
             if k.is_multiple_of(super::BUDGET_STRIDE) {
                 self.budget.check("trajectory sampling")?;
             }
             let u = (law[0] / self.v.sigma).clamp(0.0, 1.0);
             let mut row = [[0.0; 6]; 4];
-            for (j, spline) in splines.iter().enumerate() {
-                let d = chain_rule(spline.eval(u), law, self.v.sigma);
+            for (j, e) in it.joints(u, 3)?.into_iter().enumerate() {
+                let d = chain_rule(e, law, self.v.sigma);
                 for (r, value) in d.iter().enumerate() {
                     row[r][j] = *value;
                 }
