@@ -113,6 +113,7 @@ fn msg_of(r: &CutRequest) -> msg::CutRequest {
         cl_tolerance: o.cl_tolerance,
         feed_law: o.feed_law.as_str().into(),
         rto_constraint: o.rto_constraint.as_str().into(),
+        orientation_corridor: o.orientation_corridor.as_str().into(),
         time_budget: r.time_budget,
     }
 }

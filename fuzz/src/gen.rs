@@ -180,6 +180,7 @@ pub fn cut_request(u: &mut Unstructured) -> Result<msg::CutRequest> {
         cl_tolerance: if u.arbitrary()? { 0.0 } else { float(u)? },
         feed_law: string(u, &["", "time_optimal", "constant", "variable"])?,
         rto_constraint: string(u, &["box", "equality"])?,
+        orientation_corridor: string(u, &["", "allowance", "none", "off"])?,
         time_budget: if u.arbitrary()? { 0.0 } else { float(u)? },
     })
 }
