@@ -8,6 +8,7 @@
 //! KERF_PLAN_CASES=case1 KERF_PLAN_COLD=0 cargo bench -p kerf_mjto --bench plan_time
 //! KERF_PLAN_DUMP=/tmp/plans.txt cargo bench -p kerf_mjto --bench plan_time
 //! KERF_PLAN_SEQUENCE=rto_box cargo bench -p kerf_mjto --bench plan_time
+//! KERF_ORIENTATION_CORRIDOR=none cargo bench -p kerf_mjto --bench plan_time
 //! ```
 //!
 //! * **warm**: one [`Planner`] plans the same request again and again, as a planner node does
@@ -115,9 +116,19 @@ fn time_cases(runs: usize) {
         .map(|v| v.split(',').map(str::to_string).collect())
         .unwrap_or_else(|_| vec!["case1".into(), "case2".into()]);
     let with_cold = std::env::var("KERF_PLAN_COLD").map_or(true, |v| v != "0");
+    // KERF_ORIENTATION_CORRIDOR (`none` or `allowance`) overrides the requests' option.
+    let corridor = std::env::var("KERF_ORIENTATION_CORRIDOR").ok().map(|v| {
+        kerf_mjto::request::OrientationCorridor::parse(&v).expect("KERF_ORIENTATION_CORRIDOR")
+    });
     let requests: Vec<CutRequest> = names
         .iter()
-        .map(|n| request(&dir.join(format!("{n}.yaml"))))
+        .map(|n| {
+            let mut r = request(&dir.join(format!("{n}.yaml")));
+            if let Some(c) = corridor {
+                r.options.orientation_corridor = c;
+            }
+            r
+        })
         .collect();
     println!("load average before: {}", load_average());
     let mut warm: Vec<Series> = names.iter().map(|_| Series::default()).collect();
