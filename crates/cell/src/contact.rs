@@ -23,7 +23,7 @@ use crate::CellError;
 /// How much farther than its threshold a pair's query looks (m): the query then returns the
 /// pair's distance (or that it is beyond `threshold + MARGIN`), a clearance the shape may use
 /// up by moving before the pair is tested again. Larger margins test more triangles per query
-/// and fewer queries; BENCHMARKS.md, "Simulated cell", compares 0.5 to 8 mm.
+/// and fewer queries; BENCHMARKS.md, "Simulated cell", compares 0.5 to 4 mm.
 pub const MARGIN: f64 = 0.001;
 
 /// Allowance for the queries' own error (m) when a clearance decides to skip a test (GJK
@@ -294,24 +294,7 @@ impl ContactChecker {
             // add triangles to the query (10 % of the cycle with the nozzle in the part).
             let near = known.is_some_and(|k| k.lower < pair.threshold);
             let prediction = pair.threshold + if near { 0.0 } else { MARGIN };
-            let result = match o.shape.as_trimesh() {
-                Some(mesh) => mesh_contact(
-                    mesh,
-                    &o.pose,
-                    s.shape.as_ref(),
-                    &pose,
-                    prediction,
-                    candidates,
-                ),
-                None => query::contact(
-                    &pose,
-                    s.shape.as_ref(),
-                    &o.pose,
-                    o.shape.as_ref(),
-                    prediction,
-                ),
-            };
-            let c = match result {
+            let c = match pair_contact(s, &pose, o, prediction, candidates) {
                 Ok(Some(c)) => {
                     *known = Some(Clearance {
                         lower: c.dist,
@@ -393,18 +376,11 @@ impl ContactChecker {
     /// # Errors
     /// [`CellError::InvalidValue`] naming the first unsupported pair.
     pub fn probe(&self) -> Result<(), CellError> {
+        let mut scratch = Candidates::default();
         for pair in &self.pairs {
             let s = &self.shapes[pair.shape];
             let o = &self.objects[pair.object];
-            if query::contact(
-                &Pose::IDENTITY,
-                s.shape.as_ref(),
-                &o.pose,
-                o.shape.as_ref(),
-                0.0,
-            )
-            .is_err()
-            {
+            if pair_contact(s, &Pose::IDENTITY, o, 0.0, &mut scratch).is_err() {
                 return Err(CellError::InvalidValue {
                     field: format!("{} against {}", s.name, o.name),
                     value: f64::NAN,
@@ -413,5 +389,34 @@ impl ContactChecker {
             }
         }
         Ok(())
+    }
+}
+
+/// The contact query of one pair, as [`ContactChecker::check`] and
+/// [`ContactChecker::probe`] run it: [`mesh_contact`] against a triangle mesh, parry's
+/// `contact` against anything else.
+fn pair_contact(
+    s: &RobotShape,
+    pose: &Pose,
+    o: &SceneObject,
+    prediction: f64,
+    candidates: &mut Candidates,
+) -> Result<Option<query::Contact>, query::Unsupported> {
+    match o.shape.as_trimesh() {
+        Some(mesh) => mesh_contact(
+            mesh,
+            &o.pose,
+            s.shape.as_ref(),
+            pose,
+            prediction,
+            candidates,
+        ),
+        None => query::contact(
+            pose,
+            s.shape.as_ref(),
+            &o.pose,
+            o.shape.as_ref(),
+            prediction,
+        ),
     }
 }
