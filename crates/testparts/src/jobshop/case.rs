@@ -2,9 +2,10 @@
 //! demands of a planner.
 
 use kerf_mjto::request::{CutOptions, CutRequest, PoseSpec};
-use nalgebra::UnitQuaternion;
+use nalgebra::{UnitQuaternion, Vector3};
 
-use super::path::ClPath;
+use super::part::Part;
+use super::path::{sample_curve, ClPath};
 use super::AXIS_SCALE;
 use crate::placement::nominal_m_centre;
 use crate::rounding::round_to;
@@ -49,6 +50,37 @@ pub struct JobShopCase {
 }
 
 impl JobShopCase {
+    /// A case cutting `curve` on `part` with the workpiece unturned: the curve sampled at the
+    /// process's spacing ([`sample_curve`]) and the request assembled ([`make_request`]).
+    ///
+    /// # Errors
+    /// As [`sample_curve`] and [`make_request`].
+    pub(super) fn cut(
+        name: &'static str,
+        title: String,
+        part: &Part,
+        curve: &dyn Fn(f64) -> (Vector3<f64>, Vector3<f64>),
+        closed: bool,
+        process: Process,
+        expect: Expectation,
+    ) -> Result<Self, TestPartError> {
+        let path = sample_curve(curve, closed, process.spacing())?;
+        Ok(Self {
+            name,
+            title,
+            part: part.name,
+            closed,
+            request: make_request(
+                name,
+                part.mesh_reference(),
+                path,
+                UnitQuaternion::identity(),
+                process,
+            )?,
+            expect,
+        })
+    }
+
     /// Repository-relative path of the request file.
     pub fn file(&self) -> String {
         format!("crates/mjto/cases/jobshop/{}.yaml", self.name)

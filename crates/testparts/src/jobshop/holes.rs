@@ -1,12 +1,11 @@
 //! Holes and slots on curved sheet: round holes and an obround slot on the rolled panel.
 
-use nalgebra::{UnitQuaternion, Vector2};
+use nalgebra::Vector2;
 
-use super::case::{make_request, Expectation, JobShopCase, Process};
+use super::case::{Expectation, JobShopCase, Process};
 use super::contour::Outline;
 use super::panel::PanelParams;
 use super::part::Part;
-use super::path::sample_curve;
 use crate::TestPartError;
 
 /// The hole and slot cases on the panel (developed coordinates (x, s), s from the crown):
@@ -46,21 +45,15 @@ pub(super) fn hole_cases(
         .into_iter()
         .map(|(name, title, outline, process)| {
             let curve = |t: f64| panel.surface(outline.at(t));
-            let path = sample_curve(&curve, outline.closed, process.spacing())?;
-            Ok(JobShopCase {
+            JobShopCase::cut(
                 name,
-                title: title.to_owned(),
-                part: part.name,
-                closed: outline.closed,
-                request: make_request(
-                    name,
-                    part.mesh_reference(),
-                    path,
-                    UnitQuaternion::identity(),
-                    process,
-                )?,
-                expect: Expectation::Plan,
-            })
+                title.to_owned(),
+                part,
+                &curve,
+                outline.closed,
+                process,
+                Expectation::Plan,
+            )
         })
         .collect()
 }

@@ -1,10 +1,9 @@
 //! Tube-to-tube saddle cuts: the hole in the main tube where a branch tube meets it.
 
-use nalgebra::{UnitQuaternion, Vector3};
+use nalgebra::Vector3;
 
-use super::case::{make_request, Expectation, JobShopCase, Process};
+use super::case::{Expectation, JobShopCase, Process};
 use super::part::Part;
-use super::path::sample_curve;
 use super::tube::TubeParams;
 use crate::TestPartError;
 
@@ -57,26 +56,20 @@ pub(super) fn saddle_cases(
     .map(|(name, ratio)| {
         let r = ratio * tube.radius;
         let curve = saddle_curve(tube, r)?;
-        let path = sample_curve(&curve, true, process.spacing())?;
-        Ok(JobShopCase {
+        JobShopCase::cut(
             name,
-            title: format!(
+            format!(
                 "saddle cut of a Ø{:.0} mm branch in the Ø{:.0} mm main tube (r/R = {ratio}), \
                      tool axis the main tube's normal, vertical twice per loop; 10 m/min, 10°/10°",
                 2e3 * r,
                 2e3 * tube.radius
             ),
-            part: part.name,
-            closed: true,
-            request: make_request(
-                name,
-                part.mesh_reference(),
-                path,
-                UnitQuaternion::identity(),
-                process,
-            )?,
-            expect: Expectation::Plan,
-        })
+            part,
+            &curve,
+            true,
+            process,
+            Expectation::Plan,
+        )
     })
     .collect()
 }

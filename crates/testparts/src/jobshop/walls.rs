@@ -1,13 +1,12 @@
 //! Trims near walls and flanges, closed cut-outs beside a wall, a cut whose nominal tool axis
 //! collides while its allowance does not, and the two refusals of issue 16's "Bad input".
 
-use nalgebra::{UnitQuaternion, Vector2, Vector3};
+use nalgebra::{Vector2, Vector3};
 
-use super::case::{make_request, Expectation, JobShopCase, Process};
+use super::case::{Expectation, JobShopCase, Process};
 use super::channel::ChannelParams;
 use super::contour::Outline;
 use super::part::Part;
-use super::path::sample_curve;
 use crate::TestPartError;
 
 /// One case on a flat face: outline in the face's (x, y) at height z, normal +z.
@@ -25,21 +24,15 @@ fn build(part: &Part, c: FlatCase) -> Result<JobShopCase, TestPartError> {
         let p = c.outline.at(t);
         (Vector3::new(p.x, p.y, c.z), Vector3::z())
     };
-    let path = sample_curve(&curve, c.outline.closed, c.process.spacing())?;
-    Ok(JobShopCase {
-        name: c.name,
-        title: c.title.to_owned(),
-        part: part.name,
-        closed: c.outline.closed,
-        request: make_request(
-            c.name,
-            part.mesh_reference(),
-            path,
-            UnitQuaternion::identity(),
-            c.process,
-        )?,
-        expect: c.expect,
-    })
+    JobShopCase::cut(
+        c.name,
+        c.title.to_owned(),
+        part,
+        &curve,
+        c.outline.closed,
+        c.process,
+        c.expect,
+    )
 }
 
 /// The channel cases (walls 120 mm high, inner faces at y = ±0.15): a floor trim 60 mm from
