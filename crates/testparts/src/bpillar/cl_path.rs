@@ -6,8 +6,7 @@ use nalgebra::Vector3;
 use super::part::BPillar;
 use super::section::LEFT_FLANGE_FILLET_START;
 use super::surface::SurfaceVertex;
-use super::{AXIS_SCALE, COORD_SCALE};
-use crate::rounding::round_vec;
+use crate::rounding::{round_axis, round_point};
 use crate::TestPartError;
 
 /// A CL path: points on the outer surface and their nominal tool axes.
@@ -292,8 +291,8 @@ impl Polyline {
         let mut axes = Vec::with_capacity(count);
         for k in 0..count {
             let v = self.at(l0 + spacing * k as f64)?;
-            points.push(round_vec(&v.point, COORD_SCALE));
-            axes.push(round_vec(&v.normal, AXIS_SCALE));
+            points.push(round_point(&v.point));
+            axes.push(round_axis(&v.normal));
         }
         Ok(ClPath {
             points,

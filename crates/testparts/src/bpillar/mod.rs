@@ -87,12 +87,6 @@ pub const REGENERATE_COMMAND: &str = "cargo run -p kerf_testparts --example gen_
 /// shortest spine segment (m): shorter ones would give degenerate triangles.
 const MIN_PIECE: f64 = 1e-3;
 
-/// Mesh and CL coordinates are rounded to 1 / COORD_SCALE m (1 nm).
-const COORD_SCALE: f64 = 1e9;
-
-/// Tool-axis components are rounded to 1 / AXIS_SCALE.
-const AXIS_SCALE: f64 = 1e12;
-
 /// Step of the central difference that gives the change of the section
 /// along the spine in the transition (m).
 const SECTION_FD_STEP: f64 = 1e-5;

@@ -1,13 +1,12 @@
 //! Cut requests on the part: placement of the workpiece, the process
 //! parameters, the YAML form and the tool-axis changes between RTOs.
 
-use kerf_mjto::request::{CutOptions, CutRequest, PoseSpec};
+use kerf_mjto::request::{CutOptions, CutRequest};
 use nalgebra::{UnitQuaternion, Vector3};
 
 use super::cl_path::ClPath;
-use super::{AXIS_SCALE, MESH_REFERENCE, REGENERATE_COMMAND};
-use crate::placement::nominal_m_centre;
-use crate::rounding::round_to;
+use super::{MESH_REFERENCE, REGENERATE_COMMAND};
+use crate::placement::workpiece_pose;
 use crate::TestPartError;
 
 /// The CL point spacing `f Δt` of a feedrate and a sample period.
@@ -62,19 +61,7 @@ pub(super) fn make_request(
             ));
         }
     }
-    let centre = nominal_m_centre(&path.points, &path.axes, &rotation);
-    let mm = |v: f64| round_to(v, 1e3);
-    let position = [
-        mm(m_center[0] - centre.x),
-        mm(m_center[1] - centre.y),
-        mm(m_center[2] - centre.z),
-    ];
-    let q = rotation.quaternion();
-    let r = |v: f64| round_to(v, AXIS_SCALE);
-    let workpiece_pose = PoseSpec {
-        position,
-        orientation: [r(q.i), r(q.j), r(q.k), r(q.w)],
-    };
+    let workpiece_pose = workpiece_pose(&path.points, &path.axes, &rotation, m_center);
     Ok(CutRequest {
         request_id: id.to_owned(),
         points: path.points,

@@ -5,8 +5,8 @@ use nalgebra::Vector3;
 
 use super::params::BPillarParams;
 use super::spine::Spine;
-use super::{COORD_SCALE, SECTION_FD_STEP};
-use crate::rounding::round_vec;
+use super::SECTION_FD_STEP;
+use crate::rounding::round_point;
 use crate::TestPartError;
 
 /// A point of the outer surface with its unit outward (head-side) normal.
@@ -116,11 +116,11 @@ pub(super) fn build_mesh(
         ));
     }
     let mut vertices = Vec::with_capacity(2 * n_outer);
-    vertices.extend(outer.iter().map(|v| round_vec(&v.point, COORD_SCALE)));
+    vertices.extend(outer.iter().map(|v| round_point(&v.point)));
     vertices.extend(
         outer
             .iter()
-            .map(|v| round_vec(&(v.point - v.normal * thickness), COORD_SCALE)),
+            .map(|v| round_point(&(v.point - v.normal * thickness))),
     );
     let o = |i: usize, j: usize| (i * n_profile + j) as u32;
     let inn = |i: usize, j: usize| (n_outer + i * n_profile + j) as u32;

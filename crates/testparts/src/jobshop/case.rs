@@ -1,14 +1,12 @@
 //! One job-shop case: its request, the part it cuts and the outcome the issue's contract
 //! demands of a planner.
 
-use kerf_mjto::request::{CutOptions, CutRequest, PoseSpec};
+use kerf_mjto::request::{CutOptions, CutRequest};
 use nalgebra::{UnitQuaternion, Vector3};
 
 use super::part::Part;
 use super::path::{sample_curve, ClPath};
-use super::AXIS_SCALE;
-use crate::placement::nominal_m_centre;
-use crate::rounding::round_to;
+use crate::placement::workpiece_pose;
 use crate::TestPartError;
 
 /// What a planner must answer (issue 16: planned at the requested feed where a machine can
@@ -131,13 +129,10 @@ pub(super) fn make_request(
     rotation: UnitQuaternion<f64>,
     process: Process,
 ) -> Result<CutRequest, TestPartError> {
-    let centre = nominal_m_centre(&path.points, &path.axes, &rotation);
-    if !centre.iter().all(|v| v.is_finite()) {
+    let workpiece_pose = workpiece_pose(&path.points, &path.axes, &rotation, M_CENTER);
+    if !workpiece_pose.position.iter().all(|v| v.is_finite()) {
         return Err(TestPartError::invalid(id, "empty or non-finite path"));
     }
-    let mm = |v: f64| round_to(v, 1e3);
-    let q = rotation.quaternion();
-    let r = |v: f64| round_to(v, AXIS_SCALE);
     Ok(CutRequest {
         request_id: format!("jobshop-{id}"),
         points: path.points,
@@ -149,14 +144,7 @@ pub(super) fn make_request(
         max_lead_angle: process.lead,
         max_tilt_angle: process.tilt,
         mesh,
-        workpiece_pose: PoseSpec {
-            position: [
-                mm(M_CENTER[0] - centre.x),
-                mm(M_CENTER[1] - centre.y),
-                mm(M_CENTER[2] - centre.z),
-            ],
-            orientation: [r(q.i), r(q.j), r(q.k), r(q.w)],
-        },
+        workpiece_pose,
         options: CutOptions::default(),
         time_budget: 0.0,
     })

@@ -41,7 +41,6 @@ mod panel;
 mod part;
 mod path;
 mod profile;
-mod rounding;
 mod saddle;
 pub mod sheet;
 mod tube;
@@ -63,9 +62,3 @@ pub const REGENERATE_COMMAND: &str = "cargo run -p kerf_testparts --example gen_
 
 /// Largest number of triangles of a job-shop mesh.
 pub const MAX_TRIANGLES: usize = 6000;
-
-/// Coordinates are rounded to 1 / COORD_SCALE m (1 nm).
-const COORD_SCALE: f64 = 1e9;
-
-/// Tool-axis components are rounded to 1 / AXIS_SCALE.
-const AXIS_SCALE: f64 = 1e12;

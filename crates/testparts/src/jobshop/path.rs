@@ -4,7 +4,7 @@
 
 use nalgebra::Vector3;
 
-use super::rounding::{round_axis, round_point};
+use crate::rounding::{round_axis, round_point};
 use crate::TestPartError;
 
 /// Chords of the arc-length table of a curve.

@@ -5,8 +5,8 @@
 use kerf_mjto::mesh::MeshData;
 use nalgebra::Vector3;
 
-use super::rounding::round_point;
 use super::MAX_TRIANGLES;
+use crate::rounding::round_point;
 use crate::TestPartError;
 
 /// The head-side surface of a sheet sampled on a `nu × nv` grid (u-major: vertex `(i, j)` is
