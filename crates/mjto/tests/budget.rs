@@ -3,20 +3,16 @@
 //! with a cancellation, and the planner plans again afterwards.
 #![allow(clippy::unwrap_used, clippy::expect_used)] // tests report failures by panicking
 
-use std::path::Path;
+mod common;
+
+use common::case;
+
 use std::time::Duration;
 
 use kerf_budget::{Budget, CancelToken, Interrupt};
 use kerf_mjto::error::status;
 use kerf_mjto::planner::Planner;
-use kerf_mjto::{CutRequest, LaserMachine, PlanError};
-
-fn case(name: &str) -> CutRequest {
-    let path = Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("cases")
-        .join(format!("{name}.yaml"));
-    CutRequest::from_yaml(&std::fs::read_to_string(path).unwrap()).unwrap()
-}
+use kerf_mjto::{LaserMachine, PlanError};
 
 fn planner() -> Planner {
     Planner::new(LaserMachine::default_machine().unwrap()).unwrap()

@@ -11,23 +11,14 @@
 
 mod common;
 
-use std::path::Path;
-
-use common::Rng;
-use kerf_mjto::baseline::{quaternion_interpolation, Rto};
+use common::{case, Rng};
+use kerf_budget::Budget;
+use kerf_mjto::baseline::{quaternion_interpolation_along, Rto};
 use kerf_mjto::collision::{CollisionWorld, HeadModel};
 use kerf_mjto::mesh::MeshCache;
 use kerf_mjto::orientation::PathFrames;
 use kerf_mjto::planner::Planner;
-use kerf_mjto::timelaw::TimeLaw;
 use kerf_mjto::{CutPlan, CutRequest, LaserMachine};
-
-fn case(name: &str) -> CutRequest {
-    let path = Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("cases")
-        .join(format!("{name}.yaml"));
-    CutRequest::from_yaml(&std::fs::read_to_string(path).unwrap()).unwrap()
-}
 
 fn world(machine: &LaserMachine, request: &CutRequest, clearance: f64) -> CollisionWorld {
     let v = request.validate().unwrap();
@@ -36,28 +27,21 @@ fn world(machine: &LaserMachine, request: &CutRequest, clearance: f64) -> Collis
     CollisionWorld::new(head, &mesh, &v.workpiece_pose, clearance).unwrap()
 }
 
-/// The QI baseline's samples on the plan's RTOs (as the planner samples it).
+/// The QI baseline's samples on the plan's RTOs and along the plan's s(t), as the planner
+/// samples it for its metrics.
 fn qi_samples(machine: &LaserMachine, request: &CutRequest, plan: &CutPlan) -> Vec<[f64; 6]> {
     let v = request.validate().unwrap();
     let frames = PathFrames::new(&v.points, &v.axes, &v.u);
-    let law = TimeLaw::new(
-        v.sigma,
-        request.feedrate,
-        request.feed_acceleration,
-        request.feed_jerk,
-    )
-    .unwrap();
     let rtos: Vec<Rto> = plan.rtos.iter().map(Rto::from).collect();
-    quaternion_interpolation(
+    quaternion_interpolation_along(
         &frames,
         &rtos,
-        &law,
+        &plan.path_positions,
         v.sigma,
-        request.sample_period,
         machine.limits(),
+        &Budget::unlimited(),
     )
     .unwrap()
-    .1
 }
 
 /// Smooth random perturbations of a trajectory (every joint offset by a

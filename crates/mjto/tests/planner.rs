@@ -5,7 +5,11 @@
 //! against the QI baseline, and bad requests through `Planner::plan`.
 #![allow(clippy::unwrap_used, clippy::expect_used)] // tests report failures by panicking
 
-use std::path::{Path, PathBuf};
+mod common;
+
+use common::case;
+
+use std::path::PathBuf;
 
 use kerf_budget::Budget;
 use kerf_executor::spline::{coefficients, Interpolation, Knot};
@@ -30,14 +34,6 @@ const CL_TOLERANCE: f64 = 2e-4;
 /// Relative tolerance of the limit re-check (the planner's own gate uses
 /// the same 1e-6).
 const REL: f64 = 1e-6;
-
-fn case(name: &str) -> CutRequest {
-    let path = Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("cases")
-        .join(format!("{name}.yaml"));
-    let text = std::fs::read_to_string(&path).unwrap();
-    CutRequest::from_yaml(&text).unwrap()
-}
 
 fn machine() -> LaserMachine {
     LaserMachine::default_machine().unwrap()

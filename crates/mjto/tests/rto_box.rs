@@ -6,8 +6,6 @@
 //! a 30° turn of the nominal axis force RTO insertions in the paper's loop).
 #![allow(clippy::unwrap_used, clippy::expect_used)] // tests report failures by panicking
 
-use std::path::Path;
-
 use kerf_bspline::{BSpline, KnotVector};
 use kerf_budget::Budget;
 use kerf_mjto::collision::{CollisionWorld, HeadModel};
@@ -22,17 +20,11 @@ use kerf_mjto::standoff::{solve_standoff, MPathProblem};
 use kerf_mjto::{AxisLimits, CutPlan, CutRequest, LaserMachine, PlanError};
 
 mod common;
+use common::case;
 use common::saddle::{Saddle, TempMesh};
 
 fn machine() -> LaserMachine {
     LaserMachine::default_machine().unwrap()
-}
-
-fn case(name: &str) -> CutRequest {
-    let path = Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("cases")
-        .join(format!("{name}.yaml"));
-    CutRequest::from_yaml(&std::fs::read_to_string(path).unwrap()).unwrap()
 }
 
 fn world_of(request: &CutRequest) -> CollisionWorld {

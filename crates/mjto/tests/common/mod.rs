@@ -1,5 +1,16 @@
 //! Helpers shared by the integration tests of kerf_mjto.
 
+use kerf_mjto::CutRequest;
+
+/// The committed request `crates/mjto/cases/<name>.yaml`.
+#[allow(dead_code)] // each test file uses a subset
+pub fn case(name: &str) -> CutRequest {
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("cases")
+        .join(format!("{name}.yaml"));
+    CutRequest::from_yaml(&std::fs::read_to_string(path).unwrap()).unwrap()
+}
+
 /// Deterministic xorshift64* generator.
 pub struct Rng(pub u64);
 
