@@ -2,17 +2,21 @@
 
 use std::time::{Duration, Instant};
 
-use crate::{CancelToken, Interrupt};
+use crate::{memory::MemoryAccount, CancelToken, Interrupt};
 
-/// The time a piece of work may take, from its creation, and the token that cancels it.
+/// The time a piece of work may take, from its creation, the token that cancels it, and the
+/// memory its data may hold ([`Self::with_memory`]).
 ///
 /// Cheap to check (an atomic load and a clock read): call [`Self::check`] between units of
-/// work small enough that the overshoot past the deadline stays well under a second.
+/// work small enough that the overshoot past the deadline stays well under a second, and
+/// [`Self::check_memory`] / [`Self::account`] before a stage allocates data that grows with
+/// the request.
 #[derive(Debug, Clone)]
 pub struct Budget {
     start: Instant,
     limit: Option<Duration>,
     cancel: CancelToken,
+    memory: MemoryAccount,
 }
 
 impl Budget {
@@ -22,7 +26,49 @@ impl Budget {
             start: Instant::now(),
             limit,
             cancel,
+            memory: MemoryAccount::default(),
         }
+    }
+
+    /// The same budget with a memory limit of `bytes` (none: unlimited) and an empty account.
+    pub fn with_memory(mut self, bytes: Option<u64>) -> Self {
+        self.memory = MemoryAccount::new(bytes);
+        self
+    }
+
+    /// The memory limit (bytes; none: unlimited).
+    pub fn memory_limit(&self) -> Option<u64> {
+        self.memory.limit()
+    }
+
+    /// Bytes accounted so far ([`Self::account`]).
+    pub fn memory_used(&self) -> u64 {
+        self.memory.used()
+    }
+
+    /// Checks an estimate: whether a stage holding `bytes` more than what is accounted fits.
+    ///
+    /// # Arguments
+    /// * `bytes` — the stage's estimated data (e.g. [`crate::bytes_of`] of its sample count).
+    /// * `what` — what grows, with the request's figures, named in the error.
+    ///
+    /// # Errors
+    /// [`Interrupt::OverMemory`] when it would not fit.
+    pub fn check_memory(&self, bytes: u64, what: &str) -> Result<(), Interrupt> {
+        self.memory.check(bytes, what)
+    }
+
+    /// Accounts `bytes` the plan now holds (until [`Self::release`]); clones share the account.
+    ///
+    /// # Errors
+    /// [`Interrupt::OverMemory`] (nothing accounted) when they would not fit.
+    pub fn account(&self, bytes: u64, what: &str) -> Result<(), Interrupt> {
+        self.memory.account(bytes, what)
+    }
+
+    /// Gives back `bytes` accounted earlier.
+    pub fn release(&self, bytes: u64) {
+        self.memory.release(bytes)
     }
 
     /// No deadline and a token nobody holds: [`Self::check`] always passes.
@@ -44,6 +90,7 @@ impl Budget {
             start: self.start,
             limit,
             cancel: self.cancel.clone(),
+            memory: self.memory.clone(),
         }
     }
 
@@ -125,6 +172,18 @@ mod tests {
         token.cancel();
         assert!(matches!(c.check("s"), Err(Interrupt::Cancelled { .. })));
         assert!(b.is_cancelled());
+    }
+
+    #[test]
+    fn memory_is_shared_by_clones_and_tightened_budgets() {
+        let b = Budget::unlimited().with_memory(Some(100));
+        let c = b.tightened(Some(Duration::from_secs(1)));
+        assert!(c.account(80, "a").is_ok());
+        assert_eq!(b.memory_used(), 80);
+        assert!(b.check_memory(30, "b").unwrap_err().is_over_memory());
+        b.release(80);
+        assert!(c.check_memory(100, "c").is_ok());
+        assert_eq!(Budget::unlimited().memory_limit(), None);
     }
 
     #[test]

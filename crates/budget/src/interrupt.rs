@@ -23,6 +23,21 @@ pub enum Interrupt {
         /// The stage of the planner that was running.
         stage: &'static str,
     },
+    /// The plan's data would not fit in its memory budget (the node's `plan_memory`).
+    #[error(
+        "memory budget of {limit_text} exceeded: {what} needs {needed_text}; the request was \
+         not planned (simplify it, or raise the node's plan_memory)",
+        limit_text = crate::format_bytes(*.limit),
+        needed_text = crate::format_bytes(*.needed)
+    )]
+    OverMemory {
+        /// The budget (bytes).
+        limit: u64,
+        /// What the stage would have held in all (bytes, an estimate or the account).
+        needed: u64,
+        /// What grew, with the request's figures ("arc samples: 10000 helix turns × …").
+        what: String,
+    },
     /// The work was cancelled (the node is stopping).
     #[error(
         "planning cancelled after {elapsed:.3} s, during {stage}: the planner is stopping",
@@ -40,5 +55,10 @@ impl Interrupt {
     /// Whether the budget ran out (as opposed to a cancellation).
     pub fn is_timeout(&self) -> bool {
         matches!(self, Interrupt::TimedOut { .. })
+    }
+
+    /// Whether the memory budget ran out.
+    pub fn is_over_memory(&self) -> bool {
+        matches!(self, Interrupt::OverMemory { .. })
     }
 }

@@ -20,9 +20,14 @@
 mod budget;
 mod cancel;
 mod interrupt;
+mod memory;
 mod seconds;
 
 pub use budget::Budget;
 pub use cancel::CancelToken;
 pub use interrupt::Interrupt;
+pub use memory::{
+    bytes_of, format_bytes, memory_from_bytes, DEFAULT_PLAN_MEMORY, MAX_PLAN_MEMORY,
+    MIN_PLAN_MEMORY,
+};
 pub use seconds::{limit_from_seconds, MAX_BUDGET_SECONDS};
