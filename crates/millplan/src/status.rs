@@ -27,6 +27,8 @@ pub const TIMEOUT: u8 = 7;
 /// The executed plan passes closer to a singularity than the request's minimum condition
 /// indicator allows (value and arc length in the message).
 pub const ILL_CONDITIONED: u8 = 8;
+/// The plan would need more memory than its budget (the node's `plan_memory`) allows.
+pub const RESOURCE_LIMIT: u8 = 9;
 
 /// The name of a status value, `None` for an unknown one.
 pub fn status_name(value: u8) -> Option<&'static str> {
@@ -39,6 +41,7 @@ pub fn status_name(value: u8) -> Option<&'static str> {
         INTERNAL_ERROR => Some("INTERNAL_ERROR"),
         TIMEOUT => Some("TIMEOUT"),
         ILL_CONDITIONED => Some("ILL_CONDITIONED"),
+        RESOURCE_LIMIT => Some("RESOURCE_LIMIT"),
         _ => None,
     }
 }
@@ -54,6 +57,7 @@ pub fn status_name(value: u8) -> Option<&'static str> {
 /// | `Io`, `Backend`, `Mill` of a non-finite value, non-convergence, a file or robot-model failure; `Interrupted` by a cancellation | INTERNAL_ERROR 6 |
 /// | `Interrupted` by the time budget | TIMEOUT 7 |
 /// | `IllConditioned` | ILL_CONDITIONED 8 |
+/// | `Interrupted` by the memory budget | RESOURCE_LIMIT 9 |
 ///
 /// Value 5 (`QUEUE_FULL` of `kerf_msgs/msg/MillPlan`) belongs to the node
 /// (its request queue) and is not produced here.
@@ -83,6 +87,7 @@ pub fn status_of(error: &MillPlanError) -> u8 {
         | MillPlanError::Backend(_)
         | MillPlanError::NotExecutable { .. } => INTERNAL_ERROR,
         MillPlanError::Interrupted(i) if i.is_timeout() => TIMEOUT,
+        MillPlanError::Interrupted(i) if i.is_over_memory() => RESOURCE_LIMIT,
         MillPlanError::IllConditioned { .. } => ILL_CONDITIONED,
         MillPlanError::Interrupted(_) => INTERNAL_ERROR,
     }

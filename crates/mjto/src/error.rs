@@ -184,6 +184,10 @@ pub mod status {
     pub const INTERNAL_ERROR: u8 = 7;
     /// The request's time budget ran out before the plan was finished.
     pub const TIMEOUT: u8 = 8;
+    /// The request queue is full (answered by the node's harness).
+    pub const QUEUE_FULL: u8 = 9;
+    /// The plan would need more memory than its budget allows.
+    pub const RESOURCE_LIMIT: u8 = 10;
 }
 
 impl PlanError {
@@ -200,6 +204,7 @@ impl PlanError {
             PlanError::LimitViolation { .. } => status::LIMIT_VIOLATION,
             PlanError::Solver { .. } | PlanError::NotExecutable { .. } => status::INTERNAL_ERROR,
             PlanError::Interrupted(i) if i.is_timeout() => status::TIMEOUT,
+            PlanError::Interrupted(i) if i.is_over_memory() => status::RESOURCE_LIMIT,
             PlanError::Interrupted(_) => status::INTERNAL_ERROR,
         }
     }

@@ -327,6 +327,10 @@ impl CutPlan {
     pub const INTERNAL_ERROR: u8 = 7;
     /// The request's time budget ran out before the plan was finished.
     pub const TIMEOUT: u8 = 8;
+    /// The request queue is full; the request was not planned.
+    pub const QUEUE_FULL: u8 = 9;
+    /// The plan would need more memory than the node's `plan_memory` allows.
+    pub const RESOURCE_LIMIT: u8 = 10;
 
     /// Name of a status value (`"SUCCESS"` …), or `None` for an unknown value.
     pub fn status_name(status: u8) -> Option<&'static str> {
@@ -340,6 +344,8 @@ impl CutPlan {
             Self::LIMIT_VIOLATION => Some("LIMIT_VIOLATION"),
             Self::INTERNAL_ERROR => Some("INTERNAL_ERROR"),
             Self::TIMEOUT => Some("TIMEOUT"),
+            Self::QUEUE_FULL => Some("QUEUE_FULL"),
+            Self::RESOURCE_LIMIT => Some("RESOURCE_LIMIT"),
             _ => None,
         }
     }
@@ -524,6 +530,8 @@ impl MillPlan {
     pub const TIMEOUT: u8 = 7;
     /// The executed plan passes closer to a singularity than the request allows.
     pub const ILL_CONDITIONED: u8 = 8;
+    /// The plan would need more memory than the node's `plan_memory` allows.
+    pub const RESOURCE_LIMIT: u8 = 9;
 
     /// Name of a status value (`"SUCCESS"` …), or `None` for an unknown value.
     pub fn status_name(status: u8) -> Option<&'static str> {
@@ -537,6 +545,7 @@ impl MillPlan {
             Self::INTERNAL_ERROR => Some("INTERNAL_ERROR"),
             Self::TIMEOUT => Some("TIMEOUT"),
             Self::ILL_CONDITIONED => Some("ILL_CONDITIONED"),
+            Self::RESOURCE_LIMIT => Some("RESOURCE_LIMIT"),
             _ => None,
         }
     }
@@ -704,6 +713,8 @@ impl GcodePlan {
     pub const INTERNAL_ERROR: u8 = 5;
     /// The time budget ran out.
     pub const TIMEOUT: u8 = 6;
+    /// The plan would need more memory than the node's `plan_memory` allows.
+    pub const RESOURCE_LIMIT: u8 = 7;
 
     /// Name of a status value, or `None` for an unknown value.
     pub fn status_name(status: u8) -> Option<&'static str> {
@@ -715,6 +726,7 @@ impl GcodePlan {
             Self::QUEUE_FULL => Some("QUEUE_FULL"),
             Self::INTERNAL_ERROR => Some("INTERNAL_ERROR"),
             Self::TIMEOUT => Some("TIMEOUT"),
+            Self::RESOURCE_LIMIT => Some("RESOURCE_LIMIT"),
             _ => None,
         }
     }
@@ -736,7 +748,8 @@ mod tests {
                 "UNREACHABLE",
                 "QUEUE_FULL",
                 "INTERNAL_ERROR",
-                "TIMEOUT"
+                "TIMEOUT",
+                "RESOURCE_LIMIT"
             ]
         );
     }
@@ -758,7 +771,9 @@ mod tests {
         assert_eq!(CutPlan::status_name(5), Some("COLLISION"));
         assert_eq!(CutPlan::status_name(7), Some("INTERNAL_ERROR"));
         assert_eq!(CutPlan::status_name(8), Some("TIMEOUT"));
-        assert_eq!(CutPlan::status_name(9), None);
+        assert_eq!(CutPlan::status_name(9), Some("QUEUE_FULL"));
+        assert_eq!(CutPlan::status_name(10), Some("RESOURCE_LIMIT"));
+        assert_eq!(CutPlan::status_name(11), None);
     }
 
     #[test]
@@ -771,13 +786,14 @@ mod tests {
         assert_eq!(MillPlan::status_name(6), Some("INTERNAL_ERROR"));
         assert_eq!(MillPlan::status_name(7), Some("TIMEOUT"));
         assert_eq!(MillPlan::status_name(8), Some("ILL_CONDITIONED"));
-        assert_eq!(MillPlan::status_name(9), None);
+        assert_eq!(MillPlan::status_name(9), Some("RESOURCE_LIMIT"));
+        assert_eq!(MillPlan::status_name(10), None);
         // Every name is distinct and round-trips through its code.
         let names: Vec<&str> = (0..=u8::MAX).filter_map(MillPlan::status_name).collect();
-        assert_eq!(names.len(), 9);
+        assert_eq!(names.len(), 10);
         let mut sorted = names.clone();
         sorted.sort_unstable();
         sorted.dedup();
-        assert_eq!(sorted.len(), 9);
+        assert_eq!(sorted.len(), 10);
     }
 }

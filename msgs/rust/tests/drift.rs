@@ -469,6 +469,8 @@ fn rust_constants() -> ConstantTable {
                 c_u8("LIMIT_VIOLATION", Cp::LIMIT_VIOLATION),
                 c_u8("INTERNAL_ERROR", Cp::INTERNAL_ERROR),
                 c_u8("TIMEOUT", Cp::TIMEOUT),
+                c_u8("QUEUE_FULL", Cp::QUEUE_FULL),
+                c_u8("RESOURCE_LIMIT", Cp::RESOURCE_LIMIT),
             ],
         ),
         (
@@ -494,6 +496,7 @@ fn rust_constants() -> ConstantTable {
                 c_u8("INTERNAL_ERROR", Mp::INTERNAL_ERROR),
                 c_u8("TIMEOUT", Mp::TIMEOUT),
                 c_u8("ILL_CONDITIONED", Mp::ILL_CONDITIONED),
+                c_u8("RESOURCE_LIMIT", Mp::RESOURCE_LIMIT),
             ],
         ),
         (
@@ -520,6 +523,7 @@ fn rust_constants() -> ConstantTable {
                 c_u8("QUEUE_FULL", Gp::QUEUE_FULL),
                 c_u8("INTERNAL_ERROR", Gp::INTERNAL_ERROR),
                 c_u8("TIMEOUT", Gp::TIMEOUT),
+                c_u8("RESOURCE_LIMIT", Gp::RESOURCE_LIMIT),
             ],
         ),
     ]

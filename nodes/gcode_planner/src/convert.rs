@@ -11,6 +11,7 @@ use kerf_msgs::msg;
 /// | a point out of reach | UNREACHABLE |
 /// | a bad setting or field, too many points | INVALID_REQUEST |
 /// | the time budget ran out | TIMEOUT |
+/// | the memory budget ran out | RESOURCE_LIMIT |
 /// | cancelled, not executable | INTERNAL_ERROR |
 pub fn status_of(e: &GcodePlanError) -> u8 {
     match e {
@@ -23,6 +24,9 @@ pub fn status_of(e: &GcodePlanError) -> u8 {
         | GcodePlanError::TooManyPoints { .. } => msg::GcodePlan::INVALID_REQUEST,
         GcodePlanError::Interrupted(kerf_budget::Interrupt::TimedOut { .. }) => {
             msg::GcodePlan::TIMEOUT
+        }
+        GcodePlanError::Interrupted(kerf_budget::Interrupt::OverMemory { .. }) => {
+            msg::GcodePlan::RESOURCE_LIMIT
         }
         GcodePlanError::Interrupted(_) | GcodePlanError::NotExecutable { .. } => {
             msg::GcodePlan::INTERNAL_ERROR

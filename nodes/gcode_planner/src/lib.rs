@@ -222,10 +222,12 @@ impl PlanningService for GcodeService {
 
     fn failure(&self, key: &AnswerKey, failure: Failure, message: String) -> GcodePlan {
         let code = match failure {
-            Failure::Unreadable | Failure::OverBudget | Failure::TooLarge => {
+            Failure::Unreadable | Failure::OverBudget | Failure::TooLarge | Failure::BadNumber => {
                 msg::GcodePlan::INVALID_REQUEST
             }
             Failure::Busy => msg::GcodePlan::QUEUE_FULL,
+            Failure::Timeout => msg::GcodePlan::TIMEOUT,
+            Failure::ResourceLimit => msg::GcodePlan::RESOURCE_LIMIT,
             Failure::Stopped | Failure::Panicked | Failure::NotExecutable => {
                 msg::GcodePlan::INTERNAL_ERROR
             }

@@ -293,10 +293,12 @@ impl PlanningService for MillService {
     /// executable INTERNAL_ERROR.
     fn failure(&self, key: &AnswerKey, failure: Failure, message: String) -> MillPlan {
         let code = match failure {
-            Failure::Unreadable | Failure::OverBudget | Failure::TooLarge => {
+            Failure::Unreadable | Failure::OverBudget | Failure::TooLarge | Failure::BadNumber => {
                 status::INVALID_REQUEST
             }
             Failure::Busy => convert::QUEUE_FULL,
+            Failure::Timeout => status::TIMEOUT,
+            Failure::ResourceLimit => status::RESOURCE_LIMIT,
             Failure::Stopped | Failure::Panicked | Failure::NotExecutable => status::INTERNAL_ERROR,
         };
         // An unreadable sample names no planner (not even the default one).

@@ -209,16 +209,17 @@ impl PlanningService for CutService {
         }
     }
 
-    /// Unreadable samples and budgets over `plan_timeout` are INVALID_REQUEST; busy, stopped,
-    /// panicked and not executable are INTERNAL_ERROR.
+    /// Unreadable samples, bad numbers and budgets over `plan_timeout` are INVALID_REQUEST;
+    /// busy is QUEUE_FULL; stopped, panicked and not executable are INTERNAL_ERROR.
     fn failure(&self, key: &AnswerKey, failure: Failure, message: String) -> CutPlan {
         let code = match failure {
-            Failure::Unreadable | Failure::OverBudget | Failure::TooLarge => {
+            Failure::Unreadable | Failure::OverBudget | Failure::TooLarge | Failure::BadNumber => {
                 status::INVALID_REQUEST
             }
-            Failure::Busy | Failure::Stopped | Failure::Panicked | Failure::NotExecutable => {
-                status::INTERNAL_ERROR
-            }
+            Failure::Busy => status::QUEUE_FULL,
+            Failure::Timeout => status::TIMEOUT,
+            Failure::ResourceLimit => status::RESOURCE_LIMIT,
+            Failure::Stopped | Failure::Panicked | Failure::NotExecutable => status::INTERNAL_ERROR,
         };
         convert::failure_msg(&key.request_id, code, message)
     }

@@ -75,6 +75,14 @@ pub enum Failure {
     /// The answer would be larger than what is published ([`super::MAX_ANSWER_BYTES`]):
     /// refused before planning when [`PlanningService::answer_size`] tells, else after.
     TooLarge,
+    /// A numeric field is not finite, out of its declared range, or denormal where it
+    /// divides (`kerf_msgs::numbers`): refused before planning, like an invalid request.
+    BadNumber,
+    /// The plan did not end by its deadline (`plan_timeout`, or the request's own budget) plus
+    /// the harness's grace: its worker was stopped and the request answered by the harness.
+    Timeout,
+    /// The plan's worker went over the node's `plan_memory` and was stopped.
+    ResourceLimit,
 }
 
 /// An answer message (`kerf_msgs/msg/CutPlan`, `MillPlan`, …): what the harness reads of it.
