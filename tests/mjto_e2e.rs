@@ -576,7 +576,7 @@ fn full_queue_is_answered_not_dropped() {
         r.request_id = id.into();
         msg_of(&r)
     };
-    planner.burst_against_a_queue_of_one(8, burst, CutPlan::INTERNAL_ERROR, PLANNING);
+    planner.burst_against_a_queue_of_one(8, burst, CutPlan::QUEUE_FULL, PLANNING);
     planner.assert_running();
     planner.finish();
 }

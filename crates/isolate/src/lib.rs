@@ -37,4 +37,6 @@ mod supervisor;
 
 pub use error::IsolateError;
 pub use proc_stat::{resident_bytes, virtual_bytes};
-pub use supervisor::{Outcome, Supervisor, SupervisorSettings, Work, DEFAULT_GRACE};
+pub use supervisor::{
+    Outcome, Supervisor, SupervisorSettings, Work, DEFAULT_CANCEL_GRACE, DEFAULT_GRACE,
+};

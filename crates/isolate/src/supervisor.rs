@@ -22,6 +22,10 @@ use crate::{
 /// budget check answers TIMEOUT at the deadline; this is the hard limit behind it.
 pub const DEFAULT_GRACE: Duration = Duration::from_millis(500);
 
+/// How long a cancelled job may take to answer before it is stopped: short, because a node
+/// that stops (Ctrl-C) must answer and leave within 2 s.
+pub const DEFAULT_CANCEL_GRACE: Duration = Duration::from_millis(300);
+
 /// Largest answer read from a worker (bytes). Answers are published far smaller (4 MiB).
 const MAX_ANSWER_BYTES: u64 = 256 << 20;
 
@@ -48,6 +52,9 @@ pub struct SupervisorSettings {
     pub memory: u64,
     /// How long past its time limit a job may run before it is stopped.
     pub grace: Duration,
+    /// How long a cancelled job ([`Supervisor::cancel`]) may take to answer before it is
+    /// stopped.
+    pub cancel_grace: Duration,
     /// The worker is replaced after a job when its resident memory has grown by more than
     /// this since it started (bytes): what a planner keeps between jobs stays bounded.
     pub recycle_growth: u64,
@@ -57,13 +64,15 @@ pub struct SupervisorSettings {
 }
 
 impl SupervisorSettings {
-    /// The settings for a memory budget of `memory` bytes: [`DEFAULT_GRACE`], recycling past
+    /// The settings for a memory budget of `memory` bytes: [`DEFAULT_GRACE`],
+    /// [`DEFAULT_CANCEL_GRACE`], recycling past
     /// half the budget, an address-space backstop of four budgets plus 4 GiB (thread stacks
     /// and allocator arenas reserve address space they never touch).
     pub fn new(memory: u64) -> Self {
         Self {
             memory,
             grace: DEFAULT_GRACE,
+            cancel_grace: DEFAULT_CANCEL_GRACE,
             recycle_growth: memory / 2,
             address_space: Some(memory.saturating_mul(4).saturating_add(4 << 30)),
         }
@@ -233,7 +242,7 @@ impl<W: Work> Supervisor<W> {
     }
 
     /// Asks the running job to stop at its next budget check. If it has not answered
-    /// [`SupervisorSettings::grace`] later, [`Self::poll`] stops the worker
+    /// [`SupervisorSettings::cancel_grace`] later, [`Self::poll`] stops the worker
     /// ([`Outcome::Stopped`]).
     pub fn cancel(&mut self) {
         let (Some(r), Some(c)) = (self.running.as_mut(), self.child.as_ref()) else {
@@ -295,7 +304,7 @@ impl<W: Work> Supervisor<W> {
         }
         let elapsed = run.started.elapsed();
         if let Some(at) = run.cancelled_at {
-            if at.elapsed() > self.settings.grace {
+            if at.elapsed() > self.settings.cancel_grace {
                 self.retire();
                 self.running = None;
                 return Some((id, Outcome::Stopped));

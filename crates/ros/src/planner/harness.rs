@@ -1,18 +1,19 @@
 //! The planner-node loop: requests in (message and text), one worker in arrival order, one
 //! answer per request, latched answers, the trajectory on success, clean shutdown.
 
-use std::{collections::BTreeMap, fmt::Display, sync::Arc, time::Duration};
+use std::{collections::VecDeque, fmt::Display, sync::Arc, time::Duration};
 
-use kerf_budget::{Budget, CancelToken};
+use kerf_isolate::{Outcome, Supervisor, SupervisorSettings};
 use kerf_msgs::{std_msgs::StringMsg, trajectory_msgs::JointTrajectory, RosType};
 use ros2_client::Publisher;
 
 use super::{
-    check_answer, check_points, check_text_size, check_trajectory_msg, AnswerKey, Failure,
-    HarnessSettings, PlanAnswer, PlanningService, TRAJECTORY_TOPIC,
+    check_answer, check_text_size,
+    work::{HarnessWork, RawRequest},
+    AnswerKey, Failure, HarnessSettings, PlanAnswer, PlanningService, HARNESS_PARAMS,
+    TRAJECTORY_TOPIC,
 };
 use crate::{qos, Inbox, KerfNode, Logger, NodeSpec, RosArgs, RosEnv, RosError, StopToken};
-use crate::{Worker, WorkerError};
 
 /// How long the node loop sleeps when there is nothing to do.
 const POLL: Duration = Duration::from_millis(2);
@@ -27,15 +28,6 @@ const POLL: Duration = Duration::from_millis(2);
 /// in reply.
 pub const SHUTDOWN_LINGER: Duration = Duration::from_millis(1500);
 
-/// Work for the planner thread. Failed requests travel through it too, so that every answer
-/// leaves in arrival order.
-pub enum Job<R, A> {
-    /// Plan this request.
-    Plan(Box<R>),
-    /// Already answered (conversion or parse error): pass the answer through.
-    Answer(Box<A>),
-}
-
 /// Starts a planner node and serves until its stop token (or Ctrl-C) stops it.
 ///
 /// # Arguments
@@ -45,7 +37,9 @@ pub enum Job<R, A> {
 /// * `setup` — reads the node's parameters and builds the service; returns it with the
 ///   harness's settings ([`HarnessSettings::from_params`]: `queue_depth`, requests waiting or
 ///   being planned before new ones are answered [`Failure::Busy`]; `plan_timeout`, the time
-///   budget of every plan). Its error is logged ("cannot start: …") and returned.
+///   budget of every plan; `plan_memory`, its memory budget). Its error is logged ("cannot
+///   start: …") and returned. The harness's parameters ([`HARNESS_PARAMS`]) are known to the
+///   node whether `known_params` lists them or not.
 ///
 /// # Returns
 /// `Ok` after a clean shutdown; an error if the node could not start (bad parameter, model
@@ -62,10 +56,13 @@ where
     S: PlanningService,
     E: From<RosError> + Display,
 {
+    // The harness's own parameters are known to every planner node, listed or not.
+    let mut known: Vec<&str> = known_params.to_vec();
+    known.extend(HARNESS_PARAMS.iter().filter(|p| !known_params.contains(p)));
     let spec = NodeSpec {
         default_name,
         default_namespace: "/",
-        known_params,
+        known_params: &known,
     };
     let node = KerfNode::new(spec, args, env, stop)?;
     let (service, settings) = match setup(&node) {
@@ -78,55 +75,6 @@ where
     let mut n = PlannerNode::new(node, service, settings)?;
     n.spin();
     Ok(())
-}
-
-/// Runs one job on the worker thread: an already-answered job passes through; a job queued
-/// after the node began to stop is answered [`Failure::Stopped`] without planning; a plan
-/// runs under a budget of `plan_timeout` (tightened by the request's own, started now, and
-/// cancelled by `cancel`); a successful plan whose trajectory the executor would refuse
-/// ([`check_trajectory_msg`]) becomes [`Failure::NotExecutable`] and is not published as a
-/// success.
-pub fn work<S: PlanningService>(
-    service: &S,
-    cancel: &CancelToken,
-    plan_timeout: Duration,
-    job: Job<S::Request, S::Answer>,
-) -> S::Answer {
-    let request = match job {
-        Job::Answer(m) => return *m,
-        Job::Plan(r) => r,
-    };
-    if cancel.is_cancelled() {
-        // Queued when the node stopped: skipped, so that shutdown waits for one plan at most.
-        return service.failure(
-            &service.key(&request),
-            Failure::Stopped,
-            "the planner node stopped before planning this request".into(),
-        );
-    }
-    let key = service.key(&request);
-    let budget = Budget::new(Some(plan_timeout), cancel.clone())
-        .tightened(service.requested_budget(&request));
-    let answer = service.plan(*request, &budget);
-    if !answer.is_success() {
-        return answer;
-    }
-    // Checked before anything renders the answer (its YAML text would be ~6× its size).
-    let trajectory = answer.trajectory();
-    if let Err(reason) = check_points(trajectory.points.len(), trajectory.joint_names.len()) {
-        return service.failure(&key, Failure::TooLarge, reason);
-    }
-    match check_trajectory_msg(service.joint_limits(), answer.trajectory()) {
-        Ok(()) => answer,
-        Err(reason) => service.failure(
-            &key,
-            Failure::NotExecutable,
-            format!(
-                "the planned trajectory would be refused by the trajectory executor ({reason}); \
-                 it is not published (a planner bug)"
-            ),
-        ),
-    }
 }
 
 /// Longest `request_id` a request may have (bytes).
@@ -159,20 +107,39 @@ pub fn answer_text<A: PlanAnswer>(answer: &A) -> String {
     })
 }
 
-/// The node's state. Fields drop in declaration order: DDS endpoints and the worker first,
-/// `node` (and its Context) last.
+/// A request waiting for the worker, or an answer waiting for its turn (answers leave in
+/// arrival order).
+enum Queued<M, A> {
+    /// Plan it: the request as received, its key, and its time limit.
+    Plan {
+        key: AnswerKey,
+        raw: RawRequest<M>,
+        limit: Duration,
+    },
+    /// Already answered (conversion error, refused before planning).
+    Answer(Box<A>),
+}
+
+/// The job the worker process runs now.
+struct Running {
+    id: u64,
+    key: AnswerKey,
+}
+
+/// The node's state. Fields drop in declaration order: DDS endpoints and the worker process
+/// first, `node` (and its Context) last.
 struct PlannerNode<S: PlanningService> {
     requests: Inbox<S::RequestMsg>,
     text_requests: Inbox<StringMsg>,
     plans: Publisher<S::Answer>,
     plan_texts: Publisher<StringMsg>,
     trajectories: Publisher<JointTrajectory>,
-    worker: Worker<Job<S::Request, S::Answer>, S::Answer>,
+    supervisor: Supervisor<HarnessWork<S>>,
     service: Arc<S>,
-    /// Cancelled when the node stops: the plan in progress ends, queued plans are skipped.
-    cancel: CancelToken,
-    /// Ticket → key of every job submitted and not yet answered.
-    pending: BTreeMap<u64, AnswerKey>,
+    /// Requests and answers in arrival order, behind the running job.
+    queue: VecDeque<Queued<S::RequestMsg, S::Answer>>,
+    running: Option<Running>,
+    next_id: u64,
     settings: HarnessSettings,
     log: Logger,
     node: KerfNode,
@@ -191,9 +158,21 @@ impl<S: PlanningService> PlannerNode<S> {
         let trajectories =
             node.publisher(TRAJECTORY_TOPIC, JointTrajectory::ROS_TYPE, qos::commands())?;
         let log = node.logger();
+        let service = Arc::new(service);
+        let mut supervisor = Supervisor::new(
+            Arc::new(HarnessWork {
+                service: Arc::clone(&service),
+            }),
+            SupervisorSettings::new(settings.plan_memory),
+        );
+        // The worker is forked now, with the service loaded: the first request does not wait.
+        supervisor.warm().map_err(|e| RosError::Dds {
+            what: "planner worker process".into(),
+            reason: e.to_string(),
+        })?;
         log.info(&format!(
             "serving {} requests on {} and {}; plans on {}, trajectories on {}; {}; queue_depth {}, \
-             plan_timeout {} s",
+             plan_timeout {} s, plan_memory {} (plans run in worker process {})",
             topics.noun,
             node.resolve(&topics.request)?,
             node.resolve(&topics.request_text)?,
@@ -202,61 +181,73 @@ impl<S: PlanningService> PlannerNode<S> {
             service.startup_note(),
             settings.queue_depth,
             settings.plan_timeout.as_secs_f64(),
+            kerf_budget::format_bytes(settings.plan_memory),
+            supervisor.worker_pid().unwrap_or(0),
         ));
-        let service = Arc::new(service);
-        let cancel = CancelToken::new();
-        let (service_w, cancel_w) = (Arc::clone(&service), cancel.clone());
-        let timeout = settings.plan_timeout;
-        let worker = Worker::spawn("plan", 1, move |job| {
-            work(&*service_w, &cancel_w, timeout, job)
-        })
-        .map_err(|e| RosError::Dds {
-            what: "planner thread".into(),
-            reason: e.to_string(),
-        })?;
         Ok(Self {
             requests,
             text_requests,
             plans,
             plan_texts,
             trajectories,
-            worker,
+            supervisor,
             service,
-            cancel,
-            pending: BTreeMap::new(),
+            queue: VecDeque::new(),
+            running: None,
+            next_id: 0,
             settings,
             log,
             node,
         })
     }
 
+    /// Requests waiting or being planned.
+    fn pending(&self) -> usize {
+        self.queue.len() + usize::from(self.running.is_some())
+    }
+
     fn spin(&mut self) {
         while !self.node.should_stop() {
             let mut busy = self.poll_requests();
             busy |= self.poll_text_requests();
-            busy |= self.poll_results();
+            busy |= self.advance();
             if !busy {
                 std::thread::sleep(POLL);
             }
         }
-        // The plan in progress (if any) is cancelled through its budget and answered; queued
-        // requests are answered "stopped" without planning: no request is left without an
-        // answer, and the node stops as soon as the planner reaches its next budget check.
-        self.cancel.cancel();
-        if !self.pending.is_empty() {
+        self.shut_down();
+    }
+
+    /// The plan in progress (if any) is cancelled through its budget and answered (or, when it
+    /// does not answer within the cancel grace, its worker is stopped and the harness answers
+    /// it); queued requests are answered "stopped" without planning: no request is left
+    /// without an answer, and the node stops within 2 s whatever it plans.
+    fn shut_down(&mut self) {
+        let answered_at_shutdown = self.pending() > 0;
+        if answered_at_shutdown {
             self.log.warn(&format!(
                 "shutting down: cancelling the plan in progress and answering {} request(s)",
-                self.pending.len()
+                self.pending()
             ));
         }
-        let answered_at_shutdown = !self.pending.is_empty();
-        while !self.pending.is_empty() {
-            match self.worker.recv_timeout(Duration::from_secs(1)) {
-                Some(done) => self.answer(done),
-                None => self
-                    .log
-                    .warn("shutting down: the plan in progress has not reached a budget check yet"),
+        if self.running.is_some() {
+            self.supervisor.cancel();
+            while self.running.is_some() {
+                if !self.poll_worker() {
+                    std::thread::sleep(Duration::from_millis(1));
+                }
             }
+        }
+        while let Some(q) = self.queue.pop_front() {
+            let answer = match q {
+                Queued::Answer(a) => *a,
+                Queued::Plan { key, .. } => self.service.failure(
+                    &key,
+                    Failure::Stopped,
+                    "the planner node stopped before planning this request".into(),
+                ),
+            };
+            self.publish(answer);
         }
         if answered_at_shutdown {
             // Let the reliable writers deliver (and repair) the answers just written.
@@ -265,9 +256,9 @@ impl<S: PlanningService> PlannerNode<S> {
         self.log.info("shutting down");
     }
 
-    /// A job for a sample that could not be read.
-    fn unreadable(&self, what: &str, e: String) -> Job<S::Request, S::Answer> {
-        Job::Answer(Box::new(self.service.failure(
+    /// An answer for a sample that could not be read.
+    fn unreadable(&self, what: &str, e: String) -> Queued<S::RequestMsg, S::Answer> {
+        Queued::Answer(Box::new(self.service.failure(
             &AnswerKey::default(),
             Failure::Unreadable,
             format!("could not read a {what} sample: {e}"),
@@ -279,14 +270,14 @@ impl<S: PlanningService> PlannerNode<S> {
         let mut any = false;
         while let Some(received) = self.requests.try_recv() {
             any = true;
-            let job = match received {
+            let queued = match received {
                 Ok(m) => match self.service.request_from_msg(&m) {
-                    Ok(r) => self.plan_job(r),
-                    Err(answer) => Job::Answer(answer),
+                    Ok(r) => self.plan_job(r, RawRequest::Msg(m), "message"),
+                    Err(answer) => Queued::Answer(answer),
                 },
                 Err(e) => self.unreadable(S::RequestMsg::NAME, e),
             };
-            self.submit(job, "message");
+            self.submit(queued);
         }
         any
     }
@@ -296,64 +287,83 @@ impl<S: PlanningService> PlannerNode<S> {
         let mut any = false;
         while let Some(received) = self.text_requests.try_recv() {
             any = true;
-            let job = match received {
+            let queued = match received {
                 Ok(m) => match check_text_size(&m.data) {
-                    Err(reason) => Job::Answer(Box::new(self.service.failure(
+                    Err(reason) => Queued::Answer(Box::new(self.service.failure(
                         &AnswerKey::default(),
                         Failure::Unreadable,
                         reason,
                     ))),
                     Ok(()) => match self.service.request_from_text(&m.data) {
-                        Ok(r) => self.plan_job(r),
-                        Err(answer) => Job::Answer(answer),
+                        Ok(r) => self.plan_job(r, RawRequest::Text(m.data), "text"),
+                        Err(answer) => Queued::Answer(answer),
                     },
                 },
                 Err(e) => self.unreadable("text request", e),
             };
-            self.submit(job, "text");
+            self.submit(queued);
         }
         any
     }
 
-    /// The job of a converted request: planned, unless it asks for a larger time budget than
-    /// the node's `plan_timeout` ([`Failure::OverBudget`]) or its answer would be too large
-    /// ([`Failure::TooLarge`]).
-    fn plan_job(&self, request: S::Request) -> Job<S::Request, S::Answer> {
+    /// The queue entry of a converted request: planned, unless it asks for a larger time
+    /// budget than the node's `plan_timeout` ([`Failure::OverBudget`]) or its answer would be
+    /// too large ([`Failure::TooLarge`]). The converted request itself is dropped: the worker
+    /// converts `raw` again.
+    fn plan_job(
+        &self,
+        request: S::Request,
+        raw: RawRequest<S::RequestMsg>,
+        source: &str,
+    ) -> Queued<S::RequestMsg, S::Answer> {
+        let key = self.service.key(&request);
         if let Some(size) = self.service.answer_size(&request) {
             if let Err(reason) = size.check() {
-                return Job::Answer(Box::new(self.service.failure(
-                    &self.service.key(&request),
+                return Queued::Answer(Box::new(self.service.failure(
+                    &key,
                     Failure::TooLarge,
                     format!("request refused before planning: {reason}"),
                 )));
             }
         }
-        let limit = self.settings.plan_timeout;
-        match self.service.requested_budget(&request) {
-            Some(asked) if asked > limit => Job::Answer(Box::new(self.service.failure(
-                &self.service.key(&request),
-                Failure::OverBudget,
-                format!(
-                    "time_budget = {} s is over the node's plan_timeout of {} s: a request may \
-                     ask for less, not more (send 0 for the node's budget)",
-                    asked.as_secs_f64(),
-                    limit.as_secs_f64()
-                ),
-            ))),
-            _ => Job::Plan(Box::new(request)),
+        let node_limit = self.settings.plan_timeout;
+        let limit = match self.service.requested_budget(&request) {
+            Some(asked) if asked > node_limit => {
+                return Queued::Answer(Box::new(self.service.failure(
+                    &key,
+                    Failure::OverBudget,
+                    format!(
+                        "time_budget = {} s is over the node's plan_timeout of {} s: a request \
+                         may ask for less, not more (send 0 for the node's budget)",
+                        asked.as_secs_f64(),
+                        node_limit.as_secs_f64()
+                    ),
+                )))
+            }
+            Some(asked) => asked,
+            None => node_limit,
+        };
+        if cut_request_id(&key.request_id).is_none() {
+            self.log.info(&format!(
+                "request '{}' ({source}): {}, queued behind {} other(s)",
+                key.request_id,
+                self.service.describe(&request),
+                self.pending()
+            ));
         }
+        Queued::Plan { key, raw, limit }
     }
 
-    /// Queues a job, or answers at once when the queue is full.
-    fn submit(&mut self, job: Job<S::Request, S::Answer>, source: &str) {
-        let mut key = match &job {
-            Job::Plan(r) => self.service.key(r),
-            Job::Answer(m) => m.key(),
+    /// Queues an entry, or answers at once when the queue is full.
+    fn submit(&mut self, queued: Queued<S::RequestMsg, S::Answer>) {
+        let mut key = match &queued {
+            Queued::Plan { key, .. } => key.clone(),
+            Queued::Answer(m) => m.key(),
         };
         // A request id is echoed in the answer and in the log: a long one is refused, and
         // the answer carries its beginning.
-        let job = match cut_request_id(&key.request_id) {
-            None => job,
+        let queued = match cut_request_id(&key.request_id) {
+            None => queued,
             Some(short) => {
                 let message = format!(
                     "request_id is {} bytes, over the limit of {MAX_REQUEST_ID_BYTES}; this \
@@ -362,24 +372,24 @@ impl<S: PlanningService> PlannerNode<S> {
                     short.len()
                 );
                 key.request_id = short;
-                Job::Answer(Box::new(self.service.failure(
+                Queued::Answer(Box::new(self.service.failure(
                     &key,
                     Failure::TooLarge,
                     message,
                 )))
             }
         };
-        if self.pending.len() >= self.settings.queue_depth {
-            let answer = match job {
+        if self.pending() >= self.settings.queue_depth {
+            let answer = match queued {
                 // Already failed: its own status says more than "busy".
-                Job::Answer(m) => *m,
-                Job::Plan(_) => self.service.failure(
+                Queued::Answer(m) => *m,
+                Queued::Plan { .. } => self.service.failure(
                     &key,
                     Failure::Busy,
                     format!(
                         "planner busy: {} request(s) waiting or being planned (queue_depth {}); \
                          request refused, send it again later",
-                        self.pending.len(),
+                        self.pending(),
                         self.settings.queue_depth
                     ),
                 ),
@@ -387,40 +397,115 @@ impl<S: PlanningService> PlannerNode<S> {
             self.publish(answer);
             return;
         }
-        if let Job::Plan(r) = &job {
-            self.log.info(&format!(
-                "request '{}' ({source}): {}, queued behind {} other(s)",
-                key.request_id,
-                self.service.describe(r),
-                self.pending.len()
+        self.queue.push_back(queued);
+    }
+
+    /// Publishes the running job's answer when it has one; `true` if it did.
+    fn poll_worker(&mut self) -> bool {
+        let Some((id, outcome)) = self.supervisor.poll() else {
+            return false;
+        };
+        let Some(running) = self.running.take() else {
+            return false;
+        };
+        if running.id != id {
+            self.log.error(&format!(
+                "the worker answered job {id}, job {} was running",
+                running.id
             ));
         }
-        let ticket = self.worker.submit(job);
-        self.pending.insert(ticket, key);
+        let answer = self.answer_of(&running.key, outcome);
+        self.publish(answer);
+        true
     }
 
-    /// Publishes finished answers; `true` if any.
-    fn poll_results(&mut self) -> bool {
-        let mut any = false;
-        while let Some(done) = self.worker.try_recv() {
-            any = true;
-            self.answer(done);
-        }
-        any
-    }
-
-    /// Publishes the answer of one finished job (a panic becomes [`Failure::Panicked`]).
-    fn answer(&mut self, (ticket, result): (u64, Result<S::Answer, WorkerError>)) {
-        let key = self.pending.remove(&ticket).unwrap_or_default();
-        let answer = match result {
-            Ok(plan) => plan,
-            Err(WorkerError::Panicked { message, .. }) => self.service.failure(
-                &key,
+    /// The answer of a finished job.
+    fn answer_of(&self, key: &AnswerKey, outcome: Outcome<S::Answer>) -> S::Answer {
+        let s = &self.service;
+        match outcome {
+            Outcome::Answered(a) => a,
+            Outcome::Panicked { message } => s.failure(
+                key,
                 Failure::Panicked,
                 format!("the planner failed unexpectedly (panic: {message})"),
             ),
-        };
-        self.publish(answer);
+            Outcome::TimedOut { limit, elapsed } => s.failure(
+                key,
+                Failure::Timeout,
+                format!(
+                    "time budget of {:.3} s exhausted: the plan had not ended {:.3} s after it \
+                     began and was stopped (its worker process was replaced); the request was \
+                     not planned (simplify it, or ask for a larger budget up to the node's \
+                     plan_timeout)",
+                    limit.as_secs_f64(),
+                    elapsed.as_secs_f64()
+                ),
+            ),
+            Outcome::OverMemory { limit, grown } => s.failure(
+                key,
+                Failure::ResourceLimit,
+                format!(
+                    "memory budget of {} exceeded: the plan's working memory grew by {} and the \
+                     plan was stopped (its worker process was replaced); the request was not \
+                     planned (simplify it, or raise the node's plan_memory)",
+                    kerf_budget::format_bytes(limit),
+                    kerf_budget::format_bytes(grown)
+                ),
+            ),
+            Outcome::Crashed { reason } if reason.contains("SIGABRT") => s.failure(
+                key,
+                Failure::ResourceLimit,
+                format!(
+                    "the plan's worker process aborted ({reason}); with the node's plan_memory \
+                     of {} this is an allocation past its address-space backstop; the request \
+                     was not planned",
+                    kerf_budget::format_bytes(self.settings.plan_memory)
+                ),
+            ),
+            Outcome::Crashed { reason } => s.failure(
+                key,
+                Failure::Panicked,
+                format!("the planner failed unexpectedly: {reason}; its worker was replaced"),
+            ),
+            Outcome::Stopped => s.failure(
+                key,
+                Failure::Stopped,
+                "planning cancelled: the planner node is stopping (the plan did not reach a \
+                 budget check in time and its worker process was stopped)"
+                    .into(),
+            ),
+        }
+    }
+
+    /// Moves the queue on: publishes a finished job's answer, passes answered entries through
+    /// and hands the next plan to the worker; `true` if anything happened.
+    fn advance(&mut self) -> bool {
+        let mut any = self.running.is_some() && self.poll_worker();
+        while self.running.is_none() {
+            let Some(next) = self.queue.pop_front() else {
+                break;
+            };
+            any = true;
+            match next {
+                Queued::Answer(a) => self.publish(*a),
+                Queued::Plan { key, raw, limit } => {
+                    let id = self.next_id;
+                    self.next_id += 1;
+                    match self.supervisor.submit(id, &raw, limit) {
+                        Ok(()) => self.running = Some(Running { id, key }),
+                        Err(e) => {
+                            let answer = self.service.failure(
+                                &key,
+                                Failure::Panicked,
+                                format!("the plan could not be started: {e}"),
+                            );
+                            self.publish(answer);
+                        }
+                    }
+                }
+            }
+        }
+        any
     }
 
     /// Publishes one answer on the plan topics and, on success, the trajectory; logs it. An

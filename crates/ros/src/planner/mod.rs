@@ -2,31 +2,41 @@
 //!
 //! ```text
 //! request (message or text) → service.request_from_msg / request_from_text (convert, validate)
-//!   → queue (arrival order, `queue_depth`) → worker: service.plan
-//!   → executability check (the executor's own validation, check_trajectory_msg)
+//!   → queue (arrival order, `queue_depth`) → worker process (kerf_isolate): convert again,
+//!     service.plan under the budget, executability check (check_trajectory_msg)
 //!   → publish: answer (latched), answer as YAML text (latched), trajectory on success
 //! ```
 //!
 //! The harness owns:
 //! * the request topics (message and `std_msgs/String` text) and the answer topics, latched
 //!   (reliable, transient-local, keep-last 10), and `~/joint_trajectory` (reliable, volatile);
-//! * one worker thread; requests are answered in arrival order, each by exactly one answer
-//!   with its request id, status and message: a request that cannot be read, converted or
-//!   validated, a planner error and a planner panic ([`Failure::Panicked`]) all get one;
+//! * one **worker process** ([`kerf_isolate::Supervisor`], forked from the node with the
+//!   service loaded): requests are planned there one at a time and answered in arrival order,
+//!   each by exactly one answer with its request id, status and message: a request that cannot
+//!   be read, converted or validated, a planner error, a planner panic ([`Failure::Panicked`])
+//!   and a crashed worker all get one;
 //! * the busy answer: when `queue_depth` requests are waiting or being planned, a new valid
-//!   request is answered at once ([`Failure::Busy`]) and a new invalid one at once with its
-//!   own status;
+//!   request is answered at once ([`Failure::Busy`], QUEUE_FULL) and a new invalid one at once
+//!   with its own status;
 //! * the executability check: a successful plan whose trajectory the trajectory executor
 //!   would refuse is answered [`Failure::NotExecutable`] and its trajectory is not published;
-//! * deadlines and cancellation (issue 11, item 3): every plan runs under a
+//! * deadlines the planner cannot break (issue 33, item 2): every plan runs under a
 //!   [`kerf_budget::Budget`] of the node's `plan_timeout` parameter, tightened by the request's
 //!   own time budget ([`PlanningService::requested_budget`]; a request asking for more than
 //!   `plan_timeout` is refused, [`Failure::OverBudget`]); the planner checks it cooperatively
-//!   and a plan that runs out of it is answered TIMEOUT, freeing the worker;
+//!   and answers TIMEOUT; a plan that has not answered 0.5 s after its deadline is stopped with
+//!   its worker process (SIGKILL, reaped) and answered TIMEOUT by the harness
+//!   ([`Failure::Timeout`]), and the next request is planned by a fresh worker;
+//! * memory the request cannot grow (issue 33, item 3): the budget carries the node's
+//!   `plan_memory` (default 1 GiB) for the planner's estimates ([`kerf_budget::Interrupt::OverMemory`],
+//!   RESOURCE_LIMIT naming what grew), and a worker whose resident memory grows by more during
+//!   a plan is stopped ([`Failure::ResourceLimit`]); the node process itself never plans, so it
+//!   does not grow with the requests it serves;
 //! * start-up ([`HarnessSettings`]) and clean shutdown: on Ctrl-C, SIGTERM or the stop token,
 //!   the plan in progress is cancelled through its budget and answered (the planner's
-//!   cancellation status), queued requests are answered [`Failure::Stopped`] without planning,
-//!   and the node returns within a second.
+//!   cancellation status; a plan that does not answer within 0.3 s is stopped and answered
+//!   [`Failure::Stopped`]), queued requests are answered [`Failure::Stopped`] without planning,
+//!   the answers are given [`SHUTDOWN_LINGER`] to be delivered, and the node returns within 2 s.
 
 mod answers;
 mod error;
@@ -36,10 +46,11 @@ mod main;
 mod service;
 mod size;
 mod text;
+mod work;
 
 pub use error::NodeError;
 pub use executable::{check_trajectory_msg, trajectory_msg, trajectory_request};
-pub use harness::{answer_text, run, work, Job, MAX_REQUEST_ID_BYTES, SHUTDOWN_LINGER};
+pub use harness::{answer_text, run, MAX_REQUEST_ID_BYTES, SHUTDOWN_LINGER};
 pub use main::node_main;
 pub use service::{AnswerKey, Failure, PlanAnswer, PlanningService, Topics, TRAJECTORY_TOPIC};
 pub use size::{
@@ -47,6 +58,7 @@ pub use size::{
     TEXT_BYTES_PER_JOINT_POINT,
 };
 pub use text::{check_text_size, yaml_field, TextRequestError, MAX_TEXT_REQUEST_BYTES};
+pub use work::{plan_checked, work, HarnessWork, Job, RawRequest};
 
 use crate::{Params, RosError};
 
@@ -78,7 +90,7 @@ pub fn allowed_roots(params: &Params) -> Result<kerf_robot::roots::AllowedRoots,
 }
 
 /// The parameters the harness reads (every planner node lists them among its known ones).
-pub const HARNESS_PARAMS: &[&str] = &["queue_depth", "plan_timeout"];
+pub const HARNESS_PARAMS: &[&str] = &["queue_depth", "plan_timeout", "plan_memory"];
 
 /// The harness's settings, from the node's parameters ([`HarnessSettings::from_params`]).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -87,6 +99,9 @@ pub struct HarnessSettings {
     pub queue_depth: usize,
     /// The time budget of every plan; a request may ask for less, not more.
     pub plan_timeout: std::time::Duration,
+    /// The memory budget of every plan (bytes): the planner's estimates are checked against
+    /// it, and the worker process running the plan is stopped when its memory grows by more.
+    pub plan_memory: u64,
 }
 
 impl Default for HarnessSettings {
@@ -94,13 +109,16 @@ impl Default for HarnessSettings {
         Self {
             queue_depth: DEFAULT_QUEUE_DEPTH,
             plan_timeout: std::time::Duration::from_secs_f64(DEFAULT_PLAN_TIMEOUT),
+            plan_memory: kerf_budget::DEFAULT_PLAN_MEMORY,
         }
     }
 }
 
 impl HarnessSettings {
-    /// Reads `queue_depth` ([`queue_depth`]) and `plan_timeout` (seconds, a number in
-    /// (0, [`kerf_budget::MAX_BUDGET_SECONDS`]], default [`DEFAULT_PLAN_TIMEOUT`]).
+    /// Reads `queue_depth` ([`queue_depth`]), `plan_timeout` (seconds, a number in
+    /// (0, [`kerf_budget::MAX_BUDGET_SECONDS`]], default [`DEFAULT_PLAN_TIMEOUT`]) and
+    /// `plan_memory` (bytes, an integer in [[`kerf_budget::MIN_PLAN_MEMORY`],
+    /// [`kerf_budget::MAX_PLAN_MEMORY`]], default [`kerf_budget::DEFAULT_PLAN_MEMORY`], 1 GiB).
     ///
     /// # Errors
     /// [`RosError::Param`] naming the parameter for a wrong type or a value out of range.
@@ -122,9 +140,16 @@ impl HarnessSettings {
                 })
             }
         };
+        let memory = params.i64_or("plan_memory", kerf_budget::DEFAULT_PLAN_MEMORY as i64)?;
+        let plan_memory =
+            kerf_budget::memory_from_bytes(memory).map_err(|reason| RosError::Param {
+                name: "plan_memory".into(),
+                reason,
+            })?;
         Ok(Self {
             queue_depth,
             plan_timeout,
+            plan_memory,
         })
     }
 }

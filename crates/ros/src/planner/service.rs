@@ -86,7 +86,7 @@ pub enum Failure {
 }
 
 /// An answer message (`kerf_msgs/msg/CutPlan`, `MillPlan`, …): what the harness reads of it.
-pub trait PlanAnswer: RosType + Serialize + Clone + Send + 'static {
+pub trait PlanAnswer: RosType + Serialize + DeserializeOwned + Clone + Send + 'static {
     /// The request id it answers.
     fn request_id(&self) -> &str;
     /// The key of failures derived from this answer (request id, service label).
@@ -109,7 +109,7 @@ pub trait PlanAnswer: RosType + Serialize + Clone + Send + 'static {
 /// `plan` runs on the harness's worker thread; everything else on the node thread.
 pub trait PlanningService: Send + Sync + 'static {
     /// The request message (`kerf_msgs/msg/CutRequest`, …).
-    type RequestMsg: RosType + DeserializeOwned + Send + 'static;
+    type RequestMsg: RosType + Serialize + DeserializeOwned + Send + 'static;
     /// A request as the planner takes it (converted, not yet planned).
     type Request: Send + 'static;
     /// The answer message.
