@@ -24,7 +24,7 @@ pub const DEFAULT_GRACE: Duration = Duration::from_millis(500);
 
 /// How long a cancelled job may take to answer before it is stopped: short, because a node
 /// that stops (Ctrl-C) must answer and leave within 2 s.
-pub const DEFAULT_CANCEL_GRACE: Duration = Duration::from_millis(300);
+pub const DEFAULT_CANCEL_GRACE: Duration = Duration::from_millis(200);
 
 /// Largest answer read from a worker (bytes). Answers are published far smaller (4 MiB).
 const MAX_ANSWER_BYTES: u64 = 256 << 20;

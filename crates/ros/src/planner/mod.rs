@@ -34,7 +34,7 @@
 //!   does not grow with the requests it serves;
 //! * start-up ([`HarnessSettings`]) and clean shutdown: on Ctrl-C, SIGTERM or the stop token,
 //!   the plan in progress is cancelled through its budget and answered (the planner's
-//!   cancellation status; a plan that does not answer within 0.3 s is stopped and answered
+//!   cancellation status; a plan that does not answer within 0.2 s is stopped and answered
 //!   [`Failure::Stopped`]), queued requests are answered [`Failure::Stopped`] without planning,
 //!   the answers are given [`SHUTDOWN_LINGER`] to be delivered, and the node returns within 2 s.
 
