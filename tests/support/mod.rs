@@ -22,6 +22,8 @@ pub mod planner;
 #[allow(dead_code)] // not every crate including this module needs it
 mod process;
 #[allow(dead_code)] // not every crate including this module needs it
+pub mod rss;
+#[allow(dead_code)] // not every crate including this module needs it
 mod scratch;
 #[allow(dead_code)] // not every crate including this module needs it
 mod take;

@@ -1,0 +1,93 @@
+//! Resident memory of each planner node over sequential requests (issue 33, item 3), over
+//! loopback DDS. The node and a client run in this process; the node plans in its worker
+//! process. Prints the node's (this process) and the worker's VmRSS every `KERF_RSS_EVERY`
+//! answers and the slope over the second half.
+//!
+//! Run: `cargo bench --bench request_rss -- [cut|mill|gcode] [COUNT]` (default: all three,
+//! 10 000 requests for cut and G-code, 1 000 for milling).
+#![allow(clippy::unwrap_used, clippy::expect_used)] // a bench binary reports failures by panicking
+
+use kerf_msgs::msg::{CutPlan, GcodePlan, MillPlan};
+use kerf_ros::ros2_client::ServiceMapping;
+
+#[allow(dead_code)]
+#[path = "../tests/support/mod.rs"]
+mod support;
+use support::rss::{sequential, slope_kib, Reading};
+
+fn report(name: &str, readings: &[Reading]) {
+    println!("{name}: answered, node VmRSS MiB, worker VmRSS MiB");
+    for r in readings {
+        println!("  {:6} {:8.1} {:8.1}", r.answered, r.node_mib, r.worker_mib);
+    }
+    let last = readings.last().map_or(0, |r| r.answered);
+    let at_100 = readings.iter().find(|r| r.answered >= 100);
+    let end = readings.last();
+    if let (Some(a), Some(b)) = (at_100, end) {
+        println!(
+            "{name}: node {:.1} MiB after 100, {:.1} MiB after {last} ({:+.1} %); worker {:.1} -> {:.1} MiB; slope over the second half: node {:.2} KiB/request, worker {:.2} KiB/request",
+            a.node_mib,
+            b.node_mib,
+            100.0 * (b.node_mib / a.node_mib - 1.0),
+            a.worker_mib,
+            b.worker_mib,
+            slope_kib(readings, last / 2, |r| r.node_mib),
+            slope_kib(readings, last / 2, |r| r.worker_mib),
+        );
+    }
+}
+
+fn main() {
+    let args: Vec<String> = std::env::args().skip(1).filter(|a| a != "--bench").collect();
+    let which = args.first().cloned().unwrap_or_else(|| "all".into());
+    let count: Option<usize> = args.get(1).and_then(|c| c.parse().ok());
+    let every: usize = std::env::var("KERF_RSS_EVERY")
+        .ok()
+        .and_then(|v| v.parse().ok())
+        .unwrap_or(100);
+    if which == "all" || which == "cut" {
+        let case1 = std::fs::read_to_string(concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/crates/mjto/cases/case1.yaml"
+        ))
+        .unwrap();
+        let env = support::loopback(91, ServiceMapping::Enhanced);
+        let r = sequential(
+            &support::planner::mjto(),
+            &env,
+            &[],
+            count.unwrap_or(10_000),
+            every,
+            CutPlan::SUCCESS,
+            |_| case1.clone(),
+        );
+        report("cut (case 1)", &r);
+    }
+    if which == "all" || which == "gcode" {
+        let env = support::loopback(92, ServiceMapping::Enhanced);
+        let text = "request_id: square\nprogram: \"G21 G90 G17\\nM3\\nG1 X20 Y0 F3000\\nG1 X20 Y15\\nG3 X15 Y20 R5\\nG1 X0 Y20\\nG1 X0 Y0\\nM5\\nM30\\n\"\n";
+        let r = sequential(
+            &support::planner::gcode(),
+            &env,
+            &[],
+            count.unwrap_or(10_000),
+            every,
+            GcodePlan::SUCCESS,
+            |_| text.to_string(),
+        );
+        report("gcode (20 mm square)", &r);
+    }
+    if which == "all" || which == "mill" {
+        let env = support::loopback(93, ServiceMapping::Enhanced);
+        let r = sequential(
+            &support::planner::mill(),
+            &env,
+            &[],
+            count.unwrap_or(1_000),
+            every,
+            MillPlan::SUCCESS,
+            |_| "request_id: naive\nplanner: naive\n".to_string(),
+        );
+        report("mill (default path, naive)", &r);
+    }
+}
