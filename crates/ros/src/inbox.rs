@@ -28,9 +28,13 @@ pub const INBOX_POLL: Duration = Duration::from_millis(1);
 /// Most deserialized samples waiting in an inbox for the caller to take them.
 pub const INBOX_CAPACITY: usize = 4;
 
+/// A received sample and its source timestamp (ns since the epoch, the writer's clock), when
+/// the writer gave one.
+type Stamped<M> = (M, Option<i64>);
+
 /// A subscription drained by a background thread.
 pub struct Inbox<M> {
-    rx: Receiver<Result<M, String>>,
+    rx: Receiver<Result<Stamped<M>, String>>,
     stop: Arc<AtomicBool>,
     thread: Option<JoinHandle<()>>,
 }
@@ -46,7 +50,7 @@ impl<M: DeserializeOwned + Send + 'static> Inbox<M> {
             .spawn(move || {
                 // Hands `item` over, waiting while the channel is full; false once the inbox
                 // is dropped or stopped.
-                let hand_over = |mut item: Result<M, String>| loop {
+                let hand_over = |mut item: Result<Stamped<M>, String>| loop {
                     match tx.try_send(item) {
                         Ok(()) => return true,
                         Err(TrySendError::Disconnected(_)) => return false,
@@ -61,8 +65,9 @@ impl<M: DeserializeOwned + Send + 'static> Inbox<M> {
                 };
                 while !stop_t.load(Ordering::Relaxed) {
                     match sub.take() {
-                        Ok(Some((m, _))) => {
-                            if !hand_over(Ok(m)) {
+                        Ok(Some((m, info))) => {
+                            let stamp = info.source_timestamp().map(|t| t.to_nanos());
+                            if !hand_over(Ok((m, stamp))) {
                                 return;
                             }
                         }
@@ -86,6 +91,12 @@ impl<M: DeserializeOwned + Send + 'static> Inbox<M> {
     /// The next received sample (or read error, e.g. a sample that did not deserialize), if
     /// any. Never blocks.
     pub fn try_recv(&self) -> Option<Result<M, String>> {
+        self.try_recv_stamped().map(|r| r.map(|(m, _)| m))
+    }
+
+    /// As [`Self::try_recv`], with the sample's source timestamp (ns since the Unix epoch, the
+    /// writer's clock; `None` when the writer gave none).
+    pub fn try_recv_stamped(&self) -> Option<Result<(M, Option<i64>), String>> {
         self.rx.try_recv().ok()
     }
 }

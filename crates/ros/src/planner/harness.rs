@@ -15,6 +15,14 @@ use super::{
 };
 use crate::{qos, Inbox, KerfNode, Logger, NodeSpec, RosArgs, RosEnv, RosError, StopToken};
 
+/// The system time in ns since the Unix epoch (the clock DDS source timestamps use).
+fn now_ns() -> i64 {
+    std::time::SystemTime::now()
+        .duration_since(std::time::UNIX_EPOCH)
+        .map(|d| i64::try_from(d.as_nanos()).unwrap_or(i64::MAX))
+        .unwrap_or(0)
+}
+
 /// How long the node loop sleeps when there is nothing to do.
 const POLL: Duration = Duration::from_millis(2);
 
@@ -140,6 +148,9 @@ struct PlannerNode<S: PlanningService> {
     queue: VecDeque<Queued<S::RequestMsg, S::Answer>>,
     running: Option<Running>,
     next_id: u64,
+    /// When the node subscribed to its requests (ns since the epoch): older requests are
+    /// not answered (requests are not durable).
+    started_ns: i64,
     settings: HarnessSettings,
     log: Logger,
     node: KerfNode,
@@ -148,6 +159,7 @@ struct PlannerNode<S: PlanningService> {
 impl<S: PlanningService> PlannerNode<S> {
     fn new(mut node: KerfNode, service: S, settings: HarnessSettings) -> Result<Self, RosError> {
         let topics = service.topics();
+        let started_ns = now_ns();
         let requests = node.inbox(&topics.request, S::RequestMsg::ROS_TYPE, qos::commands())?;
         let text_requests =
             node.inbox(&topics.request_text, StringMsg::ROS_TYPE, qos::commands())?;
@@ -195,6 +207,7 @@ impl<S: PlanningService> PlannerNode<S> {
             queue: VecDeque::new(),
             running: None,
             next_id: 0,
+            started_ns,
             settings,
             log,
             node,
@@ -265,13 +278,34 @@ impl<S: PlanningService> PlannerNode<S> {
         )))
     }
 
+    /// Whether a request stamped `stamp` was published before this node subscribed: such a
+    /// sample is a writer's history replayed to a new reader (RustDDS replays a writer's
+    /// keep-last history to a volatile reader that matches later), and it was answered by an
+    /// earlier run of the node, or by no node at all. Requests are not durable: it is logged
+    /// and not answered, so a restarted planner never answers a request twice.
+    fn published_before_start(&self, stamp: Option<i64>, what: &str) -> bool {
+        match stamp {
+            Some(t) if t < self.started_ns => {
+                self.log.warn(&format!(
+                    "a {what} request not answered: published {:.3} s before this node \
+                     subscribed (requests are not durable: a request from before a restart \
+                     was answered then, or by no node)",
+                    (self.started_ns - t) as f64 * 1e-9
+                ));
+                true
+            }
+            _ => false,
+        }
+    }
+
     /// Reads the request message topic; `true` if anything was read.
     fn poll_requests(&mut self) -> bool {
         let mut any = false;
-        while let Some(received) = self.requests.try_recv() {
+        while let Some(received) = self.requests.try_recv_stamped() {
             any = true;
             let queued = match received {
-                Ok(m) => match self.service.request_from_msg(&m) {
+                Ok((_, stamp)) if self.published_before_start(stamp, S::RequestMsg::NAME) => continue,
+                Ok((m, _)) => match self.service.request_from_msg(&m) {
                     Ok(r) => self.plan_job(r, RawRequest::Msg(m), "message"),
                     Err(answer) => Queued::Answer(answer),
                 },
@@ -285,10 +319,11 @@ impl<S: PlanningService> PlannerNode<S> {
     /// Reads the text request topic; `true` if anything was read.
     fn poll_text_requests(&mut self) -> bool {
         let mut any = false;
-        while let Some(received) = self.text_requests.try_recv() {
+        while let Some(received) = self.text_requests.try_recv_stamped() {
             any = true;
             let queued = match received {
-                Ok(m) => match check_text_size(&m.data) {
+                Ok((_, stamp)) if self.published_before_start(stamp, "text") => continue,
+                Ok((m, _)) => match check_text_size(&m.data) {
                     Err(reason) => Queued::Answer(Box::new(self.service.failure(
                         &AnswerKey::default(),
                         Failure::Unreadable,
