@@ -38,7 +38,10 @@ fn report(name: &str, readings: &[Reading]) {
 }
 
 fn main() {
-    let args: Vec<String> = std::env::args().skip(1).filter(|a| a != "--bench").collect();
+    let args: Vec<String> = std::env::args()
+        .skip(1)
+        .filter(|a| a != "--bench")
+        .collect();
     let which = args.first().cloned().unwrap_or_else(|| "all".into());
     let count: Option<usize> = args.get(1).and_then(|c| c.parse().ok());
     let every: usize = std::env::var("KERF_RSS_EVERY")

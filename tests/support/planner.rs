@@ -327,6 +327,41 @@ impl<Req: RosType + Serialize + Debug, Plan: Answer> PlannerClient<Req, Plan> {
         self.planner.as_ref().is_none_or(|h| h.is_finished())
     }
 
+    /// Stops the planner node (it must end cleanly) and starts it again with the same
+    /// arguments, keeping this client and its endpoints: what a node restarted under a cell
+    /// controller that keeps running sees.
+    pub fn restart(&mut self, planner: &Planner<Req, Plan>, env: &RosEnv, extra: &[&str]) {
+        self.stop.stop();
+        let h = self.planner.take().expect("planner handle");
+        h.join()
+            .expect("planner thread")
+            .expect("planner ends cleanly");
+        let mut words: Vec<String> = vec!["--ros-args".into(), "--disable-rosout-logs".into()];
+        words.extend(extra.iter().map(|s| s.to_string()));
+        let (stop, handle) = spawn_node(env, words, planner.run);
+        self.stop = stop;
+        self.planner = Some(handle);
+        let matching = 3 * QUICK;
+        assert!(
+            self._client.wait_for_subscriber(&self.texts, matching),
+            "the restarted node did not subscribe within {matching:?}"
+        );
+    }
+
+    /// The next answer within `timeout`, if one comes.
+    pub fn try_next_plan(&self, timeout: Duration) -> Option<Plan> {
+        let deadline = std::time::Instant::now() + timeout;
+        loop {
+            if let Ok(Some((plan, _))) = self.plans.take() {
+                return Some(plan);
+            }
+            if std::time::Instant::now() > deadline {
+                return None;
+            }
+            std::thread::sleep(Duration::from_millis(5));
+        }
+    }
+
     /// Stops the planner; it must end cleanly.
     pub fn finish(mut self) {
         self.stop.stop();

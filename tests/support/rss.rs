@@ -26,7 +26,11 @@ pub fn children_mib() -> f64 {
         };
         for pid in children.split_whitespace() {
             if let Ok(statm) = std::fs::read_to_string(format!("/proc/{pid}/statm")) {
-                if let Some(pages) = statm.split_whitespace().nth(1).and_then(|p| p.parse::<f64>().ok()) {
+                if let Some(pages) = statm
+                    .split_whitespace()
+                    .nth(1)
+                    .and_then(|p| p.parse::<f64>().ok())
+                {
                     total += pages * 4096.0 / (1024.0 * 1024.0);
                 }
             }

@@ -304,7 +304,9 @@ impl<S: PlanningService> PlannerNode<S> {
         while let Some(received) = self.requests.try_recv_stamped() {
             any = true;
             let queued = match received {
-                Ok((_, stamp)) if self.published_before_start(stamp, S::RequestMsg::NAME) => continue,
+                Ok((_, stamp)) if self.published_before_start(stamp, S::RequestMsg::NAME) => {
+                    continue
+                }
                 Ok((m, _)) => match self.service.request_from_msg(&m) {
                     Ok(r) => self.plan_job(r, RawRequest::Msg(m), "message"),
                     Err(answer) => Queued::Answer(answer),
