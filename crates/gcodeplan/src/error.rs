@@ -91,6 +91,16 @@ pub(crate) fn check_positive(values: &[(&str, f64)]) -> Result<(), GcodePlanErro
     }
 }
 
+/// A tool path error of the run starting at `line`: the budget's interruption as itself
+/// ([`GcodePlanError::Interrupted`], whose status is TIMEOUT or RESOURCE_LIMIT), anything else
+/// as [`GcodePlanError::Path`].
+pub(crate) fn path(line: usize, error: ToolpathError) -> GcodePlanError {
+    match error {
+        ToolpathError::Interrupted(i) => GcodePlanError::Interrupted(i),
+        error => GcodePlanError::Path { line, error },
+    }
+}
+
 /// A limit the tool path library refused, as a setting.
 pub(crate) fn setting(error: ToolpathError) -> GcodePlanError {
     match error {
@@ -103,9 +113,6 @@ pub(crate) fn setting(error: ToolpathError) -> GcodePlanError {
             value,
             reason,
         },
-        other => GcodePlanError::Path {
-            line: 0,
-            error: other,
-        },
+        other => path(0, other),
     }
 }
