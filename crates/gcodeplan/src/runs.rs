@@ -417,8 +417,8 @@ fn chords(
         || {
             let turns = arc.extra_turns + 1;
             format!(
-                "arc at line {line}: {turns} turns × {:.0} chords per turn within {sagitta:.1e} m \
-                 (radius {:.3e} m), {n} chords",
+                "program runs up to line {line}, the arc there: {turns} turns × {:.0} chords per \
+                 turn within {sagitta:.1e} m (radius {:.3e} m), {n} chords",
                 (std::f64::consts::TAU / step).ceil(),
                 arc.radius
             )

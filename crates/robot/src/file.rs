@@ -97,6 +97,19 @@ pub fn open_regular(path: &Path, max_bytes: u64) -> Result<CappedReader<BufReade
     ))
 }
 
+/// Checks, without opening it, that `path` (links resolved) is a regular file of at most
+/// `max_bytes` bytes: what a node checks before it queues a request naming a file, which
+/// [`open_regular`] or [`read_regular`] checks again when it is read.
+///
+/// # Returns
+/// The file's size in bytes, or the reason it would not be read (naming the path).
+pub fn check_regular_file(path: &Path, max_bytes: u64) -> Result<u64, String> {
+    let meta =
+        std::fs::metadata(path).map_err(|e| format!("cannot read {}: {e}", path.display()))?;
+    check_regular(path, &meta, max_bytes)?;
+    Ok(meta.len())
+}
+
 /// Refuses what is not a regular file of at most `max_bytes` bytes.
 fn check_regular(path: &Path, meta: &std::fs::Metadata, max_bytes: u64) -> Result<(), String> {
     let shown = path.display();
@@ -210,7 +223,7 @@ impl<R: BufRead> BufRead for CappedReader<R> {
 
 #[cfg(test)]
 mod tests {
-    use super::{open_regular, read_regular, CappedReader};
+    use super::{check_regular_file, open_regular, read_regular, CappedReader};
     use std::io::{BufRead, Read};
 
     fn scratch(name: &str) -> std::path::PathBuf {
@@ -280,6 +293,10 @@ mod tests {
         let e = open_regular(&f, 11).unwrap_err();
         assert!(e.contains("12 bytes") && e.contains("limit of 11"), "{e}");
         assert!(open_regular(&d, 100).unwrap_err().contains("a directory"));
+        assert_eq!(check_regular_file(&f, 12), Ok(12));
+        assert!(check_regular_file(&d, 100)
+            .unwrap_err()
+            .contains("a directory"));
         assert!(open_regular(std::path::Path::new("/dev/zero"), 100)
             .unwrap_err()
             .contains("not a regular file"));
