@@ -91,7 +91,7 @@ fn non_finite_denormal_and_absurd_limits_are_refused_naming_the_field() {
             &laser,
             "rapid_feed",
         );
-        if v.is_nan() || v.is_infinite() || v < 0.0 || v > 1e5 {
+        if !(0.0..=1e5).contains(&v) {
             // 0 is "none of its own"; a tiny budget is a budget (answered TIMEOUT at once).
             refused(
                 &GcodeRequest {

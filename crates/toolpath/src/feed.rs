@@ -139,11 +139,9 @@ pub struct FeedPlan {
 impl FeedPlan {
     /// The plan at every multiple of `period` and at its end.
     pub fn sample(&self, period: f64) -> Vec<FeedSample> {
-        match self.sample_within(period, &Budget::unlimited()) {
-            Ok(samples) => samples,
-            // Only the budget interrupts, and an unlimited one never does.
-            Err(_) => Vec::new(),
-        }
+        // Only the budget interrupts, and an unlimited one never does.
+        self.sample_within(period, &Budget::unlimited())
+            .unwrap_or_default()
     }
 
     /// The number of points of [`Self::sample`] at `period`: ⌊T / period⌋ + 2 at most

@@ -45,11 +45,8 @@ pub struct PathSample {
 /// # Arguments
 /// * `max_step` — mean arc length between samples of a corner \[m\], > 0.
 pub fn sample_path(path: &SmoothedPath, max_step: f64) -> Vec<PathSample> {
-    match sample_path_within(path, max_step, &Budget::unlimited()) {
-        Ok(samples) => samples,
-        // Only the budget interrupts, and an unlimited one never does.
-        Err(_) => Vec::new(),
-    }
+    // Only the budget interrupts, and an unlimited one never does.
+    sample_path_within(path, max_step, &Budget::unlimited()).unwrap_or_default()
 }
 
 /// Samples between two checks of the deadline in [`sample_path_within`].
