@@ -122,7 +122,7 @@ pub const MAX_PROGRAM_BYTES: u64 = 256 << 20;
 /// smallest and largest values accepted.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Range {
-    /// The field and its unit, e.g. `limits.max_feed [m/s]`.
+    /// The field, what it is and its unit, e.g. `limits.max_feed (max feed) [m/s]`.
     pub field: &'static str,
     /// The smallest value accepted.
     pub min: f64,
@@ -140,18 +140,17 @@ impl Range {
         if value >= self.min && value <= self.max {
             return Ok(());
         }
+        let (min, max) = (self.min, self.max);
+        let reason = if self.min > 0.0 && !(value.is_finite() && value > 0.0) {
+            format!("{value:e} must be finite and > 0, in [{min:e}, {max:e}]")
+        } else if !value.is_finite() {
+            format!("{value:e} must be finite, in [{min:e}, {max:e}]")
+        } else {
+            format!("{value:e} is outside [{min:e}, {max:e}]")
+        };
         Err(GcodePlanError::InvalidRequest {
             field: self.field.to_string(),
-            reason: format!(
-                "{value:e} is outside [{:e}, {:e}]{}",
-                self.min,
-                self.max,
-                if value.is_finite() {
-                    ""
-                } else {
-                    " (not a finite number)"
-                }
-            ),
+            reason,
         })
     }
 }
@@ -167,42 +166,42 @@ pub const TOLERANCE: Range = Range {
 /// feed of 10⁻³⁰⁰ m/s is not a feed: it would make a trajectory of 10³⁰⁰ s.
 pub const RANGES: [Range; 8] = [
     Range {
-        field: "limits.max_feed [m/s]",
+        field: "limits.max_feed (max feed) [m/s]",
         min: 1e-5,
         max: 10.0,
     },
     Range {
-        field: "limits.tangential_acceleration [m/s^2]",
+        field: "limits.tangential_acceleration (tangential acceleration) [m/s^2]",
         min: 1e-3,
         max: 1e3,
     },
     Range {
-        field: "limits.tangential_jerk [m/s^3]",
+        field: "limits.tangential_jerk (tangential jerk) [m/s^3]",
         min: 1e-2,
         max: 1e5,
     },
     Range {
-        field: "limits.normal_acceleration [m/s^2]",
+        field: "limits.normal_acceleration (normal acceleration) [m/s^2]",
         min: 1e-3,
         max: 1e3,
     },
     Range {
-        field: "limits.normal_jerk [m/s^3]",
+        field: "limits.normal_jerk (normal jerk) [m/s^3]",
         min: 1e-2,
         max: 1e5,
     },
     Range {
-        field: "limits.chord_error [m]",
+        field: "limits.chord_error (chord error) [m]",
         min: 1e-9,
         max: 1e-2,
     },
     Range {
-        field: "limits.contour_error [m]",
+        field: "limits.contour_error (contour error) [m]",
         min: 1e-9,
         max: 1e-2,
     },
     Range {
-        field: "rapid_feed [m/s]",
+        field: "rapid_feed (G0 speed) [m/s]",
         min: 1e-5,
         max: 10.0,
     },
