@@ -151,6 +151,14 @@ pub(crate) fn read_into<R: BufRead>(
     settings.validate()?;
     let budget = held.budget();
     let mut pending: u64 = 0;
+    // The deadline is checked at every line the reader takes (comments and blank lines make
+    // no motion), the interruption kept to be told from a read error.
+    let stopped = std::cell::RefCell::new(None);
+    let source = Checked {
+        inner: source,
+        budget,
+        stopped: &stopped,
+    };
     let mut program = Program::new(source, settings.reader)?;
     let mut reading = Reading {
         start: settings.reader.start,
@@ -159,7 +167,10 @@ pub(crate) fn read_into<R: BufRead>(
     let mut open: Option<Open> = None;
     while let Some(motion) = program.next() {
         budget.check("reading the program")?;
-        let motion = motion?;
+        let motion = motion.map_err(|e| match stopped.borrow_mut().take() {
+            Some(interrupt) => GcodePlanError::Interrupted(interrupt),
+            None => GcodePlanError::Program(e),
+        })?;
         if program.lines_read() > settings.max_lines {
             return Err(GcodePlanError::InvalidRequest {
                 field: "program".to_string(),
@@ -267,6 +278,39 @@ pub(crate) fn read_into<R: BufRead>(
     reading.lines = program.lines_read();
     reading.skipped_blocks = program.skipped_blocks();
     Ok(reading)
+}
+
+/// A program source whose every `fill_buf` (each line the reader takes) checks the deadline:
+/// a program of 10⁷ comment lines is stopped like one of motions.
+struct Checked<'a, R> {
+    inner: R,
+    budget: &'a Budget,
+    stopped: &'a std::cell::RefCell<Option<kerf_budget::Interrupt>>,
+}
+
+impl<R: BufRead> std::io::Read for Checked<'_, R> {
+    fn read(&mut self, buf: &mut [u8]) -> std::io::Result<usize> {
+        let available = self.fill_buf()?;
+        let n = available.len().min(buf.len());
+        buf[..n].copy_from_slice(&available[..n]);
+        self.consume(n);
+        Ok(n)
+    }
+}
+
+impl<R: BufRead> BufRead for Checked<'_, R> {
+    fn fill_buf(&mut self) -> std::io::Result<&[u8]> {
+        if let Err(interrupt) = self.budget.check("reading the program") {
+            let message = interrupt.to_string();
+            *self.stopped.borrow_mut() = Some(interrupt);
+            return Err(std::io::Error::other(message));
+        }
+        self.inner.fill_buf()
+    }
+
+    fn consume(&mut self, amt: usize) {
+        self.inner.consume(amt);
+    }
 }
 
 fn kind_of(tool_on: bool) -> RunKind {

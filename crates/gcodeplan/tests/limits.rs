@@ -218,3 +218,25 @@ fn denormal_limits_past_the_request_end_in_a_named_refusal_of_the_budget() {
         );
     }
 }
+
+/// A program of comment lines makes no motion, yet its reading is under the deadline too
+/// (without the check at every line it would be read whole and refused as empty).
+#[test]
+fn lines_without_motion_are_read_under_the_deadline() {
+    let laser = LaserSheet::default_sheet().unwrap();
+    let mut program = String::from("G21\n");
+    for _ in 0..1_000_000 {
+        program.push_str("(c)\n");
+    }
+    let settings = PlanSettings::laser_cutter();
+    let budget = Budget::new(Some(Duration::ZERO), CancelToken::new());
+    let started = Instant::now();
+    let e = plan_program(program.as_bytes(), &laser, &settings, &budget).unwrap_err();
+    assert!(started.elapsed() < Duration::from_secs(15), "hang guard");
+    match &e {
+        GcodePlanError::Interrupted(kerf_budget::Interrupt::TimedOut { stage, .. }) => {
+            assert_eq!(*stage, "reading the program", "{e}")
+        }
+        other => panic!("{other:?}"),
+    }
+}
