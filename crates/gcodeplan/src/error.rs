@@ -96,6 +96,16 @@ pub(crate) fn check_positive(values: &[(&str, f64)]) -> Result<(), GcodePlanErro
 /// as [`GcodePlanError::Path`].
 pub(crate) fn path(line: usize, error: ToolpathError) -> GcodePlanError {
     match error {
+        // What grew is named with the run it grew in.
+        ToolpathError::Interrupted(Interrupt::OverMemory {
+            limit,
+            needed,
+            what,
+        }) if line > 0 => GcodePlanError::Interrupted(Interrupt::OverMemory {
+            limit,
+            needed,
+            what: format!("the run from line {line}: {what}"),
+        }),
         ToolpathError::Interrupted(i) => GcodePlanError::Interrupted(i),
         error => GcodePlanError::Path { line, error },
     }

@@ -92,7 +92,7 @@ fn heavy_programs_end_in_a_named_refusal_within_their_budgets() {
             helix("10000"),
             &laser_settings,
             Some(MEMORY),
-            Expect::Budget,
+            Expect::OverMemory("the run from line 2: smoothed path: 702425 vertices"),
         ),
         // Under a 16 MiB budget its chords alone do not fit: refused by their estimate.
         (
