@@ -3,11 +3,16 @@
 //! ```sh
 //! kerf plan gcode FILE [--machine laser-cutter|irb6660] [--tolerance M]
 //!                      [--method kerf|kerf-curvature|icr|ccr|nurbs] [--feed-method near-optimal|constant-intervals]
-//!                      [--g RAD] [--origin X,Y,Z] [--plots DIR] [--out plan.json]
+//!                      [--g RAD] [--origin X,Y,Z] [--plan-memory BYTES] [--plots DIR]
+//!                      [--out plan.json]
 //! ```
 //!
-//! Reads the program as a stream (`-` reads standard input), plans it with
-//! [`kerf_gcodeplan::plan_request`] (the shipped machine) and prints the totals (time, T_lb
+//! Reads the program as a stream (`-` reads standard input; a file must be a regular file, and
+//! either is read up to [`kerf_gcodeplan::MAX_PROGRAM_BYTES`]), plans it with
+//! [`kerf_gcodeplan::plan_request_within`] (the shipped machine) under a memory budget of
+//! `--plan-memory` bytes (default [`kerf_budget::DEFAULT_PLAN_MEMORY`], 1 GiB, as the node's
+//! `plan_memory`: a program whose data would not fit ends with RESOURCE_LIMIT naming what grew)
+//! and prints the totals (time, T_lb
 //! and T/T_lb, tolerance use, seeds 000/003 metrics), a table of the runs, the tool switches
 //! and the warnings. `--out` writes the answer the `gcode_planner` node would publish
 //! (`kerf_msgs/msg/GcodePlan`, with its trajectory) as JSON. `--plots DIR` writes, per cutting
@@ -17,12 +22,14 @@
 //!
 //! Exit code 0 on success; 2 on any failure (its status, line and message are printed).
 
-use std::io::Read;
 use std::path::PathBuf;
 
 use clap::{Args, ValueEnum};
 use kerf_budget::Budget;
-use kerf_gcodeplan::{plan_request, GcodePlan, GcodeRequest, MachineBase, MachineKind, RunKind};
+use kerf_gcodeplan::{
+    plan_request_reading, plan_request_within, GcodePlan, GcodeRequest, MachineBase, MachineKind,
+    RunKind, MAX_PROGRAM_BYTES,
+};
 use kerf_msgs::msg::GcodePlan as GcodePlanMsg;
 
 /// The machines, as named in requests.
@@ -58,6 +65,9 @@ pub struct GcodeArgs {
     /// The program's zero in the machine's base frame, `x,y,z` (m).
     #[arg(long, value_delimiter = ',', num_args = 3, allow_hyphen_values = true)]
     origin: Option<Vec<f64>>,
+    /// The plan's memory budget (bytes), as the node's plan_memory: 16 MiB to 1 TiB.
+    #[arg(long, default_value_t = kerf_budget::DEFAULT_PLAN_MEMORY as i64, allow_hyphen_values = true)]
+    plan_memory: i64,
     /// Write the plots here.
     #[arg(long)]
     plots: Option<PathBuf>,
@@ -81,19 +91,14 @@ pub fn run(a: GcodeArgs) -> Result<(), String> {
         MachineArg::LaserCutter => MachineKind::LaserCutter,
         MachineArg::Irb6660 => MachineKind::Irb6660,
     };
-    let (program, program_file) = if a.file.as_os_str() == "-" {
-        let mut text = String::new();
-        std::io::stdin()
-            .read_to_string(&mut text)
-            .map_err(|e| format!("cannot read standard input: {e}"))?;
-        (Some(text), None)
-    } else {
-        (None, Some(a.file.display().to_string()))
-    };
+    let memory =
+        kerf_budget::memory_from_bytes(a.plan_memory).map_err(|e| format!("--plan-memory: {e}"))?;
+    let stdin = a.file.as_os_str() == "-";
+    let program_file = (!stdin).then(|| a.file.display().to_string());
     let request = GcodeRequest {
         request_id: a.file.display().to_string(),
         machine: kind.name().to_string(),
-        program,
+        program: None,
         program_file,
         tolerance: a.tolerance,
         method: a.method.clone(),
@@ -104,7 +109,20 @@ pub fn run(a: GcodeArgs) -> Result<(), String> {
     };
     let base = MachineBase::load(kind).map_err(|e| e.to_string())?;
     let started = std::time::Instant::now();
-    let plan = plan_request(&request, &base, &Budget::unlimited()).map_err(|e| {
+    let budget = Budget::unlimited().with_memory(Some(memory));
+    let planned = if stdin {
+        // Streamed as a file is, and capped like one: /dev/zero as input ends at its first
+        // line (longer than a line may be), an endless program at the cap.
+        let input = kerf_robot::file::CappedReader::new(
+            std::io::stdin().lock(),
+            MAX_PROGRAM_BYTES,
+            "standard input",
+        );
+        plan_request_reading(&request, &base, &budget, None, input)
+    } else {
+        plan_request_within(&request, &base, &budget, None)
+    };
+    let plan = planned.map_err(|e| {
         let status = kerf_gcode_planner::convert::status_of(&e);
         let name = GcodePlanMsg::status_name(status).unwrap_or("?");
         format!("{name} ({status}): {e}")

@@ -23,6 +23,9 @@ use crate::lexer::{Block, Word};
 use crate::motion::{Motion, Plane};
 use crate::settings::ReaderSettings;
 
+/// The most turns P of one arc (a helix): more is refused as the program is read.
+pub const MAX_ARC_TURNS: u32 = 1_000_000;
+
 /// Metres per inch (exact, by definition).
 pub const METRES_PER_INCH: f64 = 0.0254;
 
@@ -385,10 +388,13 @@ impl Interpreter {
                     let turns = match p.letter('P') {
                         None => 1,
                         Some(w) => {
-                            if !(w.value >= 1.0 && w.value.fract() == 0.0 && w.value <= 1e6) {
+                            if !(w.value >= 1.0
+                                && w.value.fract() == 0.0
+                                && w.value <= MAX_ARC_TURNS as f64)
+                            {
                                 return Err(bad(
                                     w,
-                                    "the turns P of an arc must be an integer >= 1",
+                                    "the turns P of an arc must be an integer in [1, 1000000]",
                                 ));
                             }
                             w.value as u32

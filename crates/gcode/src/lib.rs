@@ -24,7 +24,7 @@ pub mod program;
 pub mod settings;
 
 pub use error::GcodeError;
-pub use interpreter::{Interpreter, PathControl};
+pub use interpreter::{Interpreter, PathControl, MAX_ARC_TURNS};
 pub use motion::{ArcMove, Motion, Plane};
 pub use points::{read_points, PointUnit};
 pub use program::{read_program, Program};

@@ -91,6 +91,26 @@ pub(crate) fn check_positive(values: &[(&str, f64)]) -> Result<(), GcodePlanErro
     }
 }
 
+/// A tool path error of the run starting at `line`: the budget's interruption as itself
+/// ([`GcodePlanError::Interrupted`], whose status is TIMEOUT or RESOURCE_LIMIT), anything else
+/// as [`GcodePlanError::Path`].
+pub(crate) fn path(line: usize, error: ToolpathError) -> GcodePlanError {
+    match error {
+        // What grew is named with the run it grew in.
+        ToolpathError::Interrupted(Interrupt::OverMemory {
+            limit,
+            needed,
+            what,
+        }) if line > 0 => GcodePlanError::Interrupted(Interrupt::OverMemory {
+            limit,
+            needed,
+            what: format!("the run from line {line}: {what}"),
+        }),
+        ToolpathError::Interrupted(i) => GcodePlanError::Interrupted(i),
+        error => GcodePlanError::Path { line, error },
+    }
+}
+
 /// A limit the tool path library refused, as a setting.
 pub(crate) fn setting(error: ToolpathError) -> GcodePlanError {
     match error {
@@ -103,9 +123,6 @@ pub(crate) fn setting(error: ToolpathError) -> GcodePlanError {
             value,
             reason,
         },
-        other => GcodePlanError::Path {
-            line: 0,
-            error: other,
-        },
+        other => path(0, other),
     }
 }

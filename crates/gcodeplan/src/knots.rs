@@ -23,7 +23,7 @@
 //!    v/r, a/r², j/r³ exactly (the same quintics in scaled time: the same
 //!    geometry, the same deviation).
 
-use kerf_budget::Budget;
+use kerf_budget::{bytes_of, Budget};
 use kerf_executor::roots::{derivative, extrema};
 use kerf_executor::spline::{
     acceleration_coefficients, coefficients, evaluate, velocity_coefficients, Interpolation, Knot,
@@ -209,6 +209,17 @@ pub fn piece_peaks(machine: &dyn Machine, a: &JointKnot, b: &JointKnot) -> [[f64
 /// (so that no piece straddles a jump of the path jerk, which a quintic would overshoot; on a
 /// line a phase's motion is a cubic in time, which the quintic Hermite reproduces exactly),
 /// and between them a grid of at most `spacing`.
+/// The number of [`initial_times`] of a run, at most: one per phase and one per `spacing` of
+/// its duration (saturating: a plan of 10³⁰⁰ s gives `u64::MAX`), known before any is made.
+fn initial_count(run: &TimedRun, spacing: f64) -> u64 {
+    let count = (run.duration() / spacing).ceil() + 2.0 * run.plan.phases.len() as f64 + 2.0;
+    if count.is_finite() && count < u64::MAX as f64 {
+        count as u64
+    } else {
+        u64::MAX
+    }
+}
+
 fn initial_times(run: &TimedRun, spacing: f64, shortest: f64) -> Vec<f64> {
     let duration = run.duration();
     let mut bounds: Vec<f64> = vec![0.0];
@@ -271,6 +282,20 @@ pub fn run_knots(
             reason,
         }
     };
+    // Counted before they are made: a run of 10³⁰⁰ s (a feed of 10⁻³⁰⁰ m/s) is refused here,
+    // not by the allocator.
+    let count = initial_count(run, knot_spacing);
+    if count > max_points as u64 + 2 * run.plan.phases.len() as u64 + 2 {
+        return Err(GcodePlanError::TooManyPoints { max: max_points });
+    }
+    budget.check_memory(
+        bytes_of::<f64>(count).saturating_add(bytes_of::<JointKnot>(count.saturating_mul(2))),
+        &format!(
+            "joint points of the run at line {line}: {:.3e} s every {knot_spacing} s, about \
+             {count} points",
+            run.duration()
+        ),
+    )?;
     let times = initial_times(run, knot_spacing, 0.25 * control_period);
     if times.len() > max_points {
         return Err(GcodePlanError::TooManyPoints { max: max_points });
@@ -279,6 +304,9 @@ pub fn run_knots(
     let mut knots: Vec<JointKnot> = Vec::with_capacity(n + 1);
     let mut previous = reference.copied();
     for (k, &t) in times.iter().enumerate() {
+        if k % 256 == 255 {
+            budget.check("joint trajectory (inverse kinematics)")?;
+        }
         let mut knot =
             knot_at(machine, run, t, previous.as_ref()).map_err(|e| unreachable(t, e))?;
         if k == 0 || k == n {
@@ -295,7 +323,10 @@ pub fn run_knots(
         budget.check("joint trajectory")?;
         let mut next: Vec<JointKnot> = Vec::with_capacity(knots.len());
         let mut split = false;
-        for w in knots.windows(2) {
+        for (k, w) in knots.windows(2).enumerate() {
+            if k % 256 == 255 {
+                budget.check("joint trajectory (interpolation check)")?;
+            }
             next.push(w[0]);
             let d = piece_deviation(machine, run, &w[0], &w[1], control_period)
                 .map_err(|e| unreachable(w[0].t, e))?;
@@ -334,7 +365,10 @@ pub fn run_knots(
     };
     let mut ratio: f64 = 0.0;
     let mut over = Vec::new();
-    for w in knots.windows(2) {
+    for (k, w) in knots.windows(2).enumerate() {
+        if k % 256 == 255 {
+            budget.check("joint trajectory (peaks)")?;
+        }
         let peaks = piece_peaks(machine, &w[0], &w[1]);
         let mut piece: f64 = 0.0;
         for (j, p) in peaks.iter().enumerate() {

@@ -9,6 +9,7 @@
 pub mod error;
 pub mod knots;
 pub mod machine;
+mod memory;
 pub mod plan;
 pub mod request;
 pub mod runs;
@@ -19,9 +20,10 @@ pub use error::GcodePlanError;
 pub use machine::{JointBounds, LaserSheet, Machine, MillingPlane, DOF};
 pub use plan::{plan_program, GcodePlan, RunReport, ToolEvent};
 pub use request::{
-    corner_method, feed_method, plan_request, plan_request_within, GcodeRequest, LimitOverrides,
-    MachineBase, MachineKind, ProgramSource, FEED_METHODS, METHODS,
+    corner_method, feed_method, open_program, plan_request, plan_request_reading,
+    plan_request_within, GcodeRequest, LimitOverrides, MachineBase, MachineKind, ProgramSource,
+    Range, FEED_METHODS, MAX_PROGRAM_BYTES, METHODS, RANGES,
 };
-pub use runs::{read_steps, Reading, Run, RunKind, Step};
+pub use runs::{read_steps, read_steps_within, Reading, Run, RunKind, Step};
 pub use settings::PlanSettings;
 pub use timed::{PathMotion, TimedRun};

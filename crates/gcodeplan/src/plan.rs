@@ -20,24 +20,41 @@
 
 use std::io::BufRead;
 
-use kerf_budget::Budget;
+use kerf_budget::{bytes_of, Budget};
 use kerf_executor::{
     check_executable, ExecutorConfig, JointSample, TrajectoryPoint, TrajectoryRequest,
 };
 use kerf_toolpath::{
-    bang_bang_under, check_plan, metrics, smooth_polyline_with, FeedConstraints, FeedLimits,
-    Metrics, PathSample, Piece, SmoothedPath,
+    bang_bang_under_within, check_plan_within, metrics_within, smooth_polyline_within,
+    FeedConstraints, FeedLimits, Metrics, PathSample, Piece, SmoothedPath,
 };
 
-use crate::error::GcodePlanError;
+use crate::error::{path as path_error_at, GcodePlanError};
 use crate::knots::{knot_at, run_knots, Peak, RunKnots};
 use crate::machine::{Machine, DOF};
-use crate::runs::{read_steps, Run, RunKind, Step};
+use crate::memory::Held;
+use crate::runs::{read_into, Run, RunKind, Step};
 use crate::settings::PlanSettings;
 use crate::timed::TimedRun;
 
 /// Rounds of the executor's check (step 5) before the plan is given up.
 pub const MAX_CHECK_ROUNDS: usize = 8;
+
+/// Bytes of one trajectory point as assembled (positions, velocities, accelerations, an empty
+/// effort: four vectors of six values) or as the executor validates it, about.
+pub const TRAJECTORY_POINT_BYTES: u64 = 4 * 24 + 3 * 6 * 8 + 8;
+
+/// Bytes a placed run holds: its pieces, samples, feed plan phases and joint points.
+fn run_bytes(timed: &TimedRun, knots: &RunKnots) -> u64 {
+    bytes_of::<Piece>(timed.path.pieces.len() as u64)
+        .saturating_add(bytes_of::<[f64; 3]>(timed.path.polyline.len() as u64))
+        .saturating_add(bytes_of::<PathSample>(timed.samples.len() as u64))
+        .saturating_add(bytes_of::<kerf_toolpath::feed::PlacedPhase>(
+            timed.plan.phases.len() as u64,
+        ))
+        .saturating_add(bytes_of::<crate::knots::JointKnot>(knots.knots.len() as u64))
+        .saturating_add((std::mem::size_of::<RunReport>() + std::mem::size_of::<Placed>()) as u64)
+}
 
 /// What one run became.
 #[derive(Debug, Clone, PartialEq)]
@@ -194,7 +211,10 @@ pub fn plan_program<R: BufRead>(
     budget: &Budget,
 ) -> Result<GcodePlan, GcodePlanError> {
     settings.validate()?;
-    let reading = read_steps(source, settings)?;
+    // What the plan holds (the runs read, each placed run's path, samples, plan and points),
+    // accounted on the budget until the plan returns.
+    let mut held = Held::new(budget);
+    let reading = read_into(source, settings, &mut held)?;
     budget.check("reading")?;
     let mut warnings = Vec::new();
     let mut placed: Vec<Placed> = Vec::new();
@@ -221,8 +241,8 @@ pub fn plan_program<R: BufRead>(
                 line: *line,
             }),
             Step::Run(run) => {
-                reachable(machine, run, reference.as_ref())?;
-                let mut prepared = prepare_run(run, machine, settings, &mut warnings)?;
+                reachable(machine, run, reference.as_ref(), budget)?;
+                let mut prepared = prepare_run(run, machine, settings, &mut warnings, budget)?;
                 let line = run.lines[0];
                 let knots = run_joints(
                     machine,
@@ -272,14 +292,26 @@ pub fn plan_program<R: BufRead>(
                     slowdown: knots.slowdown,
                     peak: knots.peak.clone(),
                     start_time: time,
-                    metrics: metrics(
+                    metrics: metrics_within(
                         &timed.plan,
                         &timed.path,
                         &timed.samples,
                         limits.curvature.interpolation_period,
                         limits.curvature.servo.as_ref(),
-                    ),
+                        budget,
+                    )?,
                 };
+                held.add(run_bytes(&timed, &knots), || {
+                    format!(
+                        "planned runs: {} runs up to line {}, {} pieces, {} samples and {} \
+                         joint points in the last",
+                        placed.len() + 1,
+                        lines.1,
+                        timed.path.pieces.len(),
+                        timed.samples.len(),
+                        knots.knots.len()
+                    )
+                })?;
                 let start = time;
                 time += timed.duration() * knots.slowdown;
                 reports.push(report);
@@ -308,6 +340,16 @@ pub fn plan_program<R: BufRead>(
     let mut round = 0;
     let (trajectory, max_interpolation_deviation) = loop {
         budget.check("executor check")?;
+        let count: usize = placed.iter().map(|p| p.knots.knots.len()).sum::<usize>() + holds.len();
+        if count > settings.max_points {
+            return Err(GcodePlanError::TooManyPoints {
+                max: settings.max_points,
+            });
+        }
+        held.check(
+            bytes_of::<u8>(count as u64).saturating_mul(2 * TRAJECTORY_POINT_BYTES),
+            || format!("joint trajectory: {count} points, assembled and validated"),
+        )?;
         let request = assemble(machine, &placed, &holds);
         if request.points.len() > settings.max_points {
             return Err(GcodePlanError::TooManyPoints {
@@ -333,9 +375,9 @@ pub fn plan_program<R: BufRead>(
                 ),
             });
         }
-        refine(machine, &mut placed, &bad)?;
+        refine(machine, &mut placed, &bad, budget)?;
     };
-    let peak_ratios = joint_peaks(machine, &placed);
+    let peak_ratios = joint_peaks(machine, &placed, budget)?;
     let timed: Vec<TimedRun> = placed.into_iter().map(|p| p.timed).collect();
     let duration = trajectory.points.last().map_or(0.0, |p| p.time_from_start);
     Ok(GcodePlan {
@@ -370,9 +412,13 @@ fn reachable(
     machine: &dyn Machine,
     run: &Run,
     reference: Option<&[f64; DOF]>,
+    budget: &Budget,
 ) -> Result<(), GcodePlanError> {
     let mut previous = reference.copied();
-    for (p, line) in run.points.iter().zip(&run.lines) {
+    for (k, (p, line)) in run.points.iter().zip(&run.lines).enumerate() {
+        if k % 256 == 255 {
+            budget.check("reach of the program's points")?;
+        }
         let q = machine.joints(*p, previous.as_ref()).map_err(|reason| {
             GcodePlanError::Unreachable {
                 line: *line,
@@ -411,10 +457,11 @@ fn prepare_run(
     machine: &dyn Machine,
     settings: &PlanSettings,
     warnings: &mut Vec<String>,
+    budget: &Budget,
 ) -> Result<Prepared, GcodePlanError> {
     let line = run.lines[0];
     let last_line = run.lines.last().copied().unwrap_or(line);
-    let path_error = |error| GcodePlanError::Path { line, error };
+    let path_error = |error| path_error_at(line, error);
     let machine_max = match run.kind {
         RunKind::Rapid => f64::INFINITY,
         _ => settings.limits.curvature.feed,
@@ -430,8 +477,13 @@ fn prepare_run(
     let feed = feeds.iter().copied().fold(0.0, f64::max);
     let mut limits: FeedLimits = settings.limits;
     limits.curvature.feed = feed;
-    let path = smooth_polyline_with(&run.points, run.corner_tolerance, &settings.corner_method)
-        .map_err(path_error)?;
+    let path = smooth_polyline_within(
+        &run.points,
+        run.corner_tolerance,
+        &settings.corner_method,
+        budget,
+    )
+    .map_err(path_error)?;
     // The feed plan, checked on its output at the interpolation period against every limit
     // (kerf_toolpath::check_plan); where it breaks one between its samples, the path is
     // sampled 4x finer (every bound of its sampling) and planned again, at most
@@ -439,12 +491,18 @@ fn prepare_run(
     let mut sampling = settings.sampling;
     let mut attempt = 0;
     let (samples, caps, plan) = loop {
-        let samples = sampling.sample(&path).map_err(path_error)?;
+        budget.check("path sampling")?;
+        let samples = sampling.sample_within(&path, budget).map_err(path_error)?;
+        // The caps, the limit curve of T_lb and the pieces' caps: three numbers per sample.
+        budget.check_memory(
+            bytes_of::<f64>(3 * samples.len() as u64),
+            &format!("programmed feeds of {} path samples", samples.len()),
+        )?;
         let caps = sample_caps(&path, &samples, &run.points, &feeds);
-        let plan =
-            feed_plan(&samples, &caps, feed, &limits, machine, settings).map_err(path_error)?;
+        let plan = feed_plan(&samples, &caps, feed, &limits, machine, settings, budget)
+            .map_err(path_error)?;
         match plan_violation(
-            &path, &samples, &caps, feed, &limits, &plan, machine, settings,
+            &path, &samples, &caps, feed, &limits, &plan, machine, settings, budget,
         )
         .map_err(path_error)?
         {
@@ -469,8 +527,8 @@ fn prepare_run(
         .zip(&caps)
         .map(|(p, cap)| limits.curvature.speed(p.curvature).min(*cap))
         .collect();
-    let lower =
-        bang_bang_under(&samples, curve, limits.tangential_acceleration).map_err(path_error)?;
+    let lower = bang_bang_under_within(&samples, curve, limits.tangential_acceleration, budget)
+        .map_err(path_error)?;
     let path_time = plan.time;
     Ok(Prepared {
         timed: TimedRun {
@@ -495,10 +553,13 @@ fn feed_plan(
     limits: &FeedLimits,
     machine: &dyn Machine,
     settings: &PlanSettings,
+    budget: &Budget,
 ) -> Result<kerf_toolpath::FeedPlan, kerf_toolpath::ToolpathError> {
-    settings
-        .feed_method
-        .plan(samples, &constraints(caps, feed, limits, machine, settings))
+    settings.feed_method.plan_within(
+        samples,
+        &constraints(caps, feed, limits, machine, settings),
+        budget,
+    )
 }
 
 /// The constraints of a run's feed plan: its limits, the per-sample feeds when they vary, and
@@ -543,14 +604,16 @@ fn plan_violation(
     plan: &kerf_toolpath::FeedPlan,
     machine: &dyn Machine,
     settings: &PlanSettings,
+    budget: &Budget,
 ) -> Result<Option<(&'static str, f64, f64)>, kerf_toolpath::ToolpathError> {
     let constraints = constraints(caps, feed, limits, machine, settings);
-    let check = check_plan(
+    let check = check_plan_within(
         path,
         samples,
         plan,
         &constraints,
         limits.curvature.interpolation_period,
+        budget,
     )?;
     if check.holds(CHECK_MARGIN) {
         return Ok(None);
@@ -619,8 +682,9 @@ fn run_joints(
             &prepared.limits,
             machine,
             settings,
+            budget,
         )
-        .map_err(|error| GcodePlanError::Path { line, error })?;
+        .map_err(|error| path_error_at(line, error))?;
         // A replanned feed that breaks a path limit is not used (the last checked one stays).
         let timed = &prepared.timed;
         if plan_violation(
@@ -632,8 +696,9 @@ fn run_joints(
             &plan,
             machine,
             settings,
+            budget,
         )
-        .map_err(|error| GcodePlanError::Path { line, error })?
+        .map_err(|error| path_error_at(line, error))?
         .is_some()
         {
             break;
@@ -840,8 +905,12 @@ fn refine(
     machine: &dyn Machine,
     placed: &mut [Placed],
     bad: &[(usize, f64)],
+    budget: &Budget,
 ) -> Result<(), GcodePlanError> {
-    for (run, t) in bad {
+    for (k, (run, t)) in bad.iter().enumerate() {
+        if k % 64 == 63 {
+            budget.check("executor check (refinement)")?;
+        }
         let p = &mut placed[*run];
         let knots = &mut p.knots.knots;
         let k = knots
@@ -869,11 +938,18 @@ fn refine(
 
 /// The largest peak ratios of every joint over every piece, after the
 /// slowdowns (v/r, a/r², j/r³).
-fn joint_peaks(machine: &dyn Machine, placed: &[Placed]) -> [[f64; 3]; DOF] {
+fn joint_peaks(
+    machine: &dyn Machine,
+    placed: &[Placed],
+    budget: &Budget,
+) -> Result<[[f64; 3]; DOF], GcodePlanError> {
     let mut out = [[0.0f64; 3]; DOF];
     for p in placed {
         let r = p.knots.slowdown;
-        for w in p.knots.knots.windows(2) {
+        for (k, w) in p.knots.knots.windows(2).enumerate() {
+            if k % 256 == 255 {
+                budget.check("joint peaks")?;
+            }
             let peaks = crate::knots::piece_peaks(machine, &w[0], &w[1]);
             for j in 0..DOF {
                 out[j][0] = out[j][0].max(peaks[j][0] / r);
@@ -882,5 +958,5 @@ fn joint_peaks(machine: &dyn Machine, placed: &[Placed]) -> [[f64; 3]; DOF] {
             }
         }
     }
-    out
+    Ok(out)
 }

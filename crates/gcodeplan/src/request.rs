@@ -13,8 +13,15 @@
 //! `tangential_jerk`, `normal_acceleration`, `normal_jerk`, `chord_error`, `contour_error`,
 //! each replacing the machine's default), `rapid_feed`, `origin` (the program's zero in the
 //! machine's base frame), `redundancy_angle` (IRB 6660 only), `standoff_axis` (laser cutter
-//! only), `time_budget`. Unknown fields are refused; every value used is checked.
+//! only), `time_budget`. Unknown fields are refused; every value given is checked, even one
+//! that does not apply to the request's machine ([`GcodeRequest::check_numbers`], ranges in
+//! [`RANGES`]).
+//!
+//! A `program_file` is read as a stream: a regular file of at most [`MAX_PROGRAM_BYTES`]
+//! (a FIFO, device, socket or directory is refused before it is opened:
+//! [`kerf_robot::file::open_regular`]).
 
+use std::io::BufRead;
 use std::path::PathBuf;
 
 use serde::{Deserialize, Serialize};
@@ -106,6 +113,121 @@ pub fn feed_method(name: &str) -> Result<kerf_toolpath::FeedMethod, GcodePlanErr
         }),
     }
 }
+
+/// The largest program file read (bytes): 256 MiB, about 10⁷ lines of dense G01 code (a
+/// program of 10⁶ lines is about 30 MB). A larger file is refused before it is read.
+pub const MAX_PROGRAM_BYTES: u64 = 256 << 20;
+
+/// The range of a request's number: its field (as in requests, with its unit), and the
+/// smallest and largest values accepted.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Range {
+    /// The field, what it is and its unit, e.g. `limits.max_feed (max feed) [m/s]`.
+    pub field: &'static str,
+    /// The smallest value accepted.
+    pub min: f64,
+    /// The largest value accepted.
+    pub max: f64,
+}
+
+impl Range {
+    /// Checks `value`: finite and within \[min, max\] (so never denormal: every `min` of a
+    /// positive quantity is far above 2.2·10⁻³⁰⁸).
+    ///
+    /// # Errors
+    /// [`GcodePlanError::InvalidRequest`] naming the field, the value and the range.
+    pub fn check(&self, value: f64) -> Result<(), GcodePlanError> {
+        if value >= self.min && value <= self.max {
+            return Ok(());
+        }
+        let (min, max) = (self.min, self.max);
+        let reason = if self.min > 0.0 && !(value.is_finite() && value > 0.0) {
+            format!("{value:e} must be finite and > 0, in [{min:e}, {max:e}]")
+        } else if !value.is_finite() {
+            format!("{value:e} must be finite, in [{min:e}, {max:e}]")
+        } else {
+            format!("{value:e} is outside [{min:e}, {max:e}]")
+        };
+        Err(GcodePlanError::InvalidRequest {
+            field: self.field.to_string(),
+            reason,
+        })
+    }
+}
+
+/// δ \[m\]: 0.1 µm to 10 mm.
+pub const TOLERANCE: Range = Range {
+    field: "tolerance [m]",
+    min: 1e-7,
+    max: 1e-2,
+};
+
+/// The ranges of a request's path limits and rapid feed (SI): what a real cell can mean. A
+/// feed of 10⁻³⁰⁰ m/s is not a feed: it would make a trajectory of 10³⁰⁰ s.
+pub const RANGES: [Range; 8] = [
+    Range {
+        field: "limits.max_feed (max feed) [m/s]",
+        min: 1e-5,
+        max: 10.0,
+    },
+    Range {
+        field: "limits.tangential_acceleration (tangential acceleration) [m/s^2]",
+        min: 1e-3,
+        max: 1e3,
+    },
+    Range {
+        field: "limits.tangential_jerk (tangential jerk) [m/s^3]",
+        min: 1e-2,
+        max: 1e5,
+    },
+    Range {
+        field: "limits.normal_acceleration (normal acceleration) [m/s^2]",
+        min: 1e-3,
+        max: 1e3,
+    },
+    Range {
+        field: "limits.normal_jerk (normal jerk) [m/s^3]",
+        min: 1e-2,
+        max: 1e5,
+    },
+    Range {
+        field: "limits.chord_error (chord error) [m]",
+        min: 1e-9,
+        max: 1e-2,
+    },
+    Range {
+        field: "limits.contour_error (contour error) [m]",
+        min: 1e-9,
+        max: 1e-2,
+    },
+    Range {
+        field: "rapid_feed (G0 speed) [m/s]",
+        min: 1e-5,
+        max: 10.0,
+    },
+];
+
+/// The program's zero, each coordinate \[m\]: within 100 m of the base.
+pub const ORIGIN: Range = Range {
+    field: "origin [m]",
+    min: -100.0,
+    max: 100.0,
+};
+
+/// The IRB 6660's redundancy angle g \[rad\]: one turn either way.
+pub const REDUNDANCY_ANGLE: Range = Range {
+    field: "redundancy_angle [rad]",
+    min: -std::f64::consts::TAU,
+    max: std::f64::consts::TAU,
+};
+
+/// The laser cutter's standoff axis q6 \[m\] (its joint limits are checked when the sheet is
+/// placed): within 10 m.
+pub const STANDOFF_AXIS: Range = Range {
+    field: "standoff_axis [m]",
+    min: -10.0,
+    max: 10.0,
+};
 
 /// Path limits that replace the machine's defaults (SI units).
 #[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
@@ -248,18 +370,58 @@ impl GcodeRequest {
     /// The time budget, when the request asks for one.
     ///
     /// # Errors
-    /// [`GcodePlanError::InvalidSetting`] for a budget that is not finite and > 0.
+    /// [`GcodePlanError::InvalidRequest`] naming `time_budget [s]` for a budget that is
+    /// negative, not finite or over a day ([`kerf_budget::limit_from_seconds`]).
     pub fn time_limit(&self) -> Result<Option<std::time::Duration>, GcodePlanError> {
         match self.time_budget {
             None => Ok(None),
             Some(s) => kerf_budget::limit_from_seconds(s).map_err(|reason| {
-                GcodePlanError::InvalidSetting {
-                    name: "time_budget [s]".to_string(),
-                    value: s,
+                GcodePlanError::InvalidRequest {
+                    field: "time_budget [s]".to_string(),
                     reason,
                 }
             }),
         }
+    }
+
+    /// Checks every number the request gives against its range ([`TOLERANCE`], [`RANGES`],
+    /// [`ORIGIN`], [`REDUNDANCY_ANGLE`], [`STANDOFF_AXIS`], the time budget), whether or not
+    /// it applies to the request's machine: NaN, ±inf, denormal and absurd values are refused
+    /// before anything is planned.
+    ///
+    /// # Errors
+    /// [`GcodePlanError::InvalidRequest`] naming the first field out of range.
+    pub fn check_numbers(&self) -> Result<(), GcodePlanError> {
+        if let Some(t) = self.tolerance {
+            TOLERANCE.check(t)?;
+        }
+        let l = self.limits.unwrap_or_default();
+        let given = [
+            l.max_feed,
+            l.tangential_acceleration,
+            l.tangential_jerk,
+            l.normal_acceleration,
+            l.normal_jerk,
+            l.chord_error,
+            l.contour_error,
+            self.rapid_feed,
+        ];
+        for (range, value) in RANGES.iter().zip(given) {
+            if let Some(v) = value {
+                range.check(v)?;
+            }
+        }
+        for v in self.origin.iter().flatten() {
+            ORIGIN.check(*v)?;
+        }
+        if let Some(g) = self.redundancy_angle {
+            REDUNDANCY_ANGLE.check(g)?;
+        }
+        if let Some(q6) = self.standoff_axis {
+            STANDOFF_AXIS.check(q6)?;
+        }
+        self.time_limit()?;
+        Ok(())
     }
 
     /// The settings to plan with: the machine's defaults with the request's values, checked.
@@ -268,6 +430,7 @@ impl GcodeRequest {
     /// [`GcodePlanError::InvalidSetting`] naming the first bad field, an unknown method, or a
     /// field of the other machine.
     pub fn settings(&self) -> Result<PlanSettings, GcodePlanError> {
+        self.check_numbers()?;
         let kind = self.machine_kind()?;
         let mut s = kind.default_settings();
         if let Some(t) = self.tolerance {
@@ -454,16 +617,55 @@ pub fn plan_request_within(
             crate::plan_program(text.as_bytes(), machine.as_ref(), &settings, budget)
         }
         ProgramSource::File(path) => {
-            let file = std::fs::File::open(&path).map_err(|e| GcodePlanError::InvalidRequest {
-                field: format!("program_file {}", path.display()),
-                reason: e.to_string(),
-            })?;
-            crate::plan_program(
-                std::io::BufReader::new(file),
-                machine.as_ref(),
-                &settings,
-                budget,
-            )
+            crate::plan_program(open_program(&path)?, machine.as_ref(), &settings, budget)
         }
     }
+}
+
+/// Opens a program file as a stream: a regular file of at most [`MAX_PROGRAM_BYTES`], refused
+/// before it is opened when it is a FIFO, a device, a socket or a directory (opening a FIFO
+/// would block), and failing while it is read if it grows past the cap
+/// ([`kerf_robot::file::open_regular`]).
+///
+/// # Errors
+/// [`GcodePlanError::InvalidRequest`] naming `program_file` and the path.
+pub fn open_program(path: &std::path::Path) -> Result<impl BufRead, GcodePlanError> {
+    kerf_robot::file::open_regular(path, MAX_PROGRAM_BYTES).map_err(|reason| {
+        GcodePlanError::InvalidRequest {
+            field: format!("program_file {}", path.display()),
+            reason: format!(
+                "{reason} (programs are read from regular files of at most {} bytes)",
+                MAX_PROGRAM_BYTES
+            ),
+        }
+    })
+}
+
+/// [`plan_request_within`] with the program read from `program` (standard input, a stream
+/// the caller capped) instead of the request's own: the request must give neither `program`
+/// nor `program_file`.
+///
+/// # Errors
+/// As [`plan_request_within`]; [`GcodePlanError::InvalidRequest`] naming `program` when the
+/// request gives one.
+pub fn plan_request_reading<R: BufRead>(
+    request: &GcodeRequest,
+    base: &MachineBase,
+    budget: &kerf_budget::Budget,
+    max_points: Option<usize>,
+    program: R,
+) -> Result<crate::GcodePlan, GcodePlanError> {
+    if request.program.is_some() || request.program_file.is_some() {
+        return Err(GcodePlanError::InvalidRequest {
+            field: "program".to_string(),
+            reason: "the program is read from the stream given; the request must not name one"
+                .to_string(),
+        });
+    }
+    let mut settings = request.settings()?;
+    if let Some(m) = max_points {
+        settings.max_points = settings.max_points.min(m);
+    }
+    let machine = base.place(request)?;
+    crate::plan_program(program, machine.as_ref(), &settings, budget)
 }

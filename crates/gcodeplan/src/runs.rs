@@ -13,10 +13,12 @@
 
 use std::io::BufRead;
 
+use kerf_budget::{bytes_of, Budget};
 use kerf_gcode::{ArcMove, Motion, PathControl, Program};
 use kerf_toolpath::corner::REVERSAL_MARGIN;
 
 use crate::error::GcodePlanError;
+use crate::memory::Held;
 use crate::settings::PlanSettings;
 
 /// What a run does.
@@ -115,7 +117,48 @@ pub fn read_steps<R: BufRead>(
     source: R,
     settings: &PlanSettings,
 ) -> Result<Reading, GcodePlanError> {
+    read_steps_within(source, settings, &Budget::unlimited())
+}
+
+/// Bytes one point of a run holds: its position, source line and feed.
+pub const BYTES_PER_POINT: u64 = 24 + 8 + 8;
+
+/// Bytes of points read between two accountings of the reading.
+const ACCOUNT_EVERY: u64 = 1 << 20;
+
+/// [`read_steps`] under a budget: the deadline checked at every motion and every few thousand
+/// chords of an arc, an arc's chords estimated before they are made (a helix of 10⁴ turns
+/// within a tolerance of 10 µm is refused by the estimate when it does not fit), and the runs'
+/// points accounted as they are read (given back when this returns).
+///
+/// # Errors
+/// As [`read_steps`]; [`GcodePlanError::Interrupted`] when the budget runs out.
+pub fn read_steps_within<R: BufRead>(
+    source: R,
+    settings: &PlanSettings,
+    budget: &Budget,
+) -> Result<Reading, GcodePlanError> {
+    let mut held = Held::new(budget);
+    read_into(source, settings, &mut held)
+}
+
+/// [`read_steps_within`], the points accounted on `held` (kept by the caller).
+pub(crate) fn read_into<R: BufRead>(
+    source: R,
+    settings: &PlanSettings,
+    held: &mut Held<'_>,
+) -> Result<Reading, GcodePlanError> {
     settings.validate()?;
+    let budget = held.budget();
+    let mut pending: u64 = 0;
+    // The deadline is checked at every line the reader takes (comments and blank lines make
+    // no motion), the interruption kept to be told from a read error.
+    let stopped = std::cell::RefCell::new(None);
+    let source = Checked {
+        inner: source,
+        budget,
+        stopped: &stopped,
+    };
     let mut program = Program::new(source, settings.reader)?;
     let mut reading = Reading {
         start: settings.reader.start,
@@ -123,7 +166,11 @@ pub fn read_steps<R: BufRead>(
     };
     let mut open: Option<Open> = None;
     while let Some(motion) = program.next() {
-        let motion = motion?;
+        budget.check("reading the program")?;
+        let motion = motion.map_err(|e| match stopped.borrow_mut().take() {
+            Some(interrupt) => GcodePlanError::Interrupted(interrupt),
+            None => GcodePlanError::Program(e),
+        })?;
         if program.lines_read() > settings.max_lines {
             return Err(GcodePlanError::InvalidRequest {
                 field: "program".to_string(),
@@ -159,24 +206,24 @@ pub fn read_steps<R: BufRead>(
                 line,
             } => (kind_of(tool_on), feed, arc.start, arc.end, line),
             Motion::Dwell { seconds, line } => {
-                close(&mut open, &mut reading, settings)?;
+                close(&mut open, &mut reading, settings, budget)?;
                 reading.steps.push(Step::Dwell { seconds, line });
                 continue;
             }
             Motion::Tool { on, line, .. } => {
-                close(&mut open, &mut reading, settings)?;
+                close(&mut open, &mut reading, settings, budget)?;
                 reading.steps.push(Step::Tool { on, line });
                 continue;
             }
             Motion::End { .. } => {
-                close(&mut open, &mut reading, settings)?;
+                close(&mut open, &mut reading, settings, budget)?;
                 break;
             }
         };
         let points = match motion {
             Motion::Arc { arc, .. } => {
                 reading.arcs += 1;
-                chords(&arc, settings, line)?
+                chords(&arc, settings, line, held, pending)?
             }
             _ if start == end => Vec::new(),
             _ => vec![end],
@@ -193,7 +240,7 @@ pub fn read_steps<R: BufRead>(
                 && !exact
         });
         if !continues {
-            close(&mut open, &mut reading, settings)?;
+            close(&mut open, &mut reading, settings, budget)?;
             open = Some(Open {
                 run: Run {
                     kind,
@@ -205,14 +252,65 @@ pub fn read_steps<R: BufRead>(
                 exact,
             });
         }
+        pending += BYTES_PER_POINT * points.len() as u64;
         for p in points {
-            push_point(&mut open, &mut reading, settings, p, line, feed)?;
+            push_point(&mut open, &mut reading, settings, p, line, feed, budget)?;
+        }
+        if pending >= ACCOUNT_EVERY {
+            let points = pending / BYTES_PER_POINT;
+            held.add(pending, || {
+                format!(
+                    "program runs: {} lines read, {points} more points",
+                    program.lines_read()
+                )
+            })?;
+            pending = 0;
         }
     }
-    close(&mut open, &mut reading, settings)?;
+    held.add(pending, || {
+        format!(
+            "program runs: {} lines read, {} more points",
+            program.lines_read(),
+            pending / BYTES_PER_POINT
+        )
+    })?;
+    close(&mut open, &mut reading, settings, budget)?;
     reading.lines = program.lines_read();
     reading.skipped_blocks = program.skipped_blocks();
     Ok(reading)
+}
+
+/// A program source whose every `fill_buf` (each line the reader takes) checks the deadline:
+/// a program of 10⁷ comment lines is stopped like one of motions.
+struct Checked<'a, R> {
+    inner: R,
+    budget: &'a Budget,
+    stopped: &'a std::cell::RefCell<Option<kerf_budget::Interrupt>>,
+}
+
+impl<R: BufRead> std::io::Read for Checked<'_, R> {
+    fn read(&mut self, buf: &mut [u8]) -> std::io::Result<usize> {
+        let available = self.fill_buf()?;
+        let n = available.len().min(buf.len());
+        buf[..n].copy_from_slice(&available[..n]);
+        self.consume(n);
+        Ok(n)
+    }
+}
+
+impl<R: BufRead> BufRead for Checked<'_, R> {
+    fn fill_buf(&mut self) -> std::io::Result<&[u8]> {
+        if let Err(interrupt) = self.budget.check("reading the program") {
+            let message = interrupt.to_string();
+            *self.stopped.borrow_mut() = Some(interrupt);
+            return Err(std::io::Error::other(message));
+        }
+        self.inner.fill_buf()
+    }
+
+    fn consume(&mut self, amt: usize) {
+        self.inner.consume(amt);
+    }
 }
 
 fn kind_of(tool_on: bool) -> RunKind {
@@ -232,6 +330,7 @@ fn push_point(
     p: [f64; 3],
     line: usize,
     feed: f64,
+    budget: &Budget,
 ) -> Result<(), GcodePlanError> {
     let Some(o) = open.as_mut() else {
         return Ok(());
@@ -249,7 +348,7 @@ fn push_point(
             ..o.run.clone()
         };
         let exact = o.exact;
-        close(open, reading, settings)?;
+        close(open, reading, settings, budget)?;
         *open = Some(Open { run, exact });
     }
     if let Some(o) = open.as_mut() {
@@ -279,6 +378,7 @@ fn close(
     open: &mut Option<Open>,
     reading: &mut Reading,
     settings: &PlanSettings,
+    budget: &Budget,
 ) -> Result<(), GcodePlanError> {
     let Some(o) = open.take() else {
         return Ok(());
@@ -289,12 +389,8 @@ fn close(
     }
     let merge = 0.5 * settings.approximation_tolerance();
     if merge > 0.0 && run.points.len() > 2 {
-        let kept = kerf_toolpath::merge_collinear_indices(&run.points, merge).map_err(|error| {
-            GcodePlanError::Path {
-                line: run.lines[0],
-                error,
-            }
-        })?;
+        let kept = kerf_toolpath::merge_collinear_indices_within(&run.points, merge, budget)
+            .map_err(|error| crate::error::path(run.lines[0], error))?;
         if kept.len() < run.points.len() {
             // A merged segment from kept point a to b replaces segments a..b: the lowest
             // of their feeds.
@@ -325,6 +421,8 @@ fn chords(
     arc: &ArcMove,
     settings: &PlanSettings,
     line: usize,
+    held: &Held<'_>,
+    pending: u64,
 ) -> Result<Vec<[f64; 3]>, GcodePlanError> {
     let sagitta = 0.5 * settings.approximation_tolerance();
     if sagitta <= 0.0 {
@@ -354,8 +452,27 @@ fn chords(
         });
     }
     let n = chords as usize;
+    // The chords and the run's points they become, on top of the points read since the last
+    // accounting.
+    held.check(
+        pending.saturating_add(
+            bytes_of::<[f64; 3]>(n as u64).saturating_add(BYTES_PER_POINT * n as u64),
+        ),
+        || {
+            let turns = arc.extra_turns + 1;
+            format!(
+                "program runs up to line {line}, the arc there: {turns} turns × {:.0} chords per \
+                 turn within {sagitta:.1e} m (radius {:.3e} m), {n} chords",
+                (std::f64::consts::TAU / step).ceil(),
+                arc.radius
+            )
+        },
+    )?;
     let mut out = Vec::with_capacity(n);
     for k in 1..=n {
+        if k % 4096 == 0 {
+            held.budget().check("arc chords")?;
+        }
         out.push(if k == n {
             arc.end
         } else {

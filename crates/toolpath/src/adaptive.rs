@@ -2,6 +2,8 @@
 //! steps bounded in arc length and turning, and a sample at every feature of
 //! a corner's curvature, so that the curvature is monotone between samples.
 
+use kerf_budget::{bytes_of, Budget, Interrupt};
+
 use crate::corner_curve::CornerCurve;
 use crate::error::ToolpathError;
 use crate::maximum::golden_argmax;
@@ -94,6 +96,21 @@ pub fn sample_path_adaptive(
     max_step: f64,
     max_turn: f64,
 ) -> Result<Vec<PathSample>, ToolpathError> {
+    sample_path_adaptive_within(path, max_step, max_turn, &Budget::unlimited())
+}
+
+/// [`sample_path_adaptive`] under a budget: the samples' memory is estimated before any is
+/// made (per corner L/`max_step` + θ/`max_turn` + [`MIN_CORNER_STEPS`] + its features, about
+/// 2 per scan span), the deadline checked at every step of the march.
+///
+/// # Errors
+/// As [`sample_path_adaptive`]; [`ToolpathError::Interrupted`] when the budget runs out.
+pub fn sample_path_adaptive_within(
+    path: &SmoothedPath,
+    max_step: f64,
+    max_turn: f64,
+    budget: &Budget,
+) -> Result<Vec<PathSample>, ToolpathError> {
     if !(max_step.is_finite() && max_step > 0.0) {
         return Err(ToolpathError::InvalidParameter {
             name: "max_step".to_string(),
@@ -108,6 +125,27 @@ pub fn sample_path_adaptive(
             reason: "must be in (0, pi/2] rad".to_string(),
         });
     }
+    let mut estimate: f64 = 1.0;
+    for piece in &path.pieces {
+        budget.check("adaptive path sampling")?;
+        estimate += match piece {
+            Piece::Line { .. } => 1.0,
+            Piece::Corner(c) => {
+                (c.curve.length(8) / max_step).ceil()
+                    + (c.turn.abs() / max_turn).ceil()
+                    + (MIN_CORNER_STEPS + 2 * FEATURE_SCAN) as f64
+            }
+        };
+    }
+    let count = estimate.min(u64::MAX as f64) as u64;
+    budget.check_memory(
+        bytes_of::<PathSample>(count),
+        &format!(
+            "adaptive path samples: {} pieces at steps of {max_step:.3e} m and {max_turn:.3e} \
+             rad, about {count} samples",
+            path.pieces.len()
+        ),
+    )?;
     let mut out: Vec<PathSample> = Vec::new();
     let mut s0 = 0.0;
     for (index, piece) in path.pieces.iter().enumerate() {
@@ -142,7 +180,7 @@ pub fn sample_path_adaptive(
                 // of the previous piece stays in its place below.
                 let first = corner_sample(curve, index, 0.0, s0);
                 let step = max_step.min(curve.length(8) / MIN_CORNER_STEPS as f64);
-                let local = march(curve, index, first, step, max_turn);
+                let local = march(curve, index, first, step, max_turn, budget)?;
                 match out.last_mut() {
                     Some(last) => {
                         last.monotone = true;
@@ -275,7 +313,8 @@ fn march(
     first: PathSample,
     max_step: f64,
     max_turn: f64,
-) -> Vec<PathSample> {
+    budget: &Budget,
+) -> Result<Vec<PathSample>, Interrupt> {
     let cos_turn = max_turn.cos();
     let mut breaks = features(curve);
     breaks.push(1.0);
@@ -283,6 +322,7 @@ fn march(
     let mut here = first;
     let mut next_break = 0usize;
     while here.u < 1.0 {
+        budget.check("adaptive path sampling")?;
         while breaks[next_break] <= here.u {
             next_break += 1;
         }
@@ -341,7 +381,7 @@ fn march(
         local.push(next);
         here = next;
     }
-    local
+    Ok(local)
 }
 
 /// How a smoothed path is sampled for feed planning.
@@ -384,6 +424,19 @@ impl Sampling {
     /// # Errors
     /// `InvalidParameter` for a bound out of range.
     pub fn sample(&self, path: &SmoothedPath) -> Result<Vec<PathSample>, ToolpathError> {
+        self.sample_within(path, &Budget::unlimited())
+    }
+
+    /// [`Self::sample`] under a budget ([`crate::samples::sample_path_within`],
+    /// [`sample_path_adaptive_within`]).
+    ///
+    /// # Errors
+    /// As [`Self::sample`]; [`ToolpathError::Interrupted`] when the budget runs out.
+    pub fn sample_within(
+        &self,
+        path: &SmoothedPath,
+        budget: &Budget,
+    ) -> Result<Vec<PathSample>, ToolpathError> {
         match *self {
             Sampling::Fixed { step } => {
                 if !(step.is_finite() && step > 0.0) {
@@ -393,10 +446,10 @@ impl Sampling {
                         reason: "must be finite and > 0".to_string(),
                     });
                 }
-                Ok(crate::samples::sample_path(path, step))
+                Ok(crate::samples::sample_path_within(path, step, budget)?)
             }
             Sampling::Adaptive { max_step, max_turn } => {
-                sample_path_adaptive(path, max_step, max_turn)
+                sample_path_adaptive_within(path, max_step, max_turn, budget)
             }
         }
     }

@@ -24,6 +24,9 @@ pub enum ToolpathError {
         /// What is wrong.
         reason: String,
     },
+    /// The time or memory budget ran out, or the work was cancelled (the `_within` variants).
+    #[error("{0}")]
+    Interrupted(#[from] kerf_budget::Interrupt),
 }
 
 /// Checks that each named value is finite and > 0.

@@ -19,6 +19,8 @@
 //! evaluates it at the interpolation period, where its limits are checked
 //! (`tests/feed.rs`).
 
+use kerf_budget::{bytes_of, Budget, Interrupt};
+
 use crate::error::{check_positive, ToolpathError};
 use crate::samples::{check_samples, PathSample};
 use crate::scurve::{reachable, scurve_distance, scurve_phases, Phase};
@@ -137,10 +139,48 @@ pub struct FeedPlan {
 impl FeedPlan {
     /// The plan at every multiple of `period` and at its end.
     pub fn sample(&self, period: f64) -> Vec<FeedSample> {
-        let mut out = Vec::new();
+        // Only the budget interrupts, and an unlimited one never does.
+        self.sample_within(period, &Budget::unlimited())
+            .unwrap_or_default()
+    }
+
+    /// The number of points of [`Self::sample`] at `period`: ⌊T / period⌋ + 2 at most
+    /// (saturating; a plan of 10³⁰⁰ s gives `u64::MAX`).
+    pub fn sample_count(&self, period: f64) -> u64 {
+        let count = (self.time / period).floor() + 2.0;
+        if count.is_finite() && count < u64::MAX as f64 {
+            count as u64
+        } else {
+            u64::MAX
+        }
+    }
+
+    /// [`Self::sample`] under a budget: the points' memory is checked before any is made (a
+    /// plan of 10³⁰⁰ s at a 4 ms period is refused by the estimate), the deadline every few
+    /// thousand points.
+    ///
+    /// # Errors
+    /// [`Interrupt`] when the budget runs out.
+    pub fn sample_within(
+        &self,
+        period: f64,
+        budget: &Budget,
+    ) -> Result<Vec<FeedSample>, Interrupt> {
+        let count = self.sample_count(period);
+        budget.check_memory(
+            bytes_of::<FeedSample>(count),
+            &format!(
+                "feed plan at the interpolation period: {:.3e} s / {period} s = {count} points",
+                self.time
+            ),
+        )?;
+        let mut out = Vec::with_capacity(usize::try_from(count.min(1 << 20)).unwrap_or(0));
         let mut k = 0usize;
         let mut p = 0usize;
         loop {
+            if k % 4096 == 4095 {
+                budget.check("feed plan sampling")?;
+            }
             let t = (k as f64 * period).min(self.time);
             while p + 1 < self.phases.len() && self.phases[p + 1].t0 <= t {
                 p += 1;
@@ -159,7 +199,7 @@ impl FeedPlan {
             }
             k += 1;
         }
-        out
+        Ok(out)
     }
 }
 
@@ -169,6 +209,19 @@ impl FeedPlan {
 /// [`ToolpathError::InvalidParameter`] for bad limits, fewer than two
 /// samples, or an arc length that does not increase.
 pub fn plan_feed(samples: &[PathSample], limits: &FeedLimits) -> Result<FeedPlan, ToolpathError> {
+    plan_feed_within(samples, limits, &Budget::unlimited())
+}
+
+/// [`plan_feed`] under a budget, checked at every pass of the bidirectional scan and every
+/// few thousand samples or intervals.
+///
+/// # Errors
+/// As [`plan_feed`]; [`ToolpathError::Interrupted`] when the budget runs out.
+pub fn plan_feed_within(
+    samples: &[PathSample],
+    limits: &FeedLimits,
+    budget: &Budget,
+) -> Result<FeedPlan, ToolpathError> {
     limits.validate()?;
     check_samples(samples)?;
     let f = limits.curvature.feed;
@@ -177,6 +230,9 @@ pub fn plan_feed(samples: &[PathSample], limits: &FeedLimits) -> Result<FeedPlan
     let mut intervals: Vec<(f64, f64, f64)> = Vec::new();
     let mut open: Option<(f64, f64)> = None;
     for (k, p) in samples.iter().enumerate() {
+        if k % 4096 == 4095 {
+            budget.check("feed planning")?;
+        }
         let v = limits.curvature.speed(p.curvature);
         if v < f {
             open = Some(match open {
@@ -198,6 +254,7 @@ pub fn plan_feed(samples: &[PathSample], limits: &FeedLimits) -> Result<FeedPlan
         (to - from).max(0.0)
     };
     loop {
+        budget.check("feed planning (bidirectional scan)")?;
         let mut changed = false;
         // Forward: the speed at the end of gap k reachable from its start.
         for k in 0..intervals.len() {
@@ -235,6 +292,9 @@ pub fn plan_feed(samples: &[PathSample], limits: &FeedLimits) -> Result<FeedPlan
     // Step 2: the phases.
     let mut phases: Vec<Phase> = Vec::new();
     for k in 0..=intervals.len() {
+        if k % 1024 == 1023 {
+            budget.check("feed planning")?;
+        }
         let v0 = if k == 0 { 0.0 } else { intervals[k - 1].2 };
         let v1 = if k == intervals.len() {
             0.0

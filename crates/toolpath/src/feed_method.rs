@@ -2,9 +2,11 @@
 //! intervals of seed 003's planner ([`crate::plan_feed`]) or kerf's near
 //! time-optimal one ([`crate::plan_feed_optimal`]), behind one call.
 
+use kerf_budget::Budget;
+
 use crate::constraints::FeedConstraints;
-use crate::feed::{plan_feed, FeedPlan};
-use crate::feed_optimal::plan_feed_optimal;
+use crate::feed::{plan_feed_within, FeedPlan};
+use crate::feed_optimal::plan_feed_optimal_within;
 use crate::samples::PathSample;
 use crate::ToolpathError;
 
@@ -12,10 +14,10 @@ use crate::ToolpathError;
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub enum FeedMethod {
     /// Seed 003's planner (its reference 19, Jia et al. 2017): every
-    /// feed-sensitive interval at its lowest limit ([`plan_feed`]). Knows
+    /// feed-sensitive interval at its lowest limit ([`crate::plan_feed`]). Knows
     /// neither per-sample feeds nor axis limits.
     ConstantIntervals,
-    /// The near time-optimal planner ([`plan_feed_optimal`]).
+    /// The near time-optimal planner ([`crate::plan_feed_optimal`]).
     NearOptimal,
 }
 
@@ -42,6 +44,19 @@ impl FeedMethod {
         samples: &[PathSample],
         constraints: &FeedConstraints<'_>,
     ) -> Result<FeedPlan, ToolpathError> {
+        self.plan_within(samples, constraints, &Budget::unlimited())
+    }
+
+    /// [`Self::plan`] under a budget ([`plan_feed_within`], [`plan_feed_optimal_within`]).
+    ///
+    /// # Errors
+    /// As [`Self::plan`]; [`ToolpathError::Interrupted`] when the budget runs out.
+    pub fn plan_within(
+        self,
+        samples: &[PathSample],
+        constraints: &FeedConstraints<'_>,
+        budget: &Budget,
+    ) -> Result<FeedPlan, ToolpathError> {
         match self {
             FeedMethod::ConstantIntervals => {
                 if constraints.caps.is_some() || constraints.axes.is_some() {
@@ -53,9 +68,9 @@ impl FeedMethod {
                             .to_string(),
                     });
                 }
-                plan_feed(samples, &constraints.limits)
+                plan_feed_within(samples, &constraints.limits, budget)
             }
-            FeedMethod::NearOptimal => plan_feed_optimal(samples, constraints),
+            FeedMethod::NearOptimal => plan_feed_optimal_within(samples, constraints, budget),
         }
     }
 }

@@ -53,6 +53,8 @@
 //! bang-bang one (e.g. 0.161 s instead of 0.135 s over 6.8 mm from 27 to
 //! 24 mm/s with A_t 0.8 m/s², J_t 20 m/s³).
 
+use kerf_budget::{bytes_of, Budget, Interrupt};
+
 use crate::constraints::FeedConstraints;
 use crate::feed::{place_phases, FeedPlan, PlacedPhase};
 use crate::limit_curve::{limit_curve, LimitCurve};
@@ -91,25 +93,50 @@ pub fn plan_feed_optimal(
     samples: &[PathSample],
     constraints: &FeedConstraints<'_>,
 ) -> Result<FeedPlan, ToolpathError> {
+    plan_feed_optimal_within(samples, constraints, &Budget::unlimited())
+}
+
+/// Bytes of the limit curve and the knots per sample, at most (three nodes per sample, each
+/// with its arc length, limit and interval limit, and a knot).
+const BYTES_PER_SAMPLE: u64 = 3 * 4 * 8 + 48;
+
+/// [`plan_feed_optimal`] under a budget: the limit curve's memory is checked before it is
+/// built, the deadline at every round, every pass of the scan and every few hundred gaps.
+///
+/// # Errors
+/// As [`plan_feed_optimal`]; [`ToolpathError::Interrupted`] when the budget runs out.
+pub fn plan_feed_optimal_within(
+    samples: &[PathSample],
+    constraints: &FeedConstraints<'_>,
+    budget: &Budget,
+) -> Result<FeedPlan, ToolpathError> {
     constraints.validate(samples)?;
+    budget.check_memory(
+        bytes_of::<u8>(samples.len() as u64).saturating_mul(BYTES_PER_SAMPLE),
+        &format!("feed plan: limit curve of {} samples", samples.len()),
+    )?;
     let curve = limit_curve(samples, constraints);
     let (a, j) = constraints.tangential();
     let mut knots = critical_points(&curve);
-    let budget = 4 * curve.s.len() + 100;
+    let most_rounds = 4 * curve.s.len() + 100;
     let mut rounds = 0usize;
     loop {
         rounds += 1;
-        if rounds > budget {
+        if rounds > most_rounds {
             return Err(ToolpathError::InvalidParameter {
                 name: "feed plan rounds".to_string(),
                 value: rounds as f64,
                 reason: "the check under the limit curve did not settle".to_string(),
             });
         }
-        settle(&mut knots, &curve, a, j);
+        budget.check("feed planning")?;
+        settle(&mut knots, &curve, a, j, budget)?;
         let mut changed = false;
         let mut inserts: Vec<(usize, Knot)> = Vec::new();
         for k in 0..knots.len() - 1 {
+            if k % 256 == 255 {
+                budget.check("feed planning (check under the limit curve)")?;
+            }
             let (p, q) = (knots[k], knots[k + 1]);
             if p.passed == Some((p.v, q.v, p.cap)) {
                 continue;
@@ -218,13 +245,19 @@ fn largest_limit(curve: &LimitCurve, a: usize, b: usize) -> f64 {
 /// knots it lowered (not binding: the speed passes below the limit there
 /// without stopping to rise or fall) removed, until none is; a removed
 /// knot comes back, for good, if its gap then exceeds the limit there.
-fn settle(knots: &mut Vec<Knot>, curve: &LimitCurve, a: f64, j: f64) {
+fn settle(
+    knots: &mut Vec<Knot>,
+    curve: &LimitCurve,
+    a: f64,
+    j: f64,
+    budget: &Budget,
+) -> Result<(), Interrupt> {
     loop {
         let last = knots.len() - 1;
         for knot in &mut knots[1..last] {
             knot.v = curve.node[knot.node];
         }
-        scan(knots, curve, a, j);
+        scan(knots, curve, a, j, budget)?;
         let before = knots.len();
         let mut kept: Vec<Knot> = Vec::with_capacity(before);
         for (i, k) in knots.iter().enumerate() {
@@ -237,7 +270,7 @@ fn settle(knots: &mut Vec<Knot>, curve: &LimitCurve, a: f64, j: f64) {
             kept.push(*k);
         }
         if kept.len() == before {
-            return;
+            return Ok(());
         }
         for g in 0..kept.len() - 1 {
             if kept[g].cap.is_nan() {
@@ -250,8 +283,15 @@ fn settle(knots: &mut Vec<Knot>, curve: &LimitCurve, a: f64, j: f64) {
 }
 
 /// Step 2: the bidirectional scan of the knot speeds.
-fn scan(knots: &mut [Knot], curve: &LimitCurve, a: f64, j: f64) {
+fn scan(
+    knots: &mut [Knot],
+    curve: &LimitCurve,
+    a: f64,
+    j: f64,
+    budget: &Budget,
+) -> Result<(), Interrupt> {
     loop {
+        budget.check("feed planning (bidirectional scan)")?;
         let mut changed = false;
         for k in 0..knots.len() - 1 {
             let d = curve.s[knots[k + 1].node] - curve.s[knots[k].node];
@@ -274,7 +314,7 @@ fn scan(knots: &mut [Knot], curve: &LimitCurve, a: f64, j: f64) {
             }
         }
         if !changed {
-            break;
+            return Ok(());
         }
     }
 }

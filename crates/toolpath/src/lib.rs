@@ -37,7 +37,7 @@ pub mod speed_limit;
 pub mod spline;
 pub mod vec3;
 
-pub use adaptive::{sample_path_adaptive, Sampling};
+pub use adaptive::{sample_path_adaptive, sample_path_adaptive_within, Sampling};
 pub use axis::AxisLimits;
 pub use baseline::{CornerMethod, NurbsSettings};
 pub use bezier::QuinticBezier;
@@ -48,17 +48,19 @@ pub use corner::{
 };
 pub use corner_curve::CornerCurve;
 pub use error::ToolpathError;
-pub use feed::{plan_feed, FeedLimits, FeedPlan, FeedSample};
+pub use feed::{plan_feed, plan_feed_within, FeedLimits, FeedPlan, FeedSample};
 pub use feed_method::FeedMethod;
-pub use feed_optimal::plan_feed_optimal;
+pub use feed_optimal::{plan_feed_optimal, plan_feed_optimal_within};
 pub use limit_curve::{limit_curve, LimitCurve};
-pub use lower_bound::{bang_bang, bang_bang_under, BangBang, BangBangLimits};
-pub use merge::{merge_collinear, merge_collinear_indices};
-pub use metrics::{metrics, Metrics};
-pub use plan_check::{check_plan, PlanCheck, Worst};
-pub use samples::{derivatives_at, point_at, sample_path, PathSample};
-pub use smooth::smooth_polyline_with;
+pub use lower_bound::{
+    bang_bang, bang_bang_under, bang_bang_under_within, BangBang, BangBangLimits,
+};
+pub use merge::{merge_collinear, merge_collinear_indices, merge_collinear_indices_within};
+pub use metrics::{metrics, metrics_within, Metrics};
+pub use plan_check::{check_plan, check_plan_within, PlanCheck, Worst};
+pub use samples::{derivatives_at, point_at, sample_path, sample_path_within, PathSample};
 pub use smooth::{smooth_polyline, Piece, SmoothedPath};
+pub use smooth::{smooth_polyline_with, smooth_polyline_within};
 pub use speed_limit::{CurvatureLimits, Servo};
 pub use spline::CubicSpline;
 pub mod plot;

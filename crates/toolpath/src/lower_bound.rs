@@ -18,6 +18,8 @@
 //! only. Within a curved interval the limit between the samples is taken as
 //! the larger of the two: the bound converges as the samples get closer.
 
+use kerf_budget::{bytes_of, Budget};
+
 use crate::error::{check_positive, ToolpathError};
 use crate::samples::{check_samples, PathSample};
 
@@ -95,7 +97,12 @@ pub fn bang_bang(
             })
         })
         .collect::<Result<_, _>>()?;
-    bang_bang_on(samples, limit, limits.tangential_acceleration)
+    bang_bang_on(
+        samples,
+        limit,
+        limits.tangential_acceleration,
+        &Budget::unlimited(),
+    )
 }
 
 /// The bang-bang bound under a given velocity-limit curve (one speed per
@@ -111,6 +118,30 @@ pub fn bang_bang_under(
     limit: Vec<f64>,
     tangential_acceleration: f64,
 ) -> Result<BangBang, ToolpathError> {
+    bang_bang_under_within(
+        samples,
+        limit,
+        tangential_acceleration,
+        &Budget::unlimited(),
+    )
+}
+
+/// [`bang_bang_under`] under a budget: the speeds' memory is checked before they are made,
+/// the deadline before each of the three linear passes.
+///
+/// # Errors
+/// As [`bang_bang_under`]; [`ToolpathError::Interrupted`] when the budget runs out.
+pub fn bang_bang_under_within(
+    samples: &[PathSample],
+    limit: Vec<f64>,
+    tangential_acceleration: f64,
+    budget: &Budget,
+) -> Result<BangBang, ToolpathError> {
+    budget.check("lower bound T_lb")?;
+    budget.check_memory(
+        bytes_of::<f64>(samples.len() as u64),
+        &format!("lower bound T_lb: speeds at {} samples", samples.len()),
+    )?;
     check_samples(samples)?;
     check_positive(&[("tangential acceleration [m/s^2]", tangential_acceleration)])?;
     if limit.len() != samples.len() {
@@ -127,7 +158,7 @@ pub fn bang_bang_under(
             reason: "must be finite and > 0".to_string(),
         });
     }
-    bang_bang_on(samples, limit, tangential_acceleration)
+    bang_bang_on(samples, limit, tangential_acceleration, budget)
 }
 
 /// The passes of the module documentation on checked input.
@@ -135,19 +166,23 @@ fn bang_bang_on(
     samples: &[PathSample],
     limit: Vec<f64>,
     a: f64,
+    budget: &Budget,
 ) -> Result<BangBang, ToolpathError> {
     let n = samples.len();
     let mut speed = limit.clone();
     speed[0] = 0.0;
+    budget.check("lower bound T_lb")?;
     for i in 0..n - 1 {
         let ds = samples[i + 1].s - samples[i].s;
         speed[i + 1] = speed[i + 1].min((speed[i] * speed[i] + 2.0 * a * ds).sqrt());
     }
     speed[n - 1] = 0.0;
+    budget.check("lower bound T_lb")?;
     for i in (0..n - 1).rev() {
         let ds = samples[i + 1].s - samples[i].s;
         speed[i] = speed[i].min((speed[i + 1] * speed[i + 1] + 2.0 * a * ds).sqrt());
     }
+    budget.check("lower bound T_lb")?;
     let time = samples
         .windows(2)
         .zip(speed.windows(2))

@@ -12,6 +12,8 @@
 //! then keeps the path within δ_m + δ_c of the original (triangle
 //! inequality).
 
+use kerf_budget::Budget;
+
 use crate::error::{check_positive, ToolpathError};
 use crate::vec3::{dot, norm, scale, sub};
 
@@ -52,6 +54,19 @@ pub fn merge_collinear_indices(
     points: &[[f64; 3]],
     tolerance: f64,
 ) -> Result<Vec<usize>, ToolpathError> {
+    merge_collinear_indices_within(points, tolerance, &Budget::unlimited())
+}
+
+/// [`merge_collinear_indices`] under a budget, checked at every kept point (each costs at most
+/// [`MERGE_WINDOW`]² / 2 distance checks, about 30 µs).
+///
+/// # Errors
+/// As [`merge_collinear`]; [`ToolpathError::Interrupted`] when the budget runs out.
+pub fn merge_collinear_indices_within(
+    points: &[[f64; 3]],
+    tolerance: f64,
+    budget: &Budget,
+) -> Result<Vec<usize>, ToolpathError> {
     check_positive(&[("merge tolerance [m]", tolerance)])?;
     if points.len() < 2 {
         return Err(ToolpathError::InvalidParameter {
@@ -70,6 +85,7 @@ pub fn merge_collinear_indices(
     let mut kept = vec![0];
     let mut i = 0;
     while i < n - 1 {
+        budget.check("merging collinear segments")?;
         let mut best = i + 1;
         let last = (i + MERGE_WINDOW).min(n - 1);
         for j in i + 2..=last {

@@ -23,7 +23,9 @@
 //! (j_rms several times its true value when the period's step is shorter
 //! than the sample spacing).
 
-use crate::feed::FeedPlan;
+use kerf_budget::{bytes_of, Budget, Interrupt};
+
+use crate::feed::{FeedPlan, FeedSample};
 use crate::samples::{point_at, PathSample};
 use crate::smooth::SmoothedPath;
 use crate::speed_limit::Servo;
@@ -61,6 +63,51 @@ pub fn metrics(
 ) -> Metrics {
     let timed = plan.sample(period);
     let points: Vec<[f64; 3]> = timed.iter().map(|p| point_at(path, samples, p.s)).collect();
+    metrics_of(plan, samples, &timed, &points, period, servo)
+}
+
+/// [`metrics()`] under a budget: the plan's points at the period are checked for memory before
+/// they are made, the deadline every thousand points placed on the path.
+///
+/// # Errors
+/// [`Interrupt`] when the budget runs out.
+pub fn metrics_within(
+    plan: &FeedPlan,
+    path: &SmoothedPath,
+    samples: &[PathSample],
+    period: f64,
+    servo: Option<&Servo>,
+    budget: &Budget,
+) -> Result<Metrics, Interrupt> {
+    let count = plan.sample_count(period);
+    budget.check_memory(
+        bytes_of::<[f64; 3]>(count).saturating_add(bytes_of::<FeedSample>(count)),
+        &format!(
+            "metrics at the interpolation period: {:.3e} s / {period} s = {count} points",
+            plan.time
+        ),
+    )?;
+    let timed = plan.sample_within(period, budget)?;
+    let mut points: Vec<[f64; 3]> = Vec::with_capacity(timed.len());
+    for (k, p) in timed.iter().enumerate() {
+        if k % 1024 == 1023 {
+            budget.check("metrics")?;
+        }
+        points.push(point_at(path, samples, p.s));
+    }
+    budget.check("metrics")?;
+    Ok(metrics_of(plan, samples, &timed, &points, period, servo))
+}
+
+/// The metrics of the plan's points `timed` at `period`, placed on the path at `points`.
+fn metrics_of(
+    plan: &FeedPlan,
+    samples: &[PathSample],
+    timed: &[FeedSample],
+    points: &[[f64; 3]],
+    period: f64,
+    servo: Option<&Servo>,
+) -> Metrics {
     let n = points.len();
     let max_curvature = samples.iter().map(|p| p.curvature).fold(0.0, f64::max);
     let mut max_turning_angle: f64 = 0.0;
@@ -103,7 +150,7 @@ pub fn metrics(
     let mut max_contour_error: f64 = 0.0;
     if let Some(servo) = servo {
         let wn = servo.natural_frequency;
-        for p in &timed {
+        for p in timed {
             let k = samples
                 .partition_point(|q| q.s < p.s)
                 .min(samples.len() - 1);

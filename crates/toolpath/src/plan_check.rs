@@ -24,6 +24,8 @@
 //! and at a quarter, half and three quarters of the arc (seed 003 eq. 15's
 //! quantity, measured), over Δ_lim.
 
+use kerf_budget::Budget;
+
 use crate::constraints::FeedConstraints;
 use crate::error::check_positive;
 use crate::feed::FeedPlan;
@@ -139,18 +141,44 @@ pub fn check_plan(
     constraints: &FeedConstraints<'_>,
     period: f64,
 ) -> Result<PlanCheck, ToolpathError> {
+    check_plan_within(
+        path,
+        samples,
+        plan,
+        constraints,
+        period,
+        &Budget::unlimited(),
+    )
+}
+
+/// [`check_plan`] under a budget: the plan's points at the period are checked for memory
+/// before they are made ([`FeedPlan::sample_within`]), the deadline every thousand points.
+///
+/// # Errors
+/// As [`check_plan`]; [`ToolpathError::Interrupted`] when the budget runs out.
+pub fn check_plan_within(
+    path: &SmoothedPath,
+    samples: &[PathSample],
+    plan: &FeedPlan,
+    constraints: &FeedConstraints<'_>,
+    period: f64,
+    budget: &Budget,
+) -> Result<PlanCheck, ToolpathError> {
     constraints.validate(samples)?;
     check_positive(&[("check period [s]", period)])?;
     let lim = &constraints.limits;
     let c = &lim.curvature;
-    let timed = plan.sample(period);
+    let timed = plan.sample_within(period, budget)?;
     let mut out = PlanCheck {
         points: timed.len(),
         ..PlanCheck::default()
     };
     let mut previous: Option<[f64; 3]> = None;
     let mut previous_s = 0.0;
-    for p in &timed {
+    for (k, p) in timed.iter().enumerate() {
+        if k % 1024 == 1023 {
+            budget.check("feed plan check")?;
+        }
         let (x, t, kn) = derivatives_at(path, samples, p.s);
         let kappa = norm(kn);
         let (v, a, j) = (p.v, p.a, p.j);

@@ -1,6 +1,8 @@
 //! A smoothed path sampled by arc length: positions, unit tangents and
 //! curvature at every sample, for feed planning ([`crate::lower_bound`]).
 
+use kerf_budget::{bytes_of, Budget};
+
 use crate::error::ToolpathError;
 use crate::smooth::{Piece, SmoothedPath};
 use crate::vec3::{dot, norm, scale, sub};
@@ -43,20 +45,64 @@ pub struct PathSample {
 /// # Arguments
 /// * `max_step` — mean arc length between samples of a corner \[m\], > 0.
 pub fn sample_path(path: &SmoothedPath, max_step: f64) -> Vec<PathSample> {
-    let mut out: Vec<PathSample> = Vec::new();
-    let mut s0 = 0.0;
-    for (index, piece) in path.pieces.iter().enumerate() {
-        let (length, steps) = match piece {
+    // Only the budget interrupts, and an unlimited one never does.
+    sample_path_within(path, max_step, &Budget::unlimited()).unwrap_or_default()
+}
+
+/// Samples between two checks of the deadline in [`sample_path_within`].
+const CHECK_EVERY: usize = 4096;
+
+/// [`sample_path`] under a budget: every piece's sample count is computed first and their
+/// memory checked before any is made (a step of 10⁻³⁰⁰ m is refused by the estimate), the
+/// deadline every few thousand samples.
+///
+/// # Errors
+/// [`kerf_budget::Interrupt`] when the budget runs out.
+pub fn sample_path_within(
+    path: &SmoothedPath,
+    max_step: f64,
+    budget: &Budget,
+) -> Result<Vec<PathSample>, kerf_budget::Interrupt> {
+    let mut counts: Vec<(f64, usize)> = Vec::with_capacity(path.pieces.len());
+    let mut total: f64 = 1.0;
+    for (k, piece) in path.pieces.iter().enumerate() {
+        if k % CHECK_EVERY == 0 {
+            budget.check("path sampling")?;
+        }
+        counts.push(match piece {
             // A line at its two ends: its curvature is 0, positions on it are exact
             // by proportion, and T_lb times a whole line exactly.
             Piece::Line { start, end } => (norm(sub(*end, *start)), 1),
             Piece::Corner(c) => {
                 let l = c.curve.length(8);
-                (l, (l / max_step).ceil().max(1.0) as usize)
+                let steps = (l / max_step).ceil().max(1.0);
+                total += steps;
+                // Saturates for an absurd step; the estimate below refuses it.
+                (l, steps.min(u64::MAX as f64) as usize)
             }
-        };
+        });
+        if matches!(piece, Piece::Line { .. }) {
+            total += 1.0;
+        }
+    }
+    let count = total.min(u64::MAX as f64) as u64;
+    budget.check_memory(
+        bytes_of::<PathSample>(count),
+        &format!(
+            "path samples: {} pieces at {max_step:.3e} m steps on corners, {count} samples",
+            path.pieces.len()
+        ),
+    )?;
+    // Reserved up to 2²⁰ samples: an unlimited budget's absurd count grows as it is sampled.
+    let mut out: Vec<PathSample> =
+        Vec::with_capacity(usize::try_from(count.min(1 << 20)).unwrap_or(0));
+    let mut s0 = 0.0;
+    for ((index, piece), &(length, steps)) in path.pieces.iter().enumerate().zip(&counts) {
         let mut s = s0;
         for k in 0..=steps {
+            if k % CHECK_EVERY == CHECK_EVERY - 1 {
+                budget.check("path sampling")?;
+            }
             if k == 0 && !out.is_empty() {
                 continue;
             }
@@ -98,7 +144,7 @@ pub fn sample_path(path: &SmoothedPath, max_step: f64) -> Vec<PathSample> {
         // summed sub-lengths, not its separately computed total).
         s0 = out.last().map_or(s0, |p| p.s);
     }
-    out
+    Ok(out)
 }
 
 /// The point of `path` at arc length `s`, exactly on its geometry: on a

@@ -2,6 +2,8 @@
 //! pieces and curvature-continuous corner transitions, within a tolerance
 //! of the polyline everywhere.
 
+use kerf_budget::{bytes_of, Budget};
+
 use crate::baseline::CornerMethod;
 use crate::corner::CornerTransition;
 use crate::error::{check_positive, ToolpathError};
@@ -139,7 +141,31 @@ pub fn smooth_polyline_with(
     tolerance: f64,
     method: &CornerMethod,
 ) -> Result<SmoothedPath, ToolpathError> {
+    smooth_polyline_within(polyline, tolerance, method, &Budget::unlimited())
+}
+
+/// [`smooth_polyline_with`] under a budget: the pieces' memory (a corner and a line per
+/// vertex, and the polyline's copy) is checked before they are built, the deadline at every
+/// corner (and within the NURBS swarm).
+///
+/// # Errors
+/// As [`smooth_polyline_with`]; [`ToolpathError::Interrupted`] when the budget runs out.
+pub fn smooth_polyline_within(
+    polyline: &[[f64; 3]],
+    tolerance: f64,
+    method: &CornerMethod,
+    budget: &Budget,
+) -> Result<SmoothedPath, ToolpathError> {
     method.check()?;
+    let vertices = polyline.len() as u64;
+    budget.check_memory(
+        bytes_of::<Piece>(vertices.saturating_mul(2))
+            .saturating_add(bytes_of::<[f64; 3]>(vertices)),
+        &format!(
+            "smoothed path: {vertices} vertices ({} B per corner)",
+            std::mem::size_of::<Piece>()
+        ),
+    )?;
     if polyline.len() < 2 {
         return Err(ToolpathError::InvalidParameter {
             name: "points".to_string(),
@@ -176,15 +202,17 @@ pub fn smooth_polyline_with(
     let mut pieces = Vec::new();
     let mut cursor = polyline[0];
     for v in 1..n - 1 {
+        budget.check("corner smoothing")?;
         let available = share(v - 1).min(share(v));
         match method
-            .transition(
+            .transition_within(
                 polyline[v - 1],
                 polyline[v],
                 polyline[v + 1],
                 tolerance,
                 available,
                 v,
+                budget,
             )
             .map_err(|e| match e {
                 ToolpathError::InvalidParameter {

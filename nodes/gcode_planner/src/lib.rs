@@ -33,8 +33,11 @@
 //! a planner error (status from [`convert::status_of`], the program line in `error_line`)
 //! and a planner panic are all answered; a full queue answers QUEUE_FULL. The trajectory's
 //! first point (time 0) is the tool at the program's start, at rest: move the robot there
-//! first. A program file (`program_uri`) must lie under `allowed_file_roots` and is read as
-//! a stream.
+//! first. A program file (`program_uri`) must lie under `allowed_file_roots`, be a regular
+//! file of at most [`kerf_gcodeplan::MAX_PROGRAM_BYTES`] (a FIFO, device or directory is
+//! refused before it is opened) and is read as a stream. Every plan runs under the harness's
+//! time and memory budget: the planner checks both in every loop that grows with the program
+//! and answers TIMEOUT or RESOURCE_LIMIT naming the stage or what grew.
 
 pub mod config;
 pub mod convert;
@@ -127,12 +130,22 @@ impl GcodeService {
         request.settings().map_err(fail)?;
         self.machine.place(&request).map_err(fail)?;
         if let ProgramSource::File(path) = request.source().map_err(fail)? {
-            self.allowed_roots.check(&path).map_err(|reason| {
+            let bad = |reason: String| {
                 fail(GcodePlanError::InvalidRequest {
                     field: format!("program_uri {}", path.display()),
                     reason,
                 })
-            })?;
+            };
+            self.allowed_roots.check(&path).map_err(bad)?;
+            // A FIFO, device or directory, or a file over the cap, is answered at once, before
+            // it is queued; the planner checks it again when it opens it (O_NONBLOCK).
+            kerf_robot::file::check_regular_file(&path, kerf_gcodeplan::MAX_PROGRAM_BYTES)
+                .map_err(|reason| {
+                    bad(format!(
+                        "{reason} (programs are read from regular files of at most {} bytes)",
+                        kerf_gcodeplan::MAX_PROGRAM_BYTES
+                    ))
+                })?;
         }
         Ok(request)
     }

@@ -19,6 +19,8 @@ pub mod pso;
 
 pub use nurbs::NurbsSettings;
 
+use kerf_budget::Budget;
+
 use crate::corner::{
     corner_frame, corner_transition, corner_transition_with, Binding, CornerTransition,
     ShapeObjective,
@@ -95,6 +97,34 @@ impl CornerMethod {
         available: f64,
         index: usize,
     ) -> Result<Option<CornerTransition>, ToolpathError> {
+        self.transition_within(
+            prev,
+            vertex,
+            next,
+            tolerance,
+            available,
+            index,
+            &Budget::unlimited(),
+        )
+    }
+
+    /// [`Self::transition`] under a budget (the NURBS swarm checks it at every particle's
+    /// move; the other methods build a corner in microseconds and leave the check to their
+    /// caller).
+    ///
+    /// # Errors
+    /// As [`Self::transition`]; [`ToolpathError::Interrupted`] when the budget runs out.
+    #[allow(clippy::too_many_arguments)] // the corner, its limits, the budget
+    pub fn transition_within(
+        &self,
+        prev: [f64; 3],
+        vertex: [f64; 3],
+        next: [f64; 3],
+        tolerance: f64,
+        available: f64,
+        index: usize,
+        budget: &Budget,
+    ) -> Result<Option<CornerTransition>, ToolpathError> {
         self.check()?;
         let framed =
             |build: &dyn Fn([f64; 3], [f64; 3], f64) -> Result<CornerTransition, ToolpathError>| {
@@ -120,7 +150,9 @@ impl CornerMethod {
                 framed(&|t1, t2, turn| ccr::transition(vertex, t1, t2, turn, tolerance, available))
             }
             CornerMethod::Nurbs(s) => framed(&|t1, t2, turn| {
-                nurbs::transition(vertex, t1, t2, turn, tolerance, available, s, index)
+                nurbs::transition_within(
+                    vertex, t1, t2, turn, tolerance, available, s, index, budget,
+                )
             }),
         }
     }

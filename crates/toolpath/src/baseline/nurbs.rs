@@ -55,7 +55,9 @@
 //!
 //! e = N₂(½) βαℓ sin θ / (2 N₂(½) + N₃(½) w).
 
-use super::pso::{minimize, Swarm};
+use kerf_budget::Budget;
+
+use super::pso::{minimize_within, Swarm};
 use crate::corner::{Binding, CornerTransition};
 use crate::corner_curve::CornerCurve;
 use crate::error::ToolpathError;
@@ -235,6 +237,35 @@ pub fn transition(
     settings: &NurbsSettings,
     index: usize,
 ) -> Result<CornerTransition, ToolpathError> {
+    transition_within(
+        v,
+        t1,
+        t2,
+        turn,
+        tolerance,
+        available,
+        settings,
+        index,
+        &Budget::unlimited(),
+    )
+}
+
+/// [`transition`] under a budget, checked at every particle's move of the swarm.
+///
+/// # Errors
+/// As [`transition`]; [`ToolpathError::Interrupted`] when the budget runs out.
+#[allow(clippy::too_many_arguments)] // the corner's geometry, its limits, the swarm, the budget
+pub fn transition_within(
+    v: [f64; 3],
+    t1: [f64; 3],
+    t2: [f64; 3],
+    turn: f64,
+    tolerance: f64,
+    available: f64,
+    settings: &NurbsSettings,
+    index: usize,
+    budget: &Budget,
+) -> Result<CornerTransition, ToolpathError> {
     let corner = Corner {
         v,
         t1,
@@ -262,7 +293,7 @@ pub fn transition(
         c3: settings.c3,
     };
     let seed = settings.seed ^ (index as u64).wrapping_mul(0x9e37_79b9_7f4a_7c15);
-    let (x, value) = minimize(objective, LOWER, UPPER, &swarm, seed);
+    let (x, value) = minimize_within(objective, LOWER, UPPER, &swarm, seed, budget)?;
     let found = candidate(&corner, &x);
     let (curve, w, deviation, l) = match found {
         Some(f) if value.is_finite() => f,

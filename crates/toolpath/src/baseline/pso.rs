@@ -2,6 +2,8 @@
 //! Eberhart, "Particle swarm optimization", Proc. ICNN 1995) with a fixed
 //! seed: the same settings give bit-identical results.
 
+use kerf_budget::{bytes_of, Budget, Interrupt};
+
 /// SplitMix64 (Steele, Lea and Flood, "Fast splittable pseudorandom number
 /// generators", OOPSLA 2014; the constants of its reference
 /// implementation): a tiny generator, enough for a swarm's draws.
@@ -63,6 +65,46 @@ pub fn minimize<const D: usize>(
     swarm: &Swarm,
     seed: u64,
 ) -> ([f64; D], f64) {
+    match run(f, lo, hi, swarm, seed, || {
+        Ok::<(), std::convert::Infallible>(())
+    }) {
+        Ok(best) => best,
+        Err(never) => match never {},
+    }
+}
+
+/// [`minimize`] under a budget: the swarm's memory (positions, velocities and bests of every
+/// particle) is checked before it is drawn, the deadline at every particle's move.
+///
+/// # Errors
+/// [`Interrupt`] when the budget runs out.
+pub fn minimize_within<const D: usize>(
+    f: impl Fn(&[f64; D]) -> f64,
+    lo: [f64; D],
+    hi: [f64; D],
+    swarm: &Swarm,
+    seed: u64,
+    budget: &Budget,
+) -> Result<([f64; D], f64), Interrupt> {
+    let n = swarm.particles.max(1) as u64;
+    budget.check_memory(
+        bytes_of::<[f64; D]>(n.saturating_mul(4)),
+        &format!("corner swarm: {n} particles"),
+    )?;
+    run(f, lo, hi, swarm, seed, || {
+        budget.check("NURBS corner swarm")
+    })
+}
+
+/// The swarm of [`minimize`], `check` called before every particle's move.
+fn run<const D: usize, E>(
+    f: impl Fn(&[f64; D]) -> f64,
+    lo: [f64; D],
+    hi: [f64; D],
+    swarm: &Swarm,
+    seed: u64,
+    mut check: impl FnMut() -> Result<(), E>,
+) -> Result<([f64; D], f64), E> {
     let mut rng = SplitMix64::new(seed);
     let n = swarm.particles.max(1);
     let mut x: Vec<[f64; D]> = (0..n)
@@ -78,6 +120,7 @@ pub fn minimize<const D: usize>(
     }
     for _ in 0..swarm.iterations {
         for i in 0..n {
+            check()?;
             for d in 0..D {
                 let (r1, r2, r3) = (rng.next_f64(), rng.next_f64(), rng.next_f64());
                 let pb = best[i].0[d];
@@ -96,5 +139,5 @@ pub fn minimize<const D: usize>(
             }
         }
     }
-    global
+    Ok(global)
 }

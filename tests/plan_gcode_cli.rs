@@ -1,0 +1,101 @@
+//! `kerf plan gcode` on the probe's inputs (issue 33): the 53-byte helix ends with
+//! RESOURCE_LIMIT and exit code 2 (not an abort), a FIFO, /dev/zero on standard input and a
+//! bad `--plan-memory` end with exit code 2 and a message at once, and a valid program read
+//! from standard input plans. No DDS: the command plans offline.
+#![allow(clippy::unwrap_used, clippy::expect_used)] // tests report failures by panicking
+
+use std::io::Write;
+use std::process::{Command, Output, Stdio};
+use std::time::{Duration, Instant};
+
+fn plan(args: &[&str], stdin: Stdio) -> (Output, Duration) {
+    let started = Instant::now();
+    let out = Command::new(env!("CARGO_BIN_EXE_kerf"))
+        .args(["plan", "gcode"])
+        .args(args)
+        .stdin(stdin)
+        .output()
+        .expect("run kerf plan gcode");
+    (out, started.elapsed())
+}
+
+fn failed_with(out: &Output, took: Duration, expect: &str) {
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    assert!(err.contains(expect), "{err}");
+    assert!(!err.contains("panicked"), "{err}");
+    assert!(took < Duration::from_secs(15), "hang guard: {err}");
+}
+
+fn scratch(name: &str) -> std::path::PathBuf {
+    let d = std::env::temp_dir().join(format!("kerf_plan_gcode_{name}_{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+#[test]
+fn the_helix_ends_with_resource_limit_not_an_abort() {
+    let d = scratch("helix");
+    let helix = d.join("helix.ngc");
+    std::fs::write(
+        &helix,
+        "G21 G17\nG1 X10 Y0 F3000\nG2 X10 Y0 Z-5 I-10 J0 P10000\n",
+    )
+    .unwrap();
+    let (out, took) = plan(
+        &[helix.to_str().unwrap(), "--plan-memory", "268435456"],
+        Stdio::null(),
+    );
+    failed_with(
+        &out,
+        took,
+        "RESOURCE_LIMIT (7): memory budget of 256.0 MiB exceeded",
+    );
+    let (out, took) = plan(
+        &[helix.to_str().unwrap(), "--plan-memory", "5"],
+        Stdio::null(),
+    );
+    failed_with(&out, took, "--plan-memory: 5 bytes must be in");
+    let _ = std::fs::remove_dir_all(&d);
+}
+
+#[test]
+fn fifos_and_endless_input_end_at_once() {
+    let d = scratch("fifo");
+    let fifo = d.join("part.ngc");
+    let c = std::ffi::CString::new(fifo.to_str().unwrap()).unwrap();
+    // SAFETY: mkfifo(3) on a NUL-terminated path we own.
+    assert_eq!(unsafe { libc::mkfifo(c.as_ptr(), 0o600) }, 0);
+    let (out, took) = plan(&[fifo.to_str().unwrap()], Stdio::null());
+    failed_with(&out, took, "is not a regular file");
+    let zero = std::fs::File::open("/dev/zero").unwrap();
+    let (out, took) = plan(&["-"], Stdio::from(zero));
+    failed_with(&out, took, "line longer than 65536 bytes");
+    let _ = std::fs::remove_dir_all(&d);
+}
+
+#[test]
+fn a_program_on_standard_input_plans() {
+    let mut child = Command::new(env!("CARGO_BIN_EXE_kerf"))
+        .args(["plan", "gcode", "-"])
+        .stdin(Stdio::piped())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    child
+        .stdin
+        .take()
+        .unwrap()
+        .write_all(b"M3\nG1 X20 F3000\nG1 Y20\nM5\n")
+        .unwrap();
+    let out = child.wait_with_output().unwrap();
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(text.contains("laser-cutter: 4 lines"), "{text}");
+}
