@@ -16,9 +16,12 @@ mod support;
 use support::rss::{sequential, slope_kib, Reading};
 
 fn report(name: &str, readings: &[Reading]) {
-    println!("{name}: answered, node VmRSS MiB, worker VmRSS MiB");
+    println!("{name}: answered, node VmRSS MiB, worker VmRSS MiB, node heap in use MiB");
     for r in readings {
-        println!("  {:6} {:8.1} {:8.1}", r.answered, r.node_mib, r.worker_mib);
+        println!(
+            "  {:6} {:8.1} {:8.1} {:8.1}",
+            r.answered, r.node_mib, r.worker_mib, r.heap_mib
+        );
     }
     let last = readings.last().map_or(0, |r| r.answered);
     let at_100 = readings.iter().find(|r| r.answered >= 100);

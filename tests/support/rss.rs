@@ -14,6 +14,14 @@ pub fn own_mib() -> f64 {
     super::status_kib("VmRSS:") as f64 / 1024.0
 }
 
+/// Bytes in use by glibc's allocator in this process (MiB): live allocations, as opposed to
+/// resident memory that fragmentation keeps.
+pub fn heap_in_use_mib() -> f64 {
+    // SAFETY: mallinfo2 only reads the allocator's statistics.
+    let info = unsafe { libc::mallinfo2() };
+    (info.uordblks + info.hblkhd) as f64 / (1024.0 * 1024.0)
+}
+
 /// Resident memory (MiB) of this process's children (the planner's worker process).
 pub fn children_mib() -> f64 {
     let mut total = 0.0;
@@ -48,6 +56,8 @@ pub struct Reading {
     pub node_mib: f64,
     /// The worker process, MiB.
     pub worker_mib: f64,
+    /// Live heap of this process (allocations in use), MiB.
+    pub heap_mib: f64,
 }
 
 /// Starts `planner`, sends `text(k)` for k in 0..count one at a time (waiting for each
@@ -69,18 +79,21 @@ pub fn sequential<Req: RosType + Serialize + Debug, Plan: Answer>(
                 answered: k,
                 node_mib: own_mib(),
                 worker_mib: children_mib(),
+                heap_mib: heap_in_use_mib(),
             });
         }
         client.send_text(&text(k));
         let plan = client.next_plan(Duration::from_secs(120));
         assert_eq!(plan.status(), status, "request {k}: {}", plan.message());
-        // The text form of the answer too, so its subscription does not fill.
+        // The text form of the answer and the trajectory too: every subscription is read.
         let _ = client.next_plan_text();
+        let _ = client.trajectories_received();
     }
     readings.push(Reading {
         answered: count,
         node_mib: own_mib(),
         worker_mib: children_mib(),
+        heap_mib: heap_in_use_mib(),
     });
     client.finish();
     readings
