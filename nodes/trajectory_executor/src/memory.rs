@@ -3,11 +3,12 @@
 //! A `JointTrajectory` arrives as one allocation per point and field (the deserialized
 //! message, then the [`kerf_executor::TrajectoryRequest`] converted from it): 10⁶ points of
 //! 6 joints are about 6·10⁶ allocations of 48 bytes, 600 MB with the vectors' headers. Each is
-//! below glibc's mmap threshold ([`kerf_ros::memory`]), so it comes from a malloc heap, and
-//! when the message and the request are freed the heap keeps the space: glibc only returns
-//! the free top of a heap, and only of the main one (the inbox and preparation threads
-//! allocate in their own arenas). The executor kept 529 MB of a 10⁶-point trajectory that
-//! way (issue 33). `malloc_trim(0)` returns every free page of every arena.
+//! below glibc's mmap threshold, so it comes from a malloc heap (of the inbox thread for the
+//! message, of the preparation thread for the request). [`kerf_ros::memory`] makes freed
+//! blocks merge at once, so that the free top of each heap goes back to the system; what is
+//! left free inside a heap, between blocks still in use, is returned by `malloc_trim(0)`,
+//! called here after a large request. Before, the executor kept 529 MB of a 10⁶-point
+//! trajectory after serving it (issue 33).
 //!
 //! The prepared trajectory itself ([`kerf_executor::PreparedTrajectory`]) is a few large
 //! vectors, served by `mmap` and unmapped when freed.
@@ -46,12 +47,14 @@ pub fn give_back_freed_memory() -> bool {
 
 #[cfg(test)]
 mod tests {
-    /// Many small blocks freed in a thread's arena come back to the system after the trim.
+    /// Many small blocks of another thread's arena, freed here, come back to the system, as
+    /// a message deserialized on the inbox thread and freed on the preparation thread.
     #[test]
     fn freed_small_blocks_are_given_back() {
         if !cfg!(all(target_os = "linux", target_env = "gnu")) {
             return;
         }
+        kerf_ros::memory::release_large_allocations();
         let rss = || kerf_ros::memory::status_kib("VmRSS:").unwrap();
         let before = rss();
         // 2·10⁶ blocks of 48 bytes (the positions of one point of 6 joints), about 128 MB,
