@@ -1,14 +1,20 @@
 //! A validated trajectory: segment polynomials, sampled with a cursor.
 //!
-//! The waypoint segments ([`Body`]) are built once by [`crate::prepare`] on time relative to
-//! the trajectory's start time and shared (`Arc`) by every trajectory finished from them, so
-//! that finishing a prepared trajectory against the current state costs O(joints), never a
-//! copy of its segments.
+//! The waypoints ([`Body`]) are stored once by [`crate::prepare`], compactly (about the
+//! message's wire size: `8 · (1 + 3 · joints) + 1` bytes per point, no allocation per point),
+//! on time relative to the trajectory's start time, and shared (`Arc`) by every trajectory
+//! finished from them, so that finishing a prepared trajectory against the current state
+//! costs O(joints), never a copy. A segment's coefficients are computed from its two
+//! waypoints when it is first sampled and kept until the cursor leaves it.
+//!
+//! Measured with `cargo run --release -p kerf_executor --example trajectory_memory`
+//! (10⁶ quintic points of 6 joints, wire size 145 MB): the prepared trajectory holds 146 MB;
+//! a table of per-segment coefficients and times held 504 MB (issue 33).
 
-use std::cell::Cell;
+use std::cell::{Cell, RefCell};
 use std::sync::Arc;
 
-use crate::spline::{evaluate, Interpolation, Knot};
+use crate::spline::{coefficients, evaluate, Interpolation, Knot};
 use crate::types::JointSample;
 
 /// Beyond this many forward steps of the cursor, [`ValidatedTrajectory::sample`] switches to
@@ -48,43 +54,110 @@ impl Segment {
     }
 }
 
-/// One waypoint in model joint order.
-#[derive(Debug, Clone)]
-pub(crate) struct ModelPoint {
-    pub positions: Vec<f64>,
-    pub velocities: Option<Vec<f64>>,
-    pub accelerations: Option<Vec<f64>>,
-    pub time_from_start: f64,
-}
+/// Bit of [`Body::given`]: the waypoint has velocities.
+pub(crate) const HAS_VELOCITIES: u8 = 1;
+/// Bit of [`Body::given`]: the waypoint has accelerations.
+pub(crate) const HAS_ACCELERATIONS: u8 = 2;
 
-impl ModelPoint {
-    /// Joint `j`'s state at this point; missing velocities or accelerations count as 0.
-    pub fn knot(&self, j: usize) -> Knot {
-        Knot {
-            p: self.positions[j],
-            v: self.velocities.as_ref().map_or(0.0, |v| v[j]),
-            a: self.accelerations.as_ref().map_or(0.0, |a| a[j]),
-        }
-    }
-}
-
-/// The request-only part of a trajectory: its waypoint segments on time from the start time.
+/// The request-only part of a trajectory: its waypoints in model joint order, on time from the
+/// start time.
+///
+/// Stored compactly, close to the message's wire size: per waypoint its time and `3 · n`
+/// values (positions, velocities, accelerations; missing ones as 0) in two flat vectors and
+/// one flag byte, 8 · (1 + 3n) + 1 bytes (145 for 6 joints), with no allocation per point.
+/// A segment's polynomial coefficients are computed from its two waypoints when it is
+/// sampled or checked (O(joints), a few dozen flops per joint), bit for bit the values a
+/// table of coefficients would hold, instead of being stored (48 bytes per joint and
+/// segment, plus the segment's times).
 #[derive(Debug)]
 pub(crate) struct Body {
     /// Number of joints.
     pub n: usize,
-    /// Segments between consecutive waypoints, on time from the start time.
-    pub segments: Vec<Segment>,
-    /// `segments.len() * n` coefficient sets, segment-major.
-    pub coeffs: Vec<[f64; 6]>,
-    /// The first waypoint (the start segment runs to it).
-    pub first: ModelPoint,
-    /// Positions of the last waypoint, held after the end.
-    pub final_positions: Vec<f64>,
-    /// Number of waypoints.
-    pub point_count: usize,
+    /// `time_from_start` of every waypoint (s), strictly increasing.
+    pub times: Vec<f64>,
+    /// Waypoint-major: positions, velocities, accelerations of each waypoint, `3 · n` values.
+    pub knots: Vec<f64>,
+    /// Per waypoint: [`HAS_VELOCITIES`] | [`HAS_ACCELERATIONS`].
+    pub given: Vec<u8>,
+}
+
+impl Body {
+    /// Number of waypoints (at least 1).
+    pub fn point_count(&self) -> usize {
+        self.times.len()
+    }
+
+    /// Number of segments between waypoints.
+    pub fn segment_count(&self) -> usize {
+        self.times.len().saturating_sub(1)
+    }
+
     /// `time_from_start` of the last waypoint (s).
-    pub duration: f64,
+    pub fn duration(&self) -> f64 {
+        self.times.last().copied().unwrap_or(0.0)
+    }
+
+    /// Positions of waypoint `k`, model order.
+    pub fn positions(&self, k: usize) -> &[f64] {
+        let at = 3 * self.n * k;
+        &self.knots[at..at + self.n]
+    }
+
+    /// Positions of the last waypoint, held after the end.
+    pub fn final_positions(&self) -> &[f64] {
+        self.positions(self.point_count() - 1)
+    }
+
+    /// Whether waypoint `k` has velocities.
+    pub fn has_velocities(&self, k: usize) -> bool {
+        self.given[k] & HAS_VELOCITIES != 0
+    }
+
+    /// Whether waypoint `k` has accelerations.
+    pub fn has_accelerations(&self, k: usize) -> bool {
+        self.given[k] & HAS_ACCELERATIONS != 0
+    }
+
+    /// Joint `j`'s state at waypoint `k`; missing velocities or accelerations count as 0.
+    pub fn knot(&self, k: usize, j: usize) -> Knot {
+        let at = 3 * self.n * k + j;
+        Knot {
+            p: self.knots[at],
+            v: self.knots[at + self.n],
+            a: self.knots[at + 2 * self.n],
+        }
+    }
+
+    /// Segment `k`, from waypoint `k` to waypoint `k + 1`.
+    pub fn segment(&self, k: usize) -> Segment {
+        let (t0, t1) = (self.times[k], self.times[k + 1]);
+        Segment {
+            t0,
+            t1,
+            duration: t1 - t0,
+            kind: Interpolation::between(
+                self.has_velocities(k),
+                self.has_accelerations(k),
+                self.has_velocities(k + 1),
+                self.has_accelerations(k + 1),
+            ),
+            from: Some(k),
+        }
+    }
+
+    /// Writes the coefficients of segment `k` (one set per joint) into `out`.
+    ///
+    /// # Performance
+    /// O(joints), no allocation once `out` has the capacity.
+    pub fn coefficients_into(&self, k: usize, out: &mut Vec<[f64; 6]>) {
+        let seg = self.segment(k);
+        out.clear();
+        out.extend(
+            (0..self.n).map(|j| {
+                coefficients(seg.kind, self.knot(k, j), self.knot(k + 1, j), seg.duration)
+            }),
+        );
+    }
 }
 
 /// The start segment, from the state a trajectory started from to its first point, on
@@ -121,6 +194,9 @@ pub struct ValidatedTrajectory {
     pub(crate) end_time: f64,
     /// Index of the waypoint segment last sampled.
     pub(crate) cursor: Cell<usize>,
+    /// The coefficients of one waypoint segment (one set per joint) and its index
+    /// (`usize::MAX`: none yet): successive samples within a segment reuse them.
+    pub(crate) cached: RefCell<(usize, Vec<[f64; 6]>)>,
 }
 
 impl ValidatedTrajectory {
@@ -131,12 +207,12 @@ impl ValidatedTrajectory {
 
     /// Number of interpolated segments, including the start segment if there is one.
     pub fn segment_count(&self) -> usize {
-        usize::from(self.lead.is_some()) + self.body.segments.len()
+        usize::from(self.lead.is_some()) + self.body.segment_count()
     }
 
     /// Number of waypoints.
     pub fn point_count(&self) -> usize {
-        self.body.point_count
+        self.body.point_count()
     }
 
     /// Absolute time the trajectory was validated at (s).
@@ -161,7 +237,7 @@ impl ValidatedTrajectory {
 
     /// Positions held after the end, in model order.
     pub fn final_positions(&self) -> &[f64] {
-        &self.body.final_positions
+        self.body.final_positions()
     }
 
     /// The commanded state at absolute time `t`.
@@ -188,18 +264,19 @@ impl ValidatedTrajectory {
         out.resize_full(self.n);
         if t.is_nan() || t >= self.end_time {
             // NaN cannot come from the executor (times are checked); hold the end for safety.
-            out.positions.copy_from_slice(&self.body.final_positions);
+            out.positions.copy_from_slice(self.body.final_positions());
             out.velocities.fill(0.0);
             out.accelerations.fill(0.0);
             return;
         }
-        match (&self.lead, self.body.segments.first()) {
+        let body_begins = (self.body.segment_count() > 0).then(|| self.body.times[0]);
+        match (&self.lead, body_begins) {
             (Some(lead), _) if t < lead.segment.t0 => self.copy_initial(out),
             (Some(lead), first) if t < lead.segment.t1 || first.is_none() => {
                 write_segment(&lead.coeffs, t - lead.segment.t0, out)
             }
             (Some(_), _) => self.sample_body(t, out),
-            (None, Some(first)) if t >= self.start_time + first.t0 => self.sample_body(t, out),
+            (None, Some(t0)) if t >= self.start_time + t0 => self.sample_body(t, out),
             (None, _) => self.copy_initial(out),
         }
     }
@@ -209,9 +286,29 @@ impl ValidatedTrajectory {
         let rel = t - self.start_time;
         let k = self.find_segment(rel);
         self.cursor.set(k);
-        let seg = &self.body.segments[k];
-        let n = self.n;
-        write_segment(&self.body.coeffs[k * n..(k + 1) * n], rel - seg.t0, out);
+        let tau = rel - self.body.times[k];
+        match self.cached.try_borrow_mut() {
+            Ok(mut cached) => {
+                if cached.0 != k {
+                    self.body.coefficients_into(k, &mut cached.1);
+                    cached.0 = k;
+                }
+                write_segment(&cached.1, tau, out);
+            }
+            // Unreachable (no sampling calls back into sampling); computed in place then.
+            Err(_) => {
+                let body = &self.body;
+                let seg = body.segment(k);
+                for j in 0..self.n {
+                    let c =
+                        coefficients(seg.kind, body.knot(k, j), body.knot(k + 1, j), seg.duration);
+                    let (p, v, a) = evaluate(&c, tau);
+                    out.positions[j] = p;
+                    out.velocities[j] = v;
+                    out.accelerations[j] = a;
+                }
+            }
+        }
     }
 
     fn copy_initial(&self, out: &mut JointSample) {
@@ -221,21 +318,22 @@ impl ValidatedTrajectory {
             .copy_from_slice(&self.initial.accelerations);
     }
 
-    /// Index of the waypoint segment with `t0 <= rel < t1` (time from the start time).
+    /// Index of the waypoint segment with `t0 <= rel < t1` (time from the start time):
+    /// segment `k` runs from `times[k]` to `times[k + 1]`.
     fn find_segment(&self, rel: f64) -> usize {
-        let segments = &self.body.segments;
-        let last = segments.len() - 1;
+        let times = &self.body.times;
+        let last = self.body.segment_count() - 1;
         let mut k = self.cursor.get().min(last);
-        if rel < segments[k].t0 {
+        if rel < times[k] {
             return self.search(rel);
         }
         for _ in 0..MAX_LINEAR_STEPS {
-            if k == last || rel < segments[k].t1 {
+            if k == last || rel < times[k + 1] {
                 return k;
             }
             k += 1;
         }
-        if k == last || rel < segments[k].t1 {
+        if k == last || rel < times[k + 1] {
             k
         } else {
             self.search(rel)
@@ -243,9 +341,9 @@ impl ValidatedTrajectory {
     }
 
     fn search(&self, rel: f64) -> usize {
-        let segments = &self.body.segments;
-        let idx = segments.partition_point(|s| s.t1 <= rel);
-        idx.min(segments.len() - 1)
+        // The segments whose end `times[k + 1]` is at or before `rel`.
+        let idx = self.body.times[1..].partition_point(|&t1| t1 <= rel);
+        idx.min(self.body.segment_count() - 1)
     }
 }
 

@@ -1,6 +1,6 @@
 //! Validation of a trajectory request against the robot model and the current state.
 
-use std::cell::Cell;
+use std::cell::{Cell, RefCell};
 use std::sync::Arc;
 
 use crate::error::ExecutorError;
@@ -9,7 +9,9 @@ use crate::slack::{position_ok, rate_ok};
 use crate::spline::{
     acceleration_coefficients, coefficients, evaluate, velocity_coefficients, Interpolation, Knot,
 };
-use crate::trajectory::{Body, Lead, ModelPoint, Segment, ValidatedTrajectory};
+use crate::trajectory::{
+    Body, Lead, Segment, ValidatedTrajectory, HAS_ACCELERATIONS, HAS_VELOCITIES,
+};
 use crate::types::{check_limits, joint_list, ExecutorConfig, JointLimits, JointSample};
 use crate::TrajectoryRequest;
 
@@ -66,63 +68,43 @@ pub fn prepare(
             return Err(ExecutorError::InvalidStartTime { value: s });
         }
     }
-    let points = to_model_order(req, &map, n);
-    check_waypoints(limits, &points)?;
+    let body = to_model_order(req, &map, n);
+    check_waypoints(limits, &body)?;
 
-    let mut segments = Vec::with_capacity(points.len().saturating_sub(1));
-    let mut coeffs = Vec::with_capacity(points.len().saturating_sub(1) * n);
-    for (k, w) in points.windows(2).enumerate() {
-        let (a, b) = (&w[0], &w[1]);
-        let kind = Interpolation::between(
-            a.velocities.is_some(),
-            a.accelerations.is_some(),
-            b.velocities.is_some(),
-            b.accelerations.is_some(),
-        );
-        let duration = b.time_from_start - a.time_from_start;
-        for j in 0..n {
-            coeffs.push(coefficients(kind, a.knot(j), b.knot(j), duration));
-        }
-        segments.push(Segment {
-            t0: a.time_from_start,
-            t1: b.time_from_start,
-            duration,
-            kind,
-            from: Some(k),
-        });
+    // Every segment's exact extrema, then every velocity step between segments (the order
+    // in which problems are reported); coefficients are computed per segment, not stored.
+    let mut coeffs = Vec::with_capacity(n);
+    for k in 0..body.segment_count() {
+        body.coefficients_into(k, &mut coeffs);
+        check_segments(
+            limits,
+            std::slice::from_ref(&body.segment(k)),
+            &coeffs,
+            n,
+            0.0,
+        )?;
     }
-    check_segments(limits, &segments, &coeffs, n, 0.0)?;
-    for k in 1..segments.len() {
-        let before = &coeffs[(k - 1) * n..k * n];
-        let after = &coeffs[k * n..(k + 1) * n];
-        let duration = segments[k - 1].duration;
+    let mut before = Vec::with_capacity(n);
+    if body.segment_count() > 1 {
+        body.coefficients_into(0, &mut before);
+    }
+    for k in 1..body.segment_count() {
+        if k > 1 {
+            std::mem::swap(&mut before, &mut coeffs);
+        }
+        body.coefficients_into(k, &mut coeffs);
+        let duration = body.segment(k - 1).duration;
         check_velocity_step(
             limits,
             cfg,
             &|j| evaluate(&before[j], duration).1,
-            &|j| after[j][1],
-            segments[k].t0,
+            &|j| coeffs[j][1],
+            body.times[k],
             &|| format!("point {k}"),
         )?;
     }
-    let last = points.len() - 1;
-    let duration = points[last].time_from_start;
-    let point_count = points.len();
-    let final_positions = points[last].positions.clone();
-    let first = points
-        .into_iter()
-        .next()
-        .ok_or(ExecutorError::EmptyTrajectory)?;
     Ok(PreparedTrajectory {
-        body: Arc::new(Body {
-            n,
-            segments,
-            coeffs,
-            first,
-            final_positions,
-            point_count,
-            duration,
-        }),
+        body: Arc::new(body),
         start_time: req.start_time,
     })
 }
@@ -135,12 +117,12 @@ impl PreparedTrajectory {
 
     /// Number of waypoints.
     pub fn point_count(&self) -> usize {
-        self.body.point_count
+        self.body.point_count()
     }
 
     /// `time_from_start` of the last point (s).
     pub fn duration(&self) -> f64 {
-        self.body.duration
+        self.body.duration()
     }
 
     /// Completes validation against the current state at time `now` (see [`validate`]).
@@ -181,7 +163,7 @@ impl PreparedTrajectory {
             });
         }
         current.check("current state", limits, false)?;
-        let p0 = &body.first;
+        let p0_time = body.times[0];
 
         // Start time (JTC: header.stamp 0 = now).
         let start = match self.start_time {
@@ -189,7 +171,7 @@ impl PreparedTrajectory {
             Some(0.0) => now,
             Some(s) => s,
         };
-        let first_abs = start + p0.time_from_start;
+        let first_abs = start + p0_time;
         if start < now && first_abs <= now {
             return Err(ExecutorError::OldHeaderTimestamp {
                 start_time: start,
@@ -213,8 +195,8 @@ impl PreparedTrajectory {
             let kind = Interpolation::between(
                 true,
                 true,
-                p0.velocities.is_some(),
-                p0.accelerations.is_some(),
+                body.has_velocities(0),
+                body.has_accelerations(0),
             );
             let duration = first_abs - t_begin;
             let coeffs: Vec<[f64; 6]> = (0..n)
@@ -224,7 +206,7 @@ impl PreparedTrajectory {
                         v: initial.velocities[j],
                         a: initial.accelerations[j],
                     };
-                    coefficients(kind, k0, p0.knot(j), duration)
+                    coefficients(kind, k0, body.knot(0, j), duration)
                 })
                 .collect();
             let segment = Segment {
@@ -239,13 +221,14 @@ impl PreparedTrajectory {
             Some(Lead { segment, coeffs })
         } else {
             // The first point is due now: it must be where the robot is commanded to be.
+            let first = body.positions(0);
             for (j, l) in limits.iter().enumerate() {
-                let difference = (p0.positions[j] - initial.positions[j]).abs();
+                let difference = (first[j] - initial.positions[j]).abs();
                 if difference > cfg.start_tolerance {
                     return Err(ExecutorError::StartMismatch {
                         joint: l.name.clone(),
                         current: initial.positions[j],
-                        first: p0.positions[j],
+                        first: first[j],
                         difference,
                         tolerance: cfg.start_tolerance,
                     });
@@ -256,9 +239,14 @@ impl PreparedTrajectory {
 
         // Velocity steps into the motion, from the start segment into the waypoint segments,
         // and into the final hold.
-        let first_segment = match (&lead, body.segments.first()) {
+        let mut body_first = Vec::with_capacity(n);
+        let body_segment = (body.segment_count() > 0).then(|| {
+            body.coefficients_into(0, &mut body_first);
+            body.segment(0)
+        });
+        let first_segment = match (&lead, &body_segment) {
             (Some(l), _) => Some((&l.coeffs[..], l.segment.t0 - start, l.segment.from)),
-            (None, Some(s)) => Some((&body.coeffs[..n], s.t0, s.from)),
+            (None, Some(s)) => Some((&body_first[..], s.t0, s.from)),
             (None, None) => None,
         };
         if let Some((c, time, from)) = first_segment {
@@ -275,26 +263,28 @@ impl PreparedTrajectory {
                 &location,
             )?;
         }
-        if let (Some(l), false) = (&lead, body.segments.is_empty()) {
-            let c1 = &body.coeffs[..n];
+        if let (Some(l), Some(_)) = (&lead, &body_segment) {
+            let c1 = &body_first[..];
             let duration = l.segment.duration;
             check_velocity_step(
                 limits,
                 cfg,
                 &|j| evaluate(&l.coeffs[j], duration).1,
                 &|j| c1[j][1],
-                p0.time_from_start,
+                p0_time,
                 &|| "point 0".to_string(),
             )?;
         }
-        let last = body.point_count - 1;
-        let end_time = start + body.duration;
-        let has_segments = lead.is_some() || !body.segments.is_empty();
-        let end_velocity = |j: usize| match (body.segments.last(), &lead) {
-            (Some(seg), _) => {
-                let k = body.segments.len() - 1;
-                evaluate(&body.coeffs[k * n + j], seg.duration).1
-            }
+        let last = body.point_count() - 1;
+        let end_time = start + body.duration();
+        let has_segments = lead.is_some() || body_segment.is_some();
+        let last_segment = body.segment_count().checked_sub(1).map(|k| {
+            let mut c = Vec::with_capacity(n);
+            body.coefficients_into(k, &mut c);
+            (body.segment(k).duration, c)
+        });
+        let end_velocity = |j: usize| match (&last_segment, &lead) {
+            (Some((duration, c)), _) => evaluate(&c[j], *duration).1,
             (None, Some(l)) => evaluate(&l.coeffs[j], l.segment.duration).1,
             (None, None) => initial.velocities[j],
         };
@@ -323,6 +313,7 @@ impl PreparedTrajectory {
             start_time: start,
             end_time,
             cursor: Cell::new(0),
+            cached: RefCell::new((usize::MAX, Vec::with_capacity(n))),
         })
     }
 }
@@ -490,34 +481,49 @@ fn check_points(req: &TrajectoryRequest) -> Result<(), ExecutorError> {
     Ok(())
 }
 
-fn to_model_order(req: &TrajectoryRequest, map: &[usize], n: usize) -> Vec<ModelPoint> {
-    let reorder = |values: &[f64]| {
-        let mut out = vec![0.0; n];
-        for (k, &j) in map.iter().enumerate() {
-            out[j] = values[k];
-        }
-        out
+/// The request's waypoints in model joint order, stored compactly ([`Body`]).
+fn to_model_order(req: &TrajectoryRequest, map: &[usize], n: usize) -> Body {
+    let count = req.points.len();
+    let mut body = Body {
+        n,
+        times: Vec::with_capacity(count),
+        knots: vec![0.0; 3 * n * count],
+        given: Vec::with_capacity(count),
     };
-    req.points
-        .iter()
-        .map(|pt| ModelPoint {
-            positions: reorder(&pt.positions),
-            velocities: (!pt.velocities.is_empty()).then(|| reorder(&pt.velocities)),
-            accelerations: (!pt.accelerations.is_empty()).then(|| reorder(&pt.accelerations)),
-            time_from_start: pt.time_from_start,
-        })
-        .collect()
+    for (i, pt) in req.points.iter().enumerate() {
+        body.times.push(pt.time_from_start);
+        let mut given = 0;
+        for (f, (values, flag)) in [
+            (&pt.positions, 0),
+            (&pt.velocities, HAS_VELOCITIES),
+            (&pt.accelerations, HAS_ACCELERATIONS),
+        ]
+        .into_iter()
+        .enumerate()
+        {
+            if values.is_empty() {
+                continue;
+            }
+            given |= flag;
+            let row = &mut body.knots[(3 * i + f) * n..(3 * i + f + 1) * n];
+            for (k, &j) in map.iter().enumerate() {
+                row[j] = values[k];
+            }
+        }
+        body.given.push(given);
+    }
+    body
 }
 
 /// Waypoint positions within the limits; times in errors are `time_from_start`.
-fn check_waypoints(limits: &[JointLimits], points: &[ModelPoint]) -> Result<(), ExecutorError> {
-    for (index, pt) in points.iter().enumerate() {
-        for (p, l) in pt.positions.iter().zip(limits) {
+fn check_waypoints(limits: &[JointLimits], body: &Body) -> Result<(), ExecutorError> {
+    for index in 0..body.point_count() {
+        for (p, l) in body.positions(index).iter().zip(limits) {
             if !position_ok(*p, l) {
                 return Err(ExecutorError::PositionLimit {
                     joint: l.name.clone(),
                     location: format!("point {index}"),
-                    time: pt.time_from_start,
+                    time: body.times[index],
                     value: *p,
                     min: l.min_position,
                     max: l.max_position,

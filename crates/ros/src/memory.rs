@@ -6,10 +6,24 @@
 //! and stay resident when freed. The soak test measured it (BENCHMARKS.md, "Soak"): 300 mixed
 //! requests grew a milling planner's RSS by 90–186 MiB with glibc's default, and by nothing
 //! with the threshold fixed.
+//!
+//! Small blocks (a message's per-point vectors: a 10⁶-point trajectory is 3·10⁶ blocks of
+//! 48 bytes) go to glibc's fastbins when freed, which never merge with their neighbours until
+//! something consolidates them; and even `malloc_trim` does not return the free top of a
+//! thread's arena (only the main arena's), where a message deserialized on an inbox thread
+//! lives. So the executor kept 58 MB of a 10⁶-point trajectory after serving it (measured
+//! with `cargo run --release -p kerf_executor --example trajectory_memory`, the request built
+//! on another thread). Fastbins are turned off as well (`M_MXFAST` 0): a freed block merges at
+//! once, and a free top of a thread's heap is returned as soon as it passes the trim threshold
+//! (128 KiB). Small allocations are still served by each thread's cache (tcache).
 
 /// `M_MMAP_THRESHOLD` of glibc's `mallopt` (malloc.h).
 #[cfg(all(target_os = "linux", target_env = "gnu"))]
 const M_MMAP_THRESHOLD: std::os::raw::c_int = -3;
+
+/// `M_MXFAST` of glibc's `mallopt` (malloc.h): the largest block size kept in fastbins.
+#[cfg(all(target_os = "linux", target_env = "gnu"))]
+const M_MXFAST: std::os::raw::c_int = 1;
 
 /// The fixed mmap threshold (bytes): glibc's default, without its dynamic increase.
 pub const MMAP_THRESHOLD_BYTES: i32 = 128 * 1024;
@@ -22,15 +36,20 @@ extern "C" {
 
 /// Fixes glibc's mmap threshold at [`MMAP_THRESHOLD_BYTES`] for the whole process, so that
 /// large buffers (received samples, request texts, answers) are returned to the system when
-/// freed. Called by every node binary and by `kerf` at start-up.
+/// freed, and turns fastbins off, so that many small freed blocks merge and are returned too
+/// (module docs). Called by every node binary and by `kerf` at start-up.
 ///
 /// # Returns
-/// Whether the setting was applied (false where the C library is not glibc).
+/// Whether the settings were applied (false where the C library is not glibc).
 pub fn release_large_allocations() -> bool {
     #[cfg(all(target_os = "linux", target_env = "gnu"))]
     {
         // SAFETY: mallopt only changes allocator tunables; it is thread-safe in glibc.
-        unsafe { mallopt(M_MMAP_THRESHOLD, MMAP_THRESHOLD_BYTES) == 1 }
+        unsafe {
+            let threshold = mallopt(M_MMAP_THRESHOLD, MMAP_THRESHOLD_BYTES) == 1;
+            let no_fastbins = mallopt(M_MXFAST, 0) == 1;
+            threshold && no_fastbins
+        }
     }
     #[cfg(not(all(target_os = "linux", target_env = "gnu")))]
     {

@@ -253,6 +253,22 @@ impl KerfNode {
         )
     }
 
+    /// How many DDS readers of the ROS topic `topic` (fully qualified, e.g. `/joint_states`)
+    /// of other participants this node's participant knows on the domain (its own are not
+    /// counted). A reader whose participant died stays counted until that participant's
+    /// lease ends, as it stays matched to every writer of the topic.
+    pub fn discovered_reader_count(&self, topic: &str) -> usize {
+        let Some(c) = self.context.as_ref() else {
+            return 0;
+        };
+        let dds_name = format!("rt{topic}");
+        c.domain_participant()
+            .discovered_readers()
+            .iter()
+            .filter(|r| *r.subscription_topic_data.topic_name() == dds_name)
+            .count()
+    }
+
     /// Expands and remaps a topic or service name as this node sees it.
     pub fn resolve(&self, name: &str) -> Result<String, RosError> {
         names::resolve(name, &self.namespace, &self.name, &self.remaps)
@@ -288,14 +304,36 @@ impl KerfNode {
 
     /// Creates a publisher on `topic` that runs on its own thread behind a queue of `capacity`
     /// samples ([`Streamer`]): publishing never blocks the caller.
+    ///
+    /// Its DDS writer's send window is [`qos::send_window`]`(rate_hz)` samples, so that a
+    /// reader that stops acknowledging (its process died or stopped) is dropped by its
+    /// participant's lease before the window fills: the other readers never see it (the
+    /// [`qos`] module docs).
+    ///
+    /// # Arguments
+    /// * `rate_hz` – how often the stream is published (Hz).
+    ///
+    /// # Errors
+    /// A bad topic or type name, a `rate_hz` out of range (named), or a DDS failure.
     pub fn streamer<M: Serialize + Send + 'static>(
         &mut self,
         topic: &str,
         ros_type: &str,
         qos: QosProfile,
         capacity: usize,
+        rate_hz: f64,
     ) -> Result<Streamer<M>, RosError> {
-        let p = self.publisher(topic, ros_type, qos)?;
+        let window = qos::send_window(rate_hz).map_err(|reason| RosError::Dds {
+            what: format!("publisher on {topic}"),
+            reason,
+        })?;
+        let (pkg, ty) = split_type(ros_type, "msg")?;
+        let name = self.ros_name(topic)?;
+        let t = self.limited_topic(&name, MessageTypeName::new(pkg, ty), &qos, window)?;
+        let p = self
+            .node_mut()?
+            .create_publisher(&t, Some(qos))
+            .map_err(dds_err(format!("publisher on {name}")))?;
         Streamer::new(p, capacity, topic.trim_start_matches(['~', '/'])).map_err(|e| {
             RosError::Dds {
                 what: format!("publisher thread for {topic}"),
@@ -313,27 +351,35 @@ impl KerfNode {
     ) -> Result<Subscription<M>, RosError> {
         let (pkg, ty) = split_type(ros_type, "msg")?;
         let name = self.ros_name(topic)?;
-        let t = self.bounded_topic(&name, MessageTypeName::new(pkg, ty), &qos)?;
+        let depth = match qos.history {
+            History::KeepLast { depth } => depth,
+            History::KeepAll => qos::DEFAULT_DEPTH,
+        };
+        let t = self.limited_topic(&name, MessageTypeName::new(pkg, ty), &qos, depth)?;
         self.node_mut()?
             .create_subscription(&t, Some(qos))
             .map_err(dds_err(format!("subscription on {name}")))
     }
 
-    /// Creates the DDS topic of a subscription with a resource limit of `depth` samples.
+    /// Creates the DDS topic `name` with a resource limit of `max_samples` samples.
     ///
-    /// RustDDS keeps every received sample in the participant's topic cache, taken or not,
-    /// until newer ones push it out; the count it keeps is the largest of the topic's
-    /// `ResourceLimits::max_samples` and history depths ever given, and ros2-client sets no
-    /// resource limit, so RustDDS's default of 64 applies: 64 large samples per topic stay in
-    /// memory (issue 11, item 5). Created here with `max_samples` = the keep-last depth, the
-    /// cache keeps at most `depth` samples. The limit is only ever raised: another topic of
-    /// the same name created in this participant through ros2-client (a publisher on it)
-    /// would raise it to 64 again, so publishers leave topics that are subscribed alone.
-    fn bounded_topic(
+    /// * For a subscription, `max_samples` is its keep-last depth. RustDDS keeps every
+    ///   received sample in the participant's topic cache, taken or not, until newer ones push
+    ///   it out; the count it keeps is the largest of the topic's `ResourceLimits::max_samples`
+    ///   and history depths ever given, and ros2-client sets no resource limit, so RustDDS's
+    ///   default of 64 applies: 64 large samples per topic stay in memory (issue 11, item 5).
+    ///   With the limit, the cache keeps at most `depth` samples. The limit is only ever
+    ///   raised: another topic of the same name created in this participant (a publisher on
+    ///   it) raises it again, so publishers leave topics that are subscribed alone.
+    /// * For a stream's writer, `max_samples` is its send window ([`qos::send_window`]): a
+    ///   writer's QoS takes the topic's resource limits, and RustDDS's window is their
+    ///   `max_samples`.
+    fn limited_topic(
         &self,
         name: &Name,
         type_name: MessageTypeName,
         qos: &QosProfile,
+        max_samples: usize,
     ) -> Result<Topic, RosError> {
         let context = self.context.as_ref().ok_or_else(|| RosError::Dds {
             what: format!("topic {name}"),
@@ -343,16 +389,12 @@ impl KerfNode {
             name: self.fqn(),
             reason: format!("{e:?}"),
         })?;
-        let depth = match qos.history {
-            History::KeepLast { depth } => depth,
-            History::KeepAll => qos::DEFAULT_DEPTH,
-        };
-        let depth = i32::try_from(depth.max(1)).unwrap_or(i32::MAX);
+        let limit = i32::try_from(max_samples.max(1)).unwrap_or(i32::MAX);
         let limits = QosPolicyBuilder::new()
             .resource_limits(ResourceLimits {
-                max_samples: depth,
+                max_samples: limit,
                 max_instances: 1,
-                max_samples_per_instance: depth,
+                max_samples_per_instance: limit,
             })
             .build();
         let dds_qos = QosPolicies::from(qos).modify_by(&limits);

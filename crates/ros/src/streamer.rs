@@ -1,10 +1,15 @@
 //! [`Streamer`]: publishing that never blocks the caller.
 //!
 //! A reliable DDS writer blocks `publish` when a matched reliable reader stops acknowledging
-//! and the send window fills (RustDDS: 8192 samples, then up to `when_full` per sample). A
-//! control loop must not stall because a remote tool is slow, so high-rate streams are handed
-//! to a thread through a bounded queue: when the queue is full the newest sample is dropped
-//! and counted, and the control loop goes on.
+//! and the send window fills (RustDDS: `ResourceLimits::max_samples`, 8192 by default, then
+//! up to `when_full` per sample). A control loop must not stall because a remote tool is
+//! slow, so high-rate streams are handed to a thread through a bounded queue: when the queue
+//! is full the newest sample is dropped and counted, and the control loop goes on.
+//!
+//! The queue protects the caller; the window protects the other readers:
+//! [`crate::KerfNode::streamer`] gives the writer a window of [`crate::qos::send_window`]
+//! samples, longer than the lease after which a reader that stopped acknowledging (a dead or
+//! stopped process) is dropped, so that such a reader never fills it ([`crate::qos`]).
 
 use std::{
     sync::{
@@ -68,7 +73,8 @@ impl<M: Serialize + Send + 'static> Streamer<M> {
         self.dropped.load(Ordering::Relaxed)
     }
 
-    /// Samples the DDS writer refused (send window full past `when_full`).
+    /// Samples the DDS writer refused (send window full past `when_full`: a reader has not
+    /// acknowledged for the whole window, longer than any default lease).
     pub fn failed(&self) -> u64 {
         self.failed.load(Ordering::Relaxed)
     }

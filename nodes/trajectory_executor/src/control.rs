@@ -93,8 +93,10 @@ pub enum Command {
 }
 
 /// Something the trajectory's size makes expensive to free: freed by the request thread.
-// The fields are never read: they exist to be dropped off the control thread.
-#[allow(dead_code)]
+// The fields are never read: they exist to be dropped off the control thread. The variants
+// differ in size (a trajectory's few hundred bytes of state against a prepared one's shared
+// pointer); boxing would allocate on the control thread to save that on a channel message.
+#[allow(dead_code, clippy::large_enum_variant)]
 pub enum Trash {
     /// A prepared trajectory after its start or dry run.
     Prepared(PreparedTrajectory),

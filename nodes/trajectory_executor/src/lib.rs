@@ -60,6 +60,7 @@ pub mod control;
 pub mod convert;
 mod goals;
 pub mod hardware;
+pub mod memory;
 mod validate_service;
 
 use std::{
@@ -151,6 +152,17 @@ enum Incoming {
     Goal(Box<FollowJointTrajectoryGoal>),
     /// An empty topic trajectory: nothing to prepare, kept in order with the others.
     Stop,
+}
+
+impl Incoming {
+    /// Number of trajectory points the request carries.
+    fn point_count(&self) -> usize {
+        match self {
+            Incoming::Trajectory(msg) => msg.points.len(),
+            Incoming::Goal(goal) => goal.trajectory.points.len(),
+            Incoming::Stop => 0,
+        }
+    }
 }
 
 /// What the worker returns: `None` for [`Incoming::Stop`].
@@ -267,26 +279,43 @@ impl ExecutorNode {
         let validate_srv =
             node.service_server("~/validate_trajectory", "kerf_msgs/srv/ValidateTrajectory")?;
         // Outgoing streams leave the control thread through bounded queues: a stalled
-        // subscriber can cost samples but never blocks the control loop.
-        let q = STREAM_QUEUE;
+        // subscriber can cost samples but never blocks the control loop. Each is published
+        // once per control period at most, and its writer's send window outlasts the lease of
+        // a reader that stops acknowledging (`kerf_ros::qos::send_window`): a dead reader
+        // never stalls the others.
+        let (q, rate) = (STREAM_QUEUE, cfg.control_rate);
         let streams = control::Streams {
-            joint_states: node.streamer("joint_states", JointState::ROS_TYPE, qos::state(), q)?,
+            joint_states: node.streamer(
+                "joint_states",
+                JointState::ROS_TYPE,
+                qos::state(),
+                q,
+                rate,
+            )?,
             controller_state: node.streamer(
                 "~/controller_state",
                 JointTrajectoryControllerState::ROS_TYPE,
                 qos::state(),
                 q,
+                rate,
             )?,
-            command: node.streamer("~/joint_command", JointState::ROS_TYPE, qos::state(), q)?,
+            command: node.streamer(
+                "~/joint_command",
+                JointState::ROS_TYPE,
+                qos::state(),
+                q,
+                rate,
+            )?,
             sim: match &cfg.sim {
                 None => None,
                 Some(_) => Some(control::SimStreams {
-                    clock: node.streamer("/clock", ClockMsg::ROS_TYPE, qos::state(), q)?,
+                    clock: node.streamer("/clock", ClockMsg::ROS_TYPE, qos::state(), q, rate)?,
                     contacts: node.streamer(
                         "~/contacts",
                         CellContacts::ROS_TYPE,
                         qos::state(),
                         q,
+                        rate,
                     )?,
                     frame_id: cfg.robot.root_link().to_string(),
                 }),
@@ -297,6 +326,7 @@ impl ExecutorNode {
             TrajectoryStatus::ROS_TYPE,
             qos::latched(),
             q,
+            rate,
         )?;
         let log = node.logger();
         let clock = if cfg.sim.is_some() {
@@ -310,7 +340,8 @@ impl ExecutorNode {
             let prepared = |req: TrajectoryRequest, tol: GoalTolerances| -> Prepared {
                 Ok((prepare(&limits, &exec_cfg, &req)?, tol))
             };
-            match incoming {
+            let points = incoming.point_count();
+            let result = match incoming {
                 Incoming::Stop => None,
                 Incoming::Trajectory(msg) => Some(
                     convert::trajectory_request(&msg, &prep_clock)
@@ -320,7 +351,13 @@ impl ExecutorNode {
                     convert::goal_request(&goal, &prep_clock)
                         .and_then(|(req, tol)| prepared(req, tol)),
                 ),
+            };
+            // The message and the request are freed by now; the prepared trajectory keeps
+            // only its compact arrays.
+            if points >= memory::TRIM_AFTER_POINTS {
+                memory::give_back_freed_memory();
             }
+            result
         })
         .map_err(|e| RosError::Dds {
             what: "trajectory preparation thread".into(),
