@@ -175,7 +175,8 @@ fn axis(x0: f64, h: f64, lo: f64, hi: f64) -> Result<(Vec<f64>, usize), MillPlan
     // overflow the node count (issue 33: "capacity overflow").
     let below = ((x0 - lo) / h + 1e-9).floor();
     let above = ((hi - x0) / h + 1e-9).floor();
-    if !(below + above < MAX_AXIS_NODES as f64) {
+    let nodes = below + above;
+    if nodes.is_nan() || nodes >= MAX_AXIS_NODES as f64 {
         return Err(MillPlanError::InvalidParameter {
             name: "DP grid axis (range / step)".to_string(),
             value: below + above + 1.0,

@@ -136,7 +136,7 @@ pub fn path_grid(cell: &MillCell, g0: f64) -> Result<GridSpec, MillPlanError> {
     // Counted in f64 before allocating: a spindle range of 1e308 rpm saturated the cast and
     // panicked collecting the nodes ("capacity overflow", issue 33).
     let intervals = ((r1 - r0) / RPM_SPACING).ceil().max(1.0);
-    if !(intervals <= MAX_RPM_INTERVALS as f64) {
+    if intervals.is_nan() || intervals > MAX_RPM_INTERVALS as f64 {
         return Err(bad(
             "spindle speed",
             format!(
