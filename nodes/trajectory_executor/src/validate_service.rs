@@ -1,7 +1,10 @@
-//! The `~/validate_trajectory` service side of the request thread: a trajectory is prepared
-//! like any other (in arrival order, off the control thread) and answered valid or not.
+//! The `~/validate_trajectory` service side of the request thread: a request whose numbers
+//! break their declared rules ([`kerf_msgs::numbers`]) is answered invalid at once, naming the
+//! field (`trajectory.points[2].positions[0]`); any other trajectory is prepared like any other
+//! (in arrival order, off the control thread) and answered valid or not.
 
 use kerf_executor::SUCCESSFUL;
+use kerf_msgs::numbers::NumberFields;
 use kerf_msgs::srv::ValidateTrajectoryResponse;
 use ros2_client::RmwRequestId;
 
@@ -15,7 +18,10 @@ impl ExecutorNode {
                 .error(&format!("could not read a validate request: {e}"));
         }
         for (req_id, req) in requests {
-            self.enqueue(Job::Validate(req_id), Incoming::Trajectory(req.trajectory));
+            match req.check_numbers() {
+                Ok(()) => self.enqueue(Job::Validate(req_id), Incoming::Trajectory(req.trajectory)),
+                Err(e) => self.answer_validate(req_id, Err(crate::convert::number_rejection(e))),
+            }
         }
     }
 

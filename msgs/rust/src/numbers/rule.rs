@@ -140,12 +140,12 @@ impl Rule {
         };
         let mut text = format!(
             "must be in {open}{}, {}{close} {}",
-            format_value(self.lo.value()),
-            format_value(self.hi.value()),
+            bound_text(self.lo.value()),
+            bound_text(self.hi.value()),
             self.unit
         );
         for (value, meaning) in self.special {
-            text.push_str(&format!(", or {} = {meaning}", format_value(*value)));
+            text.push_str(&format!(", or {} = {meaning}", bound_text(*value)));
         }
         if let Some(flag) = self.when {
             text.push_str(&format!(" (when {flag} is true; else only finite)"));
@@ -157,6 +157,15 @@ impl Rule {
     /// by `.`, `[]` for indices).
     pub fn matches(&self, key: &str) -> bool {
         pattern_matches(self.field, key)
+    }
+}
+
+/// A bound as text: whole numbers in full (`2147483647`, `100000`), others short.
+fn bound_text(v: f64) -> String {
+    if v.fract() == 0.0 && v.abs() < 1e16 {
+        format!("{}", v as i64)
+    } else {
+        format_value(v)
     }
 }
 
