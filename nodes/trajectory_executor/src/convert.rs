@@ -117,7 +117,24 @@ fn duration_secs(d: &Duration, what: &str) -> Result<f64, Rejection> {
 pub fn number_rejection(e: NumberError) -> Rejection {
     Rejection {
         code: INVALID_GOAL,
-        message: format!("invalid number: {e}"),
+        message: format!("{NUMBER_REJECTION}{e}"),
+    }
+}
+
+/// How the message of a [`number_rejection`] starts.
+pub const NUMBER_REJECTION: &str = "invalid number: ";
+
+/// `rejection` with the field of a [`number_rejection`] named inside the message that holds
+/// the trajectory (`prefix` `trajectory.` for the `ValidateTrajectory` request, whose
+/// trajectory the prepare worker checks); any other rejection unchanged.
+pub fn number_rejection_within(rejection: Rejection, prefix: &str) -> Rejection {
+    let field = format!("{NUMBER_REJECTION}field `");
+    match rejection.message.strip_prefix(&field) {
+        Some(rest) => Rejection {
+            code: rejection.code,
+            message: format!("{field}{prefix}{rest}"),
+        },
+        None => rejection,
     }
 }
 
@@ -335,12 +352,15 @@ mod tests {
             "{}",
             e.message
         );
-        // The validate service's request names the field under `trajectory`.
+        // The validate service's answer names the field under `trajectory`, as the request's
+        // own check does.
         let mut req = kerf_msgs::srv::ValidateTrajectoryRequest {
             trajectory: two_points(),
         };
         req.trajectory.points[0].positions[1] = f64::INFINITY;
         let e = number_rejection(req.check_numbers().unwrap_err());
+        let worker = trajectory_request(&req.trajectory, &clock).unwrap_err();
+        assert_eq!(number_rejection_within(worker, "trajectory."), e);
         assert_eq!(e.code, INVALID_GOAL);
         assert!(
             e.message

@@ -1,10 +1,10 @@
-//! The `~/validate_trajectory` service side of the request thread: a request whose numbers
-//! break their declared rules ([`kerf_msgs::numbers`]) is answered invalid at once, naming the
-//! field (`trajectory.points[2].positions[0]`); any other trajectory is prepared like any other
-//! (in arrival order, off the control thread) and answered valid or not.
+//! The `~/validate_trajectory` service side of the request thread: a trajectory is prepared
+//! like any other (in arrival order, off the control thread; its numbers checked against their
+//! declared rules, [`kerf_msgs::numbers`], by the prepare worker) and answered valid or not; a
+//! number outside its rule is named as a field of the request
+//! (`trajectory.points[2].positions[0]`).
 
 use kerf_executor::SUCCESSFUL;
-use kerf_msgs::numbers::NumberFields;
 use kerf_msgs::srv::ValidateTrajectoryResponse;
 use ros2_client::RmwRequestId;
 
@@ -18,10 +18,7 @@ impl ExecutorNode {
                 .error(&format!("could not read a validate request: {e}"));
         }
         for (req_id, req) in requests {
-            match req.check_numbers() {
-                Ok(()) => self.enqueue(Job::Validate(req_id), Incoming::Trajectory(req.trajectory)),
-                Err(e) => self.answer_validate(req_id, Err(crate::convert::number_rejection(e))),
-            }
+            self.enqueue(Job::Validate(req_id), Incoming::Trajectory(req.trajectory));
         }
     }
 
@@ -37,12 +34,15 @@ impl ExecutorNode {
                 message: "valid".into(),
                 duration,
             },
-            Err(rej) => ValidateTrajectoryResponse {
-                valid: false,
-                error_code: rej.code,
-                message: rej.message,
-                duration: 0.0,
-            },
+            Err(rej) => {
+                let rej = crate::convert::number_rejection_within(rej, "trajectory.");
+                ValidateTrajectoryResponse {
+                    valid: false,
+                    error_code: rej.code,
+                    message: rej.message,
+                    duration: 0.0,
+                }
+            }
         };
         if let Err(e) = self.validate_srv.send_response(req_id, resp) {
             self.log
