@@ -121,6 +121,28 @@ pub fn number_rejection(e: NumberError) -> Rejection {
     }
 }
 
+/// [`number_rejection`], naming also the joint of a per-joint array entry
+/// (`points[2].positions[4]` of joints `joint_1` … `joint_6`: `(joint joint_5)`).
+fn joint_rejection(e: NumberError, joint_names: &[String]) -> Rejection {
+    let joint = e
+        .field
+        .strip_suffix(']')
+        .and_then(|f| f.rsplit_once('['))
+        .filter(|(head, _)| {
+            [".positions", ".velocities", ".accelerations", ".effort"]
+                .iter()
+                .any(|a| head.ends_with(a))
+        })
+        .and_then(|(_, j)| j.parse::<usize>().ok())
+        .and_then(|j| joint_names.get(j))
+        .map(|name| format!(" (joint {name})"));
+    let mut rejection = number_rejection(e);
+    if let Some(joint) = joint {
+        rejection.message.push_str(&joint);
+    }
+    rejection
+}
+
 /// How the message of a [`number_rejection`] starts.
 pub const NUMBER_REJECTION: &str = "invalid number: ";
 
@@ -150,7 +172,8 @@ pub fn trajectory_request(
     msg: &JointTrajectory,
     clock: &Clock,
 ) -> Result<TrajectoryRequest, Rejection> {
-    msg.check_numbers().map_err(number_rejection)?;
+    msg.check_numbers()
+        .map_err(|e| joint_rejection(e, &msg.joint_names))?;
     convert_trajectory(msg, clock)
 }
 
@@ -190,7 +213,8 @@ pub fn goal_request(
     goal: &FollowJointTrajectoryGoal,
     clock: &Clock,
 ) -> Result<(TrajectoryRequest, GoalTolerances), Rejection> {
-    goal.check_numbers().map_err(number_rejection)?;
+    goal.check_numbers()
+        .map_err(|e| joint_rejection(e, &goal.trajectory.joint_names))?;
     let md = &goal.multi_dof_trajectory;
     if !md.joint_names.is_empty() || !md.points.is_empty() {
         return Err(Rejection {
@@ -306,6 +330,11 @@ mod tests {
                 let e = trajectory_request(&msg, &clock).unwrap_err();
                 assert_eq!(e.code, INVALID_GOAL);
                 assert!(e.message.contains(&format!("`{path}`")), "{}", e.message);
+                assert!(
+                    e.message.ends_with(")"),
+                    "the joint is named: {}",
+                    e.message
+                );
                 let goal = FollowJointTrajectoryGoal {
                     trajectory: msg,
                     ..Default::default()
@@ -358,9 +387,11 @@ mod tests {
             trajectory: two_points(),
         };
         req.trajectory.points[0].positions[1] = f64::INFINITY;
-        let e = number_rejection(req.check_numbers().unwrap_err());
         let worker = trajectory_request(&req.trajectory, &clock).unwrap_err();
-        assert_eq!(number_rejection_within(worker, "trajectory."), e);
+        let e = number_rejection_within(worker, "trajectory.");
+        assert!(e.message.ends_with("(joint b)"), "{}", e.message);
+        let own = req.check_numbers().unwrap_err();
+        assert!(e.message.contains(&own.to_string()), "{}", e.message);
         assert_eq!(e.code, INVALID_GOAL);
         assert!(
             e.message
