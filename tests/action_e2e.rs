@@ -318,7 +318,8 @@ fn refuses_bad_numbers_naming_the_field_and_keeps_serving() {
     let mut cell = Cell::start(47);
     let start = cell.position();
     let target = [0.2; 6];
-    let cases: [(&str, fn(&mut JointTrajectory)); 4] = [
+    type Set = fn(&mut JointTrajectory);
+    let cases: [(&str, Set); 4] = [
         ("points[1].velocities[0]", |t| {
             t.points[1].velocities[0] = f64::INFINITY
         }),
