@@ -461,13 +461,14 @@ feed_law: constant
     }
 
     #[test]
-    fn non_finite_values_reach_validation_and_are_refused() {
+    fn non_finite_values_are_refused_naming_the_message_field() {
         let text = LINES.replace("0.15 0.20 0.30", "0.15 NaN 0.30");
-        let r = parse_request(&text).unwrap();
-        let e = r.validate().unwrap_err().to_string();
-        assert!(e.contains("points[1]") && e.contains("not finite"), "{e}");
+        let e = parse_request(&text).unwrap_err();
+        assert_eq!(e.request_id, "slot-3");
+        let e = e.to_string();
+        assert!(e.contains("points[1].y") && e.contains("finite"), "{e}");
         let text = LINES.replace("feedrate: 0.3333", "feedrate: inf");
-        let e = parse_request(&text).unwrap().validate().unwrap_err();
+        let e = parse_request(&text).unwrap_err();
         assert!(e.to_string().contains("feedrate"), "{e}");
     }
 
