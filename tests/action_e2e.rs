@@ -310,6 +310,64 @@ fn refuses_bad_goals_with_code_and_reason_and_keeps_serving() {
     cell.wait_state(|s| max_diff(&s.position, &target) < 1e-6, "arrival");
 }
 
+/// Issue 33, item 1: NaN, infinite and huge numbers in a goal or a validate request are
+/// refused by their declared rules (kerf_msgs::numbers), the field named, and the executor
+/// keeps serving.
+#[test]
+fn refuses_bad_numbers_naming_the_field_and_keeps_serving() {
+    let mut cell = Cell::start(47);
+    let start = cell.position();
+    let target = [0.2; 6];
+    type Set = fn(&mut JointTrajectory);
+    let cases: [(&str, Set); 4] = [
+        ("points[1].velocities[0]", |t| {
+            t.points[1].velocities[0] = f64::INFINITY
+        }),
+        ("points[2].positions[3]", |t| {
+            t.points[2].positions[3] = 1e308
+        }),
+        ("points[0].accelerations[5]", |t| {
+            t.points[0].accelerations[5] = f64::NEG_INFINITY
+        }),
+        ("points[4].time_from_start.sec", |t| {
+            t.points[4].time_from_start.sec = i32::MAX
+        }),
+    ];
+    for (field, set) in cases {
+        let mut bad = min_jerk(&JOINTS, &start, &target, 1.0, 5);
+        set(&mut bad);
+        let (status, r) = cell.result(cell.send(goal(bad.clone())));
+        assert_eq!(status, GoalStatusEnum::Aborted);
+        assert_eq!(r.error_code, FollowJointTrajectoryResult::INVALID_GOAL);
+        assert!(
+            r.error_string.contains(&format!("`trajectory.{field}`")),
+            "{}",
+            r.error_string
+        );
+        let v = cell.validate(bad);
+        assert!(!v.valid);
+        assert_eq!(v.error_code, FollowJointTrajectoryResult::INVALID_GOAL);
+        assert!(
+            v.message.contains(&format!("`trajectory.{field}`")),
+            "{}",
+            v.message
+        );
+    }
+    let mut late = goal(min_jerk(&JOINTS, &start, &target, 1.0, 5));
+    late.goal_time_tolerance.nanosec = u32::MAX;
+    let (status, r) = cell.result(cell.send(late));
+    assert_eq!(status, GoalStatusEnum::Aborted);
+    assert!(
+        r.error_string.contains("`goal_time_tolerance.nanosec`"),
+        "{}",
+        r.error_string
+    );
+    // Nothing moved, and a valid goal still succeeds.
+    assert!(max_diff(&cell.position(), &start) < 1e-12);
+    let (status, r) = cell.result(cell.send(goal(min_jerk(&JOINTS, &start, &target, 1.0, 10))));
+    assert_eq!(status, GoalStatusEnum::Succeeded, "{r:?}");
+}
+
 #[test]
 fn a_new_goal_preempts_the_active_one_without_a_jump() {
     let mut cell = Cell::start(43);

@@ -156,7 +156,7 @@ fn a_program_runs_from_planner_through_executor_and_bad_ones_are_answered() {
             "request_id: negative-jerk\nlimits: {tangential_jerk: -1.0}\nprogram: \"G1 X1 F100\"\n"
                 .into(),
             GcodePlan::INVALID_REQUEST,
-            &["tangential jerk"],
+            &["tangential", "jerk"],
         ),
         (
             "yaml",

@@ -210,7 +210,7 @@ fn bad_requests_get_their_status_and_the_node_keeps_serving() {
             "nan-point",
             MillPlan::INVALID_REQUEST,
             Box::new(|m| m.points[1].y = f64::NAN),
-            s(&["points[1][1] [m]", "NaN"]),
+            s(&["points[1]", "NaN"]),
         ),
         (
             "nan-initial-feed",
@@ -221,7 +221,7 @@ fn bad_requests_get_their_status_and_the_node_keeps_serving() {
                 m.initial_feed = f64::NAN;
                 m.initial_g = 0.0;
             }),
-            s(&["initial.feed [m/s]", "finite"]),
+            s(&["initial", "feed", "finite"]),
         ),
         (
             "missing-policy",
@@ -264,7 +264,7 @@ fn bad_requests_get_their_status_and_the_node_keeps_serving() {
                 m.has_tolerances = true;
                 m.path_tolerance = 0.0;
             }),
-            s(&["tolerances.path_tolerance [m]", "must be > 0"]),
+            s(&["path_tolerance", "0"]),
         ),
         (
             "unmeetable-condition",
@@ -331,7 +331,7 @@ fn bad_requests_get_their_status_and_the_node_keeps_serving() {
         &planner.next_plan(PLANNING),
         "text-nan",
         MillPlan::INVALID_REQUEST,
-        &["points[1][1] [m]", "NaN"],
+        &["points[1]", "NaN"],
     );
     expect(
         &planner.next_plan(PLANNING),

@@ -172,11 +172,7 @@ fn bad_requests_get_their_status_and_the_node_keeps_serving() {
             },
             &["1 axes for 2 CL points"],
         ),
-        (
-            "non-unit-axis",
-            |m| m.axes[1].z = 2.0,
-            &["axes[1]", "norm 2.0"],
-        ),
+        ("non-unit-axis", |m| m.axes[1].z = 2.0, &["axes[1]"]),
         (
             "zero-axis",
             |m| m.axes[0].z = 0.0,
@@ -185,7 +181,7 @@ fn bad_requests_get_their_status_and_the_node_keeps_serving() {
         (
             "nan-point",
             |m| m.points[1].y = f64::NAN,
-            &["points[1]", "not finite"],
+            &["points[1]", "finite"],
         ),
         (
             "repeated-point",
@@ -215,7 +211,7 @@ fn bad_requests_get_their_status_and_the_node_keeps_serving() {
         (
             "negative-feedrate",
             |m| m.feedrate = -0.3,
-            &["feedrate", "must be > 0"],
+            &["feedrate", "-0.3"],
         ),
         (
             "bad-rto-indices",
@@ -267,7 +263,7 @@ fn bad_requests_get_their_status_and_the_node_keeps_serving() {
         &plan,
         "text-nan",
         CutPlan::INVALID_REQUEST,
-        &["points[1]", "not finite"],
+        &["points[1]", "finite"],
     );
 
     // Still serving after every failure.

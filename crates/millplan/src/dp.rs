@@ -157,6 +157,10 @@ impl DpSpec {
     }
 }
 
+/// Most nodes of one axis of the DP grid (spindle speed, feed or g): the DP's tables grow
+/// with the product of the three.
+pub const MAX_AXIS_NODES: usize = 100_000;
+
 /// Grid nodes `x0 + k h` within [lo, hi] (with a 1e-9 relative tolerance),
 /// and the index of x0.
 fn axis(x0: f64, h: f64, lo: f64, hi: f64) -> Result<(Vec<f64>, usize), MillPlanError> {
@@ -167,8 +171,21 @@ fn axis(x0: f64, h: f64, lo: f64, hi: f64) -> Result<(Vec<f64>, usize), MillPlan
             reason: format!("must be inside its range [{lo}, {hi}]"),
         });
     }
-    let below = ((x0 - lo) / h + 1e-9).floor() as usize;
-    let above = ((hi - x0) / h + 1e-9).floor() as usize;
+    // Counted in f64 before any allocation: a range of 1e308 rpm would saturate the casts and
+    // overflow the node count (issue 33: "capacity overflow").
+    let below = ((x0 - lo) / h + 1e-9).floor();
+    let above = ((hi - x0) / h + 1e-9).floor();
+    let nodes = below + above;
+    if nodes.is_nan() || nodes >= MAX_AXIS_NODES as f64 {
+        return Err(MillPlanError::InvalidParameter {
+            name: "DP grid axis (range / step)".to_string(),
+            value: below + above + 1.0,
+            reason: format!(
+                "[{lo}, {hi}] at steps of {h} needs more than {MAX_AXIS_NODES} grid nodes"
+            ),
+        });
+    }
+    let (below, above) = (below as usize, above as usize);
     let nodes = (0..=below + above)
         .map(|k| x0 + (k as f64 - below as f64) * h)
         .collect();

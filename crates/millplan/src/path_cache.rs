@@ -84,6 +84,9 @@ pub const PATH_CACHE_MEMO: usize = 8;
 pub const SEGMENT_SPACING_M: f64 = 0.1;
 /// Largest spacing of the spindle-speed nodes \[rpm\].
 pub const RPM_SPACING: f64 = 200.0;
+/// Most spindle-speed intervals of a per-path cache (500 cover 100 000 rpm, the fastest spindle
+/// a request may ask for).
+pub const MAX_RPM_INTERVALS: usize = 1000;
 /// The feed nodes as fractions of [f_lo, f_max] (module documentation).
 pub const FEED_FRACTIONS: [f64; 4] = [0.0, 0.4, 0.7, 1.0];
 /// Spacing of the g nodes \[rad\] (the default g step bound).
@@ -130,7 +133,19 @@ pub fn path_grid(cell: &MillCell, g0: f64) -> Result<GridSpec, MillPlanError> {
         seg.push(n - 1);
     }
     let [r0, r1] = lim.spindle_rpm;
-    let intervals = ((r1 - r0) / RPM_SPACING).ceil().max(1.0) as usize;
+    // Counted in f64 before allocating: a spindle range of 1e308 rpm saturated the cast and
+    // panicked collecting the nodes ("capacity overflow", issue 33).
+    let intervals = ((r1 - r0) / RPM_SPACING).ceil().max(1.0);
+    if intervals.is_nan() || intervals > MAX_RPM_INTERVALS as f64 {
+        return Err(bad(
+            "spindle speed",
+            format!(
+                "the range [{r0}, {r1}] rpm at {RPM_SPACING} rpm spacing needs {intervals} \
+                 intervals, more than {MAX_RPM_INTERVALS}"
+            ),
+        ));
+    }
+    let intervals = intervals as usize;
     let rpm: Vec<f64> = (0..=intervals)
         .map(|k| r0 + (r1 - r0) * k as f64 / intervals as f64)
         .collect();

@@ -17,6 +17,9 @@
 //! Every mirror implements [`RosType`]. With the `ros2` feature every mirror
 //! also implements `ros2_client::Message`.
 //!
+//! [`numbers`] declares the rule of every numeric field of every request message and checks a
+//! message against them ([`numbers::NumberFields::check_numbers`]).
+//!
 //! [`idl`] parses `.msg`, `.srv` and `.action` files (the ROS 2 interface
 //! definition format, as `rosidl_adapter` reads it).
 
@@ -26,6 +29,7 @@ mod error;
 pub mod geometry_msgs;
 pub mod idl;
 pub mod msg;
+pub mod numbers;
 mod ros_type;
 pub mod rosgraph_msgs;
 pub mod sensor_msgs;

@@ -2,6 +2,7 @@
 
 use kerf_gcodeplan::{GcodePlan, GcodePlanError, GcodeRequest, LimitOverrides, RunKind};
 use kerf_msgs::msg;
+use kerf_msgs::numbers::{check_value, Number, NumberError, NumberFields, NumberRules};
 
 /// The status of a planner error.
 ///
@@ -42,6 +43,60 @@ pub fn error_line(e: &GcodePlanError) -> u32 {
         _ => 0,
     };
     u32::try_from(line).unwrap_or(u32::MAX)
+}
+
+/// A number outside its declared rule ([`kerf_msgs::numbers`]) as the planner's error:
+/// INVALID_REQUEST naming the message's field, e.g. `max_feed: 5e-324 must not be denormal`.
+pub fn number_error(e: NumberError) -> GcodePlanError {
+    GcodePlanError::InvalidRequest {
+        field: e.field,
+        reason: format!("{} {}", e.value, e.rule),
+    }
+}
+
+/// Checks every numeric field of a `GcodeRequest` message against its declared rule
+/// ([`kerf_msgs::numbers::gcode`]).
+///
+/// # Errors
+/// [`GcodePlanError::InvalidRequest`] naming the first field outside its rule.
+pub fn check_numbers(m: &msg::GcodeRequest) -> Result<(), GcodePlanError> {
+    m.check_numbers().map_err(number_error)
+}
+
+/// Checks every number of a YAML request ([`GcodeRequest`]) against the rule of its
+/// `GcodeRequest` message field, named as in the message (`limits.max_feed` is `max_feed`,
+/// `origin[1]` is `origin.y`). A value given is used, so its full rule applies: a NaN
+/// `redundancy_angle` is refused on either machine.
+///
+/// # Errors
+/// [`GcodePlanError::InvalidRequest`] naming the first field outside its rule.
+pub fn check_text_numbers(r: &GcodeRequest) -> Result<(), GcodePlanError> {
+    let rules = <msg::GcodeRequest as NumberRules>::SECTIONS;
+    let opt = |path: &str, v: Option<f64>| {
+        v.map_or(Ok(()), |v| check_value(rules, path, Number::Float(v)))
+    };
+    let run = || -> Result<(), NumberError> {
+        opt("tolerance", r.tolerance)?;
+        if let Some(l) = &r.limits {
+            opt("max_feed", l.max_feed)?;
+            opt("tangential_acceleration", l.tangential_acceleration)?;
+            opt("tangential_jerk", l.tangential_jerk)?;
+            opt("normal_acceleration", l.normal_acceleration)?;
+            opt("normal_jerk", l.normal_jerk)?;
+            opt("chord_error", l.chord_error)?;
+            opt("contour_error", l.contour_error)?;
+        }
+        opt("rapid_feed", r.rapid_feed)?;
+        if let Some(o) = r.origin {
+            for (c, v) in ["x", "y", "z"].iter().zip(o) {
+                opt(&format!("origin.{c}"), Some(v))?;
+            }
+        }
+        opt("redundancy_angle", r.redundancy_angle)?;
+        opt("standoff_axis", r.standoff_axis)?;
+        opt("time_budget", r.time_budget)
+    };
+    run().map_err(number_error)
 }
 
 /// A request message as a [`GcodeRequest`]: empty strings and zeros are "not given" where

@@ -9,6 +9,10 @@
 //! tolerance: 1.0e-4
 //! ```
 //!
+//! Every number is checked against the declared rule of its `kerf_msgs/msg/GcodeRequest`
+//! field ([`kerf_msgs::numbers`]), named as in the message
+//! ([`crate::convert::check_text_numbers`]).
+//!
 //! `~/gcode_plan_text` carries each `GcodePlan` answer as YAML.
 
 use kerf_gcodeplan::{GcodePlanError, GcodeRequest};
@@ -34,9 +38,11 @@ pub fn parse_request(text: &str) -> Result<GcodeRequest, TextRequestError> {
             }),
         });
     }
-    GcodeRequest::from_yaml_str(text).map_err(|error| TextRequestError {
-        request_id: yaml_field(text, "request_id"),
-        planner: yaml_field(text, "method"),
-        error: Box::new(error),
-    })
+    GcodeRequest::from_yaml_str(text)
+        .and_then(|r| crate::convert::check_text_numbers(&r).map(|()| r))
+        .map_err(|error| TextRequestError {
+            request_id: yaml_field(text, "request_id"),
+            planner: yaml_field(text, "method"),
+            error: Box::new(error),
+        })
 }

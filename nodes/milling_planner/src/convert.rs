@@ -22,6 +22,7 @@ use kerf_millplan::{
     },
     MillPlanError, MillPlanOutput, MillRequest, PlannerKind,
 };
+use kerf_msgs::numbers::{check_value, Number, NumberError, NumberFields, NumberRules};
 use kerf_msgs::{msg, trajectory_msgs::JointTrajectory};
 
 /// Status of a request refused because the queue is full (`MillPlan::QUEUE_FULL`; the
@@ -41,6 +42,90 @@ pub fn planner_name(field: &str) -> &str {
     } else {
         field
     }
+}
+
+/// A number outside its declared rule ([`kerf_msgs::numbers`]) as the planner's error:
+/// INVALID_REQUEST naming the message's field, e.g. `invalid spindle_max_rpm: 1e308 must be in
+/// (0, 100000] rpm ...`.
+pub fn number_error(e: NumberError) -> MillPlanError {
+    MillPlanError::InvalidConfig {
+        name: e.field,
+        reason: format!("{} {}", e.value, e.rule),
+    }
+}
+
+/// Checks every numeric field of a `MillRequest` message against its declared rule
+/// ([`kerf_msgs::numbers::mill`]).
+///
+/// # Errors
+/// [`MillPlanError::InvalidConfig`] naming the first field outside its rule.
+pub fn check_numbers(m: &msg::MillRequest) -> Result<(), MillPlanError> {
+    m.check_numbers().map_err(number_error)
+}
+
+/// Checks every number of a YAML request ([`MillRequest`]) against the rule of its
+/// `MillRequest` message field, named as in the message (`limits.spindle_rpm[1]` is
+/// `spindle_max_rpm`, `initial.g` is `initial_g`, …).
+///
+/// # Errors
+/// [`MillPlanError::InvalidConfig`] naming the first field outside its rule.
+pub fn check_text_numbers(r: &MillRequest) -> Result<(), MillPlanError> {
+    let rules = <msg::MillRequest as NumberRules>::SECTIONS;
+    let float = |path: &str, v: f64| check_value(rules, path, Number::Float(v));
+    let opt = |path: &str, v: Option<f64>| v.map_or(Ok(()), |v| float(path, v));
+    let count = |path: &str, v: usize| {
+        let value = i128::try_from(v).unwrap_or(i128::MAX);
+        let max = i128::from(u32::MAX);
+        check_value(rules, path, Number::Int { value, min: 0, max })
+    };
+    let pair = |names: [&str; 2], v: Option<[f64; 2]>| -> Result<(), NumberError> {
+        if let Some([lo, hi]) = v {
+            float(names[0], lo)?;
+            float(names[1], hi)?;
+        }
+        Ok(())
+    };
+    let run = || -> Result<(), NumberError> {
+        for (i, p) in r.points.iter().enumerate() {
+            for (c, v) in ["x", "y", "z"].iter().zip(p) {
+                float(&format!("points[{i}].{c}"), *v)?;
+            }
+        }
+        if let Some(n) = r.segments {
+            count("segments", n)?;
+        }
+        if let Some(p) = &r.process {
+            count("teeth", p.teeth)?;
+            float("tool_radius", p.tool_radius)?;
+            float("axial_depth", p.axial_depth)?;
+            float("kt", p.kt)?;
+            float("kn", p.kn)?;
+            float("entry_angle", p.entry_angle)?;
+            float("exit_angle", p.exit_angle)?;
+        }
+        if let Some(l) = &r.limits {
+            pair(["spindle_min_rpm", "spindle_max_rpm"], l.spindle_rpm)?;
+            pair(["feed_min", "feed_max"], l.feed)?;
+            pair(["g_min", "g_max"], l.redundancy_angle)?;
+            if let Some(s) = &l.step_bounds {
+                opt("max_spindle_step_rpm", s.spindle_rpm)?;
+                opt("max_feed_step", s.feed)?;
+                opt("max_g_step", s.redundancy_angle)?;
+            }
+        }
+        if let Some(i) = &r.initial {
+            opt("initial_spindle_rpm", i.spindle_rpm)?;
+            opt("initial_feed", i.feed)?;
+            opt("initial_g", i.g)?;
+        }
+        opt("time_budget", r.time_budget)?;
+        if let Some(t) = &r.tolerances {
+            opt("path_tolerance", t.path_tolerance)?;
+            opt("min_condition_indicator", t.min_condition_indicator)?;
+        }
+        Ok(())
+    };
+    run().map_err(number_error)
 }
 
 /// Converts a `MillRequest` message to the planner's request.

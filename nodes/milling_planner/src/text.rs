@@ -12,8 +12,11 @@
 //! Optional: `segments`, `process` (all seven fields), `limits` (each of `spindle_rpm`,
 //! `feed`, `redundancy_angle` as `[min, max]` and `step_bounds`), `initial` (`spindle_rpm`,
 //! `feed`, `g`), `planner` (`ddpg` default, `fixed_g`, `dp`, `naive`) and `policy_file`.
-//! Unknown fields are refused; NaN (`.nan`) and infinities are refused by the planner's
-//! validation, which names the field. Unlike the message form, a `policy_file` given for
+//! Unknown fields are refused. Every number is checked against the declared rule of its
+//! `kerf_msgs/msg/MillRequest` field ([`kerf_msgs::numbers`]: finite, range, not denormal
+//! where it divides), named as in the message (`limits.spindle_rpm: [a, b]` are
+//! `spindle_min_rpm` and `spindle_max_rpm`); the planner's validation checks the rest
+//! (min < max, coplanar points, …). Unlike the message form, a `policy_file` given for
 //! `dp` or `naive` is ignored, as in `kerf plan mill`.
 //!
 //! `~/mill_plan_text` carries each `MillPlan` answer as YAML ([`plan_text`]).
@@ -45,11 +48,13 @@ pub fn parse_request(text: &str) -> Result<MillRequest, TextRequestError> {
             }),
         });
     }
-    MillRequest::from_yaml_str(text).map_err(|error| TextRequestError {
-        request_id: yaml_field(text, "request_id"),
-        planner: yaml_field(text, "planner"),
-        error: Box::new(error),
-    })
+    MillRequest::from_yaml_str(text)
+        .and_then(|r| crate::convert::check_text_numbers(&r).map(|()| r))
+        .map_err(|error| TextRequestError {
+            request_id: yaml_field(text, "request_id"),
+            planner: yaml_field(text, "planner"),
+            error: Box::new(error),
+        })
 }
 
 /// The YAML text of a `MillPlan` message, as published on `~/mill_plan_text` (serde's YAML of

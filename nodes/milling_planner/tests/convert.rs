@@ -73,7 +73,8 @@ fn flags_off_means_the_cell_and_empty_means_the_default() {
         .validate()
         .unwrap_err();
     assert!(e.to_string().contains("tolerances.path_tolerance"), "{e}");
-    // Values of a group whose flag is false are ignored, even NaN.
+    // Values of a group whose flag is false are ignored by the conversion, even NaN (the
+    // number check before it, kerf_msgs::numbers, refuses a NaN anywhere).
     let mut m = message();
     m.teeth = 7;
     m.feed_min = f64::NAN;

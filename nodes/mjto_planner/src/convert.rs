@@ -14,6 +14,7 @@ use kerf_mjto::{
     request::{CutOptions, OrientationCorridor, PoseSpec, RtoConstraint},
     CutRequest, PlanError,
 };
+use kerf_msgs::numbers::{NumberError, NumberFields};
 use kerf_msgs::{msg, trajectory_msgs::JointTrajectory};
 
 /// Path acceleration limit of the feed ramps used when the message says 0 (m/s²); seed 001
@@ -46,6 +47,22 @@ fn count_or_default(value: u32, default: usize) -> usize {
 /// that fits in memory).
 fn to_u32(v: usize) -> u32 {
     u32::try_from(v).unwrap_or(u32::MAX)
+}
+
+/// A number outside its declared rule ([`kerf_msgs::numbers`]) as the planner's error:
+/// INVALID_REQUEST naming the message's field, e.g. `invalid request: points[1].y: NaN must be
+/// finite`.
+pub fn number_error(e: NumberError) -> PlanError {
+    PlanError::invalid(e.field, format!("{} {}", e.value, e.rule))
+}
+
+/// Checks every numeric field of a `CutRequest` message against its declared rule
+/// ([`kerf_msgs::numbers::cut`]).
+///
+/// # Errors
+/// [`PlanError::InvalidRequest`] naming the first field outside its rule.
+pub fn check_numbers(m: &msg::CutRequest) -> Result<(), PlanError> {
+    m.check_numbers().map_err(number_error)
 }
 
 /// Converts a `CutRequest` message to the planner's request, applying the defaults of the

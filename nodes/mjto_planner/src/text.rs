@@ -34,9 +34,11 @@
 //! 0.20 0.20 0.30  0 0 1
 //! ```
 //!
-//! Any other line is refused with its line number; the values themselves (finite, positive,
-//! unit axes, …) are checked by
-//! [`kerf_mjto::CutRequest::validate`] like those of a message.
+//! Any other line is refused with its line number. Every number of either form is checked
+//! against the declared rule of its `kerf_msgs/msg/CutRequest` field ([`kerf_msgs::numbers`]:
+//! finite, range, not denormal where it divides), named as in the message (`points[2].y`,
+//! `gfd_q4_steps` for the YAML's `options.gfd.q4_steps`), like a message's; the values' meaning
+//! (unit axes, increasing indices, …) is checked by [`kerf_mjto::CutRequest::validate`].
 
 use kerf_mjto::{CutRequest, PlanError};
 use kerf_msgs::{
@@ -46,7 +48,9 @@ use kerf_msgs::{
 
 use kerf_ros::planner::yaml_field;
 
-use crate::convert::request_from_msg;
+use kerf_msgs::numbers::{check_value, Number, NumberRules};
+
+use crate::convert::{check_numbers, number_error, request_from_msg};
 
 /// A text request that could not be turned into a [`CutRequest`] (its `planner` is always
 /// empty: cut requests have none).
@@ -64,20 +68,81 @@ pub fn is_yaml(text: &str) -> bool {
 /// errors (field `request`), line-format errors (field `line N`), a zero quaternion.
 pub fn parse_request(text: &str) -> Result<CutRequest, TextRequestError> {
     if is_yaml(text) {
-        CutRequest::from_yaml(text).map_err(|error| TextRequestError {
-            request_id: yaml_field(text, "request_id"),
-            planner: String::new(),
-            error: Box::new(error),
-        })
+        CutRequest::from_yaml(text)
+            .and_then(|r| check_yaml_numbers(&r).map(|()| r))
+            .map_err(|error| TextRequestError {
+                request_id: yaml_field(text, "request_id"),
+                planner: String::new(),
+                error: Box::new(error),
+            })
     } else {
         parse_lines(text)
-            .and_then(|m| request_from_msg(&m))
+            .and_then(|m| check_numbers(&m).and_then(|()| request_from_msg(&m)))
             .map_err(|error| TextRequestError {
                 request_id: line_request_id(text),
                 planner: String::new(),
                 error: Box::new(error),
             })
     }
+}
+
+/// Checks every number of a YAML request against the rule of its `CutRequest` message field,
+/// named as in the message. The YAML's `options.weights` have no message field: the planner's
+/// validation checks them (finite, >= 0).
+///
+/// # Errors
+/// [`PlanError::InvalidRequest`] naming the first field outside its rule.
+pub fn check_yaml_numbers(r: &CutRequest) -> Result<(), PlanError> {
+    let rules = <msg::CutRequest as NumberRules>::SECTIONS;
+    let float = |path: &str, v: f64| check_value(rules, path, Number::Float(v));
+    let count = |path: &str, v: usize| {
+        let value = i128::try_from(v).unwrap_or(i128::MAX);
+        let max = i128::from(u32::MAX);
+        check_value(rules, path, Number::Int { value, min: 0, max })
+    };
+    let xyz = ["x", "y", "z"];
+    let run = || -> Result<(), kerf_msgs::numbers::NumberError> {
+        for (name, list) in [("points", &r.points), ("axes", &r.axes)] {
+            for (i, p) in list.iter().enumerate() {
+                for (c, v) in xyz.iter().zip(p) {
+                    float(&format!("{name}[{i}].{c}"), *v)?;
+                }
+            }
+        }
+        float("feedrate", r.feedrate)?;
+        float("feed_acceleration", r.feed_acceleration)?;
+        float("feed_jerk", r.feed_jerk)?;
+        float("sample_period", r.sample_period)?;
+        float("max_lead_angle", r.max_lead_angle)?;
+        float("max_tilt_angle", r.max_tilt_angle)?;
+        for (c, v) in xyz.iter().zip(&r.workpiece_pose.position) {
+            float(&format!("workpiece_pose.position.{c}"), *v)?;
+        }
+        for (c, v) in ["x", "y", "z", "w"]
+            .iter()
+            .zip(&r.workpiece_pose.orientation)
+        {
+            float(&format!("workpiece_pose.orientation.{c}"), *v)?;
+        }
+        let o = &r.options;
+        count("control_points", o.control_points)?;
+        count("max_iterations", o.max_iterations)?;
+        count("gfd_q4_steps", o.gfd.q4_steps)?;
+        count("gfd_q5_steps", o.gfd.q5_steps)?;
+        count("gfd_q6_steps", o.gfd.q6_steps)?;
+        float("gfd_q4_half_range", o.gfd.q4_half_range)?;
+        float("gfd_q5_half_range", o.gfd.q5_half_range)?;
+        for (i, v) in o.rto_indices.iter().enumerate() {
+            count(&format!("rto_indices[{i}]"), *v)?;
+        }
+        float("rto_spacing", o.rto_spacing)?;
+        float("rto_angle", o.rto_angle)?;
+        float("reference_standoff", o.reference_standoff)?;
+        float("clearance", o.clearance)?;
+        float("cl_tolerance", o.cl_tolerance)?;
+        float("time_budget", r.time_budget)
+    };
+    run().map_err(number_error)
 }
 
 /// `request_id` of a line-format text (empty if none).
@@ -396,13 +461,14 @@ feed_law: constant
     }
 
     #[test]
-    fn non_finite_values_reach_validation_and_are_refused() {
+    fn non_finite_values_are_refused_naming_the_message_field() {
         let text = LINES.replace("0.15 0.20 0.30", "0.15 NaN 0.30");
-        let r = parse_request(&text).unwrap();
-        let e = r.validate().unwrap_err().to_string();
-        assert!(e.contains("points[1]") && e.contains("not finite"), "{e}");
+        let e = parse_request(&text).unwrap_err();
+        assert_eq!(e.request_id, "slot-3");
+        let e = e.to_string();
+        assert!(e.contains("points[1].y") && e.contains("finite"), "{e}");
         let text = LINES.replace("feedrate: 0.3333", "feedrate: inf");
-        let e = parse_request(&text).unwrap().validate().unwrap_err();
+        let e = parse_request(&text).unwrap_err();
         assert!(e.to_string().contains("feedrate"), "{e}");
     }
 

@@ -1,5 +1,8 @@
 //! The `~/validate_trajectory` service side of the request thread: a trajectory is prepared
-//! like any other (in arrival order, off the control thread) and answered valid or not.
+//! like any other (in arrival order, off the control thread; its numbers checked against their
+//! declared rules, [`kerf_msgs::numbers`], by the prepare worker) and answered valid or not; a
+//! number outside its rule is named as a field of the request
+//! (`trajectory.points[2].positions[0]`).
 
 use kerf_executor::SUCCESSFUL;
 use kerf_msgs::srv::ValidateTrajectoryResponse;
@@ -31,12 +34,15 @@ impl ExecutorNode {
                 message: "valid".into(),
                 duration,
             },
-            Err(rej) => ValidateTrajectoryResponse {
-                valid: false,
-                error_code: rej.code,
-                message: rej.message,
-                duration: 0.0,
-            },
+            Err(rej) => {
+                let rej = crate::convert::number_rejection_within(rej, "trajectory.");
+                ValidateTrajectoryResponse {
+                    valid: false,
+                    error_code: rej.code,
+                    message: rej.message,
+                    duration: 0.0,
+                }
+            }
         };
         if let Err(e) = self.validate_srv.send_response(req_id, resp) {
             self.log
