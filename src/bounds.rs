@@ -64,10 +64,10 @@ impl Real {
             .parse()
             .map_err(|_| "not a number".to_string())?;
         if v.is_nan() {
-            return Err("NaN is not a number".into());
+            return Err("must be finite (NaN is not a number)".into());
         }
         if v.is_infinite() {
-            return Err("not finite".into());
+            return Err("must be finite".into());
         }
         if v != 0.0 && !v.is_normal() {
             return Err(format!(
@@ -142,6 +142,11 @@ impl<T> Count<T> {
             unit,
             of: PhantomData,
         }
+    }
+
+    /// The smallest and the largest value.
+    pub fn bounds(&self) -> (u64, u64) {
+        (self.min, self.max)
     }
 
     /// The range as stated in `--help` and in refusals, e.g. `[1, 10000] speeds`.

@@ -40,6 +40,10 @@ pub(crate) const ROBOT_CAP: u64 = 4 << 20;
 /// Cap of an indicator cache (64 MiB; the shipped one is 1 MB).
 pub(crate) const CACHE_CAP: u64 = 64 << 20;
 
+/// Cap of a ROS parameter file of `kerf launch --ros-args --params-file` (1 MiB; the shipped
+/// ones are under 2 kB).
+pub(crate) const PARAMS_CAP: u64 = 1 << 20;
+
 /// Cap of a training history, CSV or JSON (16 MiB: about 10⁵ episodes).
 pub(crate) const HISTORY_CAP: u64 = 16 << 20;
 

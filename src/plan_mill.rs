@@ -194,7 +194,8 @@ pub fn run(a: MillArgs) -> Result<(), String> {
         ("--ddpg-policy", &a.ddpg_policy),
         ("--fixed-g-policy", &a.fixed_g_policy),
     ] {
-        if let Some(f) = f {
+        // A missing policy is the planner's POLICY_ERROR (the other planners still run).
+        if let Some(f) = f.as_ref().filter(|f| f.is_stdin() || f.path().exists()) {
             input::check_file(arg, f, kerf_millplan::policy::MAX_POLICY_BYTES)?;
         }
     }

@@ -97,10 +97,26 @@ impl GridParser {
         let [min, max, count] = parts[..] else {
             return Err("expected MIN:MAX:COUNT".into());
         };
-        let min = self.values.check(min).map_err(|e| format!("MIN: {e}"))?;
-        let max = self.values.check(max).map_err(|e| format!("MAX: {e}"))?;
-        let count = usize::try_from(self.count.check(count).map_err(|e| format!("COUNT: {e}"))?)
-            .map_err(|_| "COUNT: out of range".to_string())?;
+        let min = self
+            .values
+            .check(min)
+            .map_err(|e| format!("MIN is {}: {e}", min.trim()))?;
+        let max = self
+            .values
+            .check(max)
+            .map_err(|e| format!("MAX is {}: {e}", max.trim()))?;
+        let (low, high) = self.count.bounds();
+        let count = self
+            .count
+            .check(count)
+            .ok()
+            .and_then(|c| usize::try_from(c).ok())
+            .ok_or_else(|| {
+                format!(
+                    "COUNT must be >= {low} and <= {high}, got `{}`",
+                    count.trim()
+                )
+            })?;
         Grid::new(self.name, min, max, count, f64::NEG_INFINITY, false)
     }
 }
