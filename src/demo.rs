@@ -139,7 +139,7 @@ pub fn simulate(
     let mut periods = 0u64;
     loop {
         periods += 1;
-        if periods % 64 == 0 {
+        if periods.is_multiple_of(64) {
             let elapsed = wall.elapsed().as_secs_f64();
             if elapsed - last_line >= PROGRESS_EVERY {
                 last_line = elapsed;

@@ -82,7 +82,7 @@ impl fmt::Display for InputFile {
 
 /// Bytes with a binary prefix: `4194304 bytes (4 MiB)`.
 fn show_cap(cap: u64) -> String {
-    if cap >= 1 << 20 && cap % (1 << 20) == 0 {
+    if cap >= 1 << 20 && cap.is_multiple_of(1 << 20) {
         format!("{cap} bytes ({} MiB)", cap >> 20)
     } else {
         format!("{cap} bytes")
