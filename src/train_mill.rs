@@ -138,8 +138,9 @@ pub struct MillTrainArgs {
     #[arg(long)]
     no_cache: bool,
     /// Hidden layer widths of actor and critic, comma-separated (Table 2: 256,256); each
-    /// [1, 4096] units.
-    #[arg(long, value_delimiter = ',', value_parser = Count::<usize>::new(1, 4096, "units"))]
+    /// [1, 512] units (an episode's cost grows with the width: about 2 s at 256, 4 s at 512,
+    /// measured with `--episodes 2`; a progress line follows every slow episode).
+    #[arg(long, value_delimiter = ',', value_parser = Count::<usize>::new(1, 512, "units"))]
     hidden: Option<Vec<usize>>,
     /// Actor learning rate (Table 2: 1e-4); (0, 1].
     #[arg(long, allow_hyphen_values = true, value_parser = UNIT_OPEN)]
@@ -157,8 +158,9 @@ pub struct MillTrainArgs {
     #[arg(long, value_parser = Count::<usize>::new(1, 1_000_000, "transitions"))]
     buffer: Option<usize>,
     /// Minibatch size (Table 2: 64); learning starts once the buffer holds one batch;
-    /// [1, 4096] transitions.
-    #[arg(long, value_parser = Count::<usize>::new(1, 4096, "transitions"))]
+    /// [1, 256] transitions (an episode's cost grows with it: about 2 s at 256, measured with
+    /// `--episodes 4`).
+    #[arg(long, value_parser = Count::<usize>::new(1, 256, "transitions"))]
     batch_size: Option<usize>,
     /// Initial exploration noise standard deviation, normalized action units (Table 2: 0.1);
     /// [0, 10].
