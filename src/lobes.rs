@@ -328,7 +328,7 @@ fn compute_with_progress(
             last_line = elapsed;
             let left = elapsed / done as f64 * (total - done) as f64;
             eprintln!(
-                "kerf lobes: {done}/{total} speeds, {elapsed:.0} s, about {left:.0} s left                  (Ctrl-C stops)"
+                "kerf lobes: {done}/{total} speeds, {elapsed:.0} s, about {left:.0} s left (Ctrl-C stops)"
             );
         }
     }
