@@ -9,8 +9,6 @@
 //! ([`kerf_trajectory_executor::control::ContactWatch`]: controlled stop, goal aborted).
 //! It prints the time, the tracking error, the contacts and the final state.
 
-use std::path::PathBuf;
-
 use clap::{Args, Subcommand, ValueEnum};
 use kerf_cell::{Cell, CellSettings, Mode};
 use kerf_executor::{
@@ -19,6 +17,11 @@ use kerf_executor::{
 };
 use kerf_robot::RobotModel;
 use kerf_trajectory_executor::control::{contact_message, ContactWatch};
+
+use crate::{
+    bounds::Real,
+    input::{self, InputFile},
+};
 
 /// `kerf demo`.
 #[derive(Args, Debug)]
@@ -40,11 +43,13 @@ struct DemoOpts {
     /// How the cell follows the executor.
     #[arg(long, value_enum, default_value_t = ModeArg::Dynamic)]
     mode: ModeArg,
-    /// The request (YAML): a cut request (`kerf plan cut` format) or a milling request.
+    /// The request (YAML): a cut request (`kerf plan cut` format) or a milling request (at
+    /// most 4 MiB; `-` reads standard input).
     #[arg(long)]
-    request: Option<PathBuf>,
-    /// Physics rate (Hz), an integer multiple of the 250 Hz control rate.
-    #[arg(long, default_value_t = 1000.0)]
+    request: Option<InputFile>,
+    /// Physics rate, an integer multiple of the 250 Hz control rate, at most what one control
+    /// period runs in real time (kerf_cell::settings::MAX_PHYSICS_RATE_HZ); [250, 5000] Hz.
+    #[arg(long, default_value_t = 1000.0, value_parser = PHYSICS_RATE)]
     physics_rate: f64,
 }
 
@@ -56,6 +61,13 @@ enum ModeArg {
 
 /// Control rate of the demo: the executor node's default.
 const CONTROL_RATE: f64 = 250.0;
+
+/// Wall-clock seconds between two progress lines of the simulation.
+const PROGRESS_EVERY: f64 = 2.0;
+
+/// `--physics-rate`: from the control rate up to the cell's bound.
+const PHYSICS_RATE: Real =
+    Real::closed(CONTROL_RATE, kerf_cell::settings::MAX_PHYSICS_RATE_HZ, "Hz");
 
 /// What the cell saw while the executor ran a trajectory.
 #[derive(Debug, Default)]
@@ -122,7 +134,22 @@ pub fn simulate(
     let mut watch = ContactWatch::default();
     let mut cycle = Cycle::default();
     let limit = t0 + s.planned + 10.0;
+    let wall = std::time::Instant::now();
+    let mut last_line = 0.0;
+    let mut periods = 0u64;
     loop {
+        periods += 1;
+        if periods.is_multiple_of(64) {
+            let elapsed = wall.elapsed().as_secs_f64();
+            if elapsed - last_line >= PROGRESS_EVERY {
+                last_line = elapsed;
+                eprintln!(
+                    "kerf demo: simulated {:.2} of {:.2} s in {elapsed:.0} s (Ctrl-C stops)",
+                    cell.state().time - t0,
+                    s.planned
+                );
+            }
+        }
         let now = cell.state().time;
         let measured = cell.state().joint_sample();
         exec.update_into(now, &measured, &mut cycle)
@@ -228,6 +255,11 @@ pub fn run(a: DemoArgs) -> Result<(), String> {
         DemoWhat::Cut(o) => (o, "laser_cutter", "laser_bpillar"),
         DemoWhat::Mill(o) => (o, "irb6660", "irb6660_plate"),
     };
+    // The request first (capped), before anything is loaded or planned.
+    let request_text = match &opts.request {
+        Some(f) => Some(input::read_text("--request", f, input::REQUEST_CAP)?),
+        None => None,
+    };
     let data = |rel: String| kerf_robot::data::default_path(rel);
     let urdf = data(format!("urdf/{robot_name}.urdf"));
     let limits = data(format!("urdf/{robot_name}_limits.yaml"));
@@ -244,18 +276,22 @@ pub fn run(a: DemoArgs) -> Result<(), String> {
     };
     let cell = Cell::from_files(&urdf, &cell_file, settings)
         .map_err(|e| format!("cell {}: {e}", cell_file.display()))?;
-    let read = |p: &PathBuf| {
-        std::fs::read_to_string(p).map_err(|e| format!("cannot read {}: {e}", p.display()))
-    };
     let started = std::time::Instant::now();
     let (title, request) = match &a.what {
         DemoWhat::Cut(_) => {
-            let path = opts
-                .request
-                .clone()
-                .unwrap_or_else(|| data("crates/mjto/cases/case1.yaml".into()));
-            let request = kerf_mjto::CutRequest::from_yaml(&read(&path)?)
-                .map_err(|e| format!("{}: {e}", path.display()))?;
+            let (name, text) = match (&opts.request, request_text) {
+                (Some(f), Some(text)) => (f.to_string(), text),
+                _ => {
+                    let path = data("crates/mjto/cases/case1.yaml".into());
+                    let f = InputFile::from(path.into_os_string());
+                    (
+                        f.to_string(),
+                        input::read_text("case", &f, input::REQUEST_CAP)?,
+                    )
+                }
+            };
+            let request = kerf_mjto::CutRequest::from_yaml(&text)
+                .map_err(|e| format!("--request {name}: {e}"))?;
             let machine = kerf_mjto::LaserMachine::default_machine().map_err(|e| e.to_string())?;
             let mut planner =
                 kerf_mjto::planner::Planner::new(machine).map_err(|e| e.to_string())?;
@@ -263,15 +299,15 @@ pub fn run(a: DemoArgs) -> Result<(), String> {
                 .plan(&request)
                 .map_err(|e| format!("planner: {e}"))?;
             (
-                format!("cut {} ({})", path.display(), request.request_id),
+                format!("cut {name} ({})", request.request_id),
                 plan.joint_trajectory(),
             )
         }
         DemoWhat::Mill(_) => {
-            let request = match &opts.request {
-                Some(p) => kerf_millplan::MillRequest::from_yaml_str(&read(p)?)
-                    .map_err(|e| format!("{}: {e}", p.display()))?,
-                None => kerf_millplan::MillRequest::default(),
+            let request = match (&opts.request, &request_text) {
+                (Some(f), Some(text)) => kerf_millplan::MillRequest::from_yaml_str(text)
+                    .map_err(|e| format!("--request {f}: {e}"))?,
+                _ => kerf_millplan::MillRequest::default(),
             };
             let planner = kerf_millplan::MillPlanner::with_default_cell()
                 .map_err(|e| format!("milling cell: {e}"))?;

@@ -7,7 +7,13 @@ use kerf_ros::{qos, KerfNode};
 use ros2_client::{qos::Durability, QosProfile};
 use serde::{de::DeserializeOwned, Serialize};
 
-use crate::topic_types::{cli_node, discover, dispatch, ForType, Side};
+use crate::{
+    bounds::{self, Count},
+    topic_types::{cli_node, discover, dispatch, ForType, Side},
+};
+
+/// `--count`: at least one message.
+const COUNT: Count<usize> = Count::new(1, 1_000_000_000, "messages");
 
 /// Arguments of `kerf echo`.
 #[derive(Args, Debug)]
@@ -17,14 +23,14 @@ pub struct EchoArgs {
     /// ROS type (`sensor_msgs/msg/JointState`); by default it is discovered from the publishers.
     #[arg(long = "type")]
     ros_type: Option<String>,
-    /// Exit after this many messages.
-    #[arg(long, short = 'n')]
+    /// Exit after this many messages; [1, 1000000000] messages.
+    #[arg(long, short = 'n', value_parser = COUNT)]
     count: Option<usize>,
-    /// Exit after this many seconds (the exit is an error if nothing arrived).
-    #[arg(long)]
+    /// Exit after this many seconds (the exit is an error if nothing arrived); [0, 86400] s.
+    #[arg(long, value_parser = bounds::SECONDS)]
     timeout: Option<f64>,
-    /// Seconds to wait for a publisher when the type must be discovered.
-    #[arg(long, default_value_t = 10.0)]
+    /// Seconds to wait for a publisher when the type must be discovered; [0, 86400] s.
+    #[arg(long, default_value_t = 10.0, value_parser = bounds::SECONDS)]
     discovery_timeout: f64,
     /// Subscribe transient-local, to also get the latched history (e.g. `~/trajectory_status`).
     #[arg(long)]

@@ -9,6 +9,8 @@ use std::path::PathBuf;
 use clap::{Args, ValueEnum};
 use kerf_ros::{shutdown, ParamSource, ParamValue, RosArgs, RosEnv, StopToken};
 
+use crate::input::InputFile;
+
 /// The robots whose descriptions ship in `urdf/`, named as their files and as the launch
 /// file's `robot:=` argument (`laser_cutter`, `irb6660`).
 #[derive(Debug, Clone, Copy, ValueEnum)]
@@ -189,6 +191,14 @@ pub fn run(a: LaunchArgs) -> Result<(), String> {
         return Err(format!(
             "unexpected argument {extra:?}; ROS arguments go after --ros-args"
         ));
+    }
+    // Every node reads each parameter file: regular files under the cap only (a FIFO would
+    // block the first node, and could not be read twice anyway).
+    for src in &args.params {
+        if let ParamSource::File(path) = src {
+            let file = InputFile::from(path.clone().into_os_string());
+            crate::input::check_file("--params-file", &file, crate::input::PARAMS_CAP)?;
+        }
     }
     let dir = urdf_dir(a.urdf_dir)?;
     let stem = a.robot.stem();

@@ -35,7 +35,10 @@
 mod grid;
 pub mod table;
 
-use std::{path::PathBuf, time::Instant};
+use std::{
+    path::{Path, PathBuf},
+    time::Instant,
+};
 
 use clap::{Args, ValueEnum};
 use kerf_chatter::{
@@ -44,10 +47,35 @@ use kerf_chatter::{
 };
 use kerf_mill::{CellState, MillCell};
 
-pub use grid::Grid;
+pub use grid::{Grid, GridParser};
 pub use table::table;
 
-use crate::plots;
+use crate::{
+    bounds::{Count, Real},
+    input::{self, InputFile},
+    plots,
+};
+
+/// `--rpm`: speeds in (0, 1e6] rpm, at most 10 000 of them (the plots stay readable; a long
+/// run prints progress and stops on Ctrl-C).
+const RPM_GRID: GridParser = GridParser {
+    name: "rpm",
+    values: Real::above(0.0, 1e6, "rpm"),
+    count: Count::new(1, 10_000, "speeds"),
+};
+
+/// `--feed`: feeds in [0, 10] m/s, at most 1 000 of them.
+const FEED_GRID: GridParser = GridParser {
+    name: "feed",
+    values: Real::closed(0.0, 10.0, "m/s"),
+    count: Count::new(1, 1_000, "feeds"),
+};
+
+/// Most map cells (speeds × feeds): 10⁶ (16 MB of map, an SVG of about 100 MB).
+const MAX_MAP_CELLS: usize = 1_000_000;
+
+/// Seconds between two progress lines of a long computation, about.
+const PROGRESS_EVERY: f64 = 1.0;
 
 /// Default number of spindle speeds.
 const DEFAULT_SPEEDS: usize = 100;
@@ -76,33 +104,37 @@ pub enum Format {
 /// Arguments of `kerf lobes`.
 #[derive(Args, Debug)]
 pub struct LobesArgs {
-    /// Milling cell YAML (default: the shipped urdf/irb6660_milling.yaml).
+    /// Milling cell YAML (default: the shipped urdf/irb6660_milling.yaml; at most 1 MiB).
     #[arg(long)]
-    cell: Option<PathBuf>,
-    /// Path segment index (0-based).
-    #[arg(long)]
+    cell: Option<InputFile>,
+    /// Path segment index (0-based); [0, 1000000].
+    #[arg(long, value_parser = Count::<usize>::new(0, 1_000_000, ""))]
     segment: usize,
-    /// Redundancy angle g [rad].
-    #[arg(long, allow_hyphen_values = true)]
+    /// Redundancy angle g; [-4, 4] rad.
+    #[arg(long, allow_hyphen_values = true, value_parser = Real::closed(-4.0, 4.0, "rad"))]
     g: f64,
-    /// Spindle speeds MIN:MAX:COUNT [rpm] (default: the cell's range, 100 speeds).
-    #[arg(long)]
-    rpm: Option<String>,
-    /// Largest axial depth searched [m] (default 0.02 = 20 mm).
-    #[arg(long, default_value_t = 0.02, allow_hyphen_values = true)]
+    /// Spindle speeds (default: the cell's range, 100 speeds); MIN:MAX:COUNT, MIN and MAX in
+    /// (0, 1000000] rpm, COUNT in [1, 10000] speeds. At most 10⁶ speeds × feeds.
+    #[arg(long, value_parser = RPM_GRID)]
+    rpm: Option<Grid>,
+    /// Largest axial depth searched (default 0.02 = 20 mm); (0, 1] m.
+    #[arg(long, default_value_t = 0.02, allow_hyphen_values = true,
+          value_parser = Real::above(0.0, 1.0, "m"))]
     max_depth: f64,
-    /// Feeds MIN:MAX:COUNT [m/s] of the map (default: the cell's range, 25 feeds; 0 allowed).
-    #[arg(long)]
-    feed: Option<String>,
-    /// Feed of the state-dependent lobe [m/s] (default: seed 004's f0 = 0.04 m/s if in the
-    /// cell's feed range, else the range's midpoint).
-    #[arg(long, allow_hyphen_values = true)]
+    /// Feeds of the map (default: the cell's range, 25 feeds); MIN:MAX:COUNT, MIN and MAX in
+    /// [0, 10] m/s, COUNT in [1, 1000] feeds.
+    #[arg(long, value_parser = FEED_GRID)]
+    feed: Option<Grid>,
+    /// Feed of the state-dependent lobe (default: seed 004's f0 = 0.04 m/s if in the cell's
+    /// feed range, else the range's midpoint); [0, 10] m/s.
+    #[arg(long, allow_hyphen_values = true, value_parser = Real::closed(0.0, 10.0, "m/s"))]
     nominal_feed: Option<f64>,
     /// Delay model (default: the cell's `chatter.model`).
     #[arg(long, value_enum)]
     model: Option<ModelArg>,
-    /// Sub-intervals m of the discretization (default: the cell's `chatter.steps`).
-    #[arg(long)]
+    /// Sub-intervals m of the discretization (default: the cell's `chatter.steps`, seed 004:
+    /// 40); [2, 200] sub-intervals.
+    #[arg(long, value_parser = Count::<usize>::new(2, 200, "sub-intervals"))]
     steps: Option<usize>,
     /// Output directory (created if missing).
     #[arg(long, default_value = ".")]
@@ -136,10 +168,9 @@ pub struct LobesReport {
 pub fn compute(a: &LobesArgs) -> Result<LobesReport, String> {
     let start = Instant::now();
     let cell = match &a.cell {
-        Some(p) => MillCell::load(p),
-        None => MillCell::default_cell(),
-    }
-    .map_err(|e| e.to_string())?;
+        Some(f) => load_cell("--cell", f),
+        None => MillCell::default_cell().map_err(|e| e.to_string()),
+    }?;
     let n_segments = cell.path().segments().len();
     if a.segment >= n_segments {
         return Err(format!(
@@ -155,8 +186,8 @@ pub fn compute(a: &LobesArgs) -> Result<LobesReport, String> {
         .evaluate(a.segment, a.g, None)
         .map_err(|e| format!("segment {}, g = {} rad: {e}", a.segment, a.g))?;
     let limits = *cell.state_limits();
-    let rpm_grid = match &a.rpm {
-        Some(t) => Grid::parse("rpm", t, 0.0, true)?,
+    let rpm_grid = match a.rpm {
+        Some(g) => g,
         None => Grid::new(
             "rpm",
             limits.spindle_rpm[0],
@@ -166,8 +197,8 @@ pub fn compute(a: &LobesArgs) -> Result<LobesReport, String> {
             true,
         )?,
     };
-    let feed_grid = match &a.feed {
-        Some(t) => Grid::parse("feed", t, 0.0, false)?,
+    let feed_grid = match a.feed {
+        Some(g) => g,
         None => Grid::new(
             "feed",
             limits.feed[0],
@@ -177,6 +208,12 @@ pub fn compute(a: &LobesArgs) -> Result<LobesReport, String> {
             false,
         )?,
     };
+    if rpm_grid.count.saturating_mul(feed_grid.count) > MAX_MAP_CELLS {
+        return Err(format!(
+            "--rpm and --feed: {} speeds × {} feeds is over {MAX_MAP_CELLS} map cells",
+            rpm_grid.count, feed_grid.count
+        ));
+    }
     if !(a.max_depth.is_finite() && a.max_depth > 0.0) {
         return Err(format!(
             "--max-depth {}: must be finite and > 0 [m]",
@@ -203,18 +240,13 @@ pub fn compute(a: &LobesArgs) -> Result<LobesReport, String> {
     settings
         .validate()
         .map_err(|e| format!("--steps {}: {e}", settings.steps))?;
-    let chart = LobeMap::compute(
-        &state.modal,
-        &cell.milling_process(),
-        &settings,
-        LobeGrid {
-            rpms: rpm_grid.values(),
-            feeds: feed_grid.values(),
-            nominal_feed,
-            options: depth_search(settings.steps, a.max_depth),
-        },
-    )
-    .map_err(|e| e.to_string())?;
+    let grid = LobeGrid {
+        rpms: rpm_grid.values(),
+        feeds: feed_grid.values(),
+        nominal_feed,
+        options: depth_search(settings.steps, a.max_depth),
+    };
+    let chart = compute_with_progress(&state, &cell, &settings, grid)?;
     Ok(LobesReport {
         segment: a.segment,
         g: a.g,
@@ -222,6 +254,85 @@ pub fn compute(a: &LobesArgs) -> Result<LobesReport, String> {
         chart,
         seconds: start.elapsed().as_secs_f64(),
     })
+}
+
+/// A milling cell file read through the capped reader ([`input::CELL_CAP`]); its robot files
+/// are relative to its directory (the working directory for standard input).
+///
+/// # Errors
+/// The reader's or the cell's message, naming the argument and the file.
+pub fn load_cell(arg: &str, file: &InputFile) -> Result<MillCell, String> {
+    let text = input::read_text(arg, file, input::CELL_CAP)?;
+    let dir = if file.is_stdin() {
+        Path::new(".")
+    } else {
+        file.path().parent().unwrap_or(Path::new("."))
+    };
+    MillCell::from_yaml_str(&text, dir, file.path()).map_err(|e| format!("{arg} {file}: {e}"))
+}
+
+/// [`LobeMap::compute`] over the speeds in chunks, with a progress line on stderr about every
+/// [`PROGRESS_EVERY`] s once the run has taken that long (Ctrl-C ends it: `crate::interrupt`).
+/// The chart is the one computation over all speeds gives: every speed is computed alone.
+///
+/// # Errors
+/// The chatter error with the speed it occurred at.
+fn compute_with_progress(
+    state: &CellState,
+    cell: &MillCell,
+    settings: &kerf_chatter::IndicatorSettings,
+    grid: LobeGrid,
+) -> Result<LobeMap, String> {
+    let start = Instant::now();
+    let total = grid.rpms.len();
+    let mut chart: Option<LobeMap> = None;
+    let mut done = 0;
+    let mut chunk = 1;
+    let mut last_line = 0.0;
+    while done < total {
+        let end = (done + chunk).min(total);
+        let part_started = Instant::now();
+        let part = LobeMap::compute(
+            &state.modal,
+            &cell.milling_process(),
+            settings,
+            LobeGrid {
+                rpms: grid.rpms[done..end].to_vec(),
+                ..grid.clone()
+            },
+        )
+        .map_err(|e| e.to_string())?;
+        let took = part_started.elapsed().as_secs_f64();
+        // The next chunk takes about PROGRESS_EVERY seconds.
+        let per_speed = took / (end - done) as f64;
+        chunk = if per_speed > 0.0 {
+            ((PROGRESS_EVERY / per_speed) as usize).clamp(1, 256)
+        } else {
+            256
+        };
+        done = end;
+        chart = Some(match chart {
+            None => part,
+            Some(mut c) => {
+                c.rpms.extend(part.rpms);
+                c.constant.extend(part.constant);
+                if let (Some(a), Some(b)) = (&mut c.state_dependent, part.state_dependent) {
+                    a.extend(b);
+                }
+                c.map.extend(part.map);
+                c
+            }
+        });
+        let elapsed = start.elapsed().as_secs_f64();
+        if elapsed - last_line >= PROGRESS_EVERY && done < total {
+            last_line = elapsed;
+            let left = elapsed / done as f64 * (total - done) as f64;
+            eprintln!(
+                "kerf lobes: {done}/{total} speeds, {elapsed:.0} s, about {left:.0} s left (Ctrl-C stops)"
+            );
+        }
+    }
+    chart.ok_or_else(|| "no speeds".to_string())
 }
 
 /// Runs `kerf lobes`: computes, writes the two plots, prints the table.

@@ -19,8 +19,12 @@
 //! * `kerf lobes --segment N --g RAD` draws the stability lobes and the feed × speed chatter
 //!   map of a milling state (issue 4) and prints a table (exit code 2 on failure).
 
+mod bounds;
+mod cli_model;
 mod demo;
 mod echo;
+mod input;
+mod interrupt;
 mod launch;
 mod lobes;
 mod output_paths;
@@ -34,7 +38,7 @@ mod train_mill;
 
 use std::process::ExitCode;
 
-use clap::{Parser, Subcommand};
+use clap::{CommandFactory, Parser, Subcommand};
 
 #[derive(Parser, Debug)]
 #[command(
@@ -66,6 +70,9 @@ enum Command {
     Demo(demo::DemoArgs),
     /// Train a planner's policy (`kerf train mill --out policy.safetensors`).
     Train(Box<train_mill::TrainArgs>),
+    /// Every argument of every command as JSON lines (for the bounds test).
+    #[command(hide = true, name = "cli-model")]
+    CliModel,
 }
 
 /// Exit code of every `kerf` failure, with a message on stderr (clap's usage errors exit with
@@ -75,6 +82,21 @@ pub const EXIT_FAILURE: u8 = 2;
 fn main() -> ExitCode {
     restore_default_sigpipe();
     let cli = Cli::parse();
+    // The offline commands end on Ctrl-C with exit code 130 and a line saying so; the DDS
+    // commands stop their nodes through kerf_ros's handler.
+    let offline = match &cli.command {
+        Command::Plan(_) => Some("plan"),
+        Command::Lobes(_) => Some("lobes"),
+        Command::Demo(_) => Some("demo"),
+        Command::Train(_) => Some("train"),
+        _ => None,
+    };
+    if let Some(name) = offline {
+        if let Err(e) = interrupt::exit_on_sigint(name) {
+            eprintln!("kerf: {e}");
+            return ExitCode::from(EXIT_FAILURE);
+        }
+    }
     let result = match cli.command {
         Command::Launch(a) => {
             // The nodes' large buffers go back to the system when freed (kerf_ros::memory).
@@ -87,6 +109,10 @@ fn main() -> ExitCode {
         Command::Lobes(a) => lobes::run(a),
         Command::Train(a) => train_mill::run(*a),
         Command::Demo(a) => demo::run(a),
+        Command::CliModel => {
+            print!("{}", cli_model::model(&Cli::command()));
+            Ok(())
+        }
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -20,6 +20,9 @@ use kerf_mjto::{
     CutRequest, LaserMachine, PlanError,
 };
 use kerf_msgs::msg::CutPlan as CutPlanMsg;
+use kerf_robot::RobotModel;
+
+use crate::input::{self, InputFile};
 
 /// Arguments of `kerf plan`.
 #[derive(Args, Debug)]
@@ -43,21 +46,22 @@ enum PlanCommand {
 #[derive(Args, Debug)]
 pub struct CutArgs {
     /// Request file, YAML or JSON (`points`, `axes`, `feedrate`, `sample_period`,
-    /// `max_lead_angle`, `max_tilt_angle`, `mesh`, optional `workpiece_pose` and `options`).
+    /// `max_lead_angle`, `max_tilt_angle`, `mesh`, optional `workpiece_pose` and `options`;
+    /// at most 4 MiB, `-` reads standard input).
     #[arg(long)]
-    request: PathBuf,
+    request: InputFile,
     /// Write the plan as JSON here.
     #[arg(long)]
     out: Option<PathBuf>,
     /// Write q1.svg … q6.svg (position, velocity, acceleration, jerk; MJTO vs QI) here.
     #[arg(long)]
     plots: Option<PathBuf>,
-    /// Machine URDF (default: the shipped urdf/laser_cutter.urdf).
+    /// Machine URDF (default: the shipped urdf/laser_cutter.urdf; at most 4 MiB).
     #[arg(long, requires = "limits")]
-    urdf: Option<PathBuf>,
-    /// Machine limits YAML with acceleration and jerk limits (with --urdf).
+    urdf: Option<InputFile>,
+    /// Machine limits YAML with acceleration and jerk limits (with --urdf; at most 4 MiB).
     #[arg(long, requires = "urdf")]
-    limits: Option<PathBuf>,
+    limits: Option<InputFile>,
 }
 
 /// Runs `kerf plan`.
@@ -93,15 +97,20 @@ fn describe(e: &PlanError) -> String {
 }
 
 fn cut(a: CutArgs) -> Result<(), String> {
-    let text = std::fs::read_to_string(&a.request)
-        .map_err(|e| format!("cannot read {}: {e}", a.request.display()))?;
-    let request = CutRequest::from_yaml(&text)
-        .map_err(|e| format!("{}: {}", a.request.display(), describe(&e)))?;
+    let text = input::read_text("--request", &a.request, input::REQUEST_CAP)?;
     let machine = match (&a.urdf, &a.limits) {
-        (Some(u), Some(l)) => LaserMachine::from_files(u, Some(l)),
+        (Some(u), Some(l)) => {
+            let urdf = input::read_text("--urdf", u, input::ROBOT_CAP)?;
+            let limits = input::read_text("--limits", l, input::ROBOT_CAP)?;
+            let robot = RobotModel::from_strings(&urdf, Some(&limits))
+                .map_err(|e| format!("--urdf {u} with --limits {l}: {e}"))?;
+            LaserMachine::from_robot(robot)
+        }
         _ => LaserMachine::default_machine(),
     }
     .map_err(|e| describe(&e))?;
+    let request = CutRequest::from_yaml(&text)
+        .map_err(|e| format!("--request {}: {}", a.request, describe(&e)))?;
     let limits = *machine.limits();
     let mut planner = Planner::new(machine).map_err(|e| describe(&e))?;
     let plan = planner.plan(&request).map_err(|e| describe(&e))?;

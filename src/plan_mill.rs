@@ -59,7 +59,11 @@ use kerf_millplan::{
     status_of, MillPlanError, MillPlanOutput, MillPlanner, MillRequest, PlannerKind,
 };
 
-use crate::{output_paths, plots::mill_plan};
+use crate::{
+    input::{self, InputFile},
+    output_paths,
+    plots::mill_plan,
+};
 
 pub use report::describe;
 use report::{plan_report, request_label, totals_title};
@@ -77,9 +81,9 @@ pub enum IndicatorArg {
 #[derive(Args, Debug)]
 pub struct MillArgs {
     /// Request file, YAML or JSON (`points`, optional `segments`, `process`, `limits`,
-    /// `initial`, `planner`, `policy_file`).
+    /// `initial`, `planner`, `policy_file`; at most 4 MiB, `-` reads standard input as YAML).
     #[arg(long)]
-    request: PathBuf,
+    request: InputFile,
     /// Write the per-segment plots (SVG, seed 004 Fig. 6 / Fig. 8) into this directory.
     #[arg(long)]
     plots: Option<PathBuf>,
@@ -90,12 +94,14 @@ pub struct MillArgs {
     /// greedy_best_g) instead of the request's.
     #[arg(long, value_delimiter = ',')]
     planners: Vec<String>,
-    /// Policy of the ddpg planner (default: the request's policy_file, else the shipped one).
+    /// Policy of the ddpg planner (default: the request's policy_file, else the shipped one;
+    /// a regular file of at most 64 MiB).
     #[arg(long)]
-    ddpg_policy: Option<PathBuf>,
-    /// Policy of the fixed_g planner (default: the request's policy_file, else the shipped one).
+    ddpg_policy: Option<InputFile>,
+    /// Policy of the fixed_g planner (default: the request's policy_file, else the shipped one;
+    /// a regular file of at most 64 MiB).
     #[arg(long)]
-    fixed_g_policy: Option<PathBuf>,
+    fixed_g_policy: Option<InputFile>,
     /// Source of the plans' |mu|max values.
     #[arg(long, value_enum, default_value_t = IndicatorArg::Direct)]
     indicator: IndicatorArg,
@@ -133,7 +139,7 @@ fn planner_list(a: &MillArgs, request: &MillRequest) -> Result<Vec<PlannerKind>,
         return request
             .planner_kind()
             .map(|k| vec![k])
-            .map_err(|e| format!("{}: {}", a.request.display(), describe(&e)));
+            .map_err(|e| format!("{}: {}", a.request, describe(&e)));
     }
     let mut kinds = Vec::new();
     for name in &a.planners {
@@ -150,7 +156,7 @@ fn request_for(a: &MillArgs, request: &MillRequest, kind: PlannerKind) -> MillRe
     let mut r = request.clone();
     r.planner = kind.name().to_string();
     let own = request.planner_kind().ok() == Some(kind);
-    let path = |p: &Option<PathBuf>| p.as_ref().map(|p| p.display().to_string());
+    let path = |p: &Option<InputFile>| p.as_ref().map(|p| p.path().display().to_string());
     r.policy_file = match kind {
         PlannerKind::Ddpg => path(&a.ddpg_policy).or(if own {
             request.policy_file.clone()
@@ -181,10 +187,21 @@ pub fn run(a: MillArgs) -> Result<(), String> {
     if let Some(d) = &a.plots {
         output_paths::check_dir_writable("--plots", d)?;
     }
-    let text = std::fs::read_to_string(&a.request)
-        .map_err(|e| format!("cannot read {}: {e}", a.request.display()))?;
+    let text = input::read_text("--request", &a.request, input::REQUEST_CAP)?;
+    // The policies are read by the planner (kerf_robot::file::read_regular); checked here
+    // first so that a refusal names the argument.
+    for (arg, f) in [
+        ("--ddpg-policy", &a.ddpg_policy),
+        ("--fixed-g-policy", &a.fixed_g_policy),
+    ] {
+        // A missing policy is the planner's POLICY_ERROR (the other planners still run).
+        if let Some(f) = f.as_ref().filter(|f| f.is_stdin() || f.path().exists()) {
+            input::check_file(arg, f, kerf_millplan::policy::MAX_POLICY_BYTES)?;
+        }
+    }
     let parsed = if a
         .request
+        .path()
         .extension()
         .is_some_and(|e| e.eq_ignore_ascii_case("json"))
     {
@@ -192,7 +209,7 @@ pub fn run(a: MillArgs) -> Result<(), String> {
     } else {
         MillRequest::from_yaml_str(&text)
     };
-    let request = parsed.map_err(|e| format!("{}: {}", a.request.display(), describe(&e)))?;
+    let request = parsed.map_err(|e| format!("--request {}: {}", a.request, describe(&e)))?;
     let kinds = planner_list(&a, &request)?;
     let planner = MillPlanner::with_default_cell()
         .map_err(|e| format!("milling cell: {}", describe(&e)))?

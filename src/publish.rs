@@ -1,10 +1,7 @@
 //! `kerf pub TOPIC FILE|-`: publish one message, written as YAML or JSON, like
 //! `ros2 topic pub --once`, without a ROS install.
 
-use std::{
-    io::Read,
-    time::{Duration, Instant},
-};
+use std::time::{Duration, Instant};
 
 use clap::Args;
 use kerf_ros::{qos, KerfNode};
@@ -12,7 +9,11 @@ use serde::{de::DeserializeOwned, Serialize};
 
 use kerf_robot::document::from_yaml_or_json;
 
-use crate::topic_types::{cli_node, discover, dispatch, ForType, Side};
+use crate::{
+    bounds,
+    input::{self, InputFile},
+    topic_types::{cli_node, discover, dispatch, ForType, Side},
+};
 
 /// Arguments of `kerf pub`.
 #[derive(Args, Debug)]
@@ -20,19 +21,21 @@ pub struct PubArgs {
     /// Topic, e.g. `/mjto_planner/cut_request_text`.
     topic: String,
     /// The message as a YAML or JSON document (every field of the type; `ros2 topic echo`
-    /// and `kerf echo` print this form), read from this file, or from stdin with `-`.
-    file: String,
+    /// and `kerf echo` print this form), read from this file, or from stdin with `-` (at most
+    /// 16 MiB).
+    file: InputFile,
     /// ROS type (`std_msgs/msg/String`); by default it is discovered from the topic's
     /// subscribers.
     #[arg(long = "type")]
     ros_type: Option<String>,
     /// Seconds to wait for a subscriber: the message is published only once one is matched
-    /// (a volatile sample published before matching is lost), else the command fails.
-    #[arg(long, default_value_t = 10.0)]
+    /// (a volatile sample published before matching is lost), else the command fails;
+    /// [0, 86400] s.
+    #[arg(long, default_value_t = 10.0, value_parser = bounds::SECONDS)]
     wait: f64,
     /// Seconds the publisher stays after publishing, so that the reliable protocol can
-    /// deliver (and repair) the sample before the process ends.
-    #[arg(long, default_value_t = 1.0)]
+    /// deliver (and repair) the sample before the process ends; [0, 86400] s.
+    #[arg(long, default_value_t = 1.0, value_parser = bounds::SECONDS)]
     linger: f64,
 }
 
@@ -42,22 +45,8 @@ pub struct PubArgs {
 /// An unreadable file, a document that is not a message of the type (naming the field), no
 /// subscriber within `--wait`, a DDS failure.
 pub fn run(a: PubArgs) -> Result<(), String> {
-    for (name, v) in [("--wait", a.wait), ("--linger", a.linger)] {
-        if !(v.is_finite() && v >= 0.0) {
-            return Err(format!(
-                "{name} {v}: must be a finite number of seconds >= 0"
-            ));
-        }
-    }
-    let text = if a.file == "-" {
-        let mut s = String::new();
-        std::io::stdin()
-            .read_to_string(&mut s)
-            .map_err(|e| format!("cannot read stdin: {e}"))?;
-        s
-    } else {
-        std::fs::read_to_string(&a.file).map_err(|e| format!("cannot read {}: {e}", a.file))?
-    };
+    // Read (capped) before any DDS entity exists, so that Ctrl-C still ends a stalled stdin.
+    let text = input::read_text("FILE", &a.file, input::MESSAGE_CAP)?;
     let mut node = cli_node("pub")?;
     let topic = node.resolve(&a.topic).map_err(|e| e.to_string())?;
     let ros_type = match &a.ros_type {

@@ -51,6 +51,9 @@ use kerf_millplan::{
 };
 
 use crate::{
+    bounds::{Count, Real},
+    input::{self, InputFile},
+    lobes::load_cell,
     output_paths::{check_dir_writable, check_writable},
     plan_mill::describe,
     plots::training,
@@ -59,6 +62,12 @@ use progress::{format_duration, Progress};
 
 mod curve;
 mod progress;
+
+/// A count of episodes: [1, 1000000] episodes.
+const EPISODES: Count<usize> = Count::new(1, 1_000_000, "episodes");
+
+/// A rate or factor in (0, 1].
+const UNIT_OPEN: Real = Real::above(0.0, 1.0, "");
 
 /// Arguments of `kerf train`.
 #[derive(Args, Debug)]
@@ -80,14 +89,15 @@ enum TrainCommand {
 #[derive(Args, Debug)]
 pub struct CurveArgs {
     /// History file written by `kerf train mill --history` (CSV, or JSON: an array of
-    /// episode reports, as the `train_policy` example's `.history.json`).
+    /// episode reports, as the `train_policy` example's `.history.json`; at most 16 MiB, `-`
+    /// reads standard input as JSON).
     #[arg(long)]
-    history: PathBuf,
+    history: InputFile,
     /// Write training_curve.svg into this directory (created if missing).
     #[arg(long)]
     plots: PathBuf,
-    /// Episodes of the moving average.
-    #[arg(long, default_value_t = 50)]
+    /// Episodes of the moving average; [1, 1000000] episodes.
+    #[arg(long, default_value_t = 50, value_parser = EPISODES)]
     window: usize,
 }
 
@@ -97,14 +107,16 @@ pub struct MillTrainArgs {
     /// Where to save the actor (safetensors); the JSON sidecar goes next to it (.json).
     #[arg(long)]
     out: PathBuf,
-    /// Number of episodes (seed 004 Table 2: 1000).
-    #[arg(long, default_value_t = 1000)]
+    /// Number of episodes (seed 004 Table 2: 1000); [1, 1000000] episodes.
+    #[arg(long, default_value_t = 1000, value_parser = EPISODES)]
     episodes: usize,
-    /// Steps per episode (default: every step of the path, N − 1 for N segments).
-    #[arg(long)]
+    /// Steps per episode (default: every step of the path, N − 1 for N segments);
+    /// [1, 1000000] steps.
+    #[arg(long, value_parser = Count::<usize>::new(1, 1_000_000, "steps"))]
     steps: Option<usize>,
-    /// Seed of every random number of the run (weights, noise, replay sampling).
-    #[arg(long, default_value_t = 1)]
+    /// Seed of every random number of the run (weights, noise, replay sampling);
+    /// [0, 18446744073709551615].
+    #[arg(long, default_value_t = 1, value_parser = Count::<u64>::new(0, u64::MAX, ""))]
     seed: u64,
     /// The paper's ablation: g fixed at g0 = 0, the policy sets only Ω and f.
     #[arg(long)]
@@ -115,59 +127,67 @@ pub struct MillTrainArgs {
     /// Write training_curve.svg (seed 004 Fig. 5) into this directory (created if missing).
     #[arg(long)]
     plots: Option<PathBuf>,
-    /// Milling cell YAML (default: the shipped urdf/irb6660_milling.yaml).
+    /// Milling cell YAML (default: the shipped urdf/irb6660_milling.yaml; at most 1 MiB).
     #[arg(long)]
-    cell: Option<PathBuf>,
-    /// Indicator cache built for the cell (default: the shipped cache, if it fits the cell).
+    cell: Option<InputFile>,
+    /// Indicator cache built for the cell (default: the shipped cache, if it fits the cell; a
+    /// regular file of at most 64 MiB).
     #[arg(long, conflicts_with = "no_cache")]
-    cache: Option<PathBuf>,
+    cache: Option<InputFile>,
     /// Evaluate |mu|max directly at every step (no cache; much slower).
     #[arg(long)]
     no_cache: bool,
-    /// Hidden layer widths of actor and critic, comma-separated (Table 2: 256,256).
-    #[arg(long, value_delimiter = ',')]
+    /// Hidden layer widths of actor and critic, comma-separated (Table 2: 256,256); each
+    /// [1, 512] units (an episode's cost grows with the width: about 2 s at 256, 4 s at 512,
+    /// measured with `--episodes 2`; a progress line follows every slow episode).
+    #[arg(long, value_delimiter = ',', value_parser = Count::<usize>::new(1, 512, "units"))]
     hidden: Option<Vec<usize>>,
-    /// Actor learning rate (Table 2: 1e-4).
-    #[arg(long, allow_hyphen_values = true)]
+    /// Actor learning rate (Table 2: 1e-4); (0, 1].
+    #[arg(long, allow_hyphen_values = true, value_parser = UNIT_OPEN)]
     actor_lr: Option<f64>,
-    /// Critic learning rate (Table 2: 1e-3).
-    #[arg(long, allow_hyphen_values = true)]
+    /// Critic learning rate (Table 2: 1e-3); (0, 1].
+    #[arg(long, allow_hyphen_values = true, value_parser = UNIT_OPEN)]
     critic_lr: Option<f64>,
-    /// Discount factor gamma in [0, 1] (Table 2: 0.99).
-    #[arg(long, allow_hyphen_values = true)]
+    /// Discount factor gamma (Table 2: 0.99); [0, 1].
+    #[arg(long, allow_hyphen_values = true, value_parser = Real::closed(0.0, 1.0, ""))]
     discount: Option<f64>,
-    /// Soft target update rate tau in (0, 1] (Table 2: 0.005).
-    #[arg(long, allow_hyphen_values = true)]
+    /// Soft target update rate tau (Table 2: 0.005); (0, 1].
+    #[arg(long, allow_hyphen_values = true, value_parser = UNIT_OPEN)]
     tau: Option<f64>,
-    /// Replay buffer capacity (Table 2: 10000).
-    #[arg(long)]
+    /// Replay buffer capacity (Table 2: 10000); [1, 1000000] transitions.
+    #[arg(long, value_parser = Count::<usize>::new(1, 1_000_000, "transitions"))]
     buffer: Option<usize>,
-    /// Minibatch size (Table 2: 64); learning starts once the buffer holds one batch.
-    #[arg(long)]
+    /// Minibatch size (Table 2: 64); learning starts once the buffer holds one batch;
+    /// [1, 256] transitions (an episode's cost grows with it: about 2 s at 256, measured with
+    /// `--episodes 4`).
+    #[arg(long, value_parser = Count::<usize>::new(1, 256, "transitions"))]
     batch_size: Option<usize>,
-    /// Initial exploration noise standard deviation, normalized action units (Table 2: 0.1).
-    #[arg(long, allow_hyphen_values = true)]
+    /// Initial exploration noise standard deviation, normalized action units (Table 2: 0.1);
+    /// [0, 10].
+    #[arg(long, allow_hyphen_values = true, value_parser = Real::closed(0.0, 10.0, ""))]
     noise: Option<f64>,
-    /// Per-episode noise decay factor in (0, 1] (Table 2: 0.999).
-    #[arg(long, allow_hyphen_values = true)]
+    /// Per-episode noise decay factor (Table 2: 0.999); (0, 1].
+    #[arg(long, allow_hyphen_values = true, value_parser = UNIT_OPEN)]
     noise_decay: Option<f64>,
-    /// Episodes at full noise before the decay starts (Table 2: 50).
-    #[arg(long)]
+    /// Episodes at full noise before the decay starts (Table 2: 50); [0, 1000000] episodes.
+    #[arg(long, value_parser = Count::<usize>::new(0, 1_000_000, "episodes"))]
     noise_decay_start: Option<usize>,
-    /// Inertia coefficient alpha in (0, 1] of the action filter (seed 004 eq. 11; default 0.5).
-    #[arg(long, allow_hyphen_values = true)]
+    /// Inertia coefficient alpha of the action filter (seed 004 eq. 11; default 0.5); (0, 1].
+    #[arg(long, allow_hyphen_values = true, value_parser = UNIT_OPEN)]
     alpha: Option<f64>,
     /// Weight of kerf's joint-acceleration shaping (EnvConfig::acceleration_penalty; the
     /// committed policy's 1.0 by default, 0 turns it off): w * sum_j (|a_j|/a_max_j - 1)+ at
-    /// each segment midpoint is subtracted from the step reward.
-    #[arg(long, default_value_t = 1.0, allow_hyphen_values = true)]
+    /// each segment midpoint is subtracted from the step reward; [0, 1000].
+    #[arg(long, default_value_t = 1.0, allow_hyphen_values = true,
+          value_parser = Real::closed(0.0, 1000.0, ""))]
     acceleration_penalty: f64,
-    /// Episodes of the moving average of the progress line and the training curve.
-    #[arg(long, default_value_t = 50)]
+    /// Episodes of the moving average of the progress line and the training curve;
+    /// [1, 1000000] episodes.
+    #[arg(long, default_value_t = 50, value_parser = EPISODES)]
     window: usize,
     /// When stderr is not a terminal: one progress line every this many episodes
-    /// (default: episodes / 20, at least 1).
-    #[arg(long)]
+    /// (default: episodes / 20, at least 1); [1, 1000000] episodes.
+    #[arg(long, value_parser = EPISODES)]
     log_every: Option<usize>,
 }
 
@@ -244,19 +264,19 @@ fn mill(a: MillTrainArgs) -> Result<(), String> {
     // The cell, the cache, the environment.
     let cell_name = a.cell.as_ref().map_or_else(
         || "urdf/irb6660_milling.yaml (default cell)".to_string(),
-        |p| p.display().to_string(),
+        |f| f.to_string(),
     );
     let cell = match &a.cell {
-        Some(p) => MillCell::load(p),
-        None => MillCell::default_cell(),
-    }
-    .map_err(|e| format!("cell {cell_name}: {e}"))?;
+        Some(f) => load_cell("--cell", f)?,
+        None => MillCell::default_cell().map_err(|e| format!("cell {cell_name}: {e}"))?,
+    };
     let cell = Arc::new(cell);
     let (cache, cache_name) = if a.no_cache {
         (None, "none (--no-cache)".to_string())
-    } else if let Some(p) = &a.cache {
-        let c = IndicatorCache::load(p, &cell).map_err(|e| format!("--cache: {e}"))?;
-        (Some(Arc::new(c)), p.display().to_string())
+    } else if let Some(f) = &a.cache {
+        input::check_file("--cache", f, input::CACHE_CAP)?;
+        let c = IndicatorCache::load(f.path(), &cell).map_err(|e| format!("--cache: {e}"))?;
+        (Some(Arc::new(c)), f.to_string())
     } else {
         let p = IndicatorCache::default_path();
         match IndicatorCache::load(&p, &cell) {

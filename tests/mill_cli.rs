@@ -669,7 +669,10 @@ fn bad_inputs_exit_2_with_a_message() {
         ),
         (
             vec!["train", "mill", "--out", "q.safetensors", "--episodes", "0"],
-            &["--episodes 0: must be at least 1"],
+            &[
+                "invalid value '0' for '--episodes <EPISODES>'",
+                "allowed: [1, 1000000]",
+            ],
         ),
         (
             vec![
@@ -680,11 +683,17 @@ fn bad_inputs_exit_2_with_a_message() {
                 "--actor-lr",
                 "NaN",
             ],
-            &["actor learning rate = NaN"],
+            &[
+                "invalid value 'NaN' for '--actor-lr <ACTOR_LR>'",
+                "must be finite",
+            ],
         ),
         (
             vec!["train", "mill", "--out", "q.safetensors", "--alpha", "1.5"],
-            &["--alpha 1.5: must be in (0, 1]"],
+            &[
+                "invalid value '1.5' for '--alpha <ALPHA>'",
+                "allowed: (0, 1]",
+            ],
         ),
         (
             vec![

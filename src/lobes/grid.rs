@@ -1,4 +1,11 @@
-//! The `MIN:MAX:COUNT` grids of `kerf lobes --rpm` and `--feed`.
+//! The `MIN:MAX:COUNT` grids of `kerf lobes --rpm` and `--feed`, checked at parse time by
+//! [`GridParser`] (finite, normal, bounded values and a bounded count).
+
+use std::ffi::OsStr;
+
+use clap::{builder::TypedValueParser, error::ErrorKind, Arg, Command};
+
+use crate::bounds::{Count, Real};
 
 /// An evenly spaced grid `MIN:MAX:COUNT` (COUNT = 1 needs MIN = MAX).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -12,41 +19,12 @@ pub struct Grid {
 }
 
 impl Grid {
-    /// Parses `MIN:MAX:COUNT` for the option `name`, requiring `MIN >= lower` (and
-    /// `MIN > lower` when `strict`).
+    /// Validates a grid: MIN <= MAX, MIN >= `lower` (> when `strict`), COUNT >= 1, COUNT 1
+    /// only with MIN = MAX.
     ///
     /// # Errors
-    /// A message naming the option: wrong syntax, NaN or infinite bounds, MIN > MAX, COUNT 0,
-    /// COUNT 1 with MIN ≠ MAX, a bound under `lower`.
-    pub fn parse(name: &str, text: &str, lower: f64, strict: bool) -> Result<Self, String> {
-        let parts: Vec<&str> = text.split(':').collect();
-        let [min, max, count] = parts[..] else {
-            return Err(format!("--{name} {text}: expected MIN:MAX:COUNT"));
-        };
-        let num = |what: &str, s: &str| -> Result<f64, String> {
-            let v: f64 = s
-                .trim()
-                .parse()
-                .map_err(|_| format!("--{name} {text}: {what} `{s}` is not a number"))?;
-            if v.is_finite() {
-                Ok(v)
-            } else {
-                Err(format!("--{name} {text}: {what} is {v}, must be finite"))
-            }
-        };
-        let min = num("MIN", min)?;
-        let max = num("MAX", max)?;
-        let count: usize = count
-            .trim()
-            .parse()
-            .map_err(|_| format!("--{name} {text}: COUNT `{count}` is not a whole number"))?;
-        Self::new(name, min, max, count, lower, strict)
-    }
-
-    /// Validates a grid (the checks of [`Grid::parse`]).
-    ///
-    /// # Errors
-    /// As [`Grid::parse`].
+    /// A message naming the option: NaN or infinite bounds, MIN > MAX, COUNT 0, COUNT 1 with
+    /// MIN ≠ MAX, a bound under `lower`.
     pub fn new(
         name: &str,
         min: f64,
@@ -87,31 +65,113 @@ impl Grid {
     }
 }
 
+/// The value parser of a grid argument: `MIN:MAX:COUNT` with MIN and MAX in `values` and
+/// COUNT in `count` (the refusal and `--help` state both ranges).
+#[derive(Debug, Clone, Copy)]
+pub struct GridParser {
+    /// The option's name without dashes (`rpm`, `feed`).
+    pub name: &'static str,
+    /// The range of MIN and MAX.
+    pub values: Real,
+    /// The range of COUNT.
+    pub count: Count<usize>,
+}
+
+impl GridParser {
+    /// The ranges as stated in `--help` and refusals.
+    pub fn range(&self) -> String {
+        format!(
+            "MIN:MAX:COUNT, MIN and MAX in {}, COUNT in {}",
+            self.values.range(),
+            self.count.range()
+        )
+    }
+
+    /// Checks `text`.
+    ///
+    /// # Errors
+    /// Why it is refused: syntax, a bound or the count out of its range, MIN > MAX, COUNT 1
+    /// with MIN ≠ MAX.
+    pub fn check(&self, text: &str) -> Result<Grid, String> {
+        let parts: Vec<&str> = text.split(':').collect();
+        let [min, max, count] = parts[..] else {
+            return Err("expected MIN:MAX:COUNT".into());
+        };
+        let min = self
+            .values
+            .check(min)
+            .map_err(|e| format!("MIN is {}: {e}", min.trim()))?;
+        let max = self
+            .values
+            .check(max)
+            .map_err(|e| format!("MAX is {}: {e}", max.trim()))?;
+        let (low, high) = self.count.bounds();
+        let count = self
+            .count
+            .check(count)
+            .ok()
+            .and_then(|c| usize::try_from(c).ok())
+            .ok_or_else(|| {
+                format!(
+                    "COUNT must be >= {low} and <= {high}, got `{}`",
+                    count.trim()
+                )
+            })?;
+        Grid::new(self.name, min, max, count, f64::NEG_INFINITY, false)
+    }
+}
+
+impl TypedValueParser for GridParser {
+    type Value = Grid;
+
+    fn parse_ref(
+        &self,
+        cmd: &Command,
+        arg: Option<&Arg>,
+        value: &OsStr,
+    ) -> Result<Grid, clap::Error> {
+        self.check(&value.to_string_lossy()).map_err(|why| {
+            let name = arg.map_or_else(|| self.name.to_string(), |a| a.to_string());
+            cmd.clone().error(
+                ErrorKind::ValueValidation,
+                format!(
+                    "invalid value '{}' for '{name}': {why}; allowed: {}",
+                    value.to_string_lossy(),
+                    self.range()
+                ),
+            )
+        })
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
 
     #[test]
     fn grid_parses_and_refuses_bad_ranges() {
-        let g = Grid::parse("rpm", "2000:4000:5", 0.0, true).expect("grid");
-        assert_eq!(g.values(), vec![2000.0, 2500.0, 3000.0, 3500.0, 4000.0]);
+        let p = GridParser {
+            name: "rpm",
+            values: Real::above(0.0, 1e6, "rpm"),
+            count: Count::new(1, 10, "speeds"),
+        };
+        assert_eq!(p.check("1:2:2").unwrap().values(), vec![1.0, 2.0]);
         assert_eq!(
-            Grid::parse("feed", "0:0:1", 0.0, false)
-                .expect("single")
-                .values(),
-            vec![0.0]
+            p.check("2000:4000:5").unwrap().values(),
+            vec![2000.0, 2500.0, 3000.0, 3500.0, 4000.0]
         );
-        for bad in [
-            "4000:2000:5",
-            "NaN:4000:5",
-            "2000:inf:5",
-            "2000:4000:0",
-            "2000:4000",
-        ] {
-            assert!(Grid::parse("rpm", bad, 0.0, true).is_err(), "{bad}");
+        for bad in ["4000:2000:5", "2000:4000:0", "2000:4000", "2000:4000:1"] {
+            assert!(p.check(bad).is_err(), "{bad}");
         }
-        assert!(Grid::parse("rpm", "0:4000:5", 0.0, true).is_err());
-        assert!(Grid::parse("feed", "-0.01:0.06:5", 0.0, false).is_err());
-        assert!(Grid::parse("feed", "0.01:0.06:1", 0.0, false).is_err());
+        for bad in [
+            "0:2:2",
+            "1:2:11",
+            "1:nan:2",
+            "1:1e308:2",
+            "5e-324:2:2",
+            "1:2:1e3",
+        ] {
+            assert!(p.check(bad).is_err(), "{bad}");
+        }
     }
 }

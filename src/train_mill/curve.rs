@@ -3,7 +3,7 @@
 use kerf_millplan::history::parse_history;
 
 use super::CurveArgs;
-use crate::{output_paths::check_dir_writable, plots::training};
+use crate::{input, output_paths::check_dir_writable, plots::training};
 
 /// Runs `kerf train curve`.
 ///
@@ -14,18 +14,18 @@ pub fn curve(a: CurveArgs) -> Result<(), String> {
     if a.window == 0 {
         return Err("--window 0: must be at least 1".to_string());
     }
-    let text = std::fs::read_to_string(&a.history)
-        .map_err(|e| format!("cannot read {}: {e}", a.history.display()))?;
+    let text = input::read_text("--history", &a.history, input::HISTORY_CAP)?;
     let csv = a
         .history
+        .path()
         .extension()
         .is_some_and(|e| e.eq_ignore_ascii_case("csv"));
-    let history =
-        parse_history(&a.history.display().to_string(), &text, csv).map_err(|e| e.to_string())?;
+    let history = parse_history(&a.history.to_string(), &text, csv).map_err(|e| e.to_string())?;
     check_dir_writable("--plots", &a.plots)?;
     let file = a.plots.join("training_curve.svg");
     let name = a
         .history
+        .path()
         .file_name()
         .map_or_else(String::new, |n| n.to_string_lossy().into_owned());
     training::training_curve(

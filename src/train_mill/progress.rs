@@ -1,5 +1,6 @@
 //! The progress display of `kerf train mill` on stderr: a bar redrawn in place on a
-//! terminal, else a line every N episodes.
+//! terminal, else a line every N episodes, and at least one every [`MAX_SILENCE_S`] seconds
+//! (slow episodes, e.g. wide `--hidden` layers, never leave a long run silent).
 
 use kerf_millplan::EpisodeReport;
 
@@ -28,7 +29,13 @@ pub struct Progress {
     window: usize,
     terminal: bool,
     log_every: usize,
+    /// Elapsed time of the last line printed (s).
+    last_line_s: f64,
 }
+
+/// Longest time between two progress lines when stderr is no terminal (s), checked after each
+/// episode.
+pub const MAX_SILENCE_S: f64 = 10.0;
 
 /// Width of the progress bar in characters.
 pub const BAR_WIDTH: usize = 20;
@@ -41,6 +48,7 @@ impl Progress {
             window: window.max(1),
             terminal,
             log_every: log_every.max(1),
+            last_line_s: 0.0,
         }
     }
 
@@ -77,7 +85,12 @@ impl Progress {
                 s.push('\n');
             }
             s
-        } else if r.episode.is_multiple_of(self.log_every) || last || r.episode == 1 {
+        } else if r.episode.is_multiple_of(self.log_every)
+            || last
+            || r.episode == 1
+            || r.elapsed_s - self.last_line_s >= MAX_SILENCE_S
+        {
+            self.last_line_s = r.elapsed_s;
             format!("episode {}/{}: {stats}\n", r.episode, r.episodes)
         } else {
             String::new()
@@ -101,6 +114,20 @@ mod tests {
             elapsed_s: 2.0 * episode as f64,
             remaining_s: 2.0 * (episodes - episode) as f64,
         }
+    }
+
+    #[test]
+    fn slow_episodes_still_print_a_line_every_ten_seconds() {
+        // One line every 100 episodes, but 6 s per episode: a line every other episode.
+        let mut p = Progress::new(2, false, 100);
+        let slow = |e: usize| EpisodeReport {
+            elapsed_s: 6.0 * e as f64,
+            ..report(e, 1000, 1.0)
+        };
+        let printed: Vec<usize> = (1..=7)
+            .filter(|&e| !p.update(&slow(e)).is_empty())
+            .collect();
+        assert_eq!(printed, [1, 3, 5, 7]);
     }
 
     #[test]

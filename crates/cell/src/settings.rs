@@ -2,6 +2,23 @@
 
 use crate::CellError;
 
+/// Highest physics rate (Hz) a cell accepts: what one control period runs in real time with a
+/// margin, whatever the control rate (the sub-steps of one period cost `physics rate ×
+/// period × sub-step cost`, so the bound is on the physics rate itself).
+///
+/// One sub-step of the dynamic laser cutter with its head in contact with the B-pillar (the
+/// dearest case) costs 40 µs on the mean and 82 µs at the 99th percentile on the 2-core
+/// reference machine (BENCHMARKS.md, "Simulated cell": 161 µs mean and 327 µs p99 per 4 ms
+/// cycle of 4 sub-steps, `cargo bench -p kerf_cell --bench cycle`). At 5 kHz the sub-steps
+/// take 20 % of wall time on the mean and 41 % at the p99, leaving the rest of each period to
+/// the executor, the contact watch and DDS; at 10 kHz the p99 would take 82 %. Above this
+/// rate the simulation falls behind real time (`sim_physics_rate:=1e9` ran 1000 × slower).
+pub const MAX_PHYSICS_RATE_HZ: f64 = 5_000.0;
+
+/// The refusal of a physics rate over [`MAX_PHYSICS_RATE_HZ`].
+pub const PHYSICS_RATE_BOUND: &str = "must be <= 5000 Hz (MAX_PHYSICS_RATE_HZ): one physics \
+     sub-step costs up to about 80 us, so a higher rate cannot run in real time with a margin";
+
 /// How the robot follows its commands.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Mode {
@@ -53,8 +70,8 @@ impl CellSettings {
     /// The number of physics steps per control period.
     ///
     /// # Errors
-    /// [`CellError::InvalidValue`] for a rate that is not finite and > 0, a gain setting out
-    /// of range or gravity not finite; [`CellError::RateRatio`] when the physics rate is not
+    /// [`CellError::InvalidValue`] for a rate that is not finite and > 0, a physics rate over
+    /// [`MAX_PHYSICS_RATE_HZ`], a gain setting out of range or gravity not finite; [`CellError::RateRatio`] when the physics rate is not
     /// an integer multiple (≥ 1) of the control rate (relative tolerance 1e-9).
     pub fn substeps(&self) -> Result<usize, CellError> {
         for (field, v) in [
@@ -70,6 +87,13 @@ impl CellSettings {
                     requirement: "must be finite and > 0",
                 });
             }
+        }
+        if self.physics_rate_hz > MAX_PHYSICS_RATE_HZ {
+            return Err(CellError::InvalidValue {
+                field: "physics_rate_hz".into(),
+                value: self.physics_rate_hz,
+                requirement: PHYSICS_RATE_BOUND,
+            });
         }
         if let Some(&g) = self.gravity.iter().find(|g| !g.is_finite()) {
             return Err(CellError::InvalidValue {
@@ -99,5 +123,33 @@ impl CellSettings {
             });
         }
         Ok(n as usize)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn physics_rates_are_bounded_by_what_a_period_runs() {
+        let at = |hz: f64| CellSettings {
+            physics_rate_hz: hz,
+            ..CellSettings::default()
+        };
+        assert_eq!(at(MAX_PHYSICS_RATE_HZ).substeps().unwrap(), 20);
+        for hz in [
+            MAX_PHYSICS_RATE_HZ + 250.0,
+            2.5e8,
+            1e9,
+            f64::INFINITY,
+            f64::NAN,
+        ] {
+            let e = at(hz).substeps().unwrap_err().to_string();
+            assert!(e.contains("physics_rate_hz"), "{hz}: {e}");
+        }
+        let e = at(1e9).substeps().unwrap_err().to_string();
+        assert!(e.contains("5000 Hz") && e.contains("real time"), "{e}");
+        // The message states the constant.
+        assert!(PHYSICS_RATE_BOUND.contains(&format!("{MAX_PHYSICS_RATE_HZ}")));
     }
 }

@@ -68,18 +68,28 @@ fn param_err(name: &str, reason: String) -> NodeError {
     }
 }
 
-fn positive(params: &Params, name: &str, default: f64) -> Result<f64, NodeError> {
+/// Highest `control_rate` (Hz): a 1 ms period. The control loop's own work per cycle stays
+/// under 0.1 ms, 10⁶-point hand-overs included (BENCHMARKS.md, issue 11), so 1 kHz leaves a
+/// margin of 10; faster than that, the loop's wake-up latency on a loaded PC (measured up to
+/// 6.3 ms late) is several periods, and ros2_control's JTC runs at most about this rate.
+pub const MAX_CONTROL_RATE_HZ: f64 = 1_000.0;
+
+fn non_negative(params: &Params, name: &str, default: f64) -> Result<f64, NodeError> {
     let v = params.f64_or(name, default)?;
-    if v <= 0.0 {
-        return Err(param_err(name, format!("must be > 0, got {v}")));
+    if !(v.is_finite() && v >= 0.0) {
+        return Err(param_err(name, format!("must be finite and >= 0, got {v}")));
     }
     Ok(v)
 }
 
-fn non_negative(params: &Params, name: &str, default: f64) -> Result<f64, NodeError> {
+/// A rate (Hz): finite, > 0 and at most `max`, `why` saying where the bound comes from.
+fn rate(params: &Params, name: &str, default: f64, max: f64, why: &str) -> Result<f64, NodeError> {
     let v = params.f64_or(name, default)?;
-    if v < 0.0 {
-        return Err(param_err(name, format!("must be >= 0, got {v}")));
+    if !(v.is_finite() && v > 0.0 && v <= max) {
+        return Err(param_err(
+            name,
+            format!("{v} Hz: must be finite, > 0 and <= {max} Hz ({why})"),
+        ));
     }
     Ok(v)
 }
@@ -90,7 +100,8 @@ impl NodeConfig {
     /// # Parameters
     /// * `urdf_file` (string, required), `joint_limits_file` (string, required: acceleration
     ///   limits are needed to validate trajectories).
-    /// * `control_rate` (Hz, default 250: the 4 ms of seed 001), `action_monitor_rate` (Hz, 20).
+    /// * `control_rate` (Hz, default 250: the 4 ms of seed 001; at most
+    ///   [`MAX_CONTROL_RATE_HZ`]), `action_monitor_rate` (Hz, 20; at most the control rate).
     /// * `initial_positions` (one per joint, model order; default all 0, which must be in range).
     /// * `start_tolerance` (default 1e-3): see `kerf_executor::ExecutorConfig`.
     /// * `constraints.stopped_velocity_tolerance` (0.01), `constraints.goal_time` (s, 0 = wait
@@ -101,7 +112,8 @@ impl NodeConfig {
     ///   be 0 with `hardware: sim`).
     /// * `sim_cell` (string, required with `hardware: sim`): the cell file (`kerf_cell`);
     ///   `sim_mode` (`kinematic` or `dynamic`, default `kinematic`); `sim_physics_rate` (Hz,
-    ///   default 1000, an integer multiple of `control_rate`). Refused with `hardware: mock`.
+    ///   default 1000, an integer multiple of `control_rate`, at most
+    ///   `kerf_cell::settings::MAX_PHYSICS_RATE_HZ`). Refused with `hardware: mock`.
     ///   With `hardware: sim` and no `initial_positions`, the robot starts at the cell file's
     ///   `robot.initial_positions`.
     /// * `realtime_priority` (0 = normal scheduling, 1–99 = `SCHED_FIFO` for the control
@@ -123,8 +135,20 @@ impl NodeConfig {
             other => NodeError::from(other),
         })?;
 
-        let control_rate = positive(params, "control_rate", 250.0)?;
-        let action_monitor_rate = positive(params, "action_monitor_rate", 20.0)?;
+        let control_rate = rate(
+            params,
+            "control_rate",
+            250.0,
+            MAX_CONTROL_RATE_HZ,
+            "MAX_CONTROL_RATE_HZ: what one control period runs with a margin",
+        )?;
+        let action_monitor_rate = rate(
+            params,
+            "action_monitor_rate",
+            20.0,
+            control_rate,
+            "feedback is sent from the control loop, at most once per period: the control_rate",
+        )?;
         let mut executor = ExecutorConfig {
             control_period: 1.0 / control_rate,
             stopped_velocity_tolerance: non_negative(
@@ -271,7 +295,15 @@ fn sim_config(params: &Params) -> Result<Option<SimConfig>, NodeError> {
                     ))
                 }
             };
-            let physics_rate = positive(params, "sim_physics_rate", 1000.0)?;
+            let physics_rate = rate(
+                params,
+                "sim_physics_rate",
+                1000.0,
+                kerf_cell::settings::MAX_PHYSICS_RATE_HZ,
+                "kerf_cell::settings::MAX_PHYSICS_RATE_HZ: one physics sub-step costs up to \
+                 about 80 us, so the sub-steps of a control period cannot run in real time with \
+                 a margin above it",
+            )?;
             Ok(Some(SimConfig {
                 cell_file,
                 mode,
