@@ -1,6 +1,7 @@
 //! Resident memory of each planner node over sequential requests (issue 33, item 3), over
-//! loopback DDS. The node and a client run in this process; the node plans in its worker
-//! process. Prints the node's (this process) and the worker's VmRSS every `KERF_RSS_EVERY`
+//! loopback DDS. The node runs in a `kerf launch --with-planner` process (as a cell runs it:
+//! the robot's executor and planners), its client in this process; the node plans in its
+//! worker process. Prints the node process's and the worker's VmRSS every `KERF_RSS_EVERY`
 //! answers and the slope over the second half.
 //!
 //! Run: `cargo bench --bench request_rss -- [cut|mill|gcode] [COUNT]` (default: all three,
@@ -8,7 +9,6 @@
 #![allow(clippy::unwrap_used, clippy::expect_used)] // a bench binary reports failures by panicking
 
 use kerf_msgs::msg::{CutPlan, GcodePlan, MillPlan};
-use kerf_ros::ros2_client::ServiceMapping;
 
 #[allow(dead_code)]
 #[path = "../tests/support/mod.rs"]
@@ -16,12 +16,9 @@ mod support;
 use support::rss::{sequential, slope_kib, Reading};
 
 fn report(name: &str, readings: &[Reading]) {
-    println!("{name}: answered, node VmRSS MiB, worker VmRSS MiB, node heap in use MiB");
+    println!("{name}: answered, node VmRSS MiB, worker VmRSS MiB");
     for r in readings {
-        println!(
-            "  {:6} {:8.1} {:8.1} {:8.1}",
-            r.answered, r.node_mib, r.worker_mib, r.heap_mib
-        );
+        println!("  {:6} {:8.1} {:8.1}", r.answered, r.node_mib, r.worker_mib);
     }
     let last = readings.last().map_or(0, |r| r.answered);
     let at_100 = readings.iter().find(|r| r.answered >= 100);
@@ -57,11 +54,10 @@ fn main() {
             "/crates/mjto/cases/case1.yaml"
         ))
         .unwrap();
-        let env = support::loopback(91, ServiceMapping::Enhanced);
         let r = sequential(
             &support::planner::mjto(),
-            &env,
-            &[],
+            91,
+            &["--robot", "laser_cutter", "--with-planner"],
             count.unwrap_or(10_000),
             every,
             CutPlan::SUCCESS,
@@ -70,12 +66,11 @@ fn main() {
         report("cut (case 1)", &r);
     }
     if which == "all" || which == "gcode" {
-        let env = support::loopback(92, ServiceMapping::Enhanced);
         let text = "request_id: square\nprogram: \"G21 G90 G17\\nM3\\nG1 X20 Y0 F3000\\nG1 X20 Y15\\nG3 X15 Y20 R5\\nG1 X0 Y20\\nG1 X0 Y0\\nM5\\nM30\\n\"\n";
         let r = sequential(
             &support::planner::gcode(),
-            &env,
-            &[],
+            92,
+            &["--robot", "laser_cutter", "--with-planner"],
             count.unwrap_or(10_000),
             every,
             GcodePlan::SUCCESS,
@@ -84,15 +79,24 @@ fn main() {
         report("gcode (20 mm square)", &r);
     }
     if which == "all" || which == "mill" {
-        let env = support::loopback(93, ServiceMapping::Enhanced);
+        // The seed 004 path (the default cell's), as `kerf plan mill` takes it.
+        let points: Vec<String> = kerf_millplan::MillRequest::default()
+            .points
+            .iter()
+            .map(|p| format!("[{:?}, {:?}, {:?}]", p[0], p[1], p[2]))
+            .collect();
+        let mill_text = format!(
+            "request_id: naive\nplanner: naive\npoints: [{}]\n",
+            points.join(", ")
+        );
         let r = sequential(
             &support::planner::mill(),
-            &env,
-            &[],
+            93,
+            &["--robot", "irb6660", "--with-planner"],
             count.unwrap_or(1_000),
             every,
             MillPlan::SUCCESS,
-            |_| "request_id: naive\nplanner: naive\n".to_string(),
+            |_| mill_text.clone(),
         );
         report("mill (default path, naive)", &r);
     }

@@ -8,6 +8,7 @@
 //!
 //! * [`Real`]: an `f64` (seconds, rates, lengths, factors).
 //! * [`Count`]: a whole number (counts, indices, seeds), `usize` or `u64`.
+//! * [`Coordinates`]: a point `x,y,z` ([`Point3`]), each coordinate a [`Real`] in one range.
 
 use std::{ffi::OsStr, marker::PhantomData};
 
@@ -116,6 +117,51 @@ impl TypedValueParser for Real {
     }
 }
 
+/// A point `x,y,z`: three reals separated by commas, each checked by [`Real`] (as an
+/// `--origin` takes it). Parsed by [`Coordinates`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Point3(pub [f64; 3]);
+
+/// The value parser of a [`Point3`]: each coordinate in the same range.
+#[derive(Debug, Clone, Copy)]
+pub struct Coordinates(pub Real);
+
+impl Coordinates {
+    /// Checks `text` (`x,y,z`).
+    ///
+    /// # Errors
+    /// Why the value is refused: not three numbers, or a coordinate as [`Real::check`] says.
+    pub fn check(&self, text: &str) -> Result<Point3, String> {
+        let parts: Vec<&str> = text.split(',').collect();
+        if parts.len() != 3 {
+            return Err(format!(
+                "{} value(s); three coordinates x,y,z separated by commas are required",
+                parts.len()
+            ));
+        }
+        let mut p = [0.0; 3];
+        for (k, (part, axis)) in parts.iter().zip(["x", "y", "z"]).enumerate() {
+            p[k] = self.0.check(part).map_err(|why| format!("{axis}: {why}"))?;
+        }
+        Ok(Point3(p))
+    }
+}
+
+impl TypedValueParser for Coordinates {
+    type Value = Point3;
+
+    fn parse_ref(
+        &self,
+        cmd: &Command,
+        arg: Option<&Arg>,
+        value: &OsStr,
+    ) -> Result<Point3, clap::Error> {
+        let text = value.to_string_lossy();
+        self.check(&text)
+            .map_err(|why| refusal(cmd, arg, value, &why, &self.0.range()))
+    }
+}
+
 /// A whole number in `[min, max]`, parsed as `T` (`usize` or `u64`).
 #[derive(Debug)]
 pub struct Count<T> {
@@ -212,6 +258,25 @@ mod tests {
         assert_eq!(open.range(), "(0, 1]");
         assert!(open.check("0").is_err());
         assert_eq!(open.check("1"), Ok(1.0));
+    }
+
+    #[test]
+    fn points_are_three_checked_reals() {
+        let c = Coordinates(Real::closed(-10.0, 10.0, "m"));
+        assert_eq!(c.check("1,-2,0").unwrap(), Point3([1.0, -2.0, 0.0]));
+        assert!(c.check("1,2").unwrap_err().contains("three coordinates"));
+        assert!(c
+            .check("1,2,3,4")
+            .unwrap_err()
+            .contains("three coordinates"));
+        assert!(c
+            .check("1,NaN,3")
+            .unwrap_err()
+            .starts_with("y: must be finite"));
+        assert!(c
+            .check("1,2,11")
+            .unwrap_err()
+            .starts_with("z: out of range"));
     }
 
     #[test]

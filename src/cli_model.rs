@@ -3,14 +3,15 @@
 //! or argument from its first commit.
 //!
 //! Each line: `path` (the subcommand names), `id`, `long` (or null), `positional`, `takes_value`,
-//! `kind` — `real` (`f64`), `count` (a whole number), `grid` (`MIN:MAX:COUNT`), `input` (an
+//! `kind` — `real` (`f64`), `count` (a whole number), `grid` (`MIN:MAX:COUNT`), `point`
+//! (`x,y,z`), `input` (an
 //! [`InputFile`]: a file the command reads), `enum` (a fixed set of values), `other` — and
 //! `help`.
 
 use clap::{Arg, ArgAction, Command};
 use serde_json::json;
 
-use crate::{input::InputFile, lobes::Grid};
+use crate::{bounds::Point3, input::InputFile, lobes::Grid};
 
 /// The kind of an argument's value, from its value parser's type.
 fn kind(arg: &Arg) -> &'static str {
@@ -33,6 +34,8 @@ fn kind(arg: &Arg) -> &'static str {
         "count"
     } else if id == std::any::TypeId::of::<Grid>() {
         "grid"
+    } else if id == std::any::TypeId::of::<Point3>() {
+        "point"
     } else if id == std::any::TypeId::of::<InputFile>() {
         "input"
     } else if !arg.get_possible_values().is_empty() {

@@ -7,9 +7,10 @@
 //!                      [--out plan.json]
 //! ```
 //!
-//! Reads the program as a stream (`-` reads standard input; a file must be a regular file, and
-//! either is read up to [`kerf_gcodeplan::MAX_PROGRAM_BYTES`]), plans it with
-//! [`kerf_gcodeplan::plan_request_within`] (the shipped machine) under a memory budget of
+//! Reads the program as a stream through the CLI's capped reader ([`crate::input::open`]: `-`
+//! reads standard input, a FIFO or pipe is streamed, a directory or a regular file over
+//! [`kerf_gcodeplan::MAX_PROGRAM_BYTES`] is refused before it is read, and no stream is read
+//! past that cap), plans it with [`kerf_gcodeplan::plan_request_reading`] (the shipped machine) under a memory budget of
 //! `--plan-memory` bytes (default [`kerf_budget::DEFAULT_PLAN_MEMORY`], 1 GiB, as the node's
 //! `plan_memory`: a program whose data would not fit ends with RESOURCE_LIMIT naming what grew)
 //! and prints the totals (time, T_lb
@@ -22,15 +23,36 @@
 //!
 //! Exit code 0 on success; 2 on any failure (its status, line and message are printed).
 
-use std::path::PathBuf;
+use std::{f64::consts::PI, path::PathBuf};
 
 use clap::{Args, ValueEnum};
 use kerf_budget::Budget;
 use kerf_gcodeplan::{
-    plan_request_reading, plan_request_within, GcodePlan, GcodeRequest, MachineBase, MachineKind,
-    RunKind, MAX_PROGRAM_BYTES,
+    plan_request_reading, GcodePlan, GcodeRequest, MachineBase, MachineKind, RunKind,
+    MAX_PROGRAM_BYTES,
 };
 use kerf_msgs::msg::GcodePlan as GcodePlanMsg;
+
+use crate::{
+    bounds::{Coordinates, Count, Point3, Real},
+    input::{self, InputFile},
+};
+
+/// `--tolerance`: the `tolerance` rule of `GcodeRequest` (`kerf_msgs::numbers::gcode`).
+const TOLERANCE: Real = Real::closed(1e-7, 0.01, "m");
+
+/// `--g`: the `redundancy_angle` rule of `GcodeRequest`.
+const ANGLE: Real = Real::closed(-PI, PI, "rad");
+
+/// `--origin`: the `origin.*` rule of `GcodeRequest`, for each coordinate.
+const ORIGIN: Coordinates = Coordinates(Real::closed(-1000.0, 1000.0, "m"));
+
+/// `--plan-memory`: the node's `plan_memory` range.
+const PLAN_MEMORY: Count<u64> = Count::new(
+    kerf_budget::MIN_PLAN_MEMORY,
+    kerf_budget::MAX_PLAN_MEMORY,
+    "bytes",
+);
 
 /// The machines, as named in requests.
 #[derive(Debug, Clone, Copy, ValueEnum)]
@@ -45,13 +67,13 @@ pub enum MachineArg {
 /// Arguments of `kerf plan gcode`.
 #[derive(Args, Debug)]
 pub struct GcodeArgs {
-    /// The program (G-code); `-` reads standard input.
-    file: PathBuf,
+    /// The program (G-code); `-` reads standard input. Read up to 268435456 bytes (256 MiB).
+    file: InputFile,
     /// The machine.
     #[arg(long, value_enum, default_value = "laser-cutter")]
     machine: MachineArg,
-    /// Largest distance of the executed tool tip from the programmed path (m).
-    #[arg(long)]
+    /// Largest distance of the executed tool tip from the programmed path: [0.0000001, 0.01] m.
+    #[arg(long, value_parser = TOLERANCE)]
     tolerance: Option<f64>,
     /// Corner smoothing method: kerf, kerf-curvature, icr, ccr, nurbs.
     #[arg(long)]
@@ -59,15 +81,16 @@ pub struct GcodeArgs {
     /// Feed planner: near-optimal, constant-intervals.
     #[arg(long)]
     feed_method: Option<String>,
-    /// IRB 6660: the redundancy angle g about the tool axis (rad).
-    #[arg(long, allow_hyphen_values = true)]
+    /// IRB 6660: the redundancy angle g about the tool axis: [-3.141592653589793,
+    /// 3.141592653589793] rad.
+    #[arg(long, allow_hyphen_values = true, value_parser = ANGLE)]
     g: Option<f64>,
-    /// The program's zero in the machine's base frame, `x,y,z` (m).
-    #[arg(long, value_delimiter = ',', num_args = 3, allow_hyphen_values = true)]
-    origin: Option<Vec<f64>>,
-    /// The plan's memory budget (bytes), as the node's plan_memory: 16 MiB to 1 TiB.
-    #[arg(long, default_value_t = kerf_budget::DEFAULT_PLAN_MEMORY as i64, allow_hyphen_values = true)]
-    plan_memory: i64,
+    /// The program's zero in the machine's base frame, `x,y,z`: each in [-1000, 1000] m.
+    #[arg(long, allow_hyphen_values = true, value_parser = ORIGIN)]
+    origin: Option<Point3>,
+    /// The plan's memory budget, as the node's plan_memory: [16777216, 1099511627776] bytes.
+    #[arg(long, default_value_t = kerf_budget::DEFAULT_PLAN_MEMORY, value_parser = PLAN_MEMORY)]
+    plan_memory: u64,
     /// Write the plots here.
     #[arg(long)]
     plots: Option<PathBuf>,
@@ -91,41 +114,36 @@ pub fn run(a: GcodeArgs) -> Result<(), String> {
         MachineArg::LaserCutter => MachineKind::LaserCutter,
         MachineArg::Irb6660 => MachineKind::Irb6660,
     };
-    let memory =
-        kerf_budget::memory_from_bytes(a.plan_memory).map_err(|e| format!("--plan-memory: {e}"))?;
-    let stdin = a.file.as_os_str() == "-";
-    let program_file = (!stdin).then(|| a.file.display().to_string());
+    let memory = a.plan_memory;
     let request = GcodeRequest {
-        request_id: a.file.display().to_string(),
+        request_id: a.file.path().display().to_string(),
         machine: kind.name().to_string(),
         program: None,
-        program_file,
+        program_file: None,
         tolerance: a.tolerance,
         method: a.method.clone(),
         feed_method: a.feed_method.clone(),
-        origin: a.origin.as_ref().map(|o| [o[0], o[1], o[2]]),
+        origin: a.origin.map(|o| o.0),
         redundancy_angle: a.g,
         ..GcodeRequest::default()
     };
     let base = MachineBase::load(kind).map_err(|e| e.to_string())?;
     let started = std::time::Instant::now();
     let budget = Budget::unlimited().with_memory(Some(memory));
-    let planned = if stdin {
-        // Streamed as a file is, and capped like one: /dev/zero as input ends at its first
-        // line (longer than a line may be), an endless program at the cap.
-        let input = kerf_robot::file::CappedReader::new(
-            std::io::stdin().lock(),
-            MAX_PROGRAM_BYTES,
-            "standard input",
-        );
-        plan_request_reading(&request, &base, &budget, None, input)
-    } else {
-        plan_request_within(&request, &base, &budget, None)
-    };
+    // Streamed and capped like every input of kerf; the program is named in every failure.
+    let label = format!("FILE {}", a.file);
+    let input = input::open("FILE", &a.file, MAX_PROGRAM_BYTES)?;
+    let planned = plan_request_reading(
+        &request,
+        &base,
+        &budget,
+        None,
+        std::io::BufReader::new(input),
+    );
     let plan = planned.map_err(|e| {
         let status = kerf_gcode_planner::convert::status_of(&e);
         let name = GcodePlanMsg::status_name(status).unwrap_or("?");
-        format!("{name} ({status}): {e}")
+        format!("{name} ({status}): {label}: {e}")
     })?;
     let took = started.elapsed().as_secs_f64();
     print!("{}", summary(&plan, took));

@@ -14,6 +14,12 @@ use kerf_msgs::{
     builtin_interfaces::Duration as RosDuration,
     control_msgs::{
         FollowJointTrajectoryFeedback, FollowJointTrajectoryGoal, FollowJointTrajectoryResult,
+        JointTolerance,
+    },
+    numbers::{
+        leaves,
+        probe::{expected, probe_values, with_value},
+        NumberFields,
     },
     sensor_msgs::JointState,
     srv::{ValidateTrajectoryRequest, ValidateTrajectoryResponse},
@@ -516,4 +522,64 @@ fn path_tolerances_from_the_goal_are_honoured() {
     loose.goal_time_tolerance = RosDuration::from_secs_f64(2.0).unwrap();
     let (status, r) = cell.result(cell.send(loose));
     assert_eq!(status, GoalStatusEnum::Succeeded, "{r:?}");
+}
+
+/// Issue 33, item 8 (the probe as a test): every numeric leaf of a goal with every group given
+/// (of each array, its first and last element), set in turn to each of NaN, ±inf, ±0, 5e-324,
+/// ±1e308 and the integer extremes that its declared rule refuses, is refused INVALID_GOAL
+/// naming the field, through the action and (for the trajectory's) the validate service,
+/// each within 15 s; nothing moves, and a valid goal right after succeeds.
+#[test]
+fn every_number_of_a_goal_is_refused_naming_it() {
+    let mut cell = Cell::start(52);
+    let start = cell.position();
+    let target = [0.2; 6];
+    let tolerance = |name: &str| JointTolerance {
+        name: name.into(),
+        position: 0.1,
+        velocity: 0.5,
+        acceleration: 1.0,
+    };
+    let mut base = goal(min_jerk(&JOINTS, &start, &target, 1.0, 5));
+    base.path_tolerance = vec![tolerance("joint_1"), tolerance("joint_6")];
+    base.goal_tolerance = vec![tolerance("joint_2"), tolerance("joint_5")];
+    base.goal_time_tolerance = RosDuration { sec: 1, nanosec: 0 };
+    base.check_numbers().expect("the base goal's numbers");
+    let all = leaves(&base);
+    let mut cases = 0;
+    for (i, leaf) in all.iter().enumerate() {
+        let first = all[..i].iter().all(|l| l.key != leaf.key);
+        let last = all[i + 1..].iter().all(|l| l.key != leaf.key);
+        if !(first || last) {
+            continue;
+        }
+        for v in probe_values(leaf.value) {
+            if expected::<FollowJointTrajectoryGoal>(&leaf.key, v).is_ok() {
+                continue;
+            }
+            let Ok(bad) = with_value(&base, &leaf.path, v) else {
+                continue; // a value the field's type cannot hold
+            };
+            let needle = format!("`{}`", leaf.path);
+            let asked = Instant::now();
+            let (status, r) = cell.result(cell.send(bad.clone()));
+            assert_eq!(status, GoalStatusEnum::Aborted, "{}: {r:?}", leaf.path);
+            assert_eq!(r.error_code, FollowJointTrajectoryResult::INVALID_GOAL);
+            assert!(r.error_string.contains(&needle), "{}", r.error_string);
+            if leaf.path.starts_with("trajectory.") {
+                let v = cell.validate(bad.trajectory);
+                assert!(!v.valid);
+                assert_eq!(v.error_code, FollowJointTrajectoryResult::INVALID_GOAL);
+                assert!(v.message.contains(&needle), "{}", v.message);
+            }
+            assert!(asked.elapsed() < Duration::from_secs(15), "{}", leaf.path);
+            cases += 1;
+        }
+    }
+    assert!(cases > 40, "only {cases} cases");
+    eprintln!("{cases} number cases refused naming the field");
+    assert!(max_diff(&cell.position(), &start) < 1e-12, "nothing moved");
+    let (status, r) = cell.result(cell.send(base));
+    assert_eq!(status, GoalStatusEnum::Succeeded, "{r:?}");
+    cell.wait_state(|s| max_diff(&s.position, &target) < 1e-6, "arrival");
 }

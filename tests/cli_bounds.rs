@@ -49,11 +49,6 @@ const NOT_NUMBERS: &[(&str, &str)] = &[
     ("train curve", "plots"),
 ];
 
-/// Arguments of `src/plan_gcode.rs`, capped and range-checked by the G-code part of issue 33
-/// (another branch): their cases run in [`plan_gcode_arguments_within_bounds`] (ignored
-/// until that branch is merged).
-const GCODE: &str = "plan gcode";
-
 fn kerf() -> Command {
     let mut c = Command::new(env!("CARGO_BIN_EXE_kerf"));
     c.env("ROS_DOMAIN_ID", "83")
@@ -182,7 +177,7 @@ const HUGE_COUNTS: &[&str] = &["1000000000000", "18446744073709551616"];
 
 fn numeric_arguments(args: &[ArgModel]) -> Vec<&ArgModel> {
     args.iter()
-        .filter(|a| a.takes_value && matches!(a.kind.as_str(), "real" | "count" | "grid"))
+        .filter(|a| a.takes_value && matches!(a.kind.as_str(), "real" | "count" | "grid" | "point"))
         .collect()
 }
 
@@ -227,7 +222,7 @@ fn every_numeric_argument_is_range_checked() {
     assert!(numeric.len() > 30, "{numeric:?}");
     // Every other argument that takes a value is a file the command reads, an enum, or named.
     for a in &args {
-        if a.takes_value && a.kind == "other" && a.path != GCODE {
+        if a.takes_value && a.kind == "other" {
             assert!(
                 NOT_NUMBERS.contains(&(a.path.as_str(), a.id.as_str())),
                 "kerf {} {}: takes a value that is no checked number, no input file and no enum; \
@@ -238,11 +233,12 @@ fn every_numeric_argument_is_range_checked() {
         }
     }
     let mut cases = 0;
-    for a in numeric.iter().filter(|a| a.path != GCODE) {
+    for a in &numeric {
         let long = a.long.clone().unwrap();
         // The refusal of NaN states the range; --help states the same.
         let probe = match a.kind.as_str() {
             "grid" => "NaN:1:1".to_string(),
+            "point" => "NaN,NaN,NaN".to_string(),
             _ => "NaN".to_string(),
         };
         let mut argv: Vec<String> = a.path.split(' ').map(String::from).collect();
@@ -267,6 +263,16 @@ fn every_numeric_argument_is_range_checked() {
                     check_value(a, &format!("1:1:{v}"), as_count, &range_text);
                     cases += 2;
                 }
+            }
+            "point" => {
+                // x,y,z: each coordinate in the stated range; two coordinates are refused.
+                let range = *stated.last().unwrap();
+                for v in NUMBERS {
+                    check_value(a, &format!("0,{v},0"), accepted(v, range), &range_text);
+                    cases += 1;
+                }
+                check_value(a, "0,0", false, &range_text);
+                cases += 1;
             }
             kind => {
                 let count = kind == "count";
@@ -492,10 +498,7 @@ fn input_dir(name: &str) -> PathBuf {
 #[test]
 fn every_input_is_read_within_bounds() {
     let dir = input_dir("inputs");
-    let inputs: Vec<ArgModel> = model()
-        .into_iter()
-        .filter(|a| a.kind == "input" && a.path != GCODE)
-        .collect();
+    let inputs: Vec<ArgModel> = model().into_iter().filter(|a| a.kind == "input").collect();
     assert!(inputs.len() >= 12, "{inputs:?}");
     let mut n = 0;
     for a in &inputs {
@@ -503,36 +506,6 @@ fn every_input_is_read_within_bounds() {
     }
     n += input_cases("launch", "params_file", &dir);
     eprintln!("{n} input cases over {} arguments", inputs.len() + 1);
-    let _ = std::fs::remove_dir_all(&dir);
-}
-
-/// `kerf plan gcode`: its program and its numbers (src/plan_gcode.rs, the G-code part of
-/// issue 33). Run with `--ignored` once that branch is merged.
-#[test]
-#[ignore = "src/plan_gcode.rs is capped and range-checked in the G-code part of issue 33"]
-fn plan_gcode_arguments_within_bounds() {
-    let dir = input_dir("gcode");
-    input_cases(GCODE, "file", &dir);
-    let program = dir.join("p.nc");
-    std::fs::write(&program, "G1 X10 F1000\n").unwrap();
-    for a in model()
-        .iter()
-        .filter(|a| a.path == GCODE && a.takes_value && a.kind == "real")
-    {
-        let long = a.long.clone().unwrap();
-        for v in ["NaN", "inf", "-inf", "1e308", "5e-324"] {
-            let argv: Vec<String> = vec![
-                "plan".into(),
-                "gcode".into(),
-                program.display().to_string(),
-                format!("--{long}={v}"),
-            ];
-            let o = run(&argv, Stdio::null());
-            assert!(!o.stderr.contains("panicked"), "{argv:?}: {}", o.stderr);
-            assert_eq!(o.code, Some(2), "{argv:?}: {}", o.stderr);
-            assert!(o.stderr.contains(&long), "{argv:?}: {}", o.stderr);
-        }
-    }
     let _ = std::fs::remove_dir_all(&dir);
 }
 

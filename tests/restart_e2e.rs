@@ -3,7 +3,7 @@
 //! whose writer is transient-local (as a latched `ros2 topic pub` or a controller that wants
 //! late joiners served), is stopped and started again while the controller keeps running; the
 //! writer still holds the five and replays them to the new reader. The restarted node answers
-//! none of them, and answers the next request once. Loopback DDS, domain 71.
+//! none of them, and answers the next request once. Loopback DDS, domain 78.
 
 #![allow(clippy::unwrap_used, clippy::expect_used, missing_docs)]
 
@@ -30,7 +30,7 @@ fn request(id: &str) -> String {
 
 #[test]
 fn a_restarted_planner_answers_no_request_twice() {
-    let env = support::loopback(71, ServiceMapping::Enhanced);
+    let env = support::loopback(78, ServiceMapping::Enhanced);
     let planner = mjto();
     let mut client = PlannerClient::start(&planner, &env, &[]);
     let mut controller = support::client_node("cell_controller", &env);

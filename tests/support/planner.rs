@@ -158,6 +158,15 @@ impl<Req: RosType + Serialize + Debug, Plan: Answer> PlannerClient<Req, Plan> {
         let mut words: Vec<String> = vec!["--ros-args".into(), "--disable-rosout-logs".into()];
         words.extend(extra.iter().map(|s| s.to_string()));
         let (stop, handle) = spawn_node(env, words, planner.run);
+        let mut client = Self::connect(planner, env);
+        client.stop = stop;
+        client.planner = Some(handle);
+        client
+    }
+
+    /// A client of `planner` running elsewhere (another process, e.g. `kerf launch
+    /// --with-planner`) on `env`: its request publishers matched to it.
+    pub fn connect(planner: &Planner<Req, Plan>, env: &RosEnv) -> Self {
         let mut client = client_node(&format!("{}_client", planner.noun), env);
         let (request, request_text) = (planner.topic("request"), planner.topic("request_text"));
         let requests = client
@@ -200,8 +209,8 @@ impl<Req: RosType + Serialize + Debug, Plan: Answer> PlannerClient<Req, Plan> {
             trajectories,
             _client: client,
             node: planner.node,
-            stop,
-            planner: Some(handle),
+            stop: StopToken::new(),
+            planner: None,
         }
     }
 
@@ -362,12 +371,13 @@ impl<Req: RosType + Serialize + Debug, Plan: Answer> PlannerClient<Req, Plan> {
         }
     }
 
-    /// Stops the planner; it must end cleanly.
+    /// Stops the planner (when this client started it); it must end cleanly.
     pub fn finish(mut self) {
         self.stop.stop();
-        let h = self.planner.take().expect("planner handle");
-        h.join()
-            .expect("planner thread")
-            .expect("planner ends cleanly");
+        if let Some(h) = self.planner.take() {
+            h.join()
+                .expect("planner thread")
+                .expect("planner ends cleanly");
+        }
     }
 }

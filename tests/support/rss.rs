@@ -1,46 +1,46 @@
-//! Resident memory of a planner node over sequential requests (issue 33, item 3): the node
-//! and its client in this process, the plans in the node's worker process.
+//! Resident memory of a planner node over sequential requests (issue 33, item 3): the node in
+//! a `kerf launch --with-planner` process of its own (what a cell runs), its client in this
+//! process, the plans in the node's worker process.
 
-use std::{fmt::Debug, time::Duration};
+use std::{
+    fmt::Debug,
+    process::{Command, Stdio},
+    time::Duration,
+};
 
 use kerf_msgs::RosType;
-use kerf_ros::RosEnv;
+use kerf_ros::ros2_client::ServiceMapping;
 use serde::Serialize;
 
 use super::planner::{Answer, Planner, PlannerClient};
+use super::Killed;
 
-/// Resident memory (MiB) of this process (the node and its client).
-pub fn own_mib() -> f64 {
-    super::status_kib("VmRSS:") as f64 / 1024.0
+/// A field of `/proc/<pid>/status` in MiB (`"VmRSS:"`, `"VmHWM:"`); 0 when unreadable.
+pub fn status_mib(pid: u32, field: &str) -> f64 {
+    std::fs::read_to_string(format!("/proc/{pid}/status"))
+        .ok()
+        .and_then(|s| {
+            s.lines()
+                .find_map(|l| l.strip_prefix(field))
+                .and_then(|v| v.split_whitespace().next())
+                .and_then(|v| v.parse::<f64>().ok())
+        })
+        .map_or(0.0, |kib| kib / 1024.0)
 }
 
-/// Bytes in use by glibc's allocator in this process (MiB): live allocations, as opposed to
-/// resident memory that fragmentation keeps.
-pub fn heap_in_use_mib() -> f64 {
-    // SAFETY: mallinfo2 only reads the allocator's statistics.
-    let info = unsafe { libc::mallinfo2() };
-    (info.uordblks + info.hblkhd) as f64 / (1024.0 * 1024.0)
-}
-
-/// Resident memory (MiB) of this process's children (the planner's worker process).
-pub fn children_mib() -> f64 {
+/// Resident memory (MiB) of the children of process `pid` (a planner's worker process).
+pub fn children_mib(pid: u32) -> f64 {
     let mut total = 0.0;
-    let Ok(tasks) = std::fs::read_dir("/proc/self/task") else {
+    let Ok(tasks) = std::fs::read_dir(format!("/proc/{pid}/task")) else {
         return 0.0;
     };
     for task in tasks.flatten() {
         let Ok(children) = std::fs::read_to_string(task.path().join("children")) else {
             continue;
         };
-        for pid in children.split_whitespace() {
-            if let Ok(statm) = std::fs::read_to_string(format!("/proc/{pid}/statm")) {
-                if let Some(pages) = statm
-                    .split_whitespace()
-                    .nth(1)
-                    .and_then(|p| p.parse::<f64>().ok())
-                {
-                    total += pages * 4096.0 / (1024.0 * 1024.0);
-                }
+        for child in children.split_whitespace() {
+            if let Ok(child) = child.parse::<u32>() {
+                total += status_mib(child, "VmRSS:");
             }
         }
     }
@@ -52,35 +52,49 @@ pub fn children_mib() -> f64 {
 pub struct Reading {
     /// Requests answered before the reading.
     pub answered: usize,
-    /// This process (node and client), MiB.
+    /// The node's process (`kerf launch`), MiB.
     pub node_mib: f64,
     /// The worker process, MiB.
     pub worker_mib: f64,
-    /// Live heap of this process (allocations in use), MiB.
-    pub heap_mib: f64,
 }
 
-/// Starts `planner`, sends `text(k)` for k in 0..count one at a time (waiting for each
-/// answer, which must have status `status`), and reads the memory every `every` answers.
+/// Starts `kerf launch LAUNCH…` on `domain` (loopback only), connects a client to `planner`
+/// in it, sends `text(k)` for k in 0..count one at a time (waiting for each answer, which must
+/// have status `status`), and reads the node's and its worker's memory every `every` answers.
+#[allow(clippy::too_many_arguments)]
 pub fn sequential<Req: RosType + Serialize + Debug, Plan: Answer>(
     planner: &Planner<Req, Plan>,
-    env: &RosEnv,
-    extra: &[&str],
+    domain: u16,
+    launch: &[&str],
     count: usize,
     every: usize,
     status: u8,
     text: impl Fn(usize) -> String,
 ) -> Vec<Reading> {
-    let client = PlannerClient::start(planner, env, extra);
+    let node = Killed(
+        Command::new(env!("CARGO_BIN_EXE_kerf"))
+            .arg("launch")
+            .args(launch)
+            .env("ROS_DOMAIN_ID", domain.to_string())
+            .env("ROS_AUTOMATIC_DISCOVERY_RANGE", "LOCALHOST")
+            .env_remove("ROS_STATIC_PEERS")
+            .stdout(Stdio::null())
+            .stderr(Stdio::null())
+            .spawn()
+            .expect("start kerf launch"),
+    );
+    let pid = node.0.id();
+    let env = super::loopback(domain, ServiceMapping::Enhanced);
+    let client = PlannerClient::connect(planner, &env);
+    let read = |answered| Reading {
+        answered,
+        node_mib: status_mib(pid, "VmRSS:"),
+        worker_mib: children_mib(pid),
+    };
     let mut readings = Vec::new();
     for k in 0..count {
         if k % every == 0 {
-            readings.push(Reading {
-                answered: k,
-                node_mib: own_mib(),
-                worker_mib: children_mib(),
-                heap_mib: heap_in_use_mib(),
-            });
+            readings.push(read(k));
         }
         client.send_text(&text(k));
         let plan = client.next_plan(Duration::from_secs(120));
@@ -89,13 +103,9 @@ pub fn sequential<Req: RosType + Serialize + Debug, Plan: Answer>(
         let _ = client.next_plan_text();
         let _ = client.trajectories_received();
     }
-    readings.push(Reading {
-        answered: count,
-        node_mib: own_mib(),
-        worker_mib: children_mib(),
-        heap_mib: heap_in_use_mib(),
-    });
+    readings.push(read(count));
     client.finish();
+    drop(node);
     readings
 }
 

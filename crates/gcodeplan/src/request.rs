@@ -262,7 +262,8 @@ pub struct GcodeRequest {
     /// The program text (exactly one of `program` and `program_file`).
     #[serde(default)]
     pub program: Option<String>,
-    /// A program file: a path, `file://` or `package://kerf/` URI.
+    /// A program file: a path, a local `file://` URI or `package://kerf/<path>`
+    /// ([`kerf_robot::file::resolve_uri`]).
     #[serde(default)]
     pub program_file: Option<String>,
     /// δ \[m\], default 1e-4.
@@ -325,11 +326,13 @@ impl GcodeRequest {
         MachineKind::parse(&self.machine)
     }
 
-    /// The program's source: a file resolves `package://kerf/` and `file://` URIs.
+    /// The program's source: a file is resolved by [`kerf_robot::file::resolve_uri`] (a path,
+    /// a local `file://` URI or `package://kerf/<path>`).
     ///
     /// # Errors
-    /// [`GcodePlanError::InvalidSetting`] for both or neither given, an empty one, or a URI
-    /// that does not resolve.
+    /// [`GcodePlanError::InvalidRequest`] for both or neither given, an empty one, or a
+    /// reference that does not resolve (another URI scheme or host, a malformed `file://` or
+    /// `package://` URI), naming it.
     pub fn source(&self) -> Result<ProgramSource, GcodePlanError> {
         let bad = |reason: String| GcodePlanError::InvalidRequest {
             field: "program".to_string(),
@@ -346,23 +349,12 @@ impl GcodeRequest {
                 }
             }
             (None, Some(file)) => {
-                let file = file.trim();
-                if file.is_empty() {
+                if file.trim().is_empty() {
                     return Err(bad("program_file is empty".to_string()));
                 }
-                if file.starts_with("package://") {
-                    kerf_robot::data::resolve_package_uri(file)
-                        .map(ProgramSource::File)
-                        .map_err(|e| bad(e.to_string()))
-                } else if let Some(path) = file.strip_prefix("file://") {
-                    Ok(ProgramSource::File(PathBuf::from(path)))
-                } else if file.contains("://") {
-                    Err(bad(format!(
-                        "{file}: only file:// and package://kerf/ URIs are read"
-                    )))
-                } else {
-                    Ok(ProgramSource::File(PathBuf::from(file)))
-                }
+                kerf_robot::file::resolve_uri(file)
+                    .map(ProgramSource::File)
+                    .map_err(|e| bad(e.to_string()))
             }
         }
     }

@@ -96,3 +96,30 @@ fn a_regular_program_file_still_plans_as_a_stream() {
     assert!(plan.duration > 0.0);
     let _ = std::fs::remove_dir_all(&d);
 }
+
+#[test]
+fn program_files_resolve_through_the_shared_resolver() {
+    let source = |file: &str| {
+        GcodeRequest {
+            program_file: Some(file.to_string()),
+            ..GcodeRequest::default()
+        }
+        .source()
+    };
+    for (file, path) in [
+        ("file:///tmp/a%20b.ngc", "/tmp/a b.ngc"),
+        ("file://localhost/tmp/x.ngc", "/tmp/x.ngc"),
+        ("parts/x.ngc", "parts/x.ngc"),
+    ] {
+        assert_eq!(
+            source(file).unwrap(),
+            kerf_gcodeplan::ProgramSource::File(PathBuf::from(path)),
+            "{file}"
+        );
+    }
+    for file in ["file://otherhost/x.ngc", "http://host/x.ngc"] {
+        let e = source(file).unwrap_err();
+        assert!(matches!(e, GcodePlanError::InvalidRequest { .. }), "{e}");
+        assert!(e.to_string().contains(file), "{e}");
+    }
+}

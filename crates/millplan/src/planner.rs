@@ -136,7 +136,7 @@ use crate::plan::{
     default_eval_threads, IndicatorProvenance, IndicatorSource, Plan, Reevaluation, SegmentInput,
 };
 use crate::planned::planned_trajectory;
-use crate::policy::Policy;
+use crate::policy::{resolve_policy_file, Policy};
 use crate::request::{MillRequest, PlannerKind, RequestProcess};
 use crate::rl::Environment;
 use crate::timing::{joint_limits, time_scale_inputs, TrajectorySettings};
@@ -720,7 +720,7 @@ impl MillPlanner {
         let states: Vec<PhysicalState> = match kind {
             PlannerKind::Ddpg | PlannerKind::FixedG => {
                 let path = match &request.policy_file {
-                    Some(p) => PathBuf::from(p),
+                    Some(p) => resolve_policy_file(p)?,
                     None => {
                         default_policy_path(kind).ok_or_else(|| MillPlanError::InvalidConfig {
                             name: "policy_file".to_string(),

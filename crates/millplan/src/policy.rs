@@ -120,6 +120,28 @@ pub fn metadata_path(path: &Path) -> PathBuf {
     path.with_extension("json")
 }
 
+/// The policy file a request names (`policy_file`), resolved as every file a request names
+/// ([`kerf_robot::file::resolve_uri`]).
+///
+/// # Arguments
+/// * `reference` - a path (relative paths: to the working directory), a local `file://` URI
+///   (`file:///abs/x.safetensors`, `file://localhost/abs/x.safetensors`) or
+///   `package://kerf/<path>`.
+///
+/// # Returns
+/// The weights file's path (whether it exists is not checked: [`Policy::load`] does).
+///
+/// # Errors
+/// [`MillPlanError::Policy`] naming `reference`: it is empty, a URI of another scheme or
+/// host, a malformed `file://` URI, a `package://` URI of another package or leaving the
+/// data root, or no data root is found for `package://kerf/`.
+pub fn resolve_policy_file(reference: &str) -> Result<PathBuf, MillPlanError> {
+    kerf_robot::file::resolve_uri(reference).map_err(|e| MillPlanError::Policy {
+        path: reference.to_owned(),
+        reason: e.uri_reason(),
+    })
+}
+
 fn policy_error(path: &Path, reason: impl Into<String>) -> MillPlanError {
     MillPlanError::Policy {
         path: path.display().to_string(),

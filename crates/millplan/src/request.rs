@@ -262,8 +262,9 @@ pub struct MillRequest {
     /// `ddpg`, `fixed_g`, `dp`, `naive`, `greedy` or `greedy_best_g`.
     #[serde(default = "default_planner")]
     pub planner: String,
-    /// The policy file of `ddpg`/`fixed_g` (relative paths: to the working
-    /// directory); the planner's default policy when absent.
+    /// The policy file of `ddpg`/`fixed_g`: a path (relative paths: to the working
+    /// directory), a local `file://` URI or `package://kerf/<path>`
+    /// ([`crate::policy::resolve_policy_file`]); the planner's default policy when absent.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub policy_file: Option<String>,
     /// Time budget of the plan (s), in (0, [`kerf_budget::MAX_BUDGET_SECONDS`]]; absent or 0 =

@@ -409,6 +409,25 @@ fn missing_and_incompatible_policy_files() {
         e.to_string().contains("observations of 5") && e.to_string().contains("has 37 and 3"),
         "{e}"
     );
+    // The same file named by a file:// URI is resolved and loaded (then refused alike); a
+    // URI of another scheme is refused naming it.
+    let by_uri = |uri: String| MillRequest {
+        policy_file: Some(uri),
+        ..ddpg(&obs5, "ddpg")
+    };
+    let e = planner()
+        .plan(&by_uri(format!("file://{}", obs5.display())))
+        .expect_err("obs 5 by URI");
+    assert!(e.to_string().contains("observations of 5"), "{e}");
+    let e = planner()
+        .plan(&by_uri("http://host/x.safetensors".to_string()))
+        .expect_err("http");
+    assert_eq!(status_of(&e), status::POLICY_ERROR);
+    assert!(
+        e.to_string()
+            .contains("policy http://host/x.safetensors: URI scheme 'http://'"),
+        "{e}"
+    );
     // Wrong action size: a 3-action (ddpg) policy for fixed_g (2 actions).
     let act3 = saved_actor(&dir, 4, 3);
     let e = planner().plan(&ddpg(&act3, "fixed_g")).expect_err("act 3");

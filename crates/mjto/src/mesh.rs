@@ -25,8 +25,6 @@
 
 use std::path::{Path, PathBuf};
 
-use kerf_robot::RobotError;
-
 use crate::PlanError;
 
 mod cache;
@@ -55,7 +53,8 @@ pub fn package_root() -> PathBuf {
     kerf_robot::data::default_root()
 }
 
-/// Resolves a mesh reference to a file path.
+/// Resolves a mesh reference to a file path, with the reader every file a request names goes
+/// through ([`kerf_robot::file::resolve_uri`]).
 ///
 /// # Arguments
 /// * `reference` - one of
@@ -66,6 +65,9 @@ pub fn package_root() -> PathBuf {
 ///   * `package://kerf/<relative path>`, relative to the kerf data root
 ///     ([`package_root`], [`kerf_robot::data::resolve_package_uri`]).
 ///
+/// # Returns
+/// The mesh file's path (whether it exists is not checked).
+///
 /// # Errors
 /// [`PlanError::Mesh`] for an empty reference, another package
 /// (`package://kerf_msgs/...` and every package but `kerf`), another URI
@@ -73,66 +75,10 @@ pub fn package_root() -> PathBuf {
 /// `package://kerf/` path that leaves the repository (`..`), or a
 /// `package://kerf/` URI when no kerf data root is found.
 pub fn resolve(reference: &str) -> Result<PathBuf, PlanError> {
-    let err = |reason: String| PlanError::Mesh {
+    kerf_robot::file::resolve_uri(reference).map_err(|e| PlanError::Mesh {
         source_name: reference.to_owned(),
-        reason,
-    };
-    let r = reference.trim();
-    if r.is_empty() {
-        return Err(err("empty mesh reference".into()));
-    }
-    if r.starts_with("package://") {
-        return kerf_robot::data::resolve_package_uri(r).map_err(|e| match e {
-            RobotError::PackageUri { reason, .. } => err(reason),
-            other => err(other.to_string()),
-        });
-    }
-    if let Some(rest) = r.strip_prefix("file://") {
-        let path = if rest.starts_with('/') {
-            rest
-        } else if let Some(p) = rest.strip_prefix("localhost") {
-            p
-        } else {
-            return Err(err(
-                "file:// URIs must name a local absolute path (file:///path)".into(),
-            ));
-        };
-        return Ok(PathBuf::from(percent_decode(path).map_err(err)?));
-    }
-    if let Some((scheme, _)) = r.split_once("://") {
-        if !scheme.is_empty()
-            && scheme
-                .chars()
-                .all(|c| c.is_ascii_alphanumeric() || c == '+')
-        {
-            return Err(err(format!(
-                "URI scheme '{scheme}://' is not supported (use a path, file:// or package://kerf/)"
-            )));
-        }
-    }
-    Ok(PathBuf::from(r))
-}
-
-/// Decodes `%XX` escapes of a URI path.
-fn percent_decode(s: &str) -> Result<String, String> {
-    let bytes = s.as_bytes();
-    let mut out = Vec::with_capacity(bytes.len());
-    let mut i = 0;
-    while let Some(&b) = bytes.get(i) {
-        if b == b'%' {
-            let hex = bytes
-                .get(i + 1..i + 3)
-                .and_then(|h| std::str::from_utf8(h).ok())
-                .and_then(|h| u8::from_str_radix(h, 16).ok())
-                .ok_or_else(|| format!("bad percent escape at byte {i} of the URI path"))?;
-            out.push(hex);
-            i += 3;
-        } else {
-            out.push(b);
-            i += 1;
-        }
-    }
-    String::from_utf8(out).map_err(|_| "the URI path is not UTF-8 after decoding".to_owned())
+        reason: e.uri_reason(),
+    })
 }
 
 /// Largest mesh file read (64 MiB: a binary STL of about 1.4 million triangles). A larger

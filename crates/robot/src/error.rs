@@ -270,6 +270,17 @@ pub enum RobotError {
         reason: String,
     },
 
+    /// A file reference of a request that names no local file: empty, holding a NUL byte,
+    /// a URI of another scheme or host, or a malformed `file://` URI
+    /// ([`crate::file::resolve_uri`]).
+    #[error("file reference {uri:?}: {reason}")]
+    FileUri {
+        /// The reference as given.
+        uri: String,
+        /// What is wrong with it.
+        reason: String,
+    },
+
     /// A joint value is outside the joint's position limits.
     #[error("position {value} of joint `{joint}` is outside its limits [{min}, {max}]")]
     OutOfRange {

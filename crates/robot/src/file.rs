@@ -1,6 +1,12 @@
 //! [`read_regular`] and [`open_regular`]: reading a file a request names (a mesh, a policy, a
 //! G-code program) without letting the request hang or exhaust the node: regular files only,
 //! under a size cap checked before reading and enforced while reading ([`CappedReader`]).
+//! The file a request names is found by [`resolve_uri`] (a path, `file://` or
+//! `package://kerf/`).
+
+mod uri;
+
+pub use uri::resolve_uri;
 
 use std::{
     fs::File,

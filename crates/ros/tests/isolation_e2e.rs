@@ -45,6 +45,12 @@ impl PlanningService for Misbehaving {
     fn request_from_msg(&self, msg: &StringMsg) -> Result<String, Box<GcodePlan>> {
         self.request_from_text(&msg.data)
     }
+    fn msg_key(&self, msg: &StringMsg) -> AnswerKey {
+        AnswerKey {
+            request_id: msg.data.clone(),
+            label: String::new(),
+        }
+    }
     fn request_from_text(&self, text: &str) -> Result<String, Box<GcodePlan>> {
         Ok(text.to_string())
     }

@@ -176,6 +176,13 @@ impl PlanningService for GcodeService {
         self.check(request)
     }
 
+    fn msg_key(&self, m: &msg::GcodeRequest) -> AnswerKey {
+        AnswerKey {
+            request_id: m.request_id.clone(),
+            label: m.method.clone(),
+        }
+    }
+
     fn request_from_text(&self, text: &str) -> Result<GcodeRequest, Box<GcodePlan>> {
         let request = text::parse_request(text).map_err(|e| {
             Box::new(convert::failure_msg(

@@ -194,11 +194,15 @@ impl MillService {
         self
     }
 
-    /// Checks the request's policy file against the allowed roots (POLICY_ERROR outside).
+    /// Resolves the request's policy file as the planner will
+    /// ([`kerf_millplan::policy::resolve_policy_file`]: a path, `file://` or `package://kerf/`)
+    /// and checks it against the allowed roots (POLICY_ERROR for a reference that does not
+    /// resolve, or outside the roots).
     fn check_files(&self, request: MillRequest) -> Result<MillRequest, MillPlanError> {
         if let Some(file) = &request.policy_file {
+            let path = kerf_millplan::policy::resolve_policy_file(file)?;
             self.allowed_roots
-                .check(std::path::Path::new(file))
+                .check(&path)
                 .map_err(|reason| MillPlanError::Policy {
                     path: file.clone(),
                     reason,
@@ -226,6 +230,13 @@ impl PlanningService for MillService {
         convert::request_from_msg(m)
             .and_then(|r| self.check_files(r))
             .map_err(|e| Box::new(convert::error_to_msg(&m.request_id, &m.planner, &e)))
+    }
+
+    fn msg_key(&self, m: &msg::MillRequest) -> AnswerKey {
+        AnswerKey {
+            request_id: m.request_id.clone(),
+            label: m.planner.clone(),
+        }
     }
 
     fn request_from_text(&self, text: &str) -> Result<MillRequest, Box<MillPlan>> {

@@ -42,7 +42,7 @@ impl NodeConfig {
     ///   `urdf/laser_cutter.urdf` and `urdf/laser_cutter_limits.yaml`. `joint_limits_file`
     ///   without `urdf_file` is refused.
     /// * `queue_depth` (integer ≥ 1, default 10): requests waiting or being planned; a request
-    ///   arriving when the queue is full is answered at once with status INTERNAL_ERROR.
+    ///   arriving when the queue is full is answered at once with status QUEUE_FULL.
     /// * `plan_timeout` (seconds, default 60): the time budget of every plan; a request may ask
     ///   for less with its `time_budget`. A plan that runs out of it is answered TIMEOUT.
     /// * `allowed_file_roots` (string array, default: any): directories a request's mesh must

@@ -146,6 +146,13 @@ impl PlanningService for CutService {
             .map_err(|e| Box::new(convert::error_to_msg(&m.request_id, &e)))
     }
 
+    fn msg_key(&self, m: &msg::CutRequest) -> AnswerKey {
+        AnswerKey {
+            request_id: m.request_id.clone(),
+            label: String::new(),
+        }
+    }
+
     fn request_from_text(&self, text: &str) -> Result<CutRequest, Box<CutPlan>> {
         let r = text::parse_request(text)
             .map_err(|e| Box::new(convert::error_to_msg(&e.request_id, &e.error)))?;

@@ -18,32 +18,9 @@
 /// heaps, where the next request reuses it.
 pub const TRIM_AFTER_POINTS: usize = 10_000;
 
-#[cfg(all(target_os = "linux", target_env = "gnu"))]
-extern "C" {
-    /// glibc's `int malloc_trim(size_t pad)`: returns free memory of every arena to the
-    /// system; 1 if some was released.
-    fn malloc_trim(pad: usize) -> std::os::raw::c_int;
-}
-
-/// Returns the free pages of every malloc arena to the system.
-///
-/// # Returns
-/// Whether some memory was released (always false where the C library is not glibc).
-///
-/// # Performance
-/// Walks the free chunks of every arena: about a millisecond per 100 MB of heap, taking each
-/// arena's lock in turn. Called on the preparation thread, never on the control thread.
-pub fn give_back_freed_memory() -> bool {
-    #[cfg(all(target_os = "linux", target_env = "gnu"))]
-    {
-        // SAFETY: malloc_trim only releases free pages of glibc's arenas; it is thread-safe.
-        unsafe { malloc_trim(0) == 1 }
-    }
-    #[cfg(not(all(target_os = "linux", target_env = "gnu")))]
-    {
-        false
-    }
-}
+/// Returns the free pages of every malloc arena to the system ([`kerf_ros::memory`]; called on
+/// the preparation thread, never on the control thread).
+pub use kerf_ros::memory::give_back_freed_memory;
 
 #[cfg(test)]
 mod tests {

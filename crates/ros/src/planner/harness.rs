@@ -4,7 +4,9 @@
 use std::{collections::VecDeque, fmt::Display, sync::Arc, time::Duration};
 
 use kerf_isolate::{Outcome, Supervisor, SupervisorSettings};
-use kerf_msgs::{std_msgs::StringMsg, trajectory_msgs::JointTrajectory, RosType};
+use kerf_msgs::{
+    numbers::NumberFields, std_msgs::StringMsg, trajectory_msgs::JointTrajectory, RosType,
+};
 use ros2_client::Publisher;
 
 use super::{
@@ -25,6 +27,13 @@ fn now_ns() -> i64 {
 
 /// How long the node loop sleeps when there is nothing to do.
 const POLL: Duration = Duration::from_millis(2);
+
+/// Least time between two returns of freed memory to the system
+/// ([`crate::memory::give_back_freed_memory`]), made when the node is idle after answering.
+/// Without them a node's RSS rose by 30 MiB over its first 1 500 small requests before it
+/// levelled off (the blocks of DDS samples and answer texts freed between live ones;
+/// BENCHMARKS.md, "Memory per request").
+const TRIM_EVERY: Duration = Duration::from_secs(1);
 
 /// How long a stopping node keeps its writers after answering requests at
 /// shutdown. Why: ros2-client 0.12's `Publisher` offers no wait for
@@ -152,6 +161,9 @@ struct PlannerNode<S: PlanningService> {
     /// not answered (requests are not durable).
     started_ns: i64,
     settings: HarnessSettings,
+    /// Answers published so far, and how many had been when freed memory was last returned.
+    answers: std::cell::Cell<u64>,
+    trimmed_at: (u64, std::time::Instant),
     log: Logger,
     node: KerfNode,
 }
@@ -209,6 +221,8 @@ impl<S: PlanningService> PlannerNode<S> {
             next_id: 0,
             started_ns,
             settings,
+            answers: std::cell::Cell::new(0),
+            trimmed_at: (0, std::time::Instant::now()),
             log,
             node,
         })
@@ -225,10 +239,22 @@ impl<S: PlanningService> PlannerNode<S> {
             busy |= self.poll_text_requests();
             busy |= self.advance();
             if !busy {
+                self.give_back_memory_when_idle();
                 std::thread::sleep(POLL);
             }
         }
         self.shut_down();
+    }
+
+    /// Returns freed memory to the system when nothing is pending, answers were published since
+    /// the last return, and [`TRIM_EVERY`] has passed: the node's RSS then stays where it
+    /// was after its first requests.
+    fn give_back_memory_when_idle(&mut self) {
+        let (count, at) = self.trimmed_at;
+        if self.pending() == 0 && self.answers.get() > count && at.elapsed() >= TRIM_EVERY {
+            crate::memory::give_back_freed_memory();
+            self.trimmed_at = (self.answers.get(), std::time::Instant::now());
+        }
     }
 
     /// The plan in progress (if any) is cancelled through its budget and answered (or, when it
@@ -307,9 +333,16 @@ impl<S: PlanningService> PlannerNode<S> {
                 Ok((_, stamp)) if self.published_before_start(stamp, S::RequestMsg::NAME) => {
                     continue
                 }
-                Ok((m, _)) => match self.service.request_from_msg(&m) {
-                    Ok(r) => self.plan_job(r, RawRequest::Msg(m), "message"),
-                    Err(answer) => Queued::Answer(answer),
+                Ok((m, _)) => match m.check_numbers() {
+                    Err(e) => Queued::Answer(Box::new(self.service.failure(
+                        &self.service.msg_key(&m),
+                        Failure::BadNumber,
+                        format!("invalid request: {e}"),
+                    ))),
+                    Ok(()) => match self.service.request_from_msg(&m) {
+                        Ok(r) => self.plan_job(r, RawRequest::Msg(m), "message"),
+                        Err(answer) => Queued::Answer(answer),
+                    },
                 },
                 Err(e) => self.unreadable(S::RequestMsg::NAME, e),
             };
@@ -549,6 +582,7 @@ impl<S: PlanningService> PlannerNode<S> {
     /// answer with a sample over [`super::MAX_ANSWER_BYTES`] is replaced by
     /// [`Failure::TooLarge`] (one large sample would block every later one of its topic).
     fn publish(&self, plan: S::Answer) {
+        self.answers.set(self.answers.get() + 1);
         let mut text = answer_text(&plan);
         let plan = match check_answer(&plan, &text, plan.trajectory()) {
             Ok(()) => plan,

@@ -4,7 +4,7 @@ use std::time::Duration;
 
 use kerf_budget::Budget;
 use kerf_executor::JointLimits;
-use kerf_msgs::{trajectory_msgs::JointTrajectory, RosType};
+use kerf_msgs::{numbers::NumberFields, trajectory_msgs::JointTrajectory, RosType};
 use serde::{de::DeserializeOwned, Serialize};
 
 /// The topics of one planner node, relative to the node (`~/…`), named after what it plans
@@ -109,7 +109,10 @@ pub trait PlanAnswer: RosType + Serialize + DeserializeOwned + Clone + Send + 's
 /// `plan` runs on the harness's worker thread; everything else on the node thread.
 pub trait PlanningService: Send + Sync + 'static {
     /// The request message (`kerf_msgs/msg/CutRequest`, …).
-    type RequestMsg: RosType + Serialize + DeserializeOwned + Send + 'static;
+    ///
+    /// Its numbers are checked against their declared rules ([`NumberFields`]) by the harness
+    /// before [`Self::request_from_msg`] sees it ([`Failure::BadNumber`]).
+    type RequestMsg: RosType + NumberFields + Serialize + DeserializeOwned + Send + 'static;
     /// A request as the planner takes it (converted, not yet planned).
     type Request: Send + 'static;
     /// The answer message.
@@ -121,6 +124,10 @@ pub trait PlanningService: Send + Sync + 'static {
     /// Converts a request message; a request that cannot be converted is answered with the
     /// returned answer (its status and message).
     fn request_from_msg(&self, msg: &Self::RequestMsg) -> Result<Self::Request, Box<Self::Answer>>;
+
+    /// The key of a request message (its `request_id`, and the label where the service has
+    /// one), for an answer given before it is converted (a number outside its rule).
+    fn msg_key(&self, msg: &Self::RequestMsg) -> AnswerKey;
 
     /// Parses a text request (the `data` of a `std_msgs/String`); as [`Self::request_from_msg`].
     fn request_from_text(&self, text: &str) -> Result<Self::Request, Box<Self::Answer>>;

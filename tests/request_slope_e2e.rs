@@ -1,0 +1,48 @@
+//! No growth per request (issue 33, item 3), the short form of `benches/request_rss.rs`: a
+//! G-code planner node in a `kerf launch --robot laser_cutter --with-planner` process (loopback
+//! DDS, domain 174) answers 1 500 small requests one at a time. Past its warm-up (the first
+//! 500), the node's resident memory grows by less than 8 KiB per request (least squares), and
+//! its worker process's by less than 1 KiB per request. Over 10⁴ requests the bench shows the
+//! node's RSS as a bounded saw-tooth (33-47 MiB, rising about 5 KiB per request between
+//! drops, no trend) and the worker flat; before issue 33 a G-code node grew 38 KiB per request
+//! without a plateau (BENCHMARKS.md, "Memory per request"), which this bound catches.
+#![allow(clippy::unwrap_used, clippy::expect_used)] // tests report failures by panicking
+
+use kerf_msgs::msg::GcodePlan;
+
+#[allow(dead_code)] // shared with the other end-to-end tests
+mod support;
+use support::rss::{sequential, slope_kib};
+
+/// A 20 mm square with an arc, beam on: planned in about 25 ms.
+const SQUARE: &str = "request_id: square\nprogram: \"G21 G90 G17\\nM3\\nG1 X20 Y0 F3000\\nG1 X20 Y15\\nG3 X15 Y20 R5\\nG1 X0 Y20\\nG1 X0 Y0\\nM5\\nM30\\n\"\n";
+
+#[test]
+fn a_planner_node_does_not_grow_per_request() {
+    let readings = sequential(
+        &support::planner::gcode(),
+        174,
+        &["--robot", "laser_cutter", "--with-planner"],
+        1_500,
+        100,
+        GcodePlan::SUCCESS,
+        |_| SQUARE.to_string(),
+    );
+    for r in &readings {
+        eprintln!(
+            "{:5} answered: node {:6.1} MiB, worker {:6.1} MiB",
+            r.answered, r.node_mib, r.worker_mib
+        );
+    }
+    let node = slope_kib(&readings, 500, |r| r.node_mib);
+    let worker = slope_kib(&readings, 500, |r| r.worker_mib);
+    eprintln!("slope past the warm-up: node {node:.2} KiB/request, worker {worker:.2} KiB/request");
+    assert!(
+        readings
+            .iter()
+            .all(|r| r.node_mib > 0.0 && r.worker_mib > 0.0),
+        "memory not read: {readings:?}"
+    );
+    assert!(node < 8.0, "the node grows {node:.2} KiB per request");
+    assert!(worker < 1.0, "the worker grows {worker:.2} KiB per request");
+}
