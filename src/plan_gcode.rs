@@ -45,7 +45,7 @@ const TOLERANCE: Real = Real::closed(1e-7, 0.01, "m");
 const ANGLE: Real = Real::closed(-PI, PI, "rad");
 
 /// `--origin`: the `origin.*` rule of `GcodeRequest`, for each coordinate.
-const ORIGIN: Coordinates = Coordinates(Real::closed(-1000.0, 1000.0, "m"));
+const ORIGIN: Coordinates = Coordinates(Real::closed(-100.0, 100.0, "m"));
 
 /// `--plan-memory`: the node's `plan_memory` range.
 const PLAN_MEMORY: Count<u64> = Count::new(
@@ -85,7 +85,7 @@ pub struct GcodeArgs {
     /// 3.141592653589793] rad.
     #[arg(long, allow_hyphen_values = true, value_parser = ANGLE)]
     g: Option<f64>,
-    /// The program's zero in the machine's base frame, `x,y,z`: each in [-1000, 1000] m.
+    /// The program's zero in the machine's base frame, `x,y,z`: each in [-100, 100] m.
     #[arg(long, allow_hyphen_values = true, value_parser = ORIGIN)]
     origin: Option<Point3>,
     /// The plan's memory budget, as the node's plan_memory: [16777216, 1099511627776] bytes.

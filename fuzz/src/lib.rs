@@ -7,6 +7,11 @@
 //! validates without panicking, a validated path is finite, a decoded message re-encodes to
 //! the same bytes, …); a broken property panics, so it is found like a crash.
 //!
+//! Issue 33 (item 8) adds the classes of input of its number probe and of file references:
+//! `cut_numbers`, `mill_numbers` and `gcode_msg` ([`numbers`]: request messages with hostile
+//! numbers, through `check_numbers` and the node's conversion), `file_uri` and
+//! `capped_reader` ([`files`]: file references resolved against allowed roots, capped reads).
+//!
 //! Text targets read the bytes as UTF-8 (lossily: invalid sequences become U+FFFD, as nothing
 //! that reaches a kerf parser can be anything but a Rust `str`). Message targets build the
 //! message from the bytes with [`arbitrary`] ([`gen`]); the `cdr` target decodes them as a
@@ -22,10 +27,14 @@
 //! * the coverage-guided libFuzzer drivers of `fuzz/libfuzzer/` (outside the workspace;
 //!   `BENCHMARKS.md`, "Fuzzing").
 
+pub mod files;
 pub mod gen;
 pub mod mutate;
+pub mod numbers;
 pub mod targets;
 
+pub use files::{capped_reader, file_uri};
+pub use numbers::{cut_numbers, gcode_msg, mill_numbers};
 pub use targets::*;
 
 /// A fuzz target: takes any bytes, panics only on a bug.
@@ -50,6 +59,11 @@ pub const TARGETS: &[(&str, Target)] = &[
     ("cdr", targets::cdr),
     ("gcode_program", targets::gcode_program),
     ("gcode_text", targets::gcode_text),
+    ("cut_numbers", numbers::cut_numbers),
+    ("mill_numbers", numbers::mill_numbers),
+    ("gcode_msg", numbers::gcode_msg),
+    ("file_uri", files::file_uri),
+    ("capped_reader", files::capped_reader),
 ];
 
 /// The target called `name`.

@@ -280,7 +280,7 @@ pub fn mesh_obj(data: &[u8]) {
 // ---------------------------------------------------------------------------------------------
 
 /// `kerf_mjto_planner::convert::request_from_msg` of a `CutRequest` message, then validation.
-fn cut_msg_of(m: &msg::CutRequest) {
+pub(crate) fn cut_msg_of(m: &msg::CutRequest) {
     if let Ok(req) = kerf_mjto_planner::convert::request_from_msg(m) {
         check_cut_request(&req);
     }
@@ -288,7 +288,7 @@ fn cut_msg_of(m: &msg::CutRequest) {
 
 /// `kerf_milling_planner::convert::request_from_msg` of a `MillRequest` message, then
 /// validation; an accepted message keeps its points.
-fn mill_msg_of(m: &msg::MillRequest) {
+pub(crate) fn mill_msg_of(m: &msg::MillRequest) {
     if let Ok(req) = kerf_milling_planner::convert::request_from_msg(m) {
         assert!(
             req.points.len() == m.points.len(),

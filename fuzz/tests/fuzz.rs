@@ -59,7 +59,9 @@ macro_rules! fuzz_tests {
         $(
             #[test]
             fn $name() {
+                before(stringify!($name));
                 replay_and_fuzz(stringify!($name), $iterations);
+                after(stringify!($name));
             }
         )*
 
@@ -92,4 +94,42 @@ fuzz_tests! {
     cdr: 3000,
     gcode_program: 20000,
     gcode_text: 300,
+    cut_numbers: 4000,
+    mill_numbers: 1000,
+    gcode_msg: 4000,
+    file_uri: 5000,
+    capped_reader: 10000,
+}
+
+/// What a target needs before its test: `file_uri`'s tree of roots must build (else the
+/// target would check nothing), and accept a file in a root but not a link out of it.
+fn before(name: &str) {
+    if name == "file_uri" {
+        let s = kerf_fuzz::files::scratch().expect("the file_uri tree under the temp directory");
+        assert!(s.allowed.check(&s.dir.join("a/part.ngc")).is_ok());
+        assert!(s.allowed.check(&s.dir.join("a/link-out")).is_err());
+    }
+}
+
+/// What a target leaves behind, removed after its test: `file_uri`'s tree of roots.
+fn after(name: &str) {
+    if name == "file_uri" {
+        kerf_fuzz::files::remove_scratch();
+    }
+}
+
+/// Every named seed of the numbers targets is in the corpus and still gives the message its
+/// name says (a change of `kerf_fuzz::gen` that moves them is caught here; `kerf-fuzz seeds`
+/// writes them again).
+#[test]
+fn named_seeds_give_their_messages() {
+    for (target, file, gives) in kerf_fuzz::numbers::SEEDS {
+        let path = corpus_dir().join(target).join(file);
+        let data = std::fs::read(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+        assert!(
+            gives(&data),
+            "{} no longer gives its message",
+            path.display()
+        );
+    }
 }

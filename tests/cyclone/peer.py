@@ -303,7 +303,7 @@ def scenario(args: argparse.Namespace) -> None:
     t = hold_trajectory(here, order, [0.5, 1.0])
     t.points[1].positions[order.index("joint_4")] = math.nan
     seen["NaN position"] = reject_and_check(
-        peer, "NaN position", t, INVALID_GOAL, ["point 1", "joint 'joint_4'", "NaN", "finite"]
+        peer, "NaN position", t, INVALID_GOAL, ["points[1].positions", "joint joint_4", "NaN", "finite"]
     )
 
     t = hold_trajectory(here, order, [0.5, 1.0, 1.0])

@@ -524,8 +524,12 @@ impl MillRequest {
                 });
             }
         }
-        // Coplanarity (and everything else of the path) by kerf_mill.
-        MillingPath::new(&self.path_spec(1))?;
+        // Coplanarity (and everything else of the path) by kerf_mill, on one segment whatever
+        // `segments` asks (found by fuzzing: 10 000 segments made validation cost 174 ms).
+        MillingPath::new(&PathSpec {
+            segments: 1,
+            ..self.path_spec(1)
+        })?;
         if let Some(p) = &self.process {
             for (name, v) in [
                 ("process.tool_radius [m]", p.tool_radius),

@@ -162,6 +162,9 @@ pub struct CappedReader<R> {
     remaining: u64,
     max_bytes: u64,
     name: String,
+    /// The cap was passed: every later read fails too (found by fuzzing: a caller reading on
+    /// after the error got the stream's later bytes).
+    over: bool,
 }
 
 impl<R> CappedReader<R> {
@@ -172,6 +175,7 @@ impl<R> CappedReader<R> {
             remaining: max_bytes,
             max_bytes,
             name: name.into(),
+            over: false,
         }
     }
 
@@ -186,6 +190,9 @@ impl<R> CappedReader<R> {
 
 impl<R: Read> Read for CappedReader<R> {
     fn read(&mut self, buf: &mut [u8]) -> std::io::Result<usize> {
+        if self.over {
+            return Err(self.over());
+        }
         if buf.is_empty() {
             return Ok(0);
         }
@@ -195,6 +202,7 @@ impl<R: Read> Read for CappedReader<R> {
             .min(buf.len());
         let n = self.inner.read(&mut buf[..allowed])?;
         if n as u64 > self.remaining {
+            self.over = true;
             return Err(self.over());
         }
         self.remaining -= n as u64;
@@ -204,11 +212,15 @@ impl<R: Read> Read for CappedReader<R> {
 
 impl<R: BufRead> BufRead for CappedReader<R> {
     fn fill_buf(&mut self) -> std::io::Result<&[u8]> {
+        if self.over {
+            return Err(self.over());
+        }
         if self.remaining == 0 {
             let over = self.over();
             return if self.inner.fill_buf()?.is_empty() {
                 Ok(&[])
             } else {
+                self.over = true;
                 Err(over)
             };
         }
@@ -350,5 +362,19 @@ mod tests {
         // An endless source stops at the cap.
         let mut zero = CappedReader::new(std::io::repeat(0), 1 << 20, "/dev/zero");
         assert!(zero.read_to_end(&mut Vec::new()).is_err());
+    }
+
+    /// Found by fuzzing: once past the cap, every later read fails, whatever the stream
+    /// still holds ("abcdefg" read 2 bytes at a time with a cap of 3 gave "ab", an error,
+    /// then "g" and an end).
+    #[test]
+    fn a_capped_reader_stays_failed_past_its_cap() {
+        let mut r = CappedReader::new(&b"abcdefg"[..], 3, "input");
+        let mut two = [0u8; 2];
+        assert_eq!(r.read(&mut two).unwrap(), 2);
+        for _ in 0..4 {
+            assert!(r.read(&mut two).is_err());
+            assert!(r.fill_buf().is_err());
+        }
     }
 }

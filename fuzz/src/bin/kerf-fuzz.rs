@@ -10,7 +10,10 @@
 //! prints executions per target; the first failure ends it with exit code 1, naming the file
 //! the input was saved to. `seeds` rewrites the generated seed files of the corpus
 //! (`fuzz/corpus/cdr/*.cdr`, `fuzz/corpus/{cut,mill,trajectory}_msg/gen-*`): CDR encodings of
-//! real messages and `arbitrary` byte strings.
+//! real messages and `arbitrary` byte strings; and those of issue 33's targets
+//! (`fuzz/corpus/{cut_numbers,mill_numbers,gcode_msg}/`: `gen-*` and the named seeds of
+//! `kerf_fuzz::numbers::SEEDS`, found by a search of random bytes; `fuzz/corpus/file_uri/`,
+//! `fuzz/corpus/capped_reader/`).
 
 use std::{process::ExitCode, time::Duration};
 
@@ -102,6 +105,8 @@ fn run(args: &[String]) -> Result<(), String> {
             stats.executions as f64 / secs
         );
     }
+    // `file_uri`'s tree of roots (built in the temp directory on its first input).
+    kerf_fuzz::files::remove_scratch();
     Ok(())
 }
 
@@ -264,6 +269,114 @@ fn seeds() -> Result<(), String> {
             write(target, &format!("gen-random-{k}"), &bytes)?;
         }
     }
+    issue_33_seeds()?;
     println!("wrote the generated seeds under {}", corpus_dir().display());
     Ok(())
+}
+
+/// The seeds of the targets of issue 33, item 8 (a generator of their own, so that the seeds
+/// above stay as they were).
+fn issue_33_seeds() -> Result<(), String> {
+    let mut rng = Rng::new(2033);
+    for target in ["cut_numbers", "mill_numbers", "gcode_msg"] {
+        write(target, "gen-zeros", &[0u8; 256])?;
+        write(target, "gen-ones", &[0xffu8; 256])?;
+        for k in 0..3 {
+            write(
+                target,
+                &format!("gen-random-{k}"),
+                &random_bytes(&mut rng, 512),
+            )?;
+        }
+    }
+    for (target, file, gives) in kerf_fuzz::numbers::SEEDS {
+        let data = search(&mut rng, *gives).ok_or_else(|| format!("no bytes give {file}"))?;
+        write(target, file, &data)?;
+    }
+    for (file, data) in FILE_URI_SEEDS {
+        write("file_uri", file, data)?;
+    }
+    for (file, data) in capped_reader_seeds() {
+        write("capped_reader", file, &data)?;
+    }
+    Ok(())
+}
+
+/// `n` bytes of `rng`.
+fn random_bytes(rng: &mut Rng, n: usize) -> Vec<u8> {
+    (0..n).map(|_| rng.next_u64() as u8).collect()
+}
+
+/// The first of up to 10^7 random byte strings (of 64 to 512 bytes) that `gives` accepts.
+fn search(rng: &mut Rng, gives: fn(&[u8]) -> bool) -> Option<Vec<u8>> {
+    (0..10_000_000).find_map(|_| {
+        let n = 64 + rng.below(449);
+        let bytes = random_bytes(rng, n);
+        gives(&bytes).then_some(bytes)
+    })
+}
+
+/// Seeds of `file_uri`: control bytes stand for the pieces of `kerf_fuzz::files` (0x01 root
+/// `a`, 0x04 the root given through a link, 0x05 `bb`, 0x0a `/part.ngc`, 0x0b `/link-out`,
+/// 0x0c `/link-dir-out/secret.ngc`, 0x0d `/loop`, 0x0f `/sock`, 0x13 `/big.ngc`, 0x14
+/// `/empty.ngc`, 0x1a a 256-byte component); the length of a seed picks the read's cap.
+const FILE_URI_SEEDS: &[(&str, &[u8])] = &[
+    ("etc-passwd-relative", b"../../etc/passwd"),
+    ("dev-zero", b"file:///dev/zero"),
+    ("package-escape", b"package://kerf/../Cargo.toml"),
+    (
+        "package-shipped",
+        b"package://kerf/crates/gcode/data/programs/arcs.ngc",
+    ),
+    ("root-part", b"\x01\x0a"),
+    // Read whole (cap 4096, 0 bytes of 29) and at exactly its size (cap 30).
+    ("root-part-read", b"\x01//part.ngc"),
+    ("root-empty-read", b"\x01\x14"),
+    ("root-part-exact-cap", b"\x01/././/part.ngc"),
+    ("root-link-out", b"\x01\x0b"),
+    ("root-link-dir-out", b"\x01\x0c"),
+    ("root-dotdot-outside", b"\x01/../outside/secret.ngc"),
+    ("file-uri-percent", b"file://\x01/sub/%2e%2e/part.ngc"),
+    ("nul", b"\x01/part.ngc\0.stl"),
+    (
+        "long",
+        b"\x01/\x1a\x1a\x1a\x1a\x1a\x1a\x1a\x1a\x1a\x1a\x1a\x1a\x1a\x1a\x1a\x1a\x1a",
+    ),
+    ("sibling-of-root", b"\x05/part.ngc"),
+    ("root-through-link", b"\x04\x0a"),
+    ("loop", b"\x01\x0d"),
+    ("socket", b"\x01\x0f"),
+    ("over-cap", b"\x01\x13"),
+    ("localhost", b"file://localhost\x01/part.ngc"),
+    ("other-scheme", b"http://example.com/part.ngc"),
+];
+
+/// Seeds of `capped_reader` (its layout: cap, stack, length, ops, chunks, data).
+fn capped_reader_seeds() -> Vec<(&'static str, Vec<u8>)> {
+    let seed = |cap: u16, stack: u8, length: u8, ops: &[u8], chunks: [u8; 4], data: &[u8]| {
+        let mut out = cap.to_le_bytes().to_vec();
+        out.extend([stack, length, ops.len() as u8]);
+        out.extend_from_slice(ops);
+        out.extend_from_slice(&chunks);
+        out.extend_from_slice(data);
+        out
+    };
+    // Ops: read 8 (0x20), fill_buf + consume 4 (0x0d), read_until (0x02), read_to_end (0x03).
+    let ops = [0x20, 0x0d, 0x02, 0x03];
+    let line = b"G1 X1 F100\nG1 Y1\n";
+    vec![
+        ("empty", seed(0, 0, 0, &[], [0; 4], b"")),
+        ("under-cap", seed(64, 1, 0, &ops, [1, 7, 64, 3], line)),
+        ("exact-cap", seed(30, 1, 1, &ops, [1, 7, 64, 3], line)),
+        ("cap-plus-one", seed(30, 1, 2, &ops, [1, 7, 64, 3], line)),
+        ("endless-zeros", seed(4096, 0, 3, &[0x03], [255; 4], &[0])),
+        (
+            "buffer-over-cap",
+            seed(17, 2 | (3 << 2), 2, &ops, [5; 4], line),
+        ),
+        (
+            "plain-chunks",
+            seed(100, 0, 3, &[0xfc, 0x00, 0x04], [1, 2, 3, 200], line),
+        ),
+    ]
 }

@@ -39,7 +39,7 @@ pub const RULES: &[Rule] = &[
     Rule::closed("rapid_feed", 1e-4, 10.0, "m/s")
         .or(&[(0.0, "the machine's")])
         .divides(),
-    Rule::closed("origin.*", -1000.0, 1000.0, "m").when("has_placement"),
+    Rule::closed("origin.*", -100.0, 100.0, "m").when("has_placement"),
     Rule::closed("redundancy_angle", -PI, PI, "rad").when("has_placement"),
     Rule::closed("standoff_axis", -0.1, 0.02, "m").when("has_placement"),
     Rule::closed("time_budget", 1e-6, MAX_TIME_BUDGET, "s").or(&[(0.0, "the node's plan_timeout")]),
