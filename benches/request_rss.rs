@@ -5,7 +5,8 @@
 //! answers and the slope over the second half.
 //!
 //! Run: `cargo bench --bench request_rss -- [cut|mill|gcode] [COUNT]` (default: all three,
-//! 10 000 requests for cut and G-code, 1 000 for milling).
+//! 10 000 requests for cut and G-code, 1 000 for milling); `KERF_RSS_LAUNCH_ARGS` adds
+//! arguments to `kerf launch` (e.g. `--ros-args --disable-rosout-logs`).
 #![allow(clippy::unwrap_used, clippy::expect_used)] // a bench binary reports failures by panicking
 
 use kerf_msgs::msg::{CutPlan, GcodePlan, MillPlan};
@@ -48,6 +49,15 @@ fn main() {
         .ok()
         .and_then(|v| v.parse().ok())
         .unwrap_or(100);
+    // More arguments of `kerf launch` (e.g. `--ros-args --disable-rosout-logs`).
+    let extra = std::env::var("KERF_RSS_LAUNCH_ARGS").unwrap_or_default();
+    let launch = |robot: &'static str| -> Vec<String> {
+        ["--robot", robot, "--with-planner"]
+            .into_iter()
+            .map(String::from)
+            .chain(extra.split_whitespace().map(String::from))
+            .collect()
+    };
     if which == "all" || which == "cut" {
         let case1 = std::fs::read_to_string(concat!(
             env!("CARGO_MANIFEST_DIR"),
@@ -57,7 +67,7 @@ fn main() {
         let r = sequential(
             &support::planner::mjto(),
             91,
-            &["--robot", "laser_cutter", "--with-planner"],
+            &launch("laser_cutter"),
             count.unwrap_or(10_000),
             every,
             CutPlan::SUCCESS,
@@ -70,7 +80,7 @@ fn main() {
         let r = sequential(
             &support::planner::gcode(),
             92,
-            &["--robot", "laser_cutter", "--with-planner"],
+            &launch("laser_cutter"),
             count.unwrap_or(10_000),
             every,
             GcodePlan::SUCCESS,
@@ -92,7 +102,7 @@ fn main() {
         let r = sequential(
             &support::planner::mill(),
             93,
-            &["--robot", "irb6660", "--with-planner"],
+            &launch("irb6660"),
             count.unwrap_or(1_000),
             every,
             MillPlan::SUCCESS,

@@ -65,7 +65,7 @@ pub struct Reading {
 pub fn sequential<Req: RosType + Serialize + Debug, Plan: Answer>(
     planner: &Planner<Req, Plan>,
     domain: u16,
-    launch: &[&str],
+    launch: &[impl AsRef<std::ffi::OsStr>],
     count: usize,
     every: usize,
     status: u8,
