@@ -33,6 +33,11 @@
 //!   anchor sample certifies a distance, and the following samples that the
 //!   shape provably cannot cross it in need no query; same verdicts as one
 //!   query per sample.
+//! * [`CollisionWorld::distance`] (module `distance`) answers the exact
+//!   distance of the head, not inflated, from the workpiece, and
+//!   [`HeadModel::lipschitz`] bounds how fast any head point moves per unit
+//!   of each joint: together they certify whole motions by conservative
+//!   advancement (`kerf_approach`, issue 27).
 //! * The geometry runs on `parry3d-f64` (the f64 build of parry3d 0.31).
 //!   The f32 build's GJK test of a cylinder against a large triangle
 //!   reports contact across a 1 mm gap (the nozzle above a flange at 3°
@@ -41,12 +46,16 @@
 //!   `tests/collision.rs`). Coordinates are still taken relative to the
 //!   centre of the workpiece bounding box.
 
+mod distance;
 mod head;
+mod lipschitz;
 mod separation;
 mod sweep;
 mod world;
 
+pub use distance::Distance;
 pub use head::{HeadLink, HeadModel, HeadShape, Primitive};
+pub use lipschitz::RIM_SIDES;
 pub use separation::SEPARATION_MARGIN;
 pub use sweep::{MAX_BACKOFF, MAX_EXPAND, MAX_WINDOW};
 pub use world::CollisionWorld;

@@ -124,6 +124,9 @@ pub struct HeadShape {
 #[derive(Debug, Clone, PartialEq)]
 pub struct HeadModel {
     pub(super) shapes: Vec<HeadShape>,
+    /// The URDF limits `[lower, upper]` of the standoff joint q6 (m): the
+    /// range [`HeadModel::lipschitz`] bounds the nozzle's reach over.
+    pub(super) standoff_range: [f64; 2],
 }
 
 /// The joints the specialised kinematics of [`HeadLink::pose`] expects:
@@ -184,9 +187,11 @@ impl HeadModel {
     /// are not the chain of seed 001 eq. 2 with identity origins (the
     /// specialised kinematics would be wrong), when another link carries
     /// collision geometry, for mesh or capsule geometry (only box, cylinder
-    /// and sphere are supported), for non-positive or non-finite sizes, and
-    /// when no link has collision geometry at all.
+    /// and sphere are supported), for non-positive or non-finite sizes, for
+    /// non-finite or inverted limits of q6, and when no link has collision
+    /// geometry at all.
     pub fn from_urdf(robot: &urdf_rs::Robot) -> Result<Self, PlanError> {
+        let mut standoff_range = [0.0; 2];
         for (name, parent, child, prismatic, axis) in CHAIN {
             let j = robot
                 .joints
@@ -215,6 +220,15 @@ impl HeadModel {
                     j.parent.link,
                     j.child.link
                 )));
+            }
+            if name == "q6" {
+                let (lo, hi) = (j.limit.lower, j.limit.upper);
+                if !(lo.is_finite() && hi.is_finite() && lo <= hi) {
+                    return Err(machine_err(format!(
+                        "joint q6: limits [{lo}, {hi}] must be finite with lower <= upper"
+                    )));
+                }
+                standoff_range = [lo, hi];
             }
         }
         let mut shapes = Vec::new();
@@ -288,7 +302,10 @@ impl HeadModel {
             ));
         }
         shapes.sort_by_key(|s| s.link);
-        Ok(Self { shapes })
+        Ok(Self {
+            shapes,
+            standoff_range,
+        })
     }
 
     /// Names of the links with collision geometry, in check order
@@ -306,6 +323,11 @@ impl HeadModel {
     /// The collision primitives, in check order.
     pub fn shapes(&self) -> &[HeadShape] {
         &self.shapes
+    }
+
+    /// The URDF limits `[lower, upper]` of the standoff joint q6 (m).
+    pub fn standoff_range(&self) -> [f64; 2] {
+        self.standoff_range
     }
 
     /// Poses of the links with collision geometry at `q`, in the machine

@@ -21,6 +21,9 @@ pub(super) struct WorldShape {
     /// URDF z-cylinder is turned by Rx(π/2)).
     pub(super) local: Pose,
     shape: Box<dyn Shape>,
+    /// The primitive as a parry shape, not inflated (the distance queries
+    /// of [`super::distance`]).
+    pub(super) raw: Box<dyn Shape>,
     /// The primitive (not inflated) in the same frame, for the
     /// separating-axis first stage and the motion bounds.
     pub(super) primitive: LocalPrimitive,
@@ -36,8 +39,9 @@ pub(super) struct ShapeVerdict {
     pub(super) clear_by: f64,
 }
 
-/// Euclidean distance between two boxes (0 when they overlap).
-fn aabb_gap(a: &Aabb, b: &Aabb) -> f64 {
+/// Euclidean distance between two boxes (0 when they overlap): a lower
+/// bound on the distance between any two sets they contain.
+pub(super) fn aabb_gap(a: &Aabb, b: &Aabb) -> f64 {
     let lo = (b.mins - a.maxs).max(a.mins - b.maxs).max(Vector::ZERO);
     lo.length()
 }
@@ -56,10 +60,10 @@ pub(super) struct WorldLink {
 pub struct CollisionWorld {
     head: HeadModel,
     pub(super) links: Vec<WorldLink>,
-    mesh: TriMesh,
+    pub(super) mesh: TriMesh,
     /// The mesh's triangles with their normals, by triangle index.
-    triangles: Vec<TriangleAxes>,
-    mesh_aabb: Aabb,
+    pub(super) triangles: Vec<TriangleAxes>,
+    pub(super) mesh_aabb: Aabb,
     /// Machine-frame point subtracted from every coordinate.
     pub(super) origin: Vector3<f64>,
     clearance: f64,
@@ -209,18 +213,27 @@ impl CollisionWorld {
         let mut links: Vec<WorldLink> = Vec::new();
         for s in &head.shapes {
             let (shape, primitive, fix) = parry_shape(&s.primitive, clearance);
+            let (raw, _, _) = parry_shape(&s.primitive, 0.0);
             let local = to_pose(&(s.origin * fix), &Vector3::zeros());
             let aabb = shape.compute_aabb(&local);
             // Every pair must be supported by parry's dispatcher: probe once.
-            intersection_test(&Pose::IDENTITY, &trimesh, &local, shape.as_ref()).map_err(|_| {
+            let unsupported = |_| {
                 machine_err(format!(
                     "parry3d cannot test {:?} against a triangle mesh",
                     s.primitive
                 ))
-            })?;
+            };
+            intersection_test(&Pose::IDENTITY, &trimesh, &local, shape.as_ref())
+                .map_err(unsupported)?;
+            if trimesh.num_triangles() > 0 {
+                DefaultQueryDispatcher
+                    .distance(&local, &trimesh.triangle(0), raw.as_ref())
+                    .map_err(unsupported)?;
+            }
             let ws = WorldShape {
                 local,
                 shape,
+                raw,
                 primitive,
             };
             match links.last_mut() {
