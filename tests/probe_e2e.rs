@@ -12,8 +12,9 @@
 //! * **files**: the request's file field naming a FIFO, a directory, `/dev/zero`, a symlink out
 //!   of the roots, a `..` path out of them, a `file://` URI out of them: a named refusal
 //!   (never INTERNAL_ERROR, never the file's contents);
-//! * **heavy**: requests whose plan outgrows the deadline or the memory budget: TIMEOUT,
-//!   RESOURCE_LIMIT or a refusal;
+//! * **heavy**: a text request over the 4 MiB cap (refused unparsed, its answer carrying the id
+//!   of its first line), requests whose plan outgrows the deadline or the memory budget:
+//!   TIMEOUT, RESOURCE_LIMIT or a refusal;
 //! * **burst**: twelve requests at once against a queue of one: each answered once, those over
 //!   the queue QUEUE_FULL in arrival order;
 //! * **signal**: the node stopped (what Ctrl-C does) during a heavy plan: it ends within 2 s
@@ -280,6 +281,17 @@ where
         );
     }
     still_plans(probe, &client, "files");
+
+    // A text request over the 4 MiB cap: refused before it is parsed, the answer carrying the
+    // id its first line gives.
+    let over = format!(
+        "request_id: over-cap\n#{}\n",
+        "x".repeat(kerf_ros::planner::MAX_TEXT_REQUEST_BYTES)
+    );
+    client.send_text(&over);
+    let (plan, took) = answer(&client, "over-cap");
+    expect(&plan, "over-cap", probe.status.invalid, &["over the limit"]);
+    eprintln!("{name}: a text request over the cap: INVALID_REQUEST in {took:.2?}");
 
     // Heavy requests.
     for (k, text) in probe.heavy.iter().enumerate() {

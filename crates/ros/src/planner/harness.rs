@@ -10,7 +10,7 @@ use kerf_msgs::{
 use ros2_client::Publisher;
 
 use super::{
-    check_answer, check_text_size,
+    check_answer, check_text_size, leading_request_id,
     work::{HarnessWork, RawRequest},
     AnswerKey, Failure, HarnessSettings, PlanAnswer, PlanningService, HARNESS_PARAMS,
     TRAJECTORY_TOPIC,
@@ -360,7 +360,10 @@ impl<S: PlanningService> PlannerNode<S> {
                 Ok((_, stamp)) if self.published_before_start(stamp, "text") => continue,
                 Ok((m, _)) => match check_text_size(&m.data) {
                     Err(reason) => Queued::Answer(Box::new(self.service.failure(
-                        &AnswerKey::default(),
+                        &AnswerKey {
+                            request_id: leading_request_id(&m.data),
+                            label: String::new(),
+                        },
                         Failure::Unreadable,
                         reason,
                     ))),

@@ -57,7 +57,10 @@ pub use size::{
     cdr_bytes, check_answer, check_points, max_answer_points, AnswerSize, MAX_ANSWER_BYTES,
     TEXT_BYTES_PER_JOINT_POINT,
 };
-pub use text::{check_text_size, yaml_field, TextRequestError, MAX_TEXT_REQUEST_BYTES};
+pub use text::{
+    check_text_size, leading_request_id, yaml_field, TextRequestError, LEADING_BYTES,
+    MAX_TEXT_REQUEST_BYTES,
+};
 pub use work::{plan_checked, work, HarnessWork, Job, RawRequest};
 
 use crate::{Params, RosError};

@@ -20,6 +20,56 @@ pub fn check_text_size(text: &str) -> Result<(), String> {
     Ok(())
 }
 
+/// How much of a text request over [`MAX_TEXT_REQUEST_BYTES`] is looked at for its
+/// `request_id` ([`leading_request_id`]): 64 KiB.
+pub const LEADING_BYTES: usize = 64 << 10;
+
+/// The `request_id` a text request gives in its first [`LEADING_BYTES`], read without parsing
+/// the document: a top-level YAML line `request_id: VALUE` (plain, or in quotes without
+/// escapes; a trailing ` # comment` dropped) or a JSON member `"request_id": "VALUE"` (without
+/// escapes). Empty when there is none or its value is not that simple. The answer to a text
+/// request refused for its size carries it, so that the sender can match the refusal.
+///
+/// # Performance
+/// One pass over at most [`LEADING_BYTES`] bytes; nothing is allocated but the result.
+pub fn leading_request_id(text: &str) -> String {
+    let mut end = text.len().min(LEADING_BYTES);
+    while !text.is_char_boundary(end) {
+        end -= 1;
+    }
+    let head = &text[..end];
+    if head.trim_start().starts_with('{') {
+        return json_request_id(head).unwrap_or_default().to_string();
+    }
+    head.lines()
+        .find_map(|line| line.strip_prefix("request_id:"))
+        .and_then(yaml_scalar)
+        .unwrap_or_default()
+        .to_string()
+}
+
+/// A YAML plain or quoted scalar without escapes (`a-1`, `"a 1"`, `'a'`), its comment dropped.
+fn yaml_scalar(value: &str) -> Option<&str> {
+    let v = value.trim();
+    for q in ['"', '\''] {
+        if let Some(inner) = v.strip_prefix(q) {
+            let (inner, _) = inner.split_once(q)?;
+            return (!inner.contains('\\')).then_some(inner);
+        }
+    }
+    let v = v.split(" #").next().unwrap_or_default().trim_end();
+    let special = v.chars().next().is_none_or(|c| "{[&*!|>%@`#,".contains(c));
+    (!special).then_some(v)
+}
+
+/// The string value of a JSON member `"request_id": "…"` without escapes.
+fn json_request_id(head: &str) -> Option<&str> {
+    let at = head.find("\"request_id\"")? + "\"request_id\"".len();
+    let rest = head[at..].trim_start().strip_prefix(':')?.trim_start();
+    let (value, _) = rest.strip_prefix('"')?.split_once('"')?;
+    (!value.contains('\\')).then_some(value)
+}
+
 /// A text request that could not be turned into a request.
 #[derive(Debug)]
 pub struct TextRequestError<E> {
@@ -69,6 +119,30 @@ mod tests {
         // Too deep to be parsed at all (YAML parsing is quadratic in the depth).
         let deep = format!("request_id: x\nd: {}\n", "[".repeat(100_000));
         assert_eq!(yaml_field(&deep, "request_id"), "");
+    }
+
+    #[test]
+    fn an_over_size_request_still_names_its_id() {
+        use super::leading_request_id as id;
+        let pad = "#".repeat(super::MAX_TEXT_REQUEST_BYTES);
+        assert_eq!(id(&format!("request_id: big-1\n{pad}")), "big-1");
+        assert_eq!(id(&format!("# x\nrequest_id: 'big 2'  \n{pad}")), "big 2");
+        assert_eq!(id("request_id: a-3 # the third\n"), "a-3");
+        assert_eq!(
+            id(&format!(
+                "{{\"points\": [], \"request_id\": \"j-4\", \"x\": \"{pad}\"}}"
+            )),
+            "j-4"
+        );
+        // Not simple, nested, or past the first 64 KiB: none.
+        assert_eq!(id("request_id: {a: 1}\n"), "");
+        assert_eq!(id("request_id: \"a\\\"b\"\n"), "");
+        assert_eq!(id("  request_id: nested\n"), "");
+        assert_eq!(id(&format!("{pad}\nrequest_id: late\n")), "");
+        assert_eq!(id(""), "");
+        // A multi-byte character at the 64 KiB boundary.
+        let long = format!("request_id: é-5\n{}", "é".repeat(40_000));
+        assert_eq!(id(&long), "é-5");
     }
 
     #[test]
