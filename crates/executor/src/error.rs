@@ -96,6 +96,42 @@ pub enum ExecutorError {
         /// Upper position limit.
         max: f64,
     },
+    /// A joint name appears twice in a named state (a `sensor_msgs/JointState`).
+    #[error("{what}: joint '{joint}' appears twice in the joint names")]
+    StateDuplicateJoint {
+        /// Which state.
+        what: &'static str,
+        /// The duplicated name.
+        joint: String,
+    },
+    /// Joints of the robot are missing from a named state.
+    #[error("{what}: no value for joint(s) [{missing}]; every joint of the robot is required")]
+    StateMissingJoints {
+        /// Which state.
+        what: &'static str,
+        /// The missing joint names, comma-separated.
+        missing: String,
+    },
+    /// The driver's feedback is stale: no new state for longer than the watchdog allows.
+    #[error(
+        "feedback stale: no new joint state for {age} s (the watchdog allows {limit} s: {missed} control periods)"
+    )]
+    FeedbackStale {
+        /// Time since the last state (s), or since the watchdog started when none came.
+        age: f64,
+        /// The allowed gap (s).
+        limit: f64,
+        /// The allowed number of missed periods.
+        missed: u32,
+    },
+    /// The driver's feedback went back in time (its stamp is older than the previous one).
+    #[error("feedback stamp went back: {got} s after {previous} s")]
+    FeedbackStampBack {
+        /// The previous stamp (s).
+        previous: f64,
+        /// The new stamp (s).
+        got: f64,
+    },
     /// A time argument is NaN or infinite.
     #[error("{what} is {value} s, must be finite")]
     NonFiniteTime {

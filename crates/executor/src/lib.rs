@@ -81,6 +81,7 @@
 pub mod error;
 pub mod executable;
 pub mod executor;
+pub mod measured;
 pub mod mock;
 pub mod roots;
 pub mod slack;
@@ -90,6 +91,7 @@ pub mod tolerance;
 pub mod trajectory;
 pub mod types;
 pub mod validate;
+pub mod watchdog;
 
 pub use error::{
     ExecutorError, GOAL_TOLERANCE_VIOLATED, INVALID_GOAL, INVALID_JOINTS, OLD_HEADER_TIMESTAMP,
@@ -97,6 +99,7 @@ pub use error::{
 };
 pub use executable::check_executable;
 pub use executor::{Cycle, Executor, Feedback, GoalEvent, GoalId, Outcome};
+pub use measured::{measured_state, MeasuredState, NamedState};
 pub use mock::MockHardware;
 pub use slack::LIMIT_SLACK;
 pub use stop::StopProfile;
@@ -107,3 +110,4 @@ pub use types::{
     TrajectoryRequest,
 };
 pub use validate::{prepare, validate, PreparedTrajectory};
+pub use watchdog::FeedbackWatchdog;
