@@ -34,8 +34,7 @@ use std::{
 use kerf_msgs::{
     msg::{self, CutPlan, GcodePlan, MillPlan},
     numbers::{
-        leaves,
-        probe::{expected, probe_values, with_value},
+        probe::{refused_cases, with_value},
         NumberFields, NumberRules,
     },
     RosType,
@@ -114,28 +113,6 @@ fn yaml<Req: Default + Serialize + DeserializeOwned>(text: &str) -> Req {
     let mut v = serde_yaml_ng::to_value(Req::default()).unwrap();
     overlay(&mut v, serde_yaml_ng::from_str(text).unwrap());
     serde_yaml_ng::from_value(v).unwrap_or_else(|e| panic!("{e}: {text}"))
-}
-
-/// The (path, value) cases of the numbers class: each leaf (of an array, its first and last
-/// element) and each probe value its declared rule refuses.
-fn number_cases<Req: Serialize + NumberRules>(
-    base: &Req,
-) -> Vec<(String, kerf_msgs::numbers::Number)> {
-    let all = leaves(base);
-    let mut cases = Vec::new();
-    for (i, leaf) in all.iter().enumerate() {
-        let first = all[..i].iter().all(|l| l.key != leaf.key);
-        let last = all[i + 1..].iter().all(|l| l.key != leaf.key);
-        if !(first || last) {
-            continue;
-        }
-        for v in probe_values(leaf.value) {
-            if expected::<Req>(&leaf.key, v).is_err() {
-                cases.push((leaf.path.clone(), v));
-            }
-        }
-    }
-    cases
 }
 
 /// Waits for the answer to `id` (earlier answers of other ids are a failure).
@@ -237,7 +214,7 @@ where
     if let Err(e) = probe.numbers_base.check_numbers() {
         panic!("{name}: the numbers base is refused: {e}");
     }
-    let cases = number_cases(&probe.numbers_base);
+    let cases = refused_cases(&probe.numbers_base);
     assert!(
         cases.len() > 40,
         "{name}: only {} number cases",

@@ -17,15 +17,7 @@ use super::Killed;
 
 /// A field of `/proc/<pid>/status` in MiB (`"VmRSS:"`, `"VmHWM:"`); 0 when unreadable.
 pub fn status_mib(pid: u32, field: &str) -> f64 {
-    std::fs::read_to_string(format!("/proc/{pid}/status"))
-        .ok()
-        .and_then(|s| {
-            s.lines()
-                .find_map(|l| l.strip_prefix(field))
-                .and_then(|v| v.split_whitespace().next())
-                .and_then(|v| v.parse::<f64>().ok())
-        })
-        .map_or(0.0, |kib| kib / 1024.0)
+    kerf_ros::memory::status_kib_of(pid, field).map_or(0.0, |kib| kib as f64 / 1024.0)
 }
 
 /// Resident memory (MiB) of the children of process `pid` (a planner's worker process).

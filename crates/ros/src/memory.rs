@@ -92,7 +92,21 @@ pub fn give_back_freed_memory() -> bool {
 /// # Returns
 /// `None` where the file or the field does not exist (not Linux).
 pub fn status_kib(field: &str) -> Option<u64> {
-    let status = std::fs::read_to_string("/proc/self/status").ok()?;
+    read_status_kib("/proc/self/status", field)
+}
+
+/// A field of process `pid`'s `/proc/<pid>/status` in KiB, as [`status_kib`] reads its own
+/// (a node's memory read by the test or bench that started it).
+///
+/// # Returns
+/// `None` where the process, the file or the field does not exist.
+pub fn status_kib_of(pid: u32, field: &str) -> Option<u64> {
+    read_status_kib(&format!("/proc/{pid}/status"), field)
+}
+
+/// The KiB value of `field` in a `/proc/.../status` file.
+fn read_status_kib(path: &str, field: &str) -> Option<u64> {
+    let status = std::fs::read_to_string(path).ok()?;
     status
         .lines()
         .find_map(|l| l.strip_prefix(field))
@@ -107,6 +121,10 @@ mod tests {
         let rss = super::status_kib("VmRSS:").unwrap();
         assert!(rss > 0 && rss <= super::status_kib("VmHWM:").unwrap());
         assert_eq!(super::status_kib("NoSuchField:"), None);
+        assert_eq!(
+            super::status_kib_of(std::process::id(), "VmHWM:").is_some(),
+            super::status_kib("VmHWM:").is_some()
+        );
     }
 
     #[test]

@@ -161,9 +161,9 @@ struct PlannerNode<S: PlanningService> {
     /// not answered (requests are not durable).
     started_ns: i64,
     settings: HarnessSettings,
-    /// Answers published so far, and how many had been when freed memory was last returned.
-    answers: std::cell::Cell<u64>,
-    trimmed_at: (u64, std::time::Instant),
+    /// Whether an answer was published since freed memory was last returned, and when that was.
+    answered_since_trim: std::cell::Cell<bool>,
+    trimmed_at: std::time::Instant,
     log: Logger,
     node: KerfNode,
 }
@@ -221,8 +221,8 @@ impl<S: PlanningService> PlannerNode<S> {
             next_id: 0,
             started_ns,
             settings,
-            answers: std::cell::Cell::new(0),
-            trimmed_at: (0, std::time::Instant::now()),
+            answered_since_trim: std::cell::Cell::new(false),
+            trimmed_at: std::time::Instant::now(),
             log,
             node,
         })
@@ -250,10 +250,13 @@ impl<S: PlanningService> PlannerNode<S> {
     /// the last return, and [`TRIM_EVERY`] has passed: the node's RSS then stays where it
     /// was after its first requests.
     fn give_back_memory_when_idle(&mut self) {
-        let (count, at) = self.trimmed_at;
-        if self.pending() == 0 && self.answers.get() > count && at.elapsed() >= TRIM_EVERY {
+        if self.pending() == 0
+            && self.answered_since_trim.get()
+            && self.trimmed_at.elapsed() >= TRIM_EVERY
+        {
             crate::memory::give_back_freed_memory();
-            self.trimmed_at = (self.answers.get(), std::time::Instant::now());
+            self.answered_since_trim.set(false);
+            self.trimmed_at = std::time::Instant::now();
         }
     }
 
@@ -585,7 +588,7 @@ impl<S: PlanningService> PlannerNode<S> {
     /// answer with a sample over [`super::MAX_ANSWER_BYTES`] is replaced by
     /// [`Failure::TooLarge`] (one large sample would block every later one of its topic).
     fn publish(&self, plan: S::Answer) {
-        self.answers.set(self.answers.get() + 1);
+        self.answered_since_trim.set(true);
         let mut text = answer_text(&plan);
         let plan = match check_answer(&plan, &text, plan.trajectory()) {
             Ok(()) => plan,

@@ -5,7 +5,7 @@
 use serde::{de::DeserializeOwned, Serialize};
 use serde_yaml_ng::Value;
 
-use super::{find_rule, Number, NumberRules, Rule};
+use super::{find_rule, leaves, Number, NumberRules, Rule};
 
 /// The floats every `float64` leaf is probed with: NaN, ±inf, 0, −0, the smallest denormal,
 /// ±1e308.
@@ -47,6 +47,30 @@ pub fn expected<T: NumberRules>(key: &str, value: Number) -> Result<(), String> 
         None if value.as_f64().is_finite() => Ok(()),
         None => Err("must be finite".to_string()),
     }
+}
+
+/// The refusal cases of `msg` over DDS, where each case costs a round trip: every numeric leaf
+/// (of an array, only its first and last element) with each probe value ([`probe_values`])
+/// its declared rule refuses ([`expected`]), as (path, value).
+///
+/// # Performance
+/// O(leaves²) comparisons of keys: for the small messages a probe starts from.
+pub fn refused_cases<T: Serialize + NumberRules>(msg: &T) -> Vec<(String, Number)> {
+    let all = leaves(msg);
+    let mut cases = Vec::new();
+    for (i, leaf) in all.iter().enumerate() {
+        let first = all[..i].iter().all(|l| l.key != leaf.key);
+        let last = all[i + 1..].iter().all(|l| l.key != leaf.key);
+        if !(first || last) {
+            continue;
+        }
+        for v in probe_values(leaf.value) {
+            if expected::<T>(&leaf.key, v).is_err() {
+                cases.push((leaf.path.clone(), v));
+            }
+        }
+    }
+    cases
 }
 
 /// `msg` with the numeric leaf at `path` (e.g. `points[1].x`) set to `value`.
