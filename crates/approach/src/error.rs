@@ -229,9 +229,35 @@ pub enum ApproachError {
         /// The tolerance it exceeds.
         tolerance: f64,
     },
+    /// One move of a framed process failed ([`crate::frame`]).
+    #[error("{stage}: {source}")]
+    InStage {
+        /// The move.
+        stage: crate::Stage,
+        /// Why.
+        source: Box<ApproachError>,
+    },
 }
 
 /// The violations of the moves via safe poses, for [`ApproachError::NoApproach`].
+impl ApproachError {
+    /// This error, as the failure of `stage` of a framed process.
+    pub fn in_stage(self, stage: crate::Stage) -> Self {
+        ApproachError::InStage {
+            stage,
+            source: Box::new(self),
+        }
+    }
+
+    /// The innermost error (under every [`ApproachError::InStage`]).
+    pub fn root(&self) -> &ApproachError {
+        match self {
+            ApproachError::InStage { source, .. } => source.root(),
+            e => e,
+        }
+    }
+}
+
 fn via_list(via: &[Violation]) -> String {
     if via.is_empty() {
         return "; no safe pose configured".into();

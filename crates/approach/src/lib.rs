@@ -26,6 +26,7 @@
 //! | [`planner`] | [`ApproachPlanner::approach`]: direct, else via a safe pose, else error |
 //! | [`retract`] | [`ApproachPlanner::retract`], [`tool_axis_target`] |
 //! | [`stitch`] | [`Stitched`]: approach + process + retract as one [`Timeline`] |
+//! | [`frame`] | [`frame()`]: approach, lead-in, process, lead-out, retract for one plan ([`Surroundings`]) |
 //! | [`role`], [`route`] | labels of configurations and moves in errors |
 //! | [`error`] | [`ApproachError`] |
 //!
@@ -60,6 +61,7 @@
 pub mod advance;
 pub mod clearance;
 pub mod error;
+pub mod frame;
 pub mod joint_move;
 pub mod limits;
 pub mod planner;
@@ -75,6 +77,7 @@ pub mod waypoints;
 pub use advance::{ClearanceCheck, Verdict};
 pub use clearance::{Clearance, ClosestSample, Violation, ViolationKind};
 pub use error::ApproachError;
+pub use frame::{frame, FrameSettings, FrameSettingsBuilder, Framed, Stage, Surroundings};
 pub use joint_move::JointMove;
 pub use limits::JointLimit;
 pub use planner::{ApproachPlanner, CheckedMove};
