@@ -137,8 +137,22 @@ pub struct CutRequest {
     pub orientation_corridor: String,
     /// Time budget of the plan (s): 0 = the node's `plan_timeout`; else in (0, plan_timeout].
     pub time_budget: f64,
+    /// Where the trajectory starts: `""` (current when the node has a joint state, else
+    /// none), `"current"`, `"given"` or `"none"` (issue 27).
+    pub start: String,
+    /// The start configuration with `start = "given"` (the trajectory's joint order).
+    pub start_positions: Vec<f64>,
 }
 impl_ros_type!(CutRequest, "kerf_msgs", msg, "CutRequest");
+
+impl CutRequest {
+    /// `start`: the robot's latest joint state.
+    pub const START_CURRENT: &'static str = "current";
+    /// `start`: the request's `start_positions`.
+    pub const START_GIVEN: &'static str = "given";
+    /// `start`: the process's first point (no approach, no retract).
+    pub const START_NONE: &'static str = "none";
+}
 
 /// `kerf_msgs/msg/CutRto`: one representative tool orientation of a [`CutPlan`].
 #[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
@@ -292,6 +306,8 @@ pub struct CutPlan {
     pub time_total: f64,
     /// The time-optimal feed (s).
     pub time_feed: f64,
+    /// Where the trajectory starts and its approach, process and retract stretches.
+    pub stretches: PlanStretches,
 }
 impl_ros_type!(CutPlan, "kerf_msgs", msg, "CutPlan");
 
@@ -331,6 +347,9 @@ impl CutPlan {
     pub const QUEUE_FULL: u8 = 9;
     /// The plan would need more memory than the node's `plan_memory` allows.
     pub const RESOURCE_LIMIT: u8 = 10;
+    /// No collision-free approach or retract exists (or the start is too close to an
+    /// obstacle); no trajectory is sent.
+    pub const NO_APPROACH: u8 = 11;
 
     /// Name of a status value (`"SUCCESS"` …), or `None` for an unknown value.
     pub fn status_name(status: u8) -> Option<&'static str> {
@@ -346,6 +365,7 @@ impl CutPlan {
             Self::TIMEOUT => Some("TIMEOUT"),
             Self::QUEUE_FULL => Some("QUEUE_FULL"),
             Self::RESOURCE_LIMIT => Some("RESOURCE_LIMIT"),
+            Self::NO_APPROACH => Some("NO_APPROACH"),
             _ => None,
         }
     }
@@ -428,8 +448,22 @@ pub struct MillRequest {
     /// Smallest condition indicator 1/K allowed along the executed trajectory, in [0, 1);
     /// 0 = no minimum.
     pub min_condition_indicator: f64,
+    /// Where the trajectory starts: `""` (current when the node has a joint state, else
+    /// none), `"current"`, `"given"` or `"none"` (issue 27).
+    pub start: String,
+    /// The start configuration with `start = "given"` (the trajectory's joint order).
+    pub start_positions: Vec<f64>,
 }
 impl_ros_type!(MillRequest, "kerf_msgs", msg, "MillRequest");
+
+impl MillRequest {
+    /// `start`: the robot's latest joint state.
+    pub const START_CURRENT: &'static str = "current";
+    /// `start`: the request's `start_positions`.
+    pub const START_GIVEN: &'static str = "given";
+    /// `start`: the process's first point (no approach, no retract).
+    pub const START_NONE: &'static str = "none";
+}
 
 impl MillRequest {
     /// DDPG actor of seed 004 Algorithm 1, optimizing Ω, f and g.
@@ -508,6 +542,8 @@ pub struct MillPlan {
     pub min_condition_indicator_path: f64,
     /// Arc length where it is (m).
     pub min_condition_arc_length: f64,
+    /// Where the trajectory starts and its approach, process and retract stretches.
+    pub stretches: PlanStretches,
 }
 impl_ros_type!(MillPlan, "kerf_msgs", msg, "MillPlan");
 
@@ -532,6 +568,9 @@ impl MillPlan {
     pub const ILL_CONDITIONED: u8 = 8;
     /// The plan would need more memory than the node's `plan_memory` allows.
     pub const RESOURCE_LIMIT: u8 = 9;
+    /// No collision-free approach or retract exists (or the start is too close to an
+    /// obstacle); no trajectory is sent.
+    pub const NO_APPROACH: u8 = 10;
 
     /// Name of a status value (`"SUCCESS"` …), or `None` for an unknown value.
     pub fn status_name(status: u8) -> Option<&'static str> {
@@ -546,6 +585,7 @@ impl MillPlan {
             Self::TIMEOUT => Some("TIMEOUT"),
             Self::ILL_CONDITIONED => Some("ILL_CONDITIONED"),
             Self::RESOURCE_LIMIT => Some("RESOURCE_LIMIT"),
+            Self::NO_APPROACH => Some("NO_APPROACH"),
             _ => None,
         }
     }
@@ -597,8 +637,22 @@ pub struct GcodeRequest {
     pub standoff_axis: f64,
     /// Time budget of the plan (s): 0 = the node's `plan_timeout`.
     pub time_budget: f64,
+    /// Where the trajectory starts: `""` (current when the node has a joint state, else
+    /// none), `"current"`, `"given"` or `"none"` (issue 27).
+    pub start: String,
+    /// The start configuration with `start = "given"` (the trajectory's joint order).
+    pub start_positions: Vec<f64>,
 }
 impl_ros_type!(GcodeRequest, "kerf_msgs", msg, "GcodeRequest");
+
+impl GcodeRequest {
+    /// `start`: the robot's latest joint state.
+    pub const START_CURRENT: &'static str = "current";
+    /// `start`: the request's `start_positions`.
+    pub const START_GIVEN: &'static str = "given";
+    /// `start`: the process's first point (no approach, no retract).
+    pub const START_NONE: &'static str = "none";
+}
 
 impl GcodeRequest {
     /// The laser cutter of seed 001.
@@ -695,6 +749,8 @@ pub struct GcodePlan {
     pub tool_events: Vec<GcodeToolEvent>,
     /// Warnings.
     pub warnings: Vec<String>,
+    /// Where the trajectory starts and its approach, process and retract stretches.
+    pub stretches: PlanStretches,
 }
 impl_ros_type!(GcodePlan, "kerf_msgs", msg, "GcodePlan");
 
@@ -715,6 +771,9 @@ impl GcodePlan {
     pub const TIMEOUT: u8 = 6;
     /// The plan would need more memory than the node's `plan_memory` allows.
     pub const RESOURCE_LIMIT: u8 = 7;
+    /// No collision-free approach or retract exists (or the start is too close to an
+    /// obstacle); no trajectory is sent.
+    pub const NO_APPROACH: u8 = 8;
 
     /// Name of a status value, or `None` for an unknown value.
     pub fn status_name(status: u8) -> Option<&'static str> {
@@ -727,6 +786,7 @@ impl GcodePlan {
             Self::INTERNAL_ERROR => Some("INTERNAL_ERROR"),
             Self::TIMEOUT => Some("TIMEOUT"),
             Self::RESOURCE_LIMIT => Some("RESOURCE_LIMIT"),
+            Self::NO_APPROACH => Some("NO_APPROACH"),
             _ => None,
         }
     }
@@ -749,7 +809,8 @@ mod tests {
                 "QUEUE_FULL",
                 "INTERNAL_ERROR",
                 "TIMEOUT",
-                "RESOURCE_LIMIT"
+                "RESOURCE_LIMIT",
+                "NO_APPROACH"
             ]
         );
     }
@@ -773,7 +834,8 @@ mod tests {
         assert_eq!(CutPlan::status_name(8), Some("TIMEOUT"));
         assert_eq!(CutPlan::status_name(9), Some("QUEUE_FULL"));
         assert_eq!(CutPlan::status_name(10), Some("RESOURCE_LIMIT"));
-        assert_eq!(CutPlan::status_name(11), None);
+        assert_eq!(CutPlan::status_name(11), Some("NO_APPROACH"));
+        assert_eq!(CutPlan::status_name(12), None);
     }
 
     #[test]
@@ -787,13 +849,39 @@ mod tests {
         assert_eq!(MillPlan::status_name(7), Some("TIMEOUT"));
         assert_eq!(MillPlan::status_name(8), Some("ILL_CONDITIONED"));
         assert_eq!(MillPlan::status_name(9), Some("RESOURCE_LIMIT"));
-        assert_eq!(MillPlan::status_name(10), None);
+        assert_eq!(MillPlan::status_name(10), Some("NO_APPROACH"));
+        assert_eq!(MillPlan::status_name(11), None);
         // Every name is distinct and round-trips through its code.
         let names: Vec<&str> = (0..=u8::MAX).filter_map(MillPlan::status_name).collect();
-        assert_eq!(names.len(), 10);
+        assert_eq!(names.len(), 11);
         let mut sorted = names.clone();
         sorted.sort_unstable();
         sorted.dedup();
-        assert_eq!(sorted.len(), 10);
+        assert_eq!(sorted.len(), 11);
     }
 }
+
+/// `kerf_msgs/msg/PlanStretches`: where a planned trajectory starts, and which of its stretches
+/// are approach, process and retract (issue 27).
+#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
+pub struct PlanStretches {
+    /// `"current"`, `"given"` or `"none"`; empty unless the plan succeeded.
+    pub start: String,
+    /// The configuration the trajectory starts at.
+    pub start_positions: Vec<f64>,
+    /// When the process starts (s from the trajectory's start).
+    pub process_start_time: f64,
+    /// When the process ends (s).
+    pub process_end_time: f64,
+    /// The trajectory's duration (s).
+    pub duration: f64,
+    /// `"direct"`, `"via safe pose N"`, or empty with start none.
+    pub approach_route: String,
+    /// `"tool axis"`, `"tool axis, safe pose"`, or empty with start none.
+    pub retract_route: String,
+    /// Smallest exact distance (m) over the approach and retract outside the lead moves.
+    pub min_clearance: f64,
+    /// Smallest exact distance (m) over the lead-in and lead-out, process contact left out.
+    pub min_lead_clearance: f64,
+}
+impl_ros_type!(PlanStretches, "kerf_msgs", msg, "PlanStretches");

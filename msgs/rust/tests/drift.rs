@@ -198,6 +198,7 @@ fn all_mirrors() -> Vec<Mirror> {
         msg::CutFeedLimit,
         rosgraph_msgs::Clock,
         msg::CutRequest,
+        msg::PlanStretches,
         msg::CutPlan,
         msg::CutRto,
         msg::CutMetrics,
@@ -461,6 +462,14 @@ fn rust_constants() -> ConstantTable {
             ],
         ),
         (
+            msg::CutRequest::ROS_TYPE,
+            vec![
+                c_str("START_CURRENT", msg::CutRequest::START_CURRENT),
+                c_str("START_GIVEN", msg::CutRequest::START_GIVEN),
+                c_str("START_NONE", msg::CutRequest::START_NONE),
+            ],
+        ),
+        (
             Cp::ROS_TYPE,
             vec![
                 c_u8("SUCCESS", Cp::SUCCESS),
@@ -474,6 +483,7 @@ fn rust_constants() -> ConstantTable {
                 c_u8("TIMEOUT", Cp::TIMEOUT),
                 c_u8("QUEUE_FULL", Cp::QUEUE_FULL),
                 c_u8("RESOURCE_LIMIT", Cp::RESOURCE_LIMIT),
+                c_u8("NO_APPROACH", Cp::NO_APPROACH),
             ],
         ),
         (
@@ -485,6 +495,9 @@ fn rust_constants() -> ConstantTable {
                 c_str("PLANNER_NAIVE", Mr::PLANNER_NAIVE),
                 c_str("PLANNER_GREEDY", Mr::PLANNER_GREEDY),
                 c_str("PLANNER_GREEDY_BEST_G", Mr::PLANNER_GREEDY_BEST_G),
+                c_str("START_CURRENT", Mr::START_CURRENT),
+                c_str("START_GIVEN", Mr::START_GIVEN),
+                c_str("START_NONE", Mr::START_NONE),
             ],
         ),
         (
@@ -500,6 +513,7 @@ fn rust_constants() -> ConstantTable {
                 c_u8("TIMEOUT", Mp::TIMEOUT),
                 c_u8("ILL_CONDITIONED", Mp::ILL_CONDITIONED),
                 c_u8("RESOURCE_LIMIT", Mp::RESOURCE_LIMIT),
+                c_u8("NO_APPROACH", Mp::NO_APPROACH),
             ],
         ),
         (
@@ -514,6 +528,9 @@ fn rust_constants() -> ConstantTable {
                 c_str("METHOD_NURBS", Gr::METHOD_NURBS),
                 c_str("FEED_NEAR_OPTIMAL", Gr::FEED_NEAR_OPTIMAL),
                 c_str("FEED_CONSTANT_INTERVALS", Gr::FEED_CONSTANT_INTERVALS),
+                c_str("START_CURRENT", Gr::START_CURRENT),
+                c_str("START_GIVEN", Gr::START_GIVEN),
+                c_str("START_NONE", Gr::START_NONE),
             ],
         ),
         (
@@ -527,6 +544,7 @@ fn rust_constants() -> ConstantTable {
                 c_u8("INTERNAL_ERROR", Gp::INTERNAL_ERROR),
                 c_u8("TIMEOUT", Gp::TIMEOUT),
                 c_u8("RESOURCE_LIMIT", Gp::RESOURCE_LIMIT),
+                c_u8("NO_APPROACH", Gp::NO_APPROACH),
             ],
         ),
     ]
@@ -622,7 +640,7 @@ fn every_mirror_matches_its_interface_file() {
         "mirror drift:\n{}",
         problems.join("\n")
     );
-    assert_eq!(mirrors.len(), 42, "every mirror is checked");
+    assert_eq!(mirrors.len(), 43, "every mirror is checked");
 }
 
 #[test]
@@ -947,5 +965,5 @@ fn rust_parser_agrees_with_rosidl() {
             mine["file"]
         );
     }
-    assert_eq!(ours.len(), 39, "every interface file is compared");
+    assert_eq!(ours.len(), 40, "every interface file is compared");
 }

@@ -79,6 +79,8 @@ pub const RULES: &[Rule] = &[
         .or(&[(0.0, "default 0.00015 m")])
         .divides(),
     Rule::closed("time_budget", 1e-6, MAX_TIME_BUDGET, "s").or(&[(0.0, "the node's plan_timeout")]),
+    // Joint positions; each is checked against its joint's limits when the start is resolved.
+    Rule::closed("start_positions[]", -1000.0, 1000.0, "rad or m"),
 ];
 
 /// Largest time budget of a request (s): `kerf_budget::MAX_BUDGET_SECONDS`, one day (kerf_msgs

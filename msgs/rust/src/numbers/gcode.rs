@@ -43,6 +43,8 @@ pub const RULES: &[Rule] = &[
     Rule::closed("redundancy_angle", -PI, PI, "rad").when("has_placement"),
     Rule::closed("standoff_axis", -0.1, 0.02, "m").when("has_placement"),
     Rule::closed("time_budget", 1e-6, MAX_TIME_BUDGET, "s").or(&[(0.0, "the node's plan_timeout")]),
+    // Joint positions; each is checked against its joint's limits when the start is resolved.
+    Rule::closed("start_positions[]", -1000.0, 1000.0, "rad or m"),
 ];
 
 declare_rules!(

@@ -82,6 +82,8 @@ pub const RULES: &[Rule] = &[
     .when("has_initial_state"),
     Rule::closed("initial_g", -PI, PI, "rad").when("has_initial_state"),
     Rule::closed("time_budget", 1e-6, MAX_TIME_BUDGET, "s").or(&[(0.0, "the node's plan_timeout")]),
+    // Joint positions; each is checked against its joint's limits when the start is resolved.
+    Rule::closed("start_positions[]", -1000.0, 1000.0, "rad or m"),
     Rule::closed("path_tolerance", 1e-9, 1e-3, "m")
         .divides()
         .when("has_tolerances"),

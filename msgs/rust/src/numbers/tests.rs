@@ -57,6 +57,8 @@ fn cut() -> CutRequest {
         clearance: 0.001,
         cl_tolerance: 1.5e-4,
         time_budget: 10.0,
+        start: "given".into(),
+        start_positions: vec![0.8, 0.7, 1.5, 0.0, 0.0, -0.05],
         ..Default::default()
     }
 }
@@ -91,6 +93,8 @@ fn mill() -> MillRequest {
         has_tolerances: true,
         path_tolerance: 5e-5,
         min_condition_indicator: 0.01,
+        start: "given".into(),
+        start_positions: vec![0.0; 6],
         ..Default::default()
     }
 }
@@ -113,6 +117,8 @@ fn gcode() -> GcodeRequest {
         redundancy_angle: 0.1,
         standoff_axis: -0.08,
         time_budget: 10.0,
+        start: "given".into(),
+        start_positions: vec![0.8, 0.7, 1.5, 0.0, 0.0, -0.05],
         ..Default::default()
     }
 }
