@@ -93,6 +93,22 @@ pub struct FrameSettings {
     retract_safe_pose: Option<Vec<f64>>,
 }
 
+impl Default for FrameSettings {
+    /// The defaults of [`FrameSettings::builder`].
+    fn default() -> Self {
+        Self {
+            clearance: DEFAULT_CLEARANCE,
+            control_period: crate::settings::DEFAULT_CONTROL_PERIOD,
+            safe_poses: Vec::new(),
+            max_duration: crate::settings::DEFAULT_MAX_DURATION,
+            lead_distance: DEFAULT_LEAD_DISTANCE,
+            lead_clearance: DEFAULT_LEAD_CLEARANCE,
+            retract_distance: DEFAULT_RETRACT_DISTANCE,
+            retract_safe_pose: None,
+        }
+    }
+}
+
 impl FrameSettings {
     /// A builder with the defaults ([`DEFAULT_CLEARANCE`], [`DEFAULT_LEAD_DISTANCE`],
     /// [`DEFAULT_LEAD_CLEARANCE`], [`DEFAULT_RETRACT_DISTANCE`], the approach crate's control

@@ -26,6 +26,7 @@
 //! | [`planner`] | [`ApproachPlanner::approach`]: direct, else via a safe pose, else error |
 //! | [`retract`] | [`ApproachPlanner::retract`], [`tool_axis_target`] |
 //! | [`stitch`] | [`Stitched`]: approach + process + retract as one [`Timeline`] |
+//! | [`start`] | [`StartSpec`]: current, given, none, or the default |
 //! | [`frame`] | [`frame()`]: approach, lead-in, process, lead-out, retract for one plan ([`Surroundings`]) |
 //! | [`role`], [`route`] | labels of configurations and moves in errors |
 //! | [`error`] | [`ApproachError`] |
@@ -71,6 +72,7 @@ pub mod role;
 pub mod route;
 pub mod sample;
 pub mod settings;
+pub mod start;
 pub mod stitch;
 pub mod waypoints;
 
@@ -86,5 +88,6 @@ pub use role::Role;
 pub use route::Route;
 pub use sample::Sample;
 pub use settings::{ApproachSettings, ApproachSettingsBuilder};
+pub use start::StartSpec;
 pub use stitch::{Boundary, Stitched, Timeline};
 pub use waypoints::{WaypointMove, MAX_SAMPLES};

@@ -293,6 +293,11 @@ pub struct GcodeRequest {
     /// The plan's time budget \[s\]; none = the node's.
     #[serde(default)]
     pub time_budget: Option<f64>,
+    /// Where the trajectory starts (issue 27): `current`, `none`, or a list of joint
+    /// positions; left out = current when the planner node has the robot's joint state, else
+    /// none. Resolved and framed by the planner-node harness, not by the planner.
+    #[serde(default, skip_serializing_if = "kerf_approach::StartSpec::is_default")]
+    pub start: kerf_approach::StartSpec,
 }
 
 /// Where the program comes from.

@@ -276,6 +276,11 @@ pub struct MillRequest {
     /// Tolerances of the executed plan (the planner's when absent).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub tolerances: Option<RequestTolerances>,
+    /// Where the trajectory starts (issue 27): `current`, `none`, or a list of joint
+    /// positions; left out = current when the planner node has the robot's joint state, else
+    /// none. Resolved and framed by the planner-node harness, not by the planner.
+    #[serde(default, skip_serializing_if = "kerf_approach::StartSpec::is_default")]
+    pub start: kerf_approach::StartSpec,
 }
 
 fn default_planner() -> String {
@@ -286,7 +291,7 @@ impl Default for MillRequest {
     /// The seed 004 path (the default cell's points), no overrides, planner
     /// `ddpg`.
     fn default() -> Self {
-        Self {
+        Self { start: Default::default(),
             request_id: String::new(),
             points: PathSpec::default().points,
             segments: None,

@@ -188,6 +188,8 @@ pub mod status {
     pub const QUEUE_FULL: u8 = 9;
     /// The plan would need more memory than its budget allows.
     pub const RESOURCE_LIMIT: u8 = 10;
+    /// No collision-free approach or retract (answered by the node's harness, issue 27).
+    pub const NO_APPROACH: u8 = 11;
 }
 
 impl PlanError {

@@ -357,6 +357,11 @@ pub struct CutRequest {
     /// A plan that runs out of it ends with [`PlanError::Interrupted`] (status TIMEOUT).
     #[serde(default, skip_serializing_if = "is_zero")]
     pub time_budget: f64,
+    /// Where the trajectory starts (issue 27): `current`, `none`, or a list of joint
+    /// positions; left out = current when the planner node has the robot's joint state, else
+    /// none. Resolved and framed by the planner-node harness, not by the planner.
+    #[serde(default, skip_serializing_if = "kerf_approach::StartSpec::is_default")]
+    pub start: kerf_approach::StartSpec,
 }
 
 fn is_default_rto_constraint(v: &RtoConstraint) -> bool {

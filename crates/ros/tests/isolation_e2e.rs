@@ -123,6 +123,23 @@ impl PlanningService for Misbehaving {
     fn joint_limits(&self) -> &[JointLimits] {
         &[]
     }
+    fn start_of(&self, _: &String) -> kerf_approach::StartSpec {
+        // Plans without a robot: never framed.
+        kerf_approach::StartSpec::None
+    }
+    fn approach_limits(&self) -> &[kerf_approach::JointLimit] {
+        &[]
+    }
+    fn surroundings(
+        &self,
+        request: &String,
+    ) -> Result<Box<dyn kerf_approach::Surroundings>, Box<GcodePlan>> {
+        Err(Box::new(answer(
+            request,
+            GcodePlan::INVALID_REQUEST,
+            "this service has no robot".into(),
+        )))
+    }
     fn startup_note(&self) -> String {
         "misbehaving on purpose".into()
     }

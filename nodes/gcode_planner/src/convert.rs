@@ -141,6 +141,12 @@ pub fn request_from_msg(m: &msg::GcodeRequest) -> Result<GcodeRequest, GcodePlan
         standoff_axis: (m.has_placement && m.machine != msg::GcodeRequest::MACHINE_IRB6660)
             .then_some(m.standoff_axis),
         time_budget: given(m.time_budget),
+        start: kerf_approach::StartSpec::from_fields(&m.start, &m.start_positions).map_err(
+            |reason| GcodePlanError::InvalidRequest {
+                field: "start".to_string(),
+                reason,
+            },
+        )?,
     })
 }
 

@@ -194,6 +194,11 @@ pub fn request_from_msg(m: &msg::MillRequest) -> Result<MillRequest, MillPlanErr
         g: Some(m.initial_g),
     });
     Ok(MillRequest {
+        start: kerf_approach::StartSpec::from_fields(&m.start, &m.start_positions)
+            .map_err(|reason| MillPlanError::InvalidConfig {
+                name: "start".into(),
+                reason,
+            })?,
         request_id: m.request_id.clone(),
         points: m.points.iter().map(|p| [p.x, p.y, p.z]).collect(),
         segments: (m.segments != 0).then(|| usize::try_from(m.segments).unwrap_or(usize::MAX)),

@@ -126,6 +126,8 @@ pub fn request_from_msg(m: &msg::CutRequest) -> Result<CutRequest, PlanError> {
     };
     let p = &m.workpiece_pose.position;
     Ok(CutRequest {
+        start: kerf_approach::StartSpec::from_fields(&m.start, &m.start_positions)
+            .map_err(|reason| PlanError::invalid("start", reason))?,
         request_id: m.request_id.clone(),
         points: m.points.iter().map(|p| [p.x, p.y, p.z]).collect(),
         axes: m.axes.iter().map(|a| [a.x, a.y, a.z]).collect(),
@@ -331,6 +333,8 @@ pub fn plan_to_msg(plan: &kerf_mjto::CutPlan) -> msg::CutPlan {
         time_evaluation: t.evaluation,
         time_total: t.total,
         time_feed: t.feed,
+        // Filled by the planner-node harness (start, approach, retract).
+        stretches: msg::PlanStretches::default(),
     }
 }
 

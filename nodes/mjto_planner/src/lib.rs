@@ -32,6 +32,7 @@
 
 pub mod config;
 pub mod convert;
+pub mod surroundings;
 pub mod text;
 
 use std::sync::Mutex;
@@ -87,6 +88,7 @@ pub struct CutService {
     planner: Mutex<Planner>,
     machine: LaserMachine,
     limits: Vec<JointLimits>,
+    approach_limits: Vec<kerf_approach::JointLimit>,
     machine_source: String,
     allowed_roots: AllowedRoots,
 }
@@ -101,8 +103,10 @@ impl CutService {
             .robot()
             .executor_limits()
             .map_err(|e| PlanError::invalid("machine", e.to_string()))?;
+        let names: Vec<String> = limits.iter().map(|l| l.name.clone()).collect();
         Ok(Self {
             planner: Mutex::new(Planner::new(machine.clone())?),
+            approach_limits: surroundings::approach_limits(&machine, &names),
             machine,
             limits,
             machine_source: source,
@@ -216,13 +220,16 @@ impl PlanningService for CutService {
         }
     }
 
-    /// Unreadable samples, bad numbers and budgets over `plan_timeout` are INVALID_REQUEST;
-    /// busy is QUEUE_FULL; stopped, panicked and not executable are INTERNAL_ERROR.
+    /// Unreadable samples, bad numbers, unusable starts and budgets over `plan_timeout` are
+    /// INVALID_REQUEST; no approach is NO_APPROACH; busy is QUEUE_FULL; stopped, panicked and not executable are INTERNAL_ERROR.
     fn failure(&self, key: &AnswerKey, failure: Failure, message: String) -> CutPlan {
         let code = match failure {
-            Failure::Unreadable | Failure::OverBudget | Failure::TooLarge | Failure::BadNumber => {
-                status::INVALID_REQUEST
-            }
+            Failure::Unreadable
+            | Failure::OverBudget
+            | Failure::TooLarge
+            | Failure::BadNumber
+            | Failure::BadStart => status::INVALID_REQUEST,
+            Failure::NoApproach => status::NO_APPROACH,
             Failure::Busy => status::QUEUE_FULL,
             Failure::Timeout => status::TIMEOUT,
             Failure::ResourceLimit => status::RESOURCE_LIMIT,
@@ -233,6 +240,23 @@ impl PlanningService for CutService {
 
     fn joint_limits(&self) -> &[JointLimits] {
         &self.limits
+    }
+
+    fn start_of(&self, request: &CutRequest) -> kerf_approach::StartSpec {
+        request.start.clone()
+    }
+
+    fn approach_limits(&self) -> &[kerf_approach::JointLimit] {
+        &self.approach_limits
+    }
+
+    fn surroundings(
+        &self,
+        request: &CutRequest,
+    ) -> Result<Box<dyn kerf_approach::Surroundings>, Box<CutPlan>> {
+        surroundings::LaserSurroundings::new(&self.machine, self.approach_limits.clone(), request)
+            .map(|s| Box::new(s) as Box<dyn kerf_approach::Surroundings>)
+            .map_err(|e| Box::new(convert::error_to_msg(&request.request_id, &e)))
     }
 
     fn startup_note(&self) -> String {

@@ -2,14 +2,14 @@
 //! live in other crates than the planner nodes).
 
 use kerf_msgs::{
-    msg::{CutPlan, GcodePlan, MillPlan},
+    msg::{CutPlan, GcodePlan, MillPlan, PlanStretches},
     trajectory_msgs::JointTrajectory,
 };
 
 use super::{AnswerKey, PlanAnswer};
 
 /// Implements [`PlanAnswer`] for a message with `request_id`, `status`, `message`,
-/// `trajectory`, the `SUCCESS` constant and `status_name`; `$label` gives the key's label.
+/// `trajectory`, `stretches`, the `SUCCESS` constant and `status_name`; `$label` gives the key's label.
 macro_rules! plan_answer {
     ($msg:ty, |$m:ident| $label:expr) => {
         impl PlanAnswer for $msg {
@@ -37,6 +37,12 @@ macro_rules! plan_answer {
             }
             fn trajectory(&self) -> &JointTrajectory {
                 &self.trajectory
+            }
+            fn set_trajectory(&mut self, trajectory: JointTrajectory) {
+                self.trajectory = trajectory;
+            }
+            fn set_stretches(&mut self, stretches: PlanStretches) {
+                self.stretches = stretches;
             }
         }
     };

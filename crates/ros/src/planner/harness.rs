@@ -5,13 +5,15 @@ use std::{collections::VecDeque, fmt::Display, sync::Arc, time::Duration};
 
 use kerf_isolate::{Outcome, Supervisor, SupervisorSettings};
 use kerf_msgs::{
-    numbers::NumberFields, std_msgs::StringMsg, trajectory_msgs::JointTrajectory, RosType,
+    numbers::NumberFields, sensor_msgs::JointState, std_msgs::StringMsg,
+    trajectory_msgs::JointTrajectory, RosType,
 };
 use ros2_client::Publisher;
 
 use super::{
     check_answer, check_text_size, leading_request_id,
-    work::{HarnessWork, RawRequest},
+    start::{CurrentState, JOINT_STATES_TOPIC},
+    work::{HarnessWork, PlanJob, RawRequest},
     AnswerKey, Failure, HarnessSettings, PlanAnswer, PlanningService, HARNESS_PARAMS,
     TRAJECTORY_TOPIC,
 };
@@ -151,6 +153,13 @@ struct PlannerNode<S: PlanningService> {
     plans: Publisher<S::Answer>,
     plan_texts: Publisher<StringMsg>,
     trajectories: Publisher<JointTrajectory>,
+    /// The robot's joint state (the trajectory executor's `joint_states`), for plans that
+    /// start where the robot is.
+    joint_states: Inbox<JointState>,
+    /// The latest joint state and when it arrived.
+    current: Option<(JointState, std::time::Instant)>,
+    /// `joint_states` resolved, for messages.
+    joint_states_topic: String,
     supervisor: Supervisor<HarnessWork<S>>,
     service: Arc<S>,
     /// Requests and answers in arrival order, behind the running job.
@@ -181,11 +190,32 @@ impl<S: PlanningService> PlannerNode<S> {
         // Volatile: a late (restarted) executor must never receive an old plan.
         let trajectories =
             node.publisher(TRAJECTORY_TOPIC, JointTrajectory::ROS_TYPE, qos::commands())?;
+        let joint_states = node.inbox(JOINT_STATES_TOPIC, JointState::ROS_TYPE, qos::state())?;
+        let joint_states_topic = node.resolve(JOINT_STATES_TOPIC)?;
         let log = node.logger();
+        settings
+            .framing
+            .check_reach(service.approach_limits())
+            .map_err(|e| RosError::Param {
+                name: match e {
+                    kerf_approach::ApproachError::OutOfLimits {
+                        role: kerf_approach::Role::RetractTarget(_),
+                        ..
+                    } => "retract.safe_pose".into(),
+                    kerf_approach::ApproachError::JointCount { .. }
+                    | kerf_approach::ApproachError::OutOfLimits { .. }
+                    | kerf_approach::ApproachError::NonFinitePosition { .. } => {
+                        "approach.safe_pose / retract.safe_pose".into()
+                    }
+                    _ => "approach".into(),
+                },
+                reason: format!("{e} (the robot cannot reach it)"),
+            })?;
         let service = Arc::new(service);
         let mut supervisor = Supervisor::new(
             Arc::new(HarnessWork {
                 service: Arc::clone(&service),
+                framing: settings.framing.clone(),
             }),
             SupervisorSettings::new(settings.plan_memory),
         );
@@ -214,6 +244,9 @@ impl<S: PlanningService> PlannerNode<S> {
             plans,
             plan_texts,
             trajectories,
+            joint_states,
+            current: None,
+            joint_states_topic,
             supervisor,
             service,
             queue: VecDeque::new(),
@@ -235,6 +268,7 @@ impl<S: PlanningService> PlannerNode<S> {
 
     fn spin(&mut self) {
         while !self.node.should_stop() {
+            self.poll_joint_states();
             let mut busy = self.poll_requests();
             busy |= self.poll_text_requests();
             busy |= self.advance();
@@ -244,6 +278,30 @@ impl<S: PlanningService> PlannerNode<S> {
             }
         }
         self.shut_down();
+    }
+
+    /// Keeps the latest joint state of the robot (an unreadable sample is logged and left out).
+    fn poll_joint_states(&mut self) {
+        while let Some(sample) = self.joint_states.try_recv() {
+            match sample {
+                Ok(state) => self.current = Some((state, std::time::Instant::now())),
+                Err(e) => self.log.warn(&format!(
+                    "unreadable joint state on {}: {e}",
+                    self.joint_states_topic
+                )),
+            }
+        }
+    }
+
+    /// The robot's latest joint state as the worker takes it.
+    fn current_state(&self) -> Option<CurrentState> {
+        self.current.as_ref().map(|(state, at)| CurrentState {
+            names: state.name.clone(),
+            positions: state.position.clone(),
+            velocities: state.velocity.clone(),
+            age: at.elapsed().as_secs_f64(),
+            topic: self.joint_states_topic.clone(),
+        })
     }
 
     /// Returns freed memory to the system when nothing is pending, answers were published since
@@ -567,7 +625,14 @@ impl<S: PlanningService> PlannerNode<S> {
                 Queued::Plan { key, raw, limit } => {
                     let id = self.next_id;
                     self.next_id += 1;
-                    match self.supervisor.submit(id, &raw, limit) {
+                    // The robot's state when its plan begins: a request queued behind others
+                    // starts where the robot is then.
+                    self.poll_joint_states();
+                    let job = PlanJob {
+                        raw,
+                        current: self.current_state(),
+                    };
+                    match self.supervisor.submit(id, &job, limit) {
                         Ok(()) => self.running = Some(Running { id, key }),
                         Err(e) => {
                             let answer = self.service.failure(

@@ -41,10 +41,12 @@
 mod answers;
 mod error;
 mod executable;
+pub mod framing;
 mod harness;
 mod main;
 mod service;
 mod size;
+pub mod start;
 mod text;
 mod work;
 
@@ -61,7 +63,7 @@ pub use text::{
     check_text_size, leading_request_id, yaml_field, TextRequestError, LEADING_BYTES,
     MAX_TEXT_REQUEST_BYTES,
 };
-pub use work::{plan_checked, work, HarnessWork, Job, RawRequest};
+pub use work::{plan_checked, work, HarnessWork, Job, PlanJob, RawRequest};
 
 use crate::{Params, RosError};
 
@@ -93,10 +95,21 @@ pub fn allowed_roots(params: &Params) -> Result<kerf_robot::roots::AllowedRoots,
 }
 
 /// The parameters the harness reads (every planner node lists them among its known ones).
-pub const HARNESS_PARAMS: &[&str] = &["queue_depth", "plan_timeout", "plan_memory"];
+pub const HARNESS_PARAMS: &[&str] = &[
+    "queue_depth",
+    "plan_timeout",
+    "plan_memory",
+    "approach.clearance",
+    "approach.lead_distance",
+    "approach.lead_clearance",
+    "approach.safe_pose",
+    "approach.control_period",
+    "retract.distance",
+    "retract.safe_pose",
+];
 
 /// The harness's settings, from the node's parameters ([`HarnessSettings::from_params`]).
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, PartialEq)]
 pub struct HarnessSettings {
     /// Requests waiting or being planned before new ones are answered [`Failure::Busy`] (≥ 1).
     pub queue_depth: usize,
@@ -105,6 +118,8 @@ pub struct HarnessSettings {
     /// The memory budget of every plan (bytes): the planner's estimates are checked against
     /// it, and the worker process running the plan is stopped when its memory grows by more.
     pub plan_memory: u64,
+    /// How a plan with a start is framed by its approach and retract (issue 27).
+    pub framing: kerf_approach::FrameSettings,
 }
 
 impl Default for HarnessSettings {
@@ -113,6 +128,7 @@ impl Default for HarnessSettings {
             queue_depth: DEFAULT_QUEUE_DEPTH,
             plan_timeout: std::time::Duration::from_secs_f64(DEFAULT_PLAN_TIMEOUT),
             plan_memory: kerf_budget::DEFAULT_PLAN_MEMORY,
+            framing: kerf_approach::FrameSettings::default(),
         }
     }
 }
@@ -121,7 +137,8 @@ impl HarnessSettings {
     /// Reads `queue_depth` ([`queue_depth`]), `plan_timeout` (seconds, a number in
     /// (0, [`kerf_budget::MAX_BUDGET_SECONDS`]], default [`DEFAULT_PLAN_TIMEOUT`]) and
     /// `plan_memory` (bytes, an integer in [[`kerf_budget::MIN_PLAN_MEMORY`],
-    /// [`kerf_budget::MAX_PLAN_MEMORY`]], default [`kerf_budget::DEFAULT_PLAN_MEMORY`], 1 GiB).
+    /// [`kerf_budget::MAX_PLAN_MEMORY`]], default [`kerf_budget::DEFAULT_PLAN_MEMORY`], 1 GiB),
+    /// and the framing of plans with a start ([`framing_from_params`]).
     ///
     /// # Errors
     /// [`RosError::Param`] naming the parameter for a wrong type or a value out of range.
@@ -153,8 +170,72 @@ impl HarnessSettings {
             queue_depth,
             plan_timeout,
             plan_memory,
+            framing: framing_from_params(params)?,
         })
     }
+}
+
+/// Reads how plans with a start are framed (issue 27): `approach.clearance` (m, default
+/// 0.01), `approach.lead_distance` (m along the tool axis, default 0.03),
+/// `approach.lead_clearance` (m, default 0.0005), `approach.safe_pose` (one position per
+/// joint: the approach passes through it when the direct move is not clear; default none),
+/// `approach.control_period` (s, default 0.004: the executor's), `retract.distance` (m along
+/// the tool axis, default 0.05), `retract.safe_pose` (the retract ends there; default none).
+/// Each number must be finite and > 0. The safe poses are checked against the robot's limits
+/// when the node starts.
+///
+/// # Errors
+/// [`RosError::Param`] naming the parameter.
+pub fn framing_from_params(params: &Params) -> Result<kerf_approach::FrameSettings, RosError> {
+    use kerf_approach::FrameSettings as F;
+    let number = |name: &str, default: f64| params.f64_or(name, default);
+    let b = F::builder()
+        .clearance(number(
+            "approach.clearance",
+            kerf_approach::frame::DEFAULT_CLEARANCE,
+        )?)
+        .lead_distance(number(
+            "approach.lead_distance",
+            kerf_approach::frame::DEFAULT_LEAD_DISTANCE,
+        )?)
+        .lead_clearance(number(
+            "approach.lead_clearance",
+            kerf_approach::frame::DEFAULT_LEAD_CLEARANCE,
+        )?)
+        .control_period(number(
+            "approach.control_period",
+            kerf_approach::settings::DEFAULT_CONTROL_PERIOD,
+        )?)
+        .retract_distance(number(
+            "retract.distance",
+            kerf_approach::frame::DEFAULT_RETRACT_DISTANCE,
+        )?)
+        .safe_poses(
+            params
+                .f64_array("approach.safe_pose")?
+                .into_iter()
+                .collect(),
+        )
+        .retract_safe_pose(params.f64_array("retract.safe_pose")?);
+    b.build().map_err(|e| {
+        let name = match &e {
+            kerf_approach::ApproachError::InvalidSetting { field, .. } => match field.as_str() {
+                "clearance" => "approach.clearance",
+                "lead_distance" => "approach.lead_distance",
+                "lead_clearance" => "approach.lead_clearance",
+                "control_period" => "approach.control_period",
+                "retract_distance" => "retract.distance",
+                f if f.starts_with("safe_poses") => "approach.safe_pose",
+                f if f.starts_with("retract_safe_pose") => "retract.safe_pose",
+                _ => "approach",
+            },
+            _ => "approach",
+        };
+        RosError::Param {
+            name: name.into(),
+            reason: e.to_string(),
+        }
+    })
 }
 
 /// Reads the `queue_depth` parameter (integer ≥ 1, default [`DEFAULT_QUEUE_DEPTH`]).

@@ -2,6 +2,7 @@
 
 use std::time::Duration;
 
+use kerf_approach::{JointLimit as ApproachLimit, StartSpec, Surroundings};
 use kerf_budget::Budget;
 use kerf_executor::JointLimits;
 use kerf_msgs::{numbers::NumberFields, trajectory_msgs::JointTrajectory, RosType};
@@ -83,6 +84,13 @@ pub enum Failure {
     Timeout,
     /// The plan's worker went over the node's `plan_memory` and was stopped.
     ResourceLimit,
+    /// The request's start cannot be used: `current` without a recent joint state, a state
+    /// with missing or non-finite joints, a moving robot, given positions of the wrong count
+    /// or outside the limits (issue 27). Refused like an invalid request.
+    BadStart,
+    /// No collision-free approach or retract exists, or the start is too close to an
+    /// obstacle (issue 27): the message names the stage, obstacle, time and configuration.
+    NoApproach,
 }
 
 /// An answer message (`kerf_msgs/msg/CutPlan`, `MillPlan`, …): what the harness reads of it.
@@ -101,6 +109,10 @@ pub trait PlanAnswer: RosType + Serialize + DeserializeOwned + Clone + Send + 's
     fn message(&self) -> &str;
     /// The planned trajectory (empty on failure).
     fn trajectory(&self) -> &JointTrajectory;
+    /// Replaces the trajectory (the harness frames it with approach and retract).
+    fn set_trajectory(&mut self, trajectory: JointTrajectory);
+    /// Sets where the trajectory starts and its stretches.
+    fn set_stretches(&mut self, stretches: kerf_msgs::msg::PlanStretches);
 }
 
 /// A planning service: turns requests into answers; the harness ([`super::run`]) does the
@@ -161,6 +173,26 @@ pub trait PlanningService: Send + Sync + 'static {
 
     /// The robot model the executor runs plans on: the executability check's limits.
     fn joint_limits(&self) -> &[JointLimits];
+
+    /// Where a request's trajectory starts (its `start` field; issue 27). The harness
+    /// resolves it against the robot's joint state and frames the plan with an approach and a
+    /// retract ([`super::framing`]).
+    fn start_of(&self, request: &Self::Request) -> StartSpec;
+
+    /// The robot's limits for the approach and retract moves (position, velocity,
+    /// acceleration, jerk), in the order of [`Self::joint_limits`].
+    fn approach_limits(&self) -> &[ApproachLimit];
+
+    /// The robot's surroundings for `request`: the exact distances the approach and retract
+    /// keep (the request's workpiece and the cell's objects, the process contact left out on
+    /// request) and the tool axis. Called before planning, only for a request with a start.
+    ///
+    /// # Errors
+    /// The answer to give instead (e.g. a workpiece mesh that does not load).
+    fn surroundings(
+        &self,
+        request: &Self::Request,
+    ) -> Result<Box<dyn Surroundings>, Box<Self::Answer>>;
 
     /// The service's part of the start-up log line (machine, cell, policies …).
     fn startup_note(&self) -> String;
