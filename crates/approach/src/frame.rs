@@ -299,8 +299,15 @@ fn positive(field: &str, value: f64) -> Result<f64, ApproachError> {
 pub struct Framed {
     /// Approach, process and retract samples, and the process's time marks.
     pub timeline: Timeline,
-    /// The approach's route (direct, or via safe pose `i`).
+    /// The approach's route (direct, or via safe pose `i`: the configured safe poses first,
+    /// then the points of [`AUTO_VIA_DISTANCES`] on the tool axis above the first point).
     pub approach_route: Route,
+    /// With a route via an automatic tool-axis point: its distance (m) above the first point.
+    pub auto_via: Option<f64>,
+    /// Length (m, the first three joints' displacement) of the lead-in actually used.
+    pub lead_in_distance: f64,
+    /// Length (m) of the lead-out actually used.
+    pub lead_out_distance: f64,
     /// Whether the retract ends at the retract safe pose (else at the tool-axis back-off).
     pub retract_to_safe_pose: bool,
     /// Closest configuration of the approach (full clearance).
@@ -372,23 +379,44 @@ pub fn frame(
             .max_duration(settings.max_duration)
             .build()
     };
-    let free = ApproachPlanner::new(
-        approach_settings(settings.clearance, settings.safe_poses.clone())?,
-        limits.to_vec(),
-        &full,
-    )?;
     let lead = ApproachPlanner::new(
         approach_settings(lead_clearance, Vec::new())?,
         limits.to_vec(),
         &contact,
     )?;
 
-    let pre = world
-        .back_off(&first, settings.lead_distance)
-        .map_err(in_stage(Stage::LeadIn))?;
-    let post = world
-        .back_off(&last, settings.retract_distance)
-        .map_err(in_stage(Stage::LeadOut))?;
+    // The lead-in starts, and the retract ends, where the robot keeps the full clearance: the
+    // tool-axis distance is doubled (at most LEAD_DOUBLINGS times) until it does, so that the
+    // approach can end there and the next plan can start there.
+    let pre = clear_back_off(
+        world,
+        &full,
+        &first,
+        settings.lead_distance,
+        settings.clearance,
+    )
+    .map_err(in_stage(Stage::LeadIn))?;
+    let post = clear_back_off(
+        world,
+        &full,
+        &last,
+        settings.retract_distance,
+        settings.clearance,
+    )
+    .map_err(in_stage(Stage::LeadOut))?;
+    // Via poses: the configured safe poses, then points on the tool axis farther above the
+    // first process point (the "safe pose above the part" of a cell without one configured).
+    let mut via = settings.safe_poses.clone();
+    for d in AUTO_VIA_DISTANCES {
+        if let Ok(q) = world.back_off(&first, d) {
+            via.push(q);
+        }
+    }
+    let free = ApproachPlanner::new(
+        approach_settings(settings.clearance, via)?,
+        limits.to_vec(),
+        &full,
+    )?;
     let approach = free
         .approach(start, &pre)
         .map_err(in_stage(Stage::Approach))?;
@@ -406,6 +434,11 @@ pub fn frame(
         None => None,
     };
     let approach_route = approach.route;
+    let configured = settings.safe_poses.len();
+    let auto_via = match approach.route {
+        Route::ViaSafePose(i) if i >= configured => AUTO_VIA_DISTANCES.get(i - configured).copied(),
+        _ => None,
+    };
     let approach_closest = approach.closest.clone();
     let lead_closest = closer(&lead_in.closest, &lead_out.closest).clone();
     let retract_to_safe_pose = to_safe.is_some();
@@ -420,11 +453,62 @@ pub fn frame(
     Ok(Framed {
         timeline: stitched.timeline(settings.control_period)?,
         approach_route,
+        auto_via,
+        lead_in_distance: distance_between(&pre, &first),
+        lead_out_distance: distance_between(&post, &last),
         retract_to_safe_pose,
         approach_closest,
         lead_closest,
         lead_clearance,
     })
+}
+
+/// How many times the tool-axis distance of the lead-in or lead-out is doubled, at most, to
+/// reach a configuration with the full clearance.
+pub const LEAD_DOUBLINGS: u32 = 3;
+
+/// Distances (m) along the tool axis above the first process point of the via points the
+/// approach tries after the configured safe poses.
+pub const AUTO_VIA_DISTANCES: [f64; 2] = [0.15, 0.3];
+
+/// The configuration `distance` back along the tool axis from `q`, doubled up to
+/// [`LEAD_DOUBLINGS`] times until it keeps `clearance` by `full`.
+fn clear_back_off(
+    world: &dyn Surroundings,
+    full: &dyn Fn(&[f64]) -> Clearance,
+    q: &[f64],
+    distance: f64,
+    clearance: f64,
+) -> Result<Vec<f64>, ApproachError> {
+    let mut d = distance;
+    let mut last = None;
+    for _ in 0..=LEAD_DOUBLINGS {
+        let target = world.back_off(q, d)?;
+        let c = full(&target);
+        if c.distance >= clearance {
+            return Ok(target);
+        }
+        last = Some(c);
+        d *= 2.0;
+    }
+    let c = last.unwrap_or_else(|| Clearance::new(f64::NAN, "?"));
+    Err(ApproachError::InCollision {
+        role: crate::Role::Waypoint(0),
+        obstacle: c.obstacle,
+        distance: c.distance,
+        clearance,
+    })
+}
+
+/// Euclidean distance between two configurations' first three joints (the tool translation of
+/// a gantry; a size of the move for other robots).
+fn distance_between(a: &[f64], b: &[f64]) -> f64 {
+    a.iter()
+        .zip(b)
+        .take(3)
+        .map(|(x, y)| (x - y).powi(2))
+        .sum::<f64>()
+        .sqrt()
 }
 
 fn closer<'a>(a: &'a ClosestSample, b: &'a ClosestSample) -> &'a ClosestSample {

@@ -14,6 +14,8 @@ const CLAMP: ([f64; 2], f64) = ([0.30, 0.10], 0.05);
 
 struct Gantry {
     clamp: bool,
+    /// A wall at x = 0.3 m across the whole stroke.
+    wall: bool,
 }
 
 impl Surroundings for Gantry {
@@ -21,6 +23,12 @@ impl Surroundings for Gantry {
         let mut best = Clearance::new(f64::INFINITY, "nothing");
         if !process {
             best = Clearance::new(q[1] - R, "part");
+        }
+        if self.wall {
+            let d = (q[0] - 0.3).abs() - 0.01 - R;
+            if d < best.distance {
+                best = Clearance::new(d, "wall");
+            }
         }
         if self.clamp {
             let (c, r) = CLAMP;
@@ -90,7 +98,10 @@ fn a_process_is_framed_from_the_start_to_the_tool_axis_back_off() {
         &[0.5, 0.4],
         process.clone(),
         &limits(),
-        &Gantry { clamp: false },
+        &Gantry {
+            clamp: false,
+            wall: false,
+        },
         &settings(),
     )
     .unwrap();
@@ -130,11 +141,33 @@ fn a_process_is_framed_from_the_start_to_the_tool_axis_back_off() {
 }
 
 #[test]
-fn a_blocked_direct_approach_goes_via_the_safe_pose_or_names_the_obstacle() {
-    let world = Gantry { clamp: true };
-    // From the left of the clamp, low, to the slot on its right.
+fn a_blocked_direct_approach_goes_via_a_safe_pose_or_names_the_obstacle() {
+    let world = Gantry {
+        clamp: true,
+        wall: false,
+    };
+    // From the left of the clamp, low, to the slot on its right: the direct move is blocked;
+    // without a configured safe pose, the point 0.3 m up the tool axis above the slot's start
+    // is (0.15 m is still within the clamp's reach).
     let start = [0.10, 0.10];
-    let e = frame(&start, slot(0.5, 0.7), &limits(), &world, &settings()).unwrap_err();
+    let framed = frame(&start, slot(0.5, 0.7), &limits(), &world, &settings()).unwrap();
+    assert_eq!(framed.approach_route, Route::ViaSafePose(1));
+    assert_eq!(framed.auto_via, Some(0.3));
+    assert!(framed.approach_closest.distance >= 0.01);
+    // A configured safe pose is tried first.
+    let via = FrameSettings::builder()
+        .safe_poses(vec![vec![0.3, 0.5]])
+        .build()
+        .unwrap();
+    let framed = frame(&start, slot(0.5, 0.7), &limits(), &world, &via).unwrap();
+    assert_eq!(framed.approach_route, Route::ViaSafePose(0));
+    assert_eq!(framed.auto_via, None);
+    // A wall across the stroke: no route; the error names it.
+    let walled = Gantry {
+        clamp: false,
+        wall: true,
+    };
+    let e = frame(&start, slot(0.5, 0.7), &limits(), &walled, &via).unwrap_err();
     assert!(
         matches!(
             e,
@@ -145,19 +178,54 @@ fn a_blocked_direct_approach_goes_via_the_safe_pose_or_names_the_obstacle() {
         ),
         "{e}"
     );
-    assert!(e.to_string().contains("clamp"), "{e}");
+    assert!(e.to_string().contains("wall"), "{e}");
     assert!(
         e.to_string()
             .starts_with("approach: no collision-free approach"),
         "{e}"
     );
-    let via = FrameSettings::builder()
-        .safe_poses(vec![vec![0.3, 0.5]])
+}
+
+#[test]
+fn the_lead_in_grows_until_its_start_is_clear() {
+    // The slot is 1 mm into the part; with a 4 cm clearance and a 1 cm lead distance, the
+    // lead-in's start 1, 2 and 4 cm up the axis is 9, 19 and 39 mm from the part: 8 cm
+    // (79 mm) is the first clear one.
+    let s = FrameSettings::builder()
+        .clearance(0.04)
+        .lead_distance(0.01)
         .build()
         .unwrap();
-    let framed = frame(&start, slot(0.5, 0.7), &limits(), &world, &via).unwrap();
-    assert_eq!(framed.approach_route, Route::ViaSafePose(0));
-    assert!(framed.approach_closest.distance >= 0.01);
+    let world = Gantry {
+        clamp: false,
+        wall: false,
+    };
+    let framed = frame(&[0.5, 0.4], slot(0.5, 0.7), &limits(), &world, &s).unwrap();
+    assert!(
+        (framed.lead_in_distance - 0.08).abs() < 1e-12,
+        "{}",
+        framed.lead_in_distance
+    );
+    // The retract's 5 cm end is 49 mm from the part: clear.
+    assert!((framed.lead_out_distance - 0.05).abs() < 1e-12);
+    // A lead distance that never gets clear within the doublings is refused.
+    let short = FrameSettings::builder()
+        .clearance(0.5)
+        .lead_distance(0.01)
+        .build()
+        .unwrap();
+    let e = frame(&[0.5, 0.9], slot(0.5, 0.7), &limits(), &world, &short).unwrap_err();
+    assert!(
+        matches!(
+            e,
+            ApproachError::InStage {
+                stage: Stage::LeadIn,
+                ..
+            }
+        ),
+        "{e}"
+    );
+    assert!(e.to_string().contains("part"), "{e}");
 }
 
 #[test]
@@ -166,7 +234,10 @@ fn a_start_in_the_part_and_a_safe_pose_out_of_reach_are_refused() {
         &[0.5, 0.0],
         slot(0.5, 0.7),
         &limits(),
-        &Gantry { clamp: false },
+        &Gantry {
+            clamp: false,
+            wall: false,
+        },
         &settings(),
     )
     .unwrap_err();
@@ -197,7 +268,10 @@ fn the_retract_can_end_at_a_safe_pose() {
         &[0.5, 0.4],
         slot(0.5, 0.7),
         &limits(),
-        &Gantry { clamp: false },
+        &Gantry {
+            clamp: false,
+            wall: false,
+        },
         &s,
     )
     .unwrap();

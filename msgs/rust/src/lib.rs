@@ -8,12 +8,13 @@
 //! `int32` → `i32`, `uint32` → `u32`, `uint16` → `u16`, `uint8` → `u8`,
 //! `bool` → `bool`, `T[]` → `Vec<T>`, `T[N]` → `[T; N]`, nested message →
 //! struct). The integration test `tests/drift.rs` checks every mirror against
-//! the interface files: kerf's own in `msgs/msg` and `msgs/srv`, the standard
+//! the interface files: kerf's own in `msgs/msg`, `msgs/srv` and `msgs/action`, the standard
 //! ones transcribed under `msgs/rust/interfaces/`.
 //!
 //! Module layout follows the ROS 2 packages: [`builtin_interfaces`],
 //! [`std_msgs`], [`geometry_msgs`], [`trajectory_msgs`], [`sensor_msgs`],
-//! [`control_msgs`], [`rosgraph_msgs`]; kerf's own interfaces are in [`msg`] and [`srv`].
+//! [`control_msgs`], [`rosgraph_msgs`]; kerf's own interfaces are in [`msg`], [`srv`] and
+//! [`action`].
 //! Every mirror implements [`RosType`]. With the `ros2` feature every mirror
 //! also implements `ros2_client::Message`.
 //!
@@ -23,6 +24,7 @@
 //! [`idl`] parses `.msg`, `.srv` and `.action` files (the ROS 2 interface
 //! definition format, as `rosidl_adapter` reads it).
 
+pub mod action;
 pub mod builtin_interfaces;
 pub mod control_msgs;
 mod error;

@@ -875,7 +875,7 @@ pub struct PlanStretches {
     pub process_end_time: f64,
     /// The trajectory's duration (s).
     pub duration: f64,
-    /// `"direct"`, `"via safe pose N"`, or empty with start none.
+    /// `"direct"`, `"via safe pose N"`, `"via the tool axis D m above the first point"`, or empty with start none.
     pub approach_route: String,
     /// `"tool axis"`, `"tool axis, safe pose"`, or empty with start none.
     pub retract_route: String,

@@ -112,6 +112,10 @@ mod tests {
             control_msgs::FollowJointTrajectoryFeedback::dds_type_name(),
             "control_msgs::action::dds_::FollowJointTrajectory_Feedback_"
         );
+        assert_eq!(
+            crate::action::PlanCutGoal::ROS_TYPE,
+            "kerf_msgs/action/PlanCut_Goal"
+        );
     }
 
     /// With the `ros2` feature the mirrors are `ros2_client::Message`s (a
@@ -132,5 +136,8 @@ mod tests {
         message_type_name::<control_msgs::FollowJointTrajectoryFeedback>();
         message_type_name::<srv::ValidateTrajectoryRequest>();
         message_type_name::<srv::ValidateTrajectoryResponse>();
+        message_type_name::<crate::action::PlanCutGoal>();
+        message_type_name::<crate::action::PlanMillResult>();
+        message_type_name::<crate::action::PlanGcodeFeedback>();
     }
 }

@@ -15,7 +15,7 @@ use std::process::Command;
 
 use kerf_msgs::idl::{self, Array, BaseType, FieldType, MessageSpec, Primitive, Value};
 use kerf_msgs::{
-    builtin_interfaces, control_msgs, geometry_msgs, msg, rosgraph_msgs, sensor_msgs, srv,
+    action, builtin_interfaces, control_msgs, geometry_msgs, msg, rosgraph_msgs, sensor_msgs, srv,
     std_msgs, trajectory_msgs, InterfaceKind, RosType,
 };
 use serde::{de::DeserializeOwned, Deserialize, Serialize};
@@ -211,6 +211,15 @@ fn all_mirrors() -> Vec<Mirror> {
         msg::GcodePlan,
         srv::ValidateTrajectoryRequest,
         srv::ValidateTrajectoryResponse,
+        action::PlanCutGoal,
+        action::PlanCutResult,
+        action::PlanCutFeedback,
+        action::PlanMillGoal,
+        action::PlanMillResult,
+        action::PlanMillFeedback,
+        action::PlanGcodeGoal,
+        action::PlanGcodeResult,
+        action::PlanGcodeFeedback,
     ]
 }
 
@@ -428,6 +437,9 @@ fn rust_constants() -> ConstantTable {
     type Mp = msg::MillPlan;
     type Gr = msg::GcodeRequest;
     type Gp = msg::GcodePlan;
+    type Pcf = action::PlanCutFeedback;
+    type Pmf = action::PlanMillFeedback;
+    type Pgf = action::PlanGcodeFeedback;
     vec![
         (
             Jct::ROS_TYPE,
@@ -547,6 +559,30 @@ fn rust_constants() -> ConstantTable {
                 c_u8("NO_APPROACH", Gp::NO_APPROACH),
             ],
         ),
+        (
+            Pcf::ROS_TYPE,
+            vec![
+                c_str("STAGE_QUEUED", Pcf::STAGE_QUEUED),
+                c_str("STAGE_PLANNING", Pcf::STAGE_PLANNING),
+                c_str("STAGE_EXECUTING", Pcf::STAGE_EXECUTING),
+            ],
+        ),
+        (
+            Pmf::ROS_TYPE,
+            vec![
+                c_str("STAGE_QUEUED", Pmf::STAGE_QUEUED),
+                c_str("STAGE_PLANNING", Pmf::STAGE_PLANNING),
+                c_str("STAGE_EXECUTING", Pmf::STAGE_EXECUTING),
+            ],
+        ),
+        (
+            Pgf::ROS_TYPE,
+            vec![
+                c_str("STAGE_QUEUED", Pgf::STAGE_QUEUED),
+                c_str("STAGE_PLANNING", Pgf::STAGE_PLANNING),
+                c_str("STAGE_EXECUTING", Pgf::STAGE_EXECUTING),
+            ],
+        ),
     ]
 }
 
@@ -640,7 +676,7 @@ fn every_mirror_matches_its_interface_file() {
         "mirror drift:\n{}",
         problems.join("\n")
     );
-    assert_eq!(mirrors.len(), 43, "every mirror is checked");
+    assert_eq!(mirrors.len(), 52, "every mirror is checked");
 }
 
 #[test]
@@ -699,6 +735,10 @@ fn ros_types_name_their_files() {
     check::<msg::MillRequest>();
     check::<msg::MillSegment>();
     check::<msg::MillPlan>();
+    check::<action::PlanCutGoal>();
+    check::<action::PlanCutResult>();
+    check::<action::PlanMillFeedback>();
+    check::<action::PlanGcodeResult>();
 }
 
 // Negative tests: the comparator must catch drift.
@@ -965,5 +1005,5 @@ fn rust_parser_agrees_with_rosidl() {
             mine["file"]
         );
     }
-    assert_eq!(ours.len(), 40, "every interface file is compared");
+    assert_eq!(ours.len(), 43, "every interface file is compared");
 }

@@ -84,8 +84,11 @@ pub fn stretches(kind: StartKind, start: &[f64], framed: &Framed) -> PlanStretch
         process_start_time: tl.process_start,
         process_end_time: tl.process_end,
         duration: tl.samples.last().map_or(0.0, |s| s.t),
-        approach_route: match framed.approach_route {
-            Route::ViaSafePose(i) => format!("via safe pose {i}"),
+        approach_route: match (framed.approach_route, framed.auto_via) {
+            (Route::ViaSafePose(_), Some(d)) => {
+                format!("via the tool axis {d} m above the first point")
+            }
+            (Route::ViaSafePose(i), None) => format!("via safe pose {i}"),
             _ => "direct".into(),
         },
         retract_route: if framed.retract_to_safe_pose {
