@@ -16,7 +16,9 @@
 //!   `gfd_q6_steps`, `gfd_q4_half_range`, `gfd_q5_half_range`, `rto_indices` (integers
 //!   separated by spaces or commas), `rto_spacing`, `rto_angle`, `reference_standoff` (giving
 //!   it sets `has_reference_standoff`), `clearance`, `rto_constraint` (`box` or `equality`),
-//!   `orientation_corridor` (`allowance` or `none`) and `time_budget`. `feedrate`, `sample_period`,
+//!   `orientation_corridor` (`allowance` or `none`), `time_budget`, `start` (`current`,
+//!   `given` or `none`) and `start_positions` (numbers separated by spaces or commas, with
+//!   `start: given`). `feedrate`, `sample_period`,
 //!   `max_lead_angle`, `max_tilt_angle` and `mesh` are required; every key may appear once.
 //!   Blank lines and lines starting with `#` are ignored (comments are whole lines: a value
 //!   is never cut at `#`); points keep their order even when key lines come between them.
@@ -243,6 +245,15 @@ pub fn parse_lines(text: &str) -> Result<msg::CutRequest, PlanError> {
             "orientation_corridor" => m.orientation_corridor = value.to_string(),
             "mesh" => m.mesh = value.to_string(),
             "feed_law" => m.feed_law = value.to_string(),
+            "start" => m.start = value.to_string(),
+            "start_positions" => {
+                let list = value.trim_start_matches('[').trim_end_matches(']');
+                m.start_positions = list
+                    .split(|c: char| c.is_whitespace() || c == ',')
+                    .filter(|t| !t.is_empty())
+                    .map(|t| number(n, key, t))
+                    .collect::<Result<_, _>>()?;
+            }
             "feedrate" => m.feedrate = number(n, key, value)?,
             "feed_acceleration" => m.feed_acceleration = number(n, key, value)?,
             "feed_jerk" => m.feed_jerk = number(n, key, value)?,
@@ -382,6 +393,36 @@ feed_law: constant
             kerf_mjto::optimal_feed::FeedMode::Constant
         );
         r.validate().unwrap();
+    }
+
+    #[test]
+    fn both_forms_take_the_start() {
+        use kerf_approach::StartSpec;
+        let text = format!("{LINES}start: given\nstart_positions: [0.8, 0.7, 1.5, 0, 0, -0.05]\n");
+        let r = parse_request(&text).unwrap();
+        assert_eq!(
+            r.start,
+            StartSpec::Given(vec![0.8, 0.7, 1.5, 0.0, 0.0, -0.05])
+        );
+        let r = parse_request(&format!("{LINES}start: none\n")).unwrap();
+        assert_eq!(r.start, StartSpec::None);
+        assert_eq!(parse_request(LINES).unwrap().start, StartSpec::Default);
+        let e = parse_request(&format!("{LINES}start: home\n")).unwrap_err();
+        assert!(e.to_string().contains("\"home\""), "{e}");
+        let e = parse_request(&format!("{LINES}start_positions: 1 2\n")).unwrap_err();
+        assert!(e.to_string().contains("only read with start \"given\""), "{e}");
+        let e = parse_request(&format!("{LINES}start: given\nstart_positions: 1 nan\n"))
+            .unwrap_err();
+        assert!(e.to_string().contains("start_positions"), "{e}");
+        let yaml = "request_id: y1\npoints: [[0, 0, 0], [0.1, 0, 0]]\naxes: [[0, 0, 1], [0, 0, 1]]\n\
+                    feedrate: 0.3\nsample_period: 0.01\nmax_lead_angle: 0.1\n\
+                    max_tilt_angle: 0.1\nmesh: m.stl\nstart: [0.8, 0.7, 1.5, 0, 0, -0.05]\n";
+        assert_eq!(
+            parse_request(yaml).unwrap().start,
+            StartSpec::Given(vec![0.8, 0.7, 1.5, 0.0, 0.0, -0.05])
+        );
+        let yaml = yaml.replace("start: [0.8, 0.7, 1.5, 0, 0, -0.05]", "start: current");
+        assert_eq!(parse_request(&yaml).unwrap().start, StartSpec::Current);
     }
 
     #[test]
