@@ -111,6 +111,7 @@ fn cut(a: CutArgs) -> Result<(), String> {
     .map_err(|e| describe(&e))?;
     let request = CutRequest::from_yaml(&text)
         .map_err(|e| format!("--request {}: {}", a.request, describe(&e)))?;
+    input::check_offline_start(&format!("--request {}", a.request), &request.start)?;
     let limits = *machine.limits();
     let mut planner = Planner::new(machine).map_err(|e| describe(&e))?;
     let plan = planner.plan(&request).map_err(|e| describe(&e))?;

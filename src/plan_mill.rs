@@ -210,6 +210,7 @@ pub fn run(a: MillArgs) -> Result<(), String> {
         MillRequest::from_yaml_str(&text)
     };
     let request = parsed.map_err(|e| format!("--request {}: {}", a.request, describe(&e)))?;
+    crate::input::check_offline_start(&format!("--request {}", a.request), &request.start)?;
     let kinds = planner_list(&a, &request)?;
     let planner = MillPlanner::with_default_cell()
         .map_err(|e| format!("milling cell: {}", describe(&e)))?

@@ -87,9 +87,9 @@ fn launch_echo_and_ctrl_c() {
                 b"header: {stamp: {sec: 0, nanosec: 0}, frame_id: ''}\n\
                   joint_names: [q1, q2, q3, q4, q5, q6]\n\
                   points:\n\
-                  - {positions: [0, 0, 0, 0, 0, 0], velocities: [0, 0, 0, 0, 0, 0], \
+                  - {positions: [0.8, 0.7, 1.5, 0, 0, -0.05], velocities: [0, 0, 0, 0, 0, 0], \
                      accelerations: [], effort: [], time_from_start: {sec: 0, nanosec: 0}}\n\
-                  - {positions: [0.01, 0, 0, 0, 0, 0], velocities: [0, 0, 0, 0, 0, 0], \
+                  - {positions: [0.81, 0.7, 1.5, 0, 0, -0.05], velocities: [0, 0, 0, 0, 0, 0], \
                      accelerations: [], effort: [], time_from_start: {sec: 1, nanosec: 0}}\n",
             )
             .unwrap();

@@ -17,7 +17,7 @@
 use std::time::{Duration, Instant};
 
 use kerf_budget::Budget;
-use kerf_gcodeplan::{plan_request, GcodeRequest, LaserSheet, Machine, MachineBase, MachineKind};
+use kerf_gcodeplan::{plan_request, GcodeRequest, MachineBase, MachineKind};
 use kerf_msgs::msg::{self, GcodePlan, TrajectoryStatus};
 use ros2_client::ServiceMapping;
 
@@ -41,8 +41,9 @@ fn text_request(id: &str, program: &str) -> String {
 
 #[test]
 fn a_program_runs_from_planner_through_executor_and_bad_ones_are_answered() {
-    let laser = LaserSheet::default_sheet().unwrap();
-    let first = laser.joints([0.0; 3], None).unwrap();
+    // Issue 27: the executor starts where launch_scripts/params/laser_cutter.yaml puts it, and
+    // the plan starts there (approach, the program unchanged, retract).
+    let home = [0.8, 0.7, 1.5, 0.0, 0.0, -0.05];
     let offline = plan_request(
         &GcodeRequest {
             request_id: "square".into(),
@@ -53,13 +54,12 @@ fn a_program_runs_from_planner_through_executor_and_bad_ones_are_answered() {
         &Budget::unlimited(),
     )
     .unwrap();
-    let last = offline.trajectory.points.last().unwrap().positions.clone();
 
     let env = support::loopback(75, ServiceMapping::Enhanced);
     let (exec_stop, executor) =
-        support::spawn_robot_executor(&env, "laser_cutter", &[support::initial_positions(&first)]);
+        support::spawn_robot_executor(&env, "laser_cutter", &[support::initial_positions(&home)]);
     let planner = PlannerClient::start_feeding_executor(&gcode(), &env);
-    let (watch, states, statuses) = support::watch_cell(&env, "gcode_watch", &first);
+    let (watch, states, statuses) = support::watch_cell(&env, "gcode_watch", &home);
     std::thread::sleep(Duration::from_millis(500));
 
     planner.send_text(&text_request("square", PROGRAM));
@@ -70,19 +70,27 @@ fn a_program_runs_from_planner_through_executor_and_bad_ones_are_answered() {
         plan.trajectory.joint_names,
         ["q1", "q2", "q3", "q4", "q5", "q6"]
     );
-    assert_eq!(
-        plan.trajectory.points.len(),
-        offline.trajectory.points.len()
-    );
-    for (a, b) in plan
+    let s = &plan.stretches;
+    assert_eq!(s.start, "current", "{s:?}");
+    assert_eq!(plan.trajectory.points[0].positions, home);
+    let at = plan
         .trajectory
         .points
         .iter()
+        .position(|p| (p.time_from_start.as_secs_f64() - s.process_start_time).abs() < 1e-9)
+        .expect("a point at process_start_time");
+    assert!(plan.trajectory.points.len() > at + offline.trajectory.points.len());
+    for (a, b) in plan.trajectory.points[at..]
+        .iter()
         .zip(&offline.trajectory.points)
     {
-        assert!((a.time_from_start.as_secs_f64() - b.time_from_start).abs() < 1e-6);
+        assert!(
+            (a.time_from_start.as_secs_f64() - s.process_start_time - b.time_from_start).abs()
+                < 1e-6
+        );
         assert_eq!(a.positions, b.positions, "the node's plan is the library's");
     }
+    let last = plan.trajectory.points.last().unwrap().positions.clone();
     assert_eq!(plan.arcs, 1);
     assert_eq!(plan.cut_runs, 1);
     let switches: Vec<(bool, u32)> = plan.tool_events.iter().map(|e| (e.on, e.line)).collect();
@@ -99,7 +107,7 @@ fn a_program_runs_from_planner_through_executor_and_bad_ones_are_answered() {
         succeeded |=
             support::drain_statuses(&statuses, "square").contains(&TrajectoryStatus::SUCCEEDED);
         while let Ok(Some((s, _))) = states.take() {
-            moved = moved.max((s.position[0] - first[0]).abs());
+            moved = moved.max((s.position[0] - home[0]).abs());
         }
         std::thread::sleep(Duration::from_millis(5));
     }

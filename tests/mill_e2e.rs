@@ -41,12 +41,10 @@ use kerf_millplan::{
     train, EnvConfig, MillEnv, MillPlanOutput, MillPlanner, MillRequest, Policy,
 };
 use kerf_msgs::{
-    builtin_interfaces::Duration as RosDuration,
     geometry_msgs::Point,
     msg::{self, MillPlan, TrajectoryStatus},
     sensor_msgs::JointState,
     std_msgs::StringMsg,
-    trajectory_msgs::{JointTrajectory, JointTrajectoryPoint},
     RosType,
 };
 use kerf_ros::qos;
@@ -410,13 +408,22 @@ fn assert_same_plan(answer: &MillPlan, direct: &MillPlanOutput) {
     assert_eq!(answer.chatter_free, executed.chatter_free);
     assert_eq!(answer.total_reward, executed.total_reward);
     assert_eq!(answer.trajectory.joint_names, JOINTS);
+    // The process stretch of the answer (issue 27: after the approach) is the library's
+    // trajectory, shifted to its start.
     let run = &direct.executed.scaling.trajectory;
-    assert_eq!(answer.trajectory.points.len(), run.points().len());
-    for (a, b) in answer.trajectory.points.iter().zip(run.points()) {
+    let t0 = answer.stretches.process_start_time;
+    let at = answer
+        .trajectory
+        .points
+        .iter()
+        .position(|p| (p.time_from_start.as_secs_f64() - t0).abs() <= 1e-9)
+        .expect("a point at process_start_time");
+    assert!(answer.trajectory.points.len() >= at + run.points().len());
+    for (a, b) in answer.trajectory.points[at..].iter().zip(run.points()) {
         assert_eq!(a.positions, b.positions.to_vec());
         assert_eq!(a.velocities, b.velocities.to_vec());
         assert_eq!(a.accelerations, b.accelerations.to_vec());
-        assert!((a.time_from_start.as_secs_f64() - b.time_from_start).abs() <= 1e-9);
+        assert!((a.time_from_start.as_secs_f64() - t0 - b.time_from_start).abs() <= 1e-8);
     }
     assert_eq!(
         answer.max_path_deviation,
@@ -426,8 +433,9 @@ fn assert_same_plan(answer: &MillPlan, direct: &MillPlanOutput) {
         answer.max_plane_deviation,
         direct.executed.scaling.deviation.max_off_plane
     );
-    let end = answer.trajectory.points.last().expect("points");
-    assert!((end.time_from_start.as_secs_f64() - answer.machining_time).abs() <= 1e-9);
+    // The machining time is the process stretch's.
+    let st = &answer.stretches;
+    assert!((st.process_end_time - st.process_start_time - answer.machining_time).abs() <= 1e-8);
 }
 
 /// Watches the executor until `SUCCEEDED`: every measured state lies on the plan (within
@@ -441,7 +449,7 @@ fn follow_to_the_end(
 ) {
     let (points, largest_step) = plan_points(plan);
     let (first, last) = (points[0], points[points.len() - 1]);
-    let deadline = Instant::now() + Duration::from_secs_f64(plan.machining_time) + PLANNING;
+    let deadline = Instant::now() + Duration::from_secs_f64(plan.stretches.duration) + PLANNING;
     let mut accepted = false;
     let mut succeeded = false;
     let mut seen = 0usize;
@@ -482,21 +490,20 @@ fn naive_plan_runs_from_planner_through_executor_by_message_and_by_text() {
     let direct = offline.plan(&request).unwrap_or_else(|e| {
         panic!("naive plan failed ({e}); is the indicator cache being rebuilt? retry later")
     });
-    let first = direct.trajectory.points()[0].positions.clone();
+    // Issue 27: the executor starts at the IRB 6660's rest pose (all zeros), clear of the
+    // cell; each plan starts where the robot is (approach, the process unchanged, retract),
+    // so the three plans below run one after the other without moving the robot in between.
+    let home = [0.0; 6];
 
     let env = support::loopback(73, ServiceMapping::Enhanced);
-    // The executor starts where the cut starts: the plan's first point is due at once and must
-    // equal the commanded position.
-    let (exec_stop, executor) =
-        support::spawn_executor(&env, &[support::initial_positions(&first)]);
+    let (exec_stop, executor) = support::spawn_executor(&env, &[support::initial_positions(&home)]);
     let planner = PlannerClient::start_feeding_executor(&mill(), &env);
     // The planner's (remapped) trajectory writer must be matched by the executor before
     // planning: the topic is volatile.
-    let (mut watch, states, statuses) = support::watch_cell(&env, "mill_watch", &first);
-    let back = support::executor_input(&mut watch);
+    let (watch, states, statuses) = support::watch_cell(&env, "mill_watch", &home);
     std::thread::sleep(Duration::from_millis(500));
 
-    // 1. The message form.
+    // 1. The message form, from the rest pose.
     planner.send(request_msg("run-msg", "naive"));
     let plan = planner.next_plan(PLANNING);
     expect(
@@ -505,19 +512,15 @@ fn naive_plan_runs_from_planner_through_executor_by_message_and_by_text() {
         MillPlan::SUCCESS,
         &["planned 100 segments with naive"],
     );
+    assert_eq!(plan.stretches.start, "current");
+    assert_eq!(plan.trajectory.points[0].positions, home);
     assert_same_plan(&plan, &direct);
     println!("message form: {}", plan.message);
     follow_to_the_end(&states, &statuses, &plan, "message form");
-
-    // Back to the start (rest to rest, 4 s), then 2. the text form.
-    back.publish(move_to(&first)).unwrap();
-    wait_succeeded(&statuses, "move back");
+    let rest = plan.trajectory.points.last().unwrap().positions.clone();
     std::thread::sleep(Duration::from_millis(200));
-    let end = support::take_newest(&states, QUICK, "joint state at the start");
-    for (got, want) in end.position.iter().zip(&first) {
-        assert!((got - want).abs() < 1e-9, "back at {:?}", end.position);
-    }
 
+    // 2. The text form, from where the first plan's retract left the robot.
     planner.send_text(&request_text("run-text", "naive"));
     let plan = planner.next_plan(PLANNING);
     expect(
@@ -526,8 +529,15 @@ fn naive_plan_runs_from_planner_through_executor_by_message_and_by_text() {
         MillPlan::SUCCESS,
         &["planned 100 segments with naive"],
     );
+    for (got, want) in plan.trajectory.points[0].positions.iter().zip(&rest) {
+        assert!(
+            (got - want).abs() < 1e-6,
+            "starts at {got}, the robot rests at {want}"
+        );
+    }
     assert_same_plan(&plan, &direct);
     follow_to_the_end(&states, &statuses, &plan, "text form");
+    std::thread::sleep(Duration::from_millis(200));
 
     // 3. The ddpg plan of the shipped policy: its planned timing asks a joint for more than
     // its acceleration limit, the published (time-scaled) trajectory does not, and the
@@ -539,12 +549,6 @@ fn naive_plan_runs_from_planner_through_executor_by_message_and_by_text() {
             ..MillRequest::default()
         })
         .expect("ddpg plan with the shipped policy");
-    let ddpg_first = ddpg.executed.scaling.trajectory.points()[0]
-        .positions
-        .clone();
-    back.publish(move_to(&ddpg_first)).unwrap();
-    wait_succeeded(&statuses, "move to the ddpg start");
-    std::thread::sleep(Duration::from_millis(200));
     while let Ok(Some(_)) = states.take() {}
     planner.send(request_msg("run-ddpg", "ddpg"));
     let plan = planner.next_plan(PLANNING);
@@ -573,23 +577,9 @@ fn naive_plan_runs_from_planner_through_executor_by_message_and_by_text() {
     );
 
     planner.finish();
-    drop((states, statuses, back, watch));
+    drop((states, statuses, watch));
     exec_stop.stop();
     executor.join().unwrap().unwrap();
-}
-
-/// A one-point trajectory to `positions`, reached at rest in 4 s.
-fn move_to(positions: &[f64]) -> JointTrajectory {
-    JointTrajectory {
-        joint_names: JOINTS.iter().map(|s| s.to_string()).collect(),
-        points: vec![JointTrajectoryPoint {
-            positions: positions.to_vec(),
-            velocities: vec![0.0; 6],
-            time_from_start: RosDuration { sec: 4, nanosec: 0 },
-            ..JointTrajectoryPoint::default()
-        }],
-        ..JointTrajectory::default()
-    }
 }
 
 /// Waits for the executor to ACCEPT `plan` (fails on REJECTED or ABORTED), then watches it
@@ -674,18 +664,6 @@ fn drain_on_plan(
     seen
 }
 
-/// Waits for the executor's next SUCCEEDED; fails on REJECTED or ABORTED.
-fn wait_succeeded(statuses: &Subscription<TrajectoryStatus>, what: &str) {
-    let deadline = Instant::now() + PLANNING;
-    while Instant::now() < deadline {
-        if support::drain_statuses(statuses, what).contains(&TrajectoryStatus::SUCCEEDED) {
-            return;
-        }
-        std::thread::sleep(Duration::from_millis(5));
-    }
-    panic!("{what}: no SUCCEEDED within {PLANNING:?}");
-}
-
 #[test]
 fn full_queue_is_answered_not_dropped() {
     let env = support::loopback(72, ServiceMapping::Enhanced);
@@ -710,20 +688,15 @@ fn full_queue_is_answered_not_dropped() {
 /// `kerf launch --robot irb6660 --with-planner` (the user's command, as a child process)
 /// runs the executor and the milling planner: a text request is planned, its trajectory
 /// (remapped on the command line) reaches the executor, which starts it from the
-/// `initial_positions` given on the same command line; Ctrl-C stops both cleanly.
+/// robot's start pose of the launch (no `initial_positions`: the plan approaches the path from
+/// where the robot is); Ctrl-C stops both cleanly.
 #[test]
 fn kerf_launch_irb6660_with_planner_serves_mill_requests() {
     use std::io::{BufRead, BufReader};
     use std::process::{Command, Stdio};
 
-    let offline = MillPlanner::with_default_cell().unwrap();
-    let direct = offline
-        .plan(&MillRequest {
-            planner: "naive".into(),
-            ..MillRequest::default()
-        })
-        .unwrap_or_else(|e| panic!("naive plan failed ({e}); retry when the cache is back"));
-    let first = &direct.trajectory.points()[0].positions;
+    // Issue 27: no initial_positions: the robot starts at the launch's start pose and the plan
+    // approaches the path from there.
     let child = Command::new(env!("CARGO_BIN_EXE_kerf"))
         .env("ROS_DOMAIN_ID", "74")
         .env("ROS_AUTOMATIC_DISCOVERY_RANGE", "LOCALHOST")
@@ -735,8 +708,7 @@ fn kerf_launch_irb6660_with_planner_serves_mill_requests() {
             "--with-planner",
             "--ros-args",
         ])
-        .args(["-p", "queue_depth:=2", "-p"])
-        .arg(support::initial_positions(first))
+        .args(["-p", "queue_depth:=2"])
         .args([
             "-r",
             "milling_planner:~/joint_trajectory:=/trajectory_executor/joint_trajectory",

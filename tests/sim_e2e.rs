@@ -516,23 +516,11 @@ fn nozzle_driven_into_the_sheet_penetrates_less_than_the_stated_depth() {
 /// to its end (the launch connects the planners to the executor); Ctrl-C ends it cleanly.
 #[test]
 fn kerf_launch_sim_starts_the_cell_and_the_planners() {
-    let offline = Planner::new(LaserMachine::default_machine().unwrap())
-        .unwrap()
-        .plan(&case1())
-        .unwrap();
-    let first = offline.positions[0].to_vec();
-    let last = offline.positions.last().unwrap().to_vec();
+    // Issue 27: no initial_positions: the robot starts at the cell's start pose and the plan
+    // approaches the cut from there.
     let mut command = std::process::Command::new(env!("CARGO_BIN_EXE_kerf"));
     command
-        .args([
-            "launch",
-            "--sim",
-            "--robot",
-            "laser-cutter",
-            "--ros-args",
-            "-p",
-        ])
-        .arg(support::initial_positions(&first))
+        .args(["launch", "--sim", "--robot", "laser-cutter"])
         .env("ROS_DOMAIN_ID", "144")
         .env("ROS_AUTOMATIC_DISCOVERY_RANGE", "LOCALHOST")
         .env_remove("ROS_STATIC_PEERS")
@@ -558,6 +546,14 @@ fn kerf_launch_sim_starts_the_cell_and_the_planners() {
         .unwrap();
     let s = support::take(&states, QUICK, "joint state");
     assert_eq!(s.effort.len(), 6, "{s:?}");
+    let start = s.position.clone();
+    let plans = client
+        .subscription::<kerf_msgs::msg::CutPlan>(
+            "/mjto_planner/cut_plan",
+            kerf_msgs::msg::CutPlan::ROS_TYPE,
+            qos::latched(),
+        )
+        .unwrap();
     let c0 = support::take(&clock, QUICK, "clock").clock.as_nanos();
     let c1 = support::take(&clock, QUICK, "clock").clock.as_nanos();
     assert!(c1 > c0, "{c0} then {c1}");
@@ -583,13 +579,22 @@ fn kerf_launch_sim_starts_the_cell_and_the_planners() {
         client.wait_for_subscriber(&requests, QUICK),
         "the MJTO planner's request topic"
     );
-    let (watch, cell_states, statuses) = support::watch_cell(&env, "launch_cell", &first);
+    let (watch, cell_states, statuses) = support::watch_cell(&env, "launch_cell", &start);
     let text =
         std::fs::read_to_string(std::path::Path::new(ROOT).join("crates/mjto/cases/case1.yaml"))
             .unwrap();
     requests
         .publish(kerf_msgs::std_msgs::StringMsg { data: text })
         .unwrap();
+    let plan = support::take(&plans, MOTION, "the cut plan");
+    assert_eq!(
+        plan.status,
+        kerf_msgs::msg::CutPlan::SUCCESS,
+        "{}",
+        plan.message
+    );
+    assert_eq!(plan.stretches.start, "current", "{:?}", plan.stretches);
+    let last = plan.trajectory.points.last().unwrap().positions.clone();
     let deadline = Instant::now() + MOTION;
     let mut succeeded = false;
     while Instant::now() < deadline && !succeeded {
@@ -603,6 +608,7 @@ fn kerf_launch_sim_starts_the_cell_and_the_planners() {
     );
     support::assert_rests_at(&cell_states, &last, 1e-4, "case 1 in the launched cell");
     drop((
+        plans,
         states,
         clock,
         contacts,

@@ -147,6 +147,15 @@ fn pose(u: &mut Unstructured) -> Result<Pose> {
     })
 }
 
+/// A request's `start` and `start_positions` (issue 27): the known words, a wrong one, and
+/// 0 to 7 positions of any value.
+fn start(u: &mut Unstructured) -> Result<(String, Vec<f64>)> {
+    let word = string(u, &["", "current", "given", "none"])?;
+    let n = u.int_in_range(0..=7)?;
+    let positions = (0..n).map(|_| float(u)).collect::<Result<Vec<_>>>()?;
+    Ok((word, positions))
+}
+
 /// A `kerf_msgs/msg/CutRequest`.
 pub fn cut_request(u: &mut Unstructured) -> Result<msg::CutRequest> {
     let n = u.int_in_range(0..=12)?;
@@ -162,6 +171,7 @@ pub fn cut_request(u: &mut Unstructured) -> Result<msg::CutRequest> {
         1 => vec![0, u32::try_from(n.saturating_sub(1)).unwrap_or(u32::MAX)],
         _ => u.arbitrary()?,
     };
+    let (start_word, start_positions) = start(u)?;
     Ok(msg::CutRequest {
         request_id: string(u, &["slot-3", "bpillar-case1-side-trim"])?,
         points,
@@ -192,6 +202,8 @@ pub fn cut_request(u: &mut Unstructured) -> Result<msg::CutRequest> {
         rto_constraint: string(u, &["box", "equality"])?,
         orientation_corridor: string(u, &["", "allowance", "none", "off"])?,
         time_budget: if u.arbitrary()? { 0.0 } else { float(u)? },
+        start: start_word,
+        start_positions,
     })
 }
 
@@ -199,6 +211,7 @@ pub fn cut_request(u: &mut Unstructured) -> Result<msg::CutRequest> {
 pub fn mill_request(u: &mut Unstructured) -> Result<msg::MillRequest> {
     let n = u.int_in_range(0..=10)?;
     let planar = !u.ratio(1u8, 8)?;
+    let (start_word, start_positions) = start(u)?;
     Ok(msg::MillRequest {
         request_id: string(u, &["job-17"])?,
         points: points(u, n, planar)?,
@@ -231,6 +244,8 @@ pub fn mill_request(u: &mut Unstructured) -> Result<msg::MillRequest> {
         has_tolerances: u.arbitrary()?,
         path_tolerance: positive(u, 5e-5)?,
         min_condition_indicator: float(u)?,
+        start: start_word,
+        start_positions,
     })
 }
 
@@ -592,6 +607,7 @@ pub fn gcode_request(u: &mut Unstructured) -> Result<msg::GcodeRequest> {
     let (program, program_uri) = program_source(u)?;
     let has_limits: bool = u.arbitrary()?;
     let has_placement: bool = u.arbitrary()?;
+    let (start_word, start_positions) = start(u)?;
     Ok(msg::GcodeRequest {
         request_id: string(u, &["part-7"])?,
         machine: string(
@@ -624,5 +640,7 @@ pub fn gcode_request(u: &mut Unstructured) -> Result<msg::GcodeRequest> {
         redundancy_angle: n.gated(u, "redundancy_angle", has_placement)?,
         standoff_axis: n.gated(u, "standoff_axis", has_placement)?,
         time_budget: n.float(u, "time_budget")?,
+        start: start_word,
+        start_positions,
     })
 }

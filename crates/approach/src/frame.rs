@@ -355,7 +355,7 @@ pub fn frame(
     // out), so that the lead-in can end where the process starts.
     let ends = contact(&first).distance.min(contact(&last).distance);
     let lead_clearance = settings.lead_clearance.min(0.5 * ends);
-    if !(lead_clearance > 0.0) {
+    if lead_clearance.is_nan() || lead_clearance <= 0.0 {
         let (role, q) = if contact(&first).distance <= contact(&last).distance {
             (crate::Role::Goal, &first)
         } else {

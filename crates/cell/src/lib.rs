@@ -19,6 +19,9 @@
 //! | [`mesh_contact`] | a shape against a triangle mesh, triangles deepest-first, pruned by plane |
 //! | [`settings`] | mode, rates, servo bandwidth |
 //! | [`cell`] | [`Cell`], the lock-step of control and physics |
+//! | [`surroundings`] | [`CellSurroundings`]: the robot against the cell by exact distance, for a plan's approach and retract (issue 27) |
+//! | [`lipschitz`] | per-joint bounds of how fast a robot shape point moves |
+//! | [`milling_tool`] | the IRB 6660's milling tool axis by `kerf_mill`'s IK; its cell's surroundings |
 
 pub mod cell;
 pub mod chain;
@@ -29,13 +32,18 @@ pub mod error;
 pub mod geometry;
 pub mod hermite;
 pub mod inertia;
+pub mod lipschitz;
 pub mod mesh_contact;
+pub mod milling_tool;
 pub mod motion;
 pub mod settings;
+pub mod surroundings;
 pub mod world;
 
 pub use cell::{load_robot, Cell, CellState};
 pub use config::CellFile;
 pub use contact::{Contact, QueryCounts};
 pub use error::CellError;
+pub use milling_tool::{irb6660_cell_path, milling_surroundings, IRB6660_CELL};
 pub use settings::{CellSettings, Mode};
+pub use surroundings::{approach_limits, CellSurroundings, ToolAxis};

@@ -132,6 +132,14 @@ pub enum ExecutorError {
         /// The new stamp (s).
         got: f64,
     },
+    /// The hold cannot move to a measured state while a goal is active or the reference moves.
+    #[error(
+        "cannot hold at the measured state at t = {time} s: a goal is active or the reference is still moving"
+    )]
+    HoldWhileMoving {
+        /// The time of the request (s).
+        time: f64,
+    },
     /// A time argument is NaN or infinite.
     #[error("{what} is {value} s, must be finite")]
     NonFiniteTime {

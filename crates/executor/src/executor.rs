@@ -381,6 +381,34 @@ impl Executor {
         Ok(Some(goal.id))
     }
 
+    /// Makes the robot's measured state the hold: at rest at `positions` from `now` on.
+    ///
+    /// A real robot's driver reports where the robot is (issue 27): before its first state
+    /// the executor holds a placeholder, and after a driver fault (stale or bad feedback, a
+    /// restarted driver) the commanded and the measured positions may differ. Starting the
+    /// next goal from the commanded state would then command a jump; re-synchronizing while
+    /// the robot is at rest starts it from where it is (JTC likewise sets its hold position
+    /// from the measured state on activation).
+    ///
+    /// # Errors
+    /// [`ExecutorError::HoldWhileMoving`] while a goal is active or the reference moves (a
+    /// stop in progress); [`ExecutorError::NonFiniteTime`] for a non-finite `now`;
+    /// [`ExecutorError::StateLength`], [`ExecutorError::NonFiniteState`] or
+    /// [`ExecutorError::StateOutOfLimits`] for positions that are not one finite value per
+    /// joint within its limits. Nothing changes on an error.
+    pub fn hold_at(&mut self, now: f64, positions: &[f64]) -> Result<(), ExecutorError> {
+        let t = self.request_time("now", now)?;
+        if self.active.is_some() || self.is_moving(t) {
+            return Err(ExecutorError::HoldWhileMoving { time: t });
+        }
+        let state = JointSample::at_rest(positions.to_vec());
+        state.check("measured state", &self.limits, true)?;
+        state.check_in_limits("measured state", &self.limits)?;
+        self.replace_motion(Motion::Hold(state.positions.clone()));
+        self.commanded = state;
+        Ok(())
+    }
+
     fn start_stop(&mut self, t: f64) {
         let state = self.commanded_at(t);
         self.replace_motion(Motion::Stop(StopProfile::new(&self.limits, &state, t)));

@@ -730,3 +730,44 @@ fn fault_aborts_with_its_message_and_stops_within_limits() {
     );
     assert!(!exec.is_moving(2.1));
 }
+
+/// Issue 27: a real robot's measured state becomes the hold while the robot is at rest; never
+/// while a goal runs or a stop is in progress, and never at an invalid position.
+#[test]
+fn hold_at_moves_the_hold_to_the_measured_state_only_at_rest() {
+    let limits = limits6();
+    let mut exec = executor(&limits, ExecutorConfig::default(), 0.0);
+    let mut hw = MockHardware::new(vec![0.0; 6]);
+    let measured = [0.1, -0.1, 0.05, 0.0, 0.2, -0.3];
+    exec.hold_at(0.0, &measured).unwrap();
+    assert_eq!(exec.commanded().positions, measured);
+    assert!(exec.commanded().velocities.iter().all(|v| *v == 0.0));
+    let cycle = exec
+        .update(0.004, &JointSample::at_rest(measured.to_vec()))
+        .unwrap();
+    assert_eq!(cycle.reference.positions, measured);
+    // A goal from there starts at the measured state.
+    let id = exec
+        .submit(
+            &min_jerk_request(&measured, &TARGET, 2.0, 4),
+            &GoalTolerances::default(),
+            0.008,
+        )
+        .unwrap();
+    let e = exec.hold_at(0.5, &measured).unwrap_err();
+    assert!(matches!(e, ExecutorError::HoldWhileMoving { .. }), "{e}");
+    // During the stop of a cancel: still refused; at rest again: accepted.
+    run(&mut exec, &mut hw, 0.008, 0.5);
+    exec.cancel(id, 0.5).unwrap();
+    exec.update(0.504, &JointSample::at_rest(measured.to_vec()))
+        .unwrap();
+    assert!(exec.hold_at(0.504, &measured).is_err());
+    run(&mut exec, &mut hw, 0.508, 3.0);
+    exec.hold_at(3.0, &measured).unwrap();
+    // Invalid positions change nothing.
+    for bad in [vec![0.0; 5], vec![f64::NAN; 6], vec![100.0; 6]] {
+        assert!(exec.hold_at(3.0, &bad).is_err(), "{bad:?}");
+    }
+    assert_eq!(exec.commanded().positions, measured);
+    assert!(exec.hold_at(f64::NAN, &measured).is_err());
+}

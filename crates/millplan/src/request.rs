@@ -291,7 +291,8 @@ impl Default for MillRequest {
     /// The seed 004 path (the default cell's points), no overrides, planner
     /// `ddpg`.
     fn default() -> Self {
-        Self { start: Default::default(),
+        Self {
+            start: Default::default(),
             request_id: String::new(),
             points: PathSpec::default().points,
             segments: None,

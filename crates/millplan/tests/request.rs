@@ -61,6 +61,7 @@ fn saved_actor(dir: &std::path::Path, obs: usize, act: usize) -> PathBuf {
 
 fn full_request() -> MillRequest {
     MillRequest {
+        start: Default::default(),
         request_id: "job-17".to_string(),
         points: vec![[1.4, -0.3, 1.7], [1.7, 0.0, 1.7], [2.0, 0.2, 1.7]],
         segments: Some(40),

@@ -409,3 +409,33 @@ fn checked(i: usize, v: f64, limits: &[AxisLimits; 6], note: String) -> Result<f
         note,
     })
 }
+
+/// The configuration with the head `distance` m further back along its tool axis, away from
+/// the part (issue 27, approach and retract): the gantry moves the rotary-axes centre
+/// `M = (q1, q2, q3)` by `distance · O(q4, q5)` (eq. 2: `C = M + q6 O`, the head above the
+/// part along `O`); the head's orientation and the standoff q6 are unchanged.
+///
+/// # Errors
+/// [`kerf_approach::ApproachError::JointCount`] for a configuration of another length than 6,
+/// [`kerf_approach::ApproachError::OutOfLimits`] (and the other configuration errors) when
+/// the result leaves `limits`.
+pub fn tool_axis_back_off(
+    q: &[f64],
+    distance: f64,
+    limits: &[kerf_approach::JointLimit],
+) -> Result<Vec<f64>, kerf_approach::ApproachError> {
+    if q.len() != 6 {
+        return Err(kerf_approach::ApproachError::JointCount {
+            what: "tool-axis back-off".into(),
+            expected: 6,
+            found: q.len(),
+        });
+    }
+    let o = tool_axis(q[3], q[4]);
+    let mut out = q.to_vec();
+    for (k, v) in out.iter_mut().take(3).enumerate() {
+        *v += distance * o[k];
+    }
+    kerf_approach::limits::check_configuration(kerf_approach::Role::Waypoint(0), &out, limits)?;
+    Ok(out)
+}

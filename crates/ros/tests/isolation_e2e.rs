@@ -113,7 +113,7 @@ impl PlanningService for Misbehaving {
             Failure::Busy => GcodePlan::QUEUE_FULL,
             Failure::Timeout => GcodePlan::TIMEOUT,
             Failure::ResourceLimit => GcodePlan::RESOURCE_LIMIT,
-            Failure::Stopped | Failure::Panicked | Failure::NotExecutable => {
+            Failure::Stopped | Failure::Canceled | Failure::Panicked | Failure::NotExecutable => {
                 GcodePlan::INTERNAL_ERROR
             }
             _ => GcodePlan::INVALID_REQUEST,

@@ -207,6 +207,8 @@ fn mill_request() -> msg::MillRequest {
         has_tolerances: true,
         path_tolerance: 5e-5,
         min_condition_indicator: 0.1,
+        start: msg::MillRequest::START_NONE.into(),
+        start_positions: Vec::new(),
     }
 }
 

@@ -261,5 +261,7 @@ pub fn plan_to_msg(request: &GcodeRequest, plan: &GcodePlan) -> Result<msg::Gcod
             })
             .collect(),
         warnings: plan.warnings.clone(),
+        // Set by the planner-node harness when it frames the plan (issue 27).
+        stretches: msg::PlanStretches::default(),
     })
 }

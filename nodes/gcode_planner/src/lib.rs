@@ -12,7 +12,8 @@
 //! | `~/joint_trajectory` | `trajectory_msgs/msg/JointTrajectory` | the trajectory, on success only (reliable, volatile) |
 //!
 //! Parameters ([`NodeConfig::from_params`]): `machine`, `queue_depth`, `plan_timeout`,
-//! `allowed_file_roots`.
+//! `allowed_file_roots`, `collision_cell_file` (irb6660), and the harness's `approach.*` and
+//! `retract.*`.
 //!
 //! # How to run it
 //!
@@ -26,14 +27,28 @@
 //! cargo run --release -- echo /gcode_planner/gcode_plan_text --transient-local -n 1
 //! ```
 //!
+//! # Where a plan starts (issue 27)
+//! A request with a start (`start` given, `current`, or left out while the node receives the
+//! robot's `joint_states`) is framed by the harness: the trajectory starts at that
+//! configuration, approaches the program's first point backed off along the tool axis, leads
+//! in along it, runs the program unchanged and leads out along the tool axis. The approach
+//! keeps `approach.clearance` (0.01 m) from the machine's surroundings ([`surroundings`]): on
+//! the laser cutter the head against the sheet under the program ([`sheet`]: the program's
+//! plane at its origin, its extent plus 5 cm; a G-code request names no workpiece mesh), on the
+//! IRB 6660 the robot and spindle against the collision cell (`collision_cell_file`, the
+//! milling planner's). A start inside that clearance, or no clear route, is answered
+//! NO_APPROACH naming the obstacle; a start of the wrong length INVALID_REQUEST naming
+//! `start_positions`. The answer's `stretches` say where the program starts and ends on the
+//! trajectory (its tool event times are the program's, from `process_start_time`).
+//!
 //! # Behaviour
 //! The node is a [`kerf_ros::planner::PlanningService`] ([`GcodeService`]) run by the
 //! planner-node harness: requests are answered in arrival order, each by exactly one
 //! `GcodePlan` with its `request_id`; a request that cannot be read, converted or validated,
 //! a planner error (status from [`convert::status_of`], the program line in `error_line`)
 //! and a planner panic are all answered; a full queue answers QUEUE_FULL. The trajectory's
-//! first point (time 0) is the tool at the program's start, at rest: move the robot there
-//! first. A program file (`program_uri`) must lie under `allowed_file_roots`, be a regular
+//! first point (time 0) is the plan's start, at rest (above; without one, the tool at the
+//! program's start: move the robot there first). A program file (`program_uri`) must lie under `allowed_file_roots`, be a regular
 //! file of at most [`kerf_gcodeplan::MAX_PROGRAM_BYTES`] (a FIFO, device or directory is
 //! refused before it is opened) and is read as a stream. Every plan runs under the harness's
 //! time and memory budget: the planner checks both in every loop that grows with the program
@@ -41,6 +56,8 @@
 
 pub mod config;
 pub mod convert;
+pub mod sheet;
+pub mod surroundings;
 pub mod text;
 
 use std::time::Duration;
@@ -56,6 +73,7 @@ use kerf_ros::{
     planner::{self, AnswerKey, AnswerSize, Failure, PlanningService, Topics},
     RosArgs, RosEnv, StopToken,
 };
+use surroundings::MachineSurroundings;
 
 pub use config::{NodeConfig, KNOWN_PARAMS};
 
@@ -82,7 +100,8 @@ pub fn run(args: &RosArgs, env: &RosEnv, stop: StopToken) -> Result<(), NodeErro
     planner::run(DEFAULT_NAME, KNOWN_PARAMS, args, env, stop, |node| {
         let cfg = NodeConfig::from_params(node.params())?;
         let harness = cfg.harness;
-        let service = GcodeService::new(cfg.machine)?.with_allowed_roots(cfg.allowed_roots);
+        let service = GcodeService::with_surroundings(cfg.machine, cfg.surroundings)?
+            .with_allowed_roots(cfg.allowed_roots);
         Ok((service, harness))
     })
 }
@@ -91,22 +110,45 @@ pub fn run(args: &RosArgs, env: &RosEnv, stop: StopToken) -> Result<(), NodeErro
 pub struct GcodeService {
     machine: MachineBase,
     limits: Vec<JointLimits>,
+    approach_limits: Vec<kerf_approach::JointLimit>,
+    surroundings: MachineSurroundings,
     allowed_roots: AllowedRoots,
 }
 
 impl GcodeService {
-    /// A service planning for `machine`.
+    /// A service planning for `machine`, its approaches kept clear of the machine's shipped
+    /// surroundings ([`MachineSurroundings::load`]).
     ///
     /// # Errors
-    /// [`NodeError::Config`] (`machine`) when a joint has no acceleration limit.
+    /// [`NodeError::Config`] (`collision_cell_file`) when they do not load; as
+    /// [`GcodeService::with_surroundings`].
     pub fn new(machine: MachineBase) -> Result<Self, NodeError> {
+        let surroundings = MachineSurroundings::load(&machine, None)
+            .map_err(|reason| NodeError::config("collision_cell_file", reason))?;
+        Self::with_surroundings(machine, surroundings)
+    }
+
+    /// A service planning for `machine`; the approach and retract of every plan with a start
+    /// keep clear of `surroundings` (issue 27).
+    ///
+    /// # Errors
+    /// [`NodeError::Config`] (`machine`) when a joint has no acceleration limit (the
+    /// executability check needs it) or no jerk limit (the approach needs it).
+    pub fn with_surroundings(
+        machine: MachineBase,
+        surroundings: MachineSurroundings,
+    ) -> Result<Self, NodeError> {
         let limits = machine
             .robot()
             .executor_limits()
             .map_err(|e| NodeError::config("machine", e.to_string()))?;
+        let approach_limits = kerf_cell::approach_limits(machine.robot())
+            .map_err(|e| NodeError::config("machine", e.to_string()))?;
         Ok(Self {
             machine,
             limits,
+            approach_limits,
+            surroundings,
             allowed_roots: AllowedRoots::any(),
         })
     }
@@ -240,15 +282,22 @@ impl PlanningService for GcodeService {
         }
     }
 
+    /// Unreadable samples, budgets over `plan_timeout`, bad numbers and unusable starts are
+    /// INVALID_REQUEST; no collision-free approach or retract NO_APPROACH; busy QUEUE_FULL;
+    /// stopped, canceled, panicked and not executable INTERNAL_ERROR.
     fn failure(&self, key: &AnswerKey, failure: Failure, message: String) -> GcodePlan {
         let code = match failure {
-            Failure::Unreadable | Failure::OverBudget | Failure::TooLarge | Failure::BadNumber => {
-                msg::GcodePlan::INVALID_REQUEST
-            }
+            Failure::Unreadable
+            | Failure::OverBudget
+            | Failure::TooLarge
+            | Failure::BadNumber
+            | Failure::BadStart => msg::GcodePlan::INVALID_REQUEST,
+            Failure::NoApproach => msg::GcodePlan::NO_APPROACH,
             Failure::Busy => msg::GcodePlan::QUEUE_FULL,
             Failure::Timeout => msg::GcodePlan::TIMEOUT,
             Failure::ResourceLimit => msg::GcodePlan::RESOURCE_LIMIT,
-            Failure::Stopped | Failure::Panicked | Failure::NotExecutable => {
+            // No CANCELED status in GcodePlan: answered like a stop (the message says so).
+            Failure::Stopped | Failure::Canceled | Failure::Panicked | Failure::NotExecutable => {
                 msg::GcodePlan::INTERNAL_ERROR
             }
         };
@@ -265,7 +314,31 @@ impl PlanningService for GcodeService {
         &self.limits
     }
 
+    fn start_of(&self, request: &GcodeRequest) -> kerf_approach::StartSpec {
+        request.start.clone()
+    }
+
+    fn approach_limits(&self) -> &[kerf_approach::JointLimit] {
+        &self.approach_limits
+    }
+
+    /// The machine's surroundings for `request` ([`MachineSurroundings::for_request`]: the
+    /// sheet under the program, or the IRB 6660's collision cell); a program the sheet cannot
+    /// be read from is answered with the planner's error.
+    fn surroundings(
+        &self,
+        request: &GcodeRequest,
+    ) -> Result<Box<dyn kerf_approach::Surroundings>, Box<GcodePlan>> {
+        self.surroundings
+            .for_request(&self.approach_limits, request)
+            .map_err(|e| Box::new(convert::error_to_msg(request, self.machine_name(), &e)))
+    }
+
     fn startup_note(&self) -> String {
-        format!("machine: {}", self.machine_name())
+        format!(
+            "machine: {}; approach surroundings: {}",
+            self.machine_name(),
+            self.surroundings.source()
+        )
     }
 }

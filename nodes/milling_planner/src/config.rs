@@ -3,6 +3,7 @@
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
+use kerf_cell::CellSurroundings;
 use kerf_mill::MillCell;
 use kerf_millplan::{
     default_policy_path, plan::IndicatorSource, IndicatorCache, MillPlanner, PlannerKind,
@@ -23,6 +24,7 @@ pub const KNOWN_PARAMS: &[&str] = &[
     "queue_depth",
     "plan_timeout",
     "allowed_file_roots",
+    "collision_cell_file",
 ];
 
 pub use kerf_ros::planner::DEFAULT_QUEUE_DEPTH;
@@ -46,6 +48,9 @@ pub struct NodeConfig {
     pub harness: HarnessSettings,
     /// Where a request's policy file may be (`allowed_file_roots`).
     pub allowed_roots: AllowedRoots,
+    /// The robot against the cell's objects, for the approach and retract of every plan with
+    /// a start (`collision_cell_file`).
+    pub surroundings: CellSurroundings,
 }
 
 /// A path parameter: `None` when unset, an error when set to the empty string.
@@ -104,6 +109,13 @@ impl NodeConfig {
     /// * `allowed_file_roots` (string array, default: any): directories a request's
     ///   `policy_file` must resolve under (links resolved; the shipped data is always
     ///   allowed); a policy outside is POLICY_ERROR.
+    /// * `collision_cell_file` (string): the kerf_cell cell file (the one the executor's
+    ///   `sim_cell` reads) whose objects every approach and retract keeps its clearance from:
+    ///   the robot's URDF shapes and the cell's tool shapes against its objects, the cell's
+    ///   allowances (the cutter in the stock) left out only on the lead-in and lead-out;
+    ///   unset = the shipped `urdf/cells/irb6660_plate.yaml` (the stock under the default
+    ///   path at z = 1.7 m, on its fixture plate). Its robot must be the cell's. (Not
+    ///   `cell_file`: that is the milling cell above.)
     ///
     /// Empty strings are refused (leave a parameter unset for its default). Relative paths
     /// are relative to the node's working directory.
@@ -143,6 +155,7 @@ impl NodeConfig {
         };
         let harness = HarnessSettings::from_params(params)?;
         let allowed_roots = kerf_ros::planner::allowed_roots(params)?;
+        let collision_cell_file = path_param(params, "collision_cell_file")?;
 
         let (planner, cell_source, cache_note) = match (cell_file, cache_file) {
             (None, None) => {
@@ -187,6 +200,9 @@ impl NodeConfig {
                 (planner, cell_path.display().to_string(), note)
             }
         };
+        let surroundings =
+            kerf_cell::milling_surroundings(planner.cell(), collision_cell_file.as_deref())
+                .map_err(|e| NodeError::config("collision_cell_file", e.to_string()))?;
         let mut planner = planner.with_indicator_source(indicator_source);
         if let Some(n) = eval_threads {
             planner = planner.with_eval_threads(n).map_err(NodeError::setup)?;
@@ -200,6 +216,7 @@ impl NodeConfig {
             fixed_g_policy_file,
             harness,
             allowed_roots,
+            surroundings,
         })
     }
 

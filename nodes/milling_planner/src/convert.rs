@@ -3,7 +3,7 @@
 //! `kerf_msgs/msg/MillPlan`.
 //!
 //! A plan is published AS THE ROBOT RUNS IT ([`kerf_millplan::Executed`]): the trajectory is
-//! the planner's executed one (from rest to rest, time-scaled so that its cubic Hermite
+//! the planner's executed one (from rest to rest, time-scaled so that its quintic Hermite
 //! interpolation stays within every joint's velocity and acceleration limit), and the
 //! segments and totals of the `MillPlan` are those of the plan at the feeds that trajectory
 //! runs (|μ|max and reward re-evaluated where the joints' limits lowered a feed). The message
@@ -194,11 +194,12 @@ pub fn request_from_msg(m: &msg::MillRequest) -> Result<MillRequest, MillPlanErr
         g: Some(m.initial_g),
     });
     Ok(MillRequest {
-        start: kerf_approach::StartSpec::from_fields(&m.start, &m.start_positions)
-            .map_err(|reason| MillPlanError::InvalidConfig {
+        start: kerf_approach::StartSpec::from_fields(&m.start, &m.start_positions).map_err(
+            |reason| MillPlanError::InvalidConfig {
                 name: "start".into(),
                 reason,
-            })?,
+            },
+        )?,
         request_id: m.request_id.clone(),
         points: m.points.iter().map(|p| [p.x, p.y, p.z]).collect(),
         segments: (m.segments != 0).then(|| usize::try_from(m.segments).unwrap_or(usize::MAX)),
@@ -300,8 +301,9 @@ pub fn check_trajectory(t: &kerf_millplan::JointTrajectory) -> Result<(), String
 /// rest to rest and time-scaled to the joints' velocity and acceleration limits) as it is —
 /// its executor form ([`kerf_millplan::JointTrajectory::request`], a
 /// `kerf_executor::TrajectoryRequest`) converted by [`kerf_ros::planner::trajectory_msg`]: the planner's joint names (`joint_1` …
-/// `joint_6`), one point per trajectory point with its positions, velocities and time (the
-/// planner gives no accelerations: the executor interpolates cubic Hermite segments).
+/// `joint_6`), one point per trajectory point with its positions, velocities, accelerations
+/// and time (the executor interpolates quintic Hermite segments; the harness's framing needs
+/// the accelerations, issue 27).
 /// `header.stamp` is zero (the planner's `start_time` is `None`: the executor starts it on
 /// receipt).
 ///
@@ -475,6 +477,8 @@ pub fn output_to_msg(out: &MillPlanOutput) -> msg::MillPlan {
         path_tolerance: out.executed.settings.path_tolerance,
         min_condition_indicator_path: out.executed.scaling.min_condition_indicator.0,
         min_condition_arc_length: out.executed.scaling.min_condition_indicator.1,
+        // Set by the planner-node harness when it frames the plan (issue 27).
+        stretches: msg::PlanStretches::default(),
     }
 }
 

@@ -14,7 +14,7 @@
 //!
 //! Parameters ([`NodeConfig::from_params`]): `cell_file`, `indicator_cache_file`,
 //! `ddpg_policy_file`, `fixed_g_policy_file`, `indicator_source`, `eval_threads`,
-//! `queue_depth`.
+//! `queue_depth`, `collision_cell_file`, and the harness's `approach.*` and `retract.*`.
 //!
 //! # How to run it
 //!
@@ -35,19 +35,33 @@
 //! # Behaviour
 //! The trajectory is the plan as the robot runs it ([`kerf_millplan::Executed`], published as it
 //! is by [`convert::trajectory_msg`]): the planner's N + 2 points (path start, the N segment
-//! midpoints, path end) with their joint positions and velocities, from rest to rest (zero
-//! velocity at the path start and end, the first and the last half-segment ramps over twice
-//! their planned time), time-scaled by the planner so that its cubic Hermite interpolation
+//! midpoints, path end, and more where the path tolerance needs them) with their joint
+//! positions, velocities and accelerations, from rest to rest (zero velocity at the path start
+//! and end, the first and the last half-segment ramps over twice their planned time),
+//! time-scaled by the planner so that its quintic Hermite interpolation
 //! stays within every joint's velocity and acceleration limit: an interval is slowed where
 //! the planned feeds ask too much of a joint, never sped up. The `MillPlan` segments and
 //! totals are those of that executed plan (the feeds run, |μ|max re-evaluated at them;
 //! `machining_time` is the trajectory's duration); its message also gives the values at the
-//! planned feeds. Its first point (time 0) is the robot at the start of the path and
-//! its `header.stamp` is zero, so an executor starts it on receipt and accepts it only when
-//! its commanded position is that first point (within its `start_tolerance`): move the robot
-//! there first, or start the executor with `initial_positions` at the plan's first point
-//! (`MillPlan.trajectory.points[0].positions`). The trajectory topic is volatile on purpose: a
+//! planned feeds. Its first point (time 0) is the plan's start (below; without one, the robot
+//! at the start of the path) and its `header.stamp` is zero, so an executor starts it on
+//! receipt and accepts it only when its commanded position is that first point (within its
+//! `start_tolerance`). The trajectory topic is volatile on purpose: a
 //! restarted executor must not receive an old cut.
+//!
+//! # Where a plan starts (issue 27)
+//! A request with a start (`start` given, `current`, or left out while the node receives the
+//! robot's `joint_states`) is framed by the harness: the trajectory starts at that
+//! configuration, approaches the path's first point backed off along the tool axis (direct, or
+//! via `approach.safe_pose`), leads in along the tool axis, mills the path unchanged, and leads
+//! out along the tool axis (`retract.distance`). The approach keeps `approach.clearance` (0.01 m)
+//! from every object of the collision cell (`collision_cell_file`: the shipped
+//! `urdf/cells/irb6660_plate.yaml`, the stock under the path and its fixture plate), the robot's
+//! links, spindle and cutter measured by exact distance ([`kerf_cell::CellSurroundings`]); the
+//! lead moves leave the cutter's engagement in the stock out. A start inside that clearance,
+//! or no clear route, is answered NO_APPROACH naming the object; a start of the wrong length or
+//! outside the limits INVALID_REQUEST naming `start_positions`. The answer's `stretches` say
+//! where the milling starts and ends on the trajectory (its segment times are the process's).
 //!
 //! The node is a [`kerf_ros::planner::PlanningService`] ([`MillService`]) run by the
 //! planner-node harness [`kerf_ros::planner::run`]: request → convert and validate → plan
@@ -74,6 +88,7 @@ use std::path::PathBuf;
 use std::time::Duration;
 
 use kerf_budget::Budget;
+use kerf_cell::CellSurroundings;
 use kerf_executor::JointLimits;
 use kerf_millplan::{planner::status, MillPlanError, MillPlanner, MillRequest, PlannerKind};
 use kerf_msgs::msg::{self, MillPlan};
@@ -141,9 +156,11 @@ pub fn run(args: &RosArgs, env: &RosEnv, stop: StopToken) -> Result<(), NodeErro
             policies.ddpg.display(),
             policies.fixed_g.display(),
         );
+        let note = format!("{note}; collision cell: {}", cfg.surroundings.source());
         let harness = cfg.harness;
         let service =
-            MillService::new(cfg.planner, policies, note)?.with_allowed_roots(cfg.allowed_roots);
+            MillService::with_surroundings(cfg.planner, policies, note, cfg.surroundings)?
+                .with_allowed_roots(cfg.allowed_roots);
         Ok((service, harness))
     })
 }
@@ -157,31 +174,57 @@ pub struct MillService {
     planner: MillPlanner,
     policies: DefaultPolicies,
     limits: Vec<JointLimits>,
+    approach_limits: Vec<kerf_approach::JointLimit>,
+    surroundings: CellSurroundings,
     note: String,
     allowed_roots: AllowedRoots,
 }
 
 impl MillService {
-    /// A service planning with `planner`; `policies` fill `ddpg` / `fixed_g` requests that
-    /// name no policy file; `note` describes the set-up in the start-up log.
+    /// A service planning with `planner`, its approaches and retracts kept clear of the
+    /// shipped collision cell ([`kerf_cell::IRB6660_CELL`]); see
+    /// [`MillService::with_surroundings`].
     ///
     /// # Errors
-    /// [`NodeError::Config`] (`joint_limits`) when a joint of the cell's robot has no
-    /// acceleration limit: the executability check needs it.
+    /// [`NodeError::Config`] (`collision_cell_file`) when the shipped cell does not load, and
+    /// those of [`MillService::with_surroundings`].
     pub fn new(
         planner: MillPlanner,
         policies: DefaultPolicies,
         note: String,
     ) -> Result<Self, NodeError> {
-        let limits = planner
-            .cell()
-            .robot()
+        let surroundings = kerf_cell::milling_surroundings(planner.cell(), None)
+            .map_err(|e| NodeError::config("collision_cell_file", e.to_string()))?;
+        Self::with_surroundings(planner, policies, note, surroundings)
+    }
+
+    /// A service planning with `planner`; `policies` fill `ddpg` / `fixed_g` requests that
+    /// name no policy file; `note` describes the set-up in the start-up log; `surroundings`
+    /// are the robot against the cell's objects, for the approach and retract of every plan
+    /// with a start (issue 27).
+    ///
+    /// # Errors
+    /// [`NodeError::Config`] (`cell_file`) when a joint of the cell's robot has no
+    /// acceleration limit (the executability check needs it) or no jerk limit (the approach
+    /// needs it).
+    pub fn with_surroundings(
+        planner: MillPlanner,
+        policies: DefaultPolicies,
+        note: String,
+        surroundings: CellSurroundings,
+    ) -> Result<Self, NodeError> {
+        let robot = planner.cell().robot();
+        let limits = robot
             .executor_limits()
+            .map_err(|e| NodeError::config("cell_file", e.to_string()))?;
+        let approach_limits = kerf_cell::approach_limits(robot)
             .map_err(|e| NodeError::config("cell_file", e.to_string()))?;
         Ok(Self {
             planner,
             policies,
             limits,
+            approach_limits,
+            surroundings,
             note,
             allowed_roots: AllowedRoots::any(),
         })
@@ -299,18 +342,25 @@ impl PlanningService for MillService {
         }
     }
 
-    /// Busy is QUEUE_FULL; unreadable samples and budgets over `plan_timeout`
-    /// INVALID_REQUEST (no planner named for an unreadable sample); stopped, panicked and not
-    /// executable INTERNAL_ERROR.
+    /// Busy is QUEUE_FULL; unreadable samples, budgets over `plan_timeout` and unusable
+    /// starts INVALID_REQUEST (no planner named for an unreadable sample); no collision-free
+    /// approach or retract NO_APPROACH; stopped, canceled, panicked and not executable
+    /// INTERNAL_ERROR.
     fn failure(&self, key: &AnswerKey, failure: Failure, message: String) -> MillPlan {
         let code = match failure {
-            Failure::Unreadable | Failure::OverBudget | Failure::TooLarge | Failure::BadNumber => {
-                status::INVALID_REQUEST
-            }
+            Failure::Unreadable
+            | Failure::OverBudget
+            | Failure::TooLarge
+            | Failure::BadNumber
+            | Failure::BadStart => status::INVALID_REQUEST,
+            Failure::NoApproach => MillPlan::NO_APPROACH,
             Failure::Busy => convert::QUEUE_FULL,
             Failure::Timeout => status::TIMEOUT,
             Failure::ResourceLimit => status::RESOURCE_LIMIT,
-            Failure::Stopped | Failure::Panicked | Failure::NotExecutable => status::INTERNAL_ERROR,
+            // No CANCELED status in MillPlan: answered like a stop (the message says so).
+            Failure::Stopped | Failure::Canceled | Failure::Panicked | Failure::NotExecutable => {
+                status::INTERNAL_ERROR
+            }
         };
         // An unreadable sample names no planner (not even the default one).
         let planner = match failure {
@@ -322,6 +372,23 @@ impl PlanningService for MillService {
 
     fn joint_limits(&self) -> &[JointLimits] {
         &self.limits
+    }
+
+    fn start_of(&self, request: &MillRequest) -> kerf_approach::StartSpec {
+        request.start.clone()
+    }
+
+    fn approach_limits(&self) -> &[kerf_approach::JointLimit] {
+        &self.approach_limits
+    }
+
+    /// The robot against the collision cell's objects ([`CellSurroundings`], the same for
+    /// every request: a mill request names no workpiece of its own).
+    fn surroundings(
+        &self,
+        _request: &MillRequest,
+    ) -> Result<Box<dyn kerf_approach::Surroundings>, Box<MillPlan>> {
+        Ok(Box::new(self.surroundings.clone()))
     }
 
     fn startup_note(&self) -> String {

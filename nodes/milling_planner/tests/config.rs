@@ -70,6 +70,15 @@ fn shipped_cell_and_policies_by_default_and_replaced_by_parameters() {
     assert_eq!(c.planner.indicator_source(), IndicatorSource::Direct);
     assert_eq!(c.default_policy(PlannerKind::Dp), None);
     assert_eq!(c.default_policy(PlannerKind::Naive), None);
+    // The approach's surroundings: the shipped collision cell (issue 27).
+    assert!(
+        c.surroundings
+            .source()
+            .ends_with("urdf/cells/irb6660_plate.yaml"),
+        "{}",
+        c.surroundings.source()
+    );
+    assert_eq!(c.surroundings.object_names(), ["stock", "fixture_plate"]);
 
     // Explicit cell file and policies; the policies need not exist at start-up.
     let cell = format!("cell_file:={ROOT}/urdf/irb6660_milling.yaml");
@@ -80,8 +89,10 @@ fn shipped_cell_and_policies_by_default_and_replaced_by_parameters() {
         "fixed_g_policy_file:=b.safetensors",
         "indicator_source:=cache",
         "eval_threads:=2",
+        &format!("collision_cell_file:={ROOT}/urdf/cells/irb6660_plate.yaml"),
     ])
     .unwrap();
+    assert!(c.surroundings.source().starts_with(ROOT));
     assert_eq!(c.harness.queue_depth, 3);
     assert_eq!(c.indicator_source, IndicatorSource::Cache);
     assert_eq!(c.planner.indicator_source(), IndicatorSource::Cache);
@@ -125,12 +136,32 @@ fn bad_parameters_are_refused_by_name() {
         "indicator_cache_file",
         "ddpg_policy_file",
         "fixed_g_policy_file",
+        "collision_cell_file",
     ] {
         let e = config(&[&format!("{name}:=''")]).unwrap_err();
         assert!(matches!(e, NodeError::Config { .. }), "{name}: {e}");
         let e = e.to_string();
         assert!(
             e.contains(&format!("'{name}'")) && e.contains("empty"),
+            "{e}"
+        );
+    }
+    // The collision cell is loaded at start-up: a missing file, or a cell of another robot.
+    for (file, expect) in [
+        (
+            "/nonexistent/plate.yaml".to_string(),
+            "/nonexistent/plate.yaml",
+        ),
+        (
+            format!("{ROOT}/urdf/cells/laser_bpillar.yaml"),
+            "robot.name is 'laser_cutter'",
+        ),
+    ] {
+        let e = config(&[&format!("collision_cell_file:={file}")]).unwrap_err();
+        assert!(matches!(e, NodeError::Config { .. }), "{e}");
+        let e = e.to_string();
+        assert!(
+            e.contains("'collision_cell_file'") && e.contains(expect),
             "{e}"
         );
     }

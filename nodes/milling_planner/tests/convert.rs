@@ -44,6 +44,8 @@ fn flags_off_means_the_cell_and_empty_means_the_default() {
             policy_file: None,
             time_budget: None,
             tolerances: None,
+            // No start given: the robot's state when the node has one (issue 27).
+            start: kerf_approach::StartSpec::Default,
         }
     );
     let mut m = message();

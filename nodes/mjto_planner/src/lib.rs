@@ -233,7 +233,9 @@ impl PlanningService for CutService {
             Failure::Busy => status::QUEUE_FULL,
             Failure::Timeout => status::TIMEOUT,
             Failure::ResourceLimit => status::RESOURCE_LIMIT,
-            Failure::Stopped | Failure::Panicked | Failure::NotExecutable => status::INTERNAL_ERROR,
+            Failure::Stopped | Failure::Canceled | Failure::Panicked | Failure::NotExecutable => {
+                status::INTERNAL_ERROR
+            }
         };
         convert::failure_msg(&key.request_id, code, message)
     }

@@ -3,10 +3,9 @@
 //! ([`CollisionWorld::distance_up_to`]), the tool axis by the machine's kinematics (seed 001,
 //! eq. 2).
 
-use kerf_approach::{ApproachError, Clearance, JointLimit, Role, Surroundings};
+use kerf_approach::{ApproachError, Clearance, JointLimit, Surroundings};
 use kerf_mjto::{
     collision::{CollisionWorld, HeadModel},
-    kinematics::tool_axis,
     mesh, CutRequest, LaserMachine, PlanError,
 };
 
@@ -71,20 +70,7 @@ impl Surroundings for LaserSurroundings {
     /// axis `O(q4, q5)` (seed 001 eq. 2: `C = M + q6 O`, the head above the part along `O`);
     /// the head's orientation and standoff are unchanged.
     fn back_off(&self, q: &[f64], distance: f64) -> Result<Vec<f64>, ApproachError> {
-        if q.len() != 6 {
-            return Err(ApproachError::JointCount {
-                what: "tool-axis back-off".into(),
-                expected: 6,
-                found: q.len(),
-            });
-        }
-        let o = tool_axis(q[3], q[4]);
-        let mut out = q.to_vec();
-        for (k, v) in out.iter_mut().take(3).enumerate() {
-            *v += distance * o[k];
-        }
-        kerf_approach::limits::check_configuration(Role::Waypoint(0), &out, &self.limits)?;
-        Ok(out)
+        kerf_mjto::kinematics::tool_axis_back_off(q, distance, &self.limits)
     }
 }
 

@@ -410,11 +410,15 @@ feed_law: constant
         let e = parse_request(&format!("{LINES}start: home\n")).unwrap_err();
         assert!(e.to_string().contains("\"home\""), "{e}");
         let e = parse_request(&format!("{LINES}start_positions: 1 2\n")).unwrap_err();
-        assert!(e.to_string().contains("only read with start \"given\""), "{e}");
-        let e = parse_request(&format!("{LINES}start: given\nstart_positions: 1 nan\n"))
-            .unwrap_err();
+        assert!(
+            e.to_string().contains("only read with start \"given\""),
+            "{e}"
+        );
+        let e =
+            parse_request(&format!("{LINES}start: given\nstart_positions: 1 nan\n")).unwrap_err();
         assert!(e.to_string().contains("start_positions"), "{e}");
-        let yaml = "request_id: y1\npoints: [[0, 0, 0], [0.1, 0, 0]]\naxes: [[0, 0, 1], [0, 0, 1]]\n\
+        let yaml =
+            "request_id: y1\npoints: [[0, 0, 0], [0.1, 0, 0]]\naxes: [[0, 0, 1], [0, 0, 1]]\n\
                     feedrate: 0.3\nsample_period: 0.01\nmax_lead_angle: 0.1\n\
                     max_tilt_angle: 0.1\nmesh: m.stl\nstart: [0.8, 0.7, 1.5, 0, 0, -0.05]\n";
         assert_eq!(

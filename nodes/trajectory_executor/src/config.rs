@@ -25,6 +25,87 @@ pub const KNOWN_PARAMS: &[&str] = &[
     "hardware.*",
 ];
 
+/// Default `hardware.command_topic`: the command topic of ros2_control's
+/// `forward_command_controller` loaded as `forward_position_controller` (its `~/commands`).
+pub const DEFAULT_COMMAND_TOPIC: &str = "/forward_position_controller/commands";
+
+/// Default `hardware.state_topic`: the driver's joint states. Not `/joint_states`, which is the
+/// executor's own output; remap ros2_control's `joint_state_broadcaster` there
+/// (`-r /joint_states:=/driver/joint_states`) or set this parameter.
+pub const DEFAULT_STATE_TOPIC: &str = "/driver/joint_states";
+
+/// Default `hardware.jtc_action`: the action of ros2_control's `joint_trajectory_controller`
+/// loaded as `joint_trajectory_controller`.
+pub const DEFAULT_JTC_ACTION: &str = "/joint_trajectory_controller/follow_joint_trajectory";
+
+/// Default `hardware.feedback_timeout_periods`: 5 control periods (20 ms at 250 Hz), as
+/// ros2_control drivers commonly allow a few missed cycles before they fault.
+pub const DEFAULT_FEEDBACK_TIMEOUT_PERIODS: i64 = 5;
+
+/// Longest feedback silence `hardware.feedback_timeout_periods` may allow (s): beyond a second
+/// a robot moving at speed travels too far on stale feedback for a watchdog to mean anything.
+pub const MAX_FEEDBACK_TIMEOUT_S: f64 = 1.0;
+
+/// Default `hardware.jtc_timeout` (s).
+pub const DEFAULT_JTC_TIMEOUT_S: f64 = 1.0;
+
+/// Largest `hardware.jtc_timeout` (s).
+pub const MAX_JTC_TIMEOUT_S: f64 = 60.0;
+
+/// The message type of the command stream of `hardware: topic`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum CommandType {
+    /// `std_msgs/msg/Float64MultiArray`: one position per joint in the model's joint order
+    /// (ros2_control's `forward_command_controller` `~/commands`).
+    Float64MultiArray,
+    /// `sensor_msgs/msg/JointState`: names and positions (topic-based drivers).
+    JointState,
+}
+
+impl CommandType {
+    /// The ROS type name (`std_msgs/msg/Float64MultiArray`).
+    pub fn ros_type(self) -> &'static str {
+        match self {
+            Self::Float64MultiArray => "std_msgs/msg/Float64MultiArray",
+            Self::JointState => "sensor_msgs/msg/JointState",
+        }
+    }
+}
+
+/// `hardware: topic`: a driver reached through a command topic and a joint-state topic.
+#[derive(Debug, Clone, PartialEq)]
+pub struct TopicConfig {
+    /// Where the commands go (`hardware.command_topic`).
+    pub command_topic: String,
+    /// Their type (`hardware.command_type`).
+    pub command_type: CommandType,
+    /// The driver's measured joint states (`hardware.state_topic`).
+    pub state_topic: String,
+    /// Control periods without a new joint state before the feedback is stale
+    /// (`hardware.feedback_timeout_periods`).
+    pub feedback_timeout_periods: u32,
+}
+
+/// `hardware: jtc`: an external `control_msgs/action/FollowJointTrajectory` server.
+#[derive(Debug, Clone, PartialEq)]
+pub struct JtcConfig {
+    /// The external action (`hardware.jtc_action`).
+    pub action: String,
+    /// An optional joint-state topic of the driver (`hardware.state_topic`).
+    pub state_topic: Option<String>,
+    /// How long to wait for the external server (s, `hardware.jtc_timeout`).
+    pub timeout: f64,
+}
+
+/// A real robot's driver (`hardware: topic` or `hardware: jtc`).
+#[derive(Debug, Clone, PartialEq)]
+pub enum DriverConfig {
+    /// Command stream and measured joint states.
+    Topic(TopicConfig),
+    /// Trajectories forwarded to an external FollowJointTrajectory server.
+    Jtc(JtcConfig),
+}
+
 /// The simulated cell's settings (`hardware: sim`).
 #[derive(Debug, Clone, PartialEq)]
 pub struct SimConfig {
@@ -57,8 +138,10 @@ pub struct NodeConfig {
     pub lag_time_constant: f64,
     /// `SCHED_FIFO` priority of the control thread (1–99); 0 = normal scheduling.
     pub realtime_priority: i64,
-    /// The simulated cell (`hardware: sim`); `None` for the mock hardware.
+    /// The simulated cell (`hardware: sim`); `None` otherwise.
     pub sim: Option<SimConfig>,
+    /// A real robot's driver (`hardware: topic` or `jtc`); `None` otherwise.
+    pub driver: Option<DriverConfig>,
 }
 
 fn param_err(name: &str, reason: String) -> NodeError {
@@ -107,9 +190,26 @@ impl NodeConfig {
     /// * `constraints.stopped_velocity_tolerance` (0.01), `constraints.goal_time` (s, 0 = wait
     ///   forever), `constraints.<joint>.trajectory` and `constraints.<joint>.goal` (position
     ///   tolerances, 0 = unchecked): JTC's names and defaults.
-    /// * `hardware` (`mock` or `sim`, default `mock`): the hardware the control loop drives.
+    /// * `hardware` (`mock`, `sim`, `topic` or `jtc`, default `mock`): the hardware the control
+    ///   loop drives.
     /// * `hardware.lag_time_constant` (s, default 0: the mock follows commands exactly; must
-    ///   be 0 with `hardware: sim`).
+    ///   be 0 with any other hardware).
+    /// * `hardware: topic` (a real robot's driver, e.g. ros2_control with a
+    ///   `forward_command_controller` and a `joint_state_broadcaster`; [`crate::driver`]):
+    ///   `hardware.command_topic` (default [`DEFAULT_COMMAND_TOPIC`]), `hardware.command_type`
+    ///   (`std_msgs/msg/Float64MultiArray`, the default: one position per joint in model order;
+    ///   or `sensor_msgs/msg/JointState`: names and positions), `hardware.state_topic`
+    ///   (`sensor_msgs/msg/JointState`, default [`DEFAULT_STATE_TOPIC`]; never the executor's own
+    ///   topics), `hardware.feedback_timeout_periods` (integer >= 1, default
+    ///   [`DEFAULT_FEEDBACK_TIMEOUT_PERIODS`], at most [`MAX_FEEDBACK_TIMEOUT_S`] of control
+    ///   periods). The robot starts where the driver's first joint state says;
+    ///   `initial_positions` is not used.
+    /// * `hardware: jtc` (an external FollowJointTrajectory server; [`crate::jtc`]):
+    ///   `hardware.jtc_action` (default [`DEFAULT_JTC_ACTION`]; not the executor's own),
+    ///   `hardware.state_topic` (optional: the driver's joint states, the start state of
+    ///   validation), `hardware.jtc_timeout` (s, default [`DEFAULT_JTC_TIMEOUT_S`], at most
+    ///   [`MAX_JTC_TIMEOUT_S`]). Each `hardware.*` parameter is refused with a hardware it
+    ///   does not apply to.
     /// * `sim_cell` (string, required with `hardware: sim`): the cell file (`kerf_cell`);
     ///   `sim_mode` (`kinematic` or `dynamic`, default `kinematic`); `sim_physics_rate` (Hz,
     ///   default 1000, an integer multiple of `control_rate`, at most
@@ -195,10 +295,11 @@ impl NodeConfig {
             }
         }
         for (name, _) in params.iter() {
-            if name.starts_with("hardware.") && name != "hardware.lag_time_constant" {
+            if name.starts_with("hardware.") && !HARDWARE_PARAMS.iter().any(|(p, _)| p == name) {
+                let known: Vec<&str> = HARDWARE_PARAMS.iter().map(|(p, _)| *p).collect();
                 return Err(param_err(
                     name,
-                    "unknown; hardware.lag_time_constant is the only hardware parameter".into(),
+                    format!("unknown; the hardware parameters are {}", known.join(", ")),
                 ));
             }
         }
@@ -221,6 +322,16 @@ impl NodeConfig {
                 ),
             ));
         }
+        let driver = driver_config(params, control_rate)?;
+        if driver.is_some() && lag_time_constant != 0.0 {
+            return Err(param_err(
+                "hardware.lag_time_constant",
+                format!(
+                    "{lag_time_constant}: a lag applies to hardware: mock only (0 or unset with \
+                     a real robot's driver, which has its own dynamics)"
+                ),
+            ));
+        }
         let initial_positions = match (params.f64_array("initial_positions")?, &sim) {
             (Some(v), _) => v,
             (None, Some(sim)) => {
@@ -229,6 +340,19 @@ impl NodeConfig {
                     .robot
                     .initial_positions
             }
+            // With a topic driver the robot starts at the driver's first joint state; until
+            // then the executor holds a placeholder it never commands (the middle of each
+            // joint's range, so that it is valid).
+            (None, None) if matches!(driver, Some(DriverConfig::Topic(_))) => limits
+                .iter()
+                .map(|l| {
+                    if l.min_position.is_finite() && l.max_position.is_finite() {
+                        0.5 * (l.min_position + l.max_position)
+                    } else {
+                        0.0_f64.clamp(l.min_position, l.max_position)
+                    }
+                })
+                .collect(),
             (None, None) => vec![0.0; robot.dof()],
         };
         if initial_positions.len() != robot.dof() {
@@ -257,6 +381,7 @@ impl NodeConfig {
             lag_time_constant,
             realtime_priority,
             sim,
+            driver,
         })
     }
 }
@@ -265,12 +390,12 @@ impl NodeConfig {
 fn sim_config(params: &Params) -> Result<Option<SimConfig>, NodeError> {
     let hardware = params.string("hardware")?;
     match hardware.as_deref().unwrap_or("mock") {
-        "mock" => {
+        kind @ ("mock" | "topic" | "jtc") => {
             for name in ["sim_cell", "sim_mode", "sim_physics_rate"] {
                 if params.get(name).is_some() {
                     return Err(param_err(
                         name,
-                        "applies to hardware: sim only (hardware is mock)".into(),
+                        format!("applies to hardware: sim only (hardware is {kind})"),
                     ));
                 }
             }
@@ -312,7 +437,116 @@ fn sim_config(params: &Params) -> Result<Option<SimConfig>, NodeError> {
         }
         other => Err(param_err(
             "hardware",
-            format!("must be mock or sim, got '{other}'"),
+            format!("must be mock, sim, topic or jtc, got '{other}'"),
         )),
+    }
+}
+
+/// Every `hardware.*` parameter and the hardware kinds it applies to.
+pub const HARDWARE_PARAMS: &[(&str, &[&str])] = &[
+    (
+        "hardware.lag_time_constant",
+        &["mock", "sim", "topic", "jtc"],
+    ),
+    ("hardware.command_topic", &["topic"]),
+    ("hardware.command_type", &["topic"]),
+    ("hardware.state_topic", &["topic", "jtc"]),
+    ("hardware.feedback_timeout_periods", &["topic"]),
+    ("hardware.jtc_action", &["jtc"]),
+    ("hardware.jtc_timeout", &["jtc"]),
+];
+
+/// A topic or action name parameter: a valid ROS name (checked by expansion in the root
+/// namespace; the node checks it again against its own namespace and remappings).
+fn name_param(
+    params: &Params,
+    name: &str,
+    default: Option<&str>,
+) -> Result<Option<String>, NodeError> {
+    let Some(v) = params.string(name)?.or_else(|| default.map(str::to_string)) else {
+        return Ok(None);
+    };
+    kerf_ros::names::expand(&v, "/", crate::DEFAULT_NAME)
+        .map_err(|e| param_err(name, format!("'{v}' is not a valid ROS name: {e}")))?;
+    Ok(Some(v))
+}
+
+/// Reads `hardware: topic|jtc` and their parameters; refuses a `hardware.*` parameter that
+/// does not apply to the hardware chosen.
+fn driver_config(params: &Params, control_rate: f64) -> Result<Option<DriverConfig>, NodeError> {
+    let kind = params.string("hardware")?.unwrap_or_else(|| "mock".into());
+    for (name, applies) in HARDWARE_PARAMS {
+        if params.get(name).is_some() && !applies.contains(&kind.as_str()) {
+            return Err(param_err(
+                name,
+                format!(
+                    "applies to hardware: {} only (hardware is {kind})",
+                    applies.join(" or ")
+                ),
+            ));
+        }
+    }
+    match kind.as_str() {
+        "topic" => {
+            let command_type = match params.string("hardware.command_type")?.as_deref() {
+                None | Some("std_msgs/msg/Float64MultiArray") => CommandType::Float64MultiArray,
+                Some("sensor_msgs/msg/JointState") => CommandType::JointState,
+                Some(other) => {
+                    return Err(param_err(
+                        "hardware.command_type",
+                        format!(
+                            "must be std_msgs/msg/Float64MultiArray or sensor_msgs/msg/JointState, \
+                             got '{other}'"
+                        ),
+                    ))
+                }
+            };
+            let periods = params.i64_or(
+                "hardware.feedback_timeout_periods",
+                DEFAULT_FEEDBACK_TIMEOUT_PERIODS,
+            )?;
+            let max_periods = (MAX_FEEDBACK_TIMEOUT_S * control_rate).floor() as i64;
+            if !(1..=max_periods).contains(&periods) {
+                return Err(param_err(
+                    "hardware.feedback_timeout_periods",
+                    format!(
+                        "{periods}: must be an integer from 1 to {max_periods} (at most \
+                         {MAX_FEEDBACK_TIMEOUT_S} s of control periods at {control_rate} Hz)"
+                    ),
+                ));
+            }
+            let command_topic = name_param(
+                params,
+                "hardware.command_topic",
+                Some(DEFAULT_COMMAND_TOPIC),
+            )?
+            .unwrap_or_default();
+            let state_topic =
+                name_param(params, "hardware.state_topic", Some(DEFAULT_STATE_TOPIC))?
+                    .unwrap_or_default();
+            Ok(Some(DriverConfig::Topic(TopicConfig {
+                command_topic,
+                command_type,
+                state_topic,
+                // In range: checked above (1 ..= 1000 at the highest control rate).
+                feedback_timeout_periods: periods as u32,
+            })))
+        }
+        "jtc" => {
+            let timeout = params.f64_or("hardware.jtc_timeout", DEFAULT_JTC_TIMEOUT_S)?;
+            if !(timeout > 0.0 && timeout <= MAX_JTC_TIMEOUT_S) {
+                return Err(param_err(
+                    "hardware.jtc_timeout",
+                    format!("{timeout} s: must be > 0 and <= {MAX_JTC_TIMEOUT_S} s"),
+                ));
+            }
+            Ok(Some(DriverConfig::Jtc(JtcConfig {
+                action: name_param(params, "hardware.jtc_action", Some(DEFAULT_JTC_ACTION))?
+                    .unwrap_or_default(),
+                state_topic: name_param(params, "hardware.state_topic", None)?,
+                timeout,
+            })))
+        }
+        _ => Ok(None),
     }
 }

@@ -1,6 +1,7 @@
 //! The control thread: read → update → write every control period, and nothing else.
 //!
-//! The thread owns the executor core and the hardware ([`Hardware`]: mock or simulated cell). It never touches DDS except
+//! The thread owns the executor core and the hardware ([`Hardware`]: mock, simulated cell or a
+//! robot driver's topics). It never touches DDS except
 //! through [`Streamer`] queues, never deserializes, validates, copies or frees anything whose
 //! size depends on a trajectory, and never blocks:
 //! * requests arrive as [`Command`]s already prepared by the preparation worker
@@ -13,6 +14,15 @@
 //!   ([`Executor::defer_drops`]);
 //! * answers, goal ends, feedback and log lines go back as [`Report`]s on an unbounded
 //!   channel (a send never blocks).
+//!
+//! # A robot driver (`hardware: topic`)
+//! Each cycle first takes the driver's joint states from their inbox ([`crate::driver`]):
+//! the feedback monitor's faults abort the active goal with a controlled stop
+//! (`Executor::fault`, PATH_TOLERANCE_VIOLATED), good feedback after none or after a fault
+//! moves the hold to the measured state once the robot is at rest (`Executor::hold_at`), and
+//! starts are refused while the feedback is not good. Nothing is commanded before the first
+//! state; after a fault, commands continue until the stop has been commanded to rest, then
+//! pause until good states come back (so a restarted driver never receives a stale hold).
 //!
 //! # Contacts (simulated cell)
 //! After each write the cell's contacts are checked ([`ContactWatch`]). While the reference
@@ -36,7 +46,7 @@ use std::{
 use kerf_cell::Contact;
 use kerf_executor::{
     Cycle, Executor, GoalId as ExecGoalId, GoalTolerances, JointLimits, JointSample, Outcome,
-    PreparedTrajectory, ValidatedTrajectory, PATH_TOLERANCE_VIOLATED,
+    PreparedTrajectory, ValidatedTrajectory, INVALID_GOAL, PATH_TOLERANCE_VIOLATED,
 };
 use kerf_msgs::{
     control_msgs::{FollowJointTrajectoryFeedback, JointTrajectoryControllerState},
@@ -49,12 +59,19 @@ use kerf_msgs::{
 use kerf_ros::{LogLevel, Streamer};
 
 use crate::convert::{self, Clock, Rejection};
+use crate::driver::FeedbackEvent;
 use crate::hardware::Hardware;
 
 /// A contact present when a motion started stays tolerated while its signed distance does
 /// not fall more than this below the distance it had then (m): 0.1 mm, above the cell's
 /// distance noise, well below the depths a fault is meant to catch.
 pub const DEEPER: f64 = 1e-4;
+
+/// `hardware: topic`: how long the measured state must stay within the start tolerance before
+/// the hold moves to it after a driver fault (s). Ten periods of a 250 Hz driver: longer than
+/// the lag of a driver that follows the commands, so that a robot still catching up with the
+/// stop is not mistaken for one at rest elsewhere.
+pub const SETTLE: f64 = 0.04;
 
 /// Commands the control thread takes in one cycle at most; the rest wait for the next cycle,
 /// so a burst of requests costs at most this many O(joints) hand-overs per cycle.
@@ -89,6 +106,12 @@ pub enum Command {
     Stop {
         /// The request's ticket.
         tag: u64,
+    },
+    /// `hardware: topic`: the request thread's check of the driver topics' types found an
+    /// endpoint of another type (the message), or none any more.
+    DriverTypes {
+        /// What is wrong, or `None`.
+        fault: Option<String>,
     },
 }
 
@@ -306,6 +329,17 @@ pub struct ControlLoop {
     next_feedback: f64,
     publish_failures: u64,
     cycle_failures: u64,
+    /// `hardware: topic`: the hold moves to the measured state once the robot is at rest
+    /// (after the first good joint state, and after a driver fault).
+    resync: bool,
+    /// Why the last attempt to hold at the measured state failed.
+    resync_failed: Option<String>,
+    /// Reused buffer of the driver's feedback events.
+    driver_events: Vec<FeedbackEvent>,
+    /// Whether the last command sent to the hardware was at rest.
+    rest_sent: bool,
+    /// The pending re-synchronization is the first state's.
+    resync_first: bool,
 }
 
 impl ControlLoop {
@@ -342,6 +376,11 @@ impl ControlLoop {
             next_feedback: 0.0,
             publish_failures: 0,
             cycle_failures: 0,
+            resync: false,
+            resync_failed: None,
+            driver_events: Vec::with_capacity(4),
+            rest_sent: false,
+            resync_first: false,
         }
     }
 
@@ -374,6 +413,7 @@ impl ControlLoop {
             }
             // The cycle's time, after the hand-over.
             let now = self.clock.now();
+            self.poll_driver(now);
             let mut batch = std::mem::take(&mut self.batch);
             for c in batch.drain(..) {
                 self.apply(c, now);
@@ -406,9 +446,189 @@ impl ControlLoop {
         }
     }
 
+    /// `hardware: topic`: takes the driver's joint states and checks its watchdog; a fault
+    /// aborts the active goal with a controlled stop, good feedback (first, or after a fault)
+    /// moves the hold to the measured state once the robot is at rest. Good states are
+    /// republished on `joint_states` as received.
+    fn poll_driver(&mut self, now: f64) {
+        let Some(driver) = self.hw.topic() else {
+            return;
+        };
+        let mut events = std::mem::take(&mut self.driver_events);
+        driver.poll(now, &mut events);
+        let f = &mut self.publish_failures;
+        for js in driver.take_received() {
+            Self::publish(
+                &self.streams.joint_states,
+                js,
+                f,
+                &self.reports,
+                "joint states",
+            );
+        }
+        for event in events.drain(..) {
+            self.on_feedback(event, now);
+        }
+        self.driver_events = events;
+        self.resync_at_rest(now);
+    }
+
+    fn on_feedback(&mut self, event: FeedbackEvent, now: f64) {
+        let topic = match &self.hw {
+            Hardware::Topic(d) => d.monitor().topic().to_string(),
+            _ => return,
+        };
+        match event {
+            FeedbackEvent::Fault(message) => {
+                let moving = self.exec.active_goal().is_some() || self.exec.is_moving(now);
+                if moving {
+                    let message = format!("{message}; the motion was brought to a controlled stop");
+                    self.log(LogLevel::Error, message.clone());
+                    if let Err(e) = self.exec.fault(now, PATH_TOLERANCE_VIOLATED, message) {
+                        self.log(LogLevel::Error, format!("driver fault: {e}"));
+                    }
+                } else {
+                    self.log(LogLevel::Error, message);
+                }
+            }
+            FeedbackEvent::Good { first } => {
+                self.resync = true;
+                self.resync_first |= first;
+                let message = if first {
+                    format!("first joint state from the driver on {topic}; goals are accepted")
+                } else {
+                    format!(
+                        "good joint states on {topic} again; goals are accepted once the robot \
+                         is at rest at the hold (or still elsewhere: the hold then moves there)"
+                    )
+                };
+                self.log(LogLevel::Info, message);
+            }
+        }
+    }
+
+    /// Ends a pending re-synchronization once the feedback is good and the commanded motion
+    /// has ended: at once for the first state (nothing was commanded yet); otherwise when the
+    /// measured state is within the start tolerance of the hold (the robot followed the
+    /// stop: the hold stays, no jump), or, when it is not, once it has been still for
+    /// [`SETTLE`] (the robot is elsewhere, e.g. a restarted driver: the hold moves there).
+    fn resync_at_rest(&mut self, now: f64) {
+        if !self.resync || self.exec.active_goal().is_some() || self.exec.is_moving(now) {
+            return;
+        }
+        let Hardware::Topic(d) = &self.hw else {
+            return;
+        };
+        let m = d.monitor();
+        if !m.is_good() {
+            return;
+        }
+        let positions = m.measured().positions.clone();
+        if !self.resync_first {
+            let off = positions
+                .iter()
+                .zip(&self.exec.commanded().positions)
+                .map(|(a, b)| (a - b).abs())
+                .fold(0.0, f64::max);
+            if off <= self.exec.config().start_tolerance {
+                self.resync = false;
+                self.resync_failed = None;
+                self.log(
+                    LogLevel::Info,
+                    format!("the robot is at the hold (within {off:.2e}); goals are accepted"),
+                );
+                return;
+            }
+            if m.still_for(now) < SETTLE {
+                return;
+            }
+        }
+        match self.exec.hold_at(now, &positions) {
+            Ok(()) => {
+                self.resync = false;
+                self.resync_first = false;
+                self.resync_failed = None;
+                self.log(
+                    LogLevel::Info,
+                    format!("holding at the measured state {positions:?}"),
+                );
+            }
+            Err(e) => {
+                let message = format!(
+                    "cannot hold at the driver's measured state: {e}; goals are refused until \
+                     the robot reports a valid state"
+                );
+                if self.resync_failed.as_ref() != Some(&message) {
+                    self.log(LogLevel::Error, message.clone());
+                    self.resync_failed = Some(message);
+                }
+            }
+        }
+    }
+
+    /// Whether a topic driver's feedback is good and the hold is where the robot is.
+    fn driver_ready(&self) -> bool {
+        match &self.hw {
+            Hardware::Topic(d) => d.monitor().is_good() && !self.resync,
+            _ => true,
+        }
+    }
+
+    /// Why a goal cannot start now because of the driver (`hardware: topic`), if it cannot.
+    fn driver_refusal(&self) -> Option<Rejection> {
+        let Hardware::Topic(d) = &self.hw else {
+            return None;
+        };
+        let message = d.monitor().refusal().or_else(|| {
+            self.resync.then(|| {
+                self.resync_failed.clone().unwrap_or_else(|| {
+                    "the robot is coming to rest after a driver fault; goals are accepted once \
+                     the measured state is at the hold, or still elsewhere"
+                        .to_string()
+                })
+            })
+        })?;
+        Some(Rejection {
+            code: INVALID_GOAL,
+            message,
+        })
+    }
+
     /// Applies one command at the cycle time `now`, in O(joints).
     fn apply(&mut self, command: Command, now: f64) {
         match command {
+            Command::Start {
+                tag,
+                prepared,
+                tolerances,
+            } if self.driver_refusal().is_some() => {
+                drop(tolerances);
+                self.report(Report::Trash(Trash::Prepared(prepared)));
+                if let Some(rejection) = self.driver_refusal() {
+                    self.report(Report::Refused { tag, rejection });
+                }
+            }
+            Command::Validate {
+                tag,
+                prepared,
+                tolerances,
+            } if self.driver_refusal().is_some() => {
+                drop(tolerances);
+                self.report(Report::Trash(Trash::Prepared(prepared)));
+                if let Some(rejection) = self.driver_refusal() {
+                    self.report(Report::Validated {
+                        tag,
+                        result: Err(rejection),
+                    });
+                }
+            }
+            Command::DriverTypes { fault } => {
+                if let Some(d) = self.hw.topic() {
+                    if let Some(event) = d.monitor_mut().set_type_fault(fault) {
+                        self.on_feedback(event, now);
+                    }
+                }
+            }
             Command::Start {
                 tag,
                 prepared,
@@ -535,7 +755,15 @@ impl ControlLoop {
     }
 
     /// Read → update → write at `now`, then the state streams, goal ends and feedback.
+    ///
+    /// A topic driver's robot is not commanded before its first joint state: until then the
+    /// cycle does nothing.
     fn control_cycle(&mut self, now: f64) {
+        let topic = match &self.hw {
+            Hardware::Topic(d) if !d.monitor().has_state() => return,
+            Hardware::Topic(_) => true,
+            _ => false,
+        };
         let measured = self.hw.state().clone();
         self.efforts.clear();
         self.efforts.extend_from_slice(self.hw.efforts());
@@ -554,14 +782,30 @@ impl ControlLoop {
             self.cycle = cycle;
             return;
         }
-        if let Err(e) = self
-            .hw
-            .write(&self.cfg.limits, &cycle.reference, self.cfg.control_period)
-        {
-            self.log(
-                LogLevel::Error,
-                format!("hardware refused the command: {e}"),
-            );
+        // A topic driver is commanded while its feedback is good, and after a fault until
+        // the controlled stop has been commanded to rest: a driver that comes back (a restart,
+        // elsewhere) must not get a stale hold before the hold has moved to where it is.
+        let send = !topic || self.driver_ready() || self.exec.is_moving(now) || !self.rest_sent;
+        if send {
+            if let Err(e) =
+                self.hw
+                    .write(&self.cfg.limits, &cycle.reference, self.cfg.control_period)
+            {
+                self.log(
+                    LogLevel::Error,
+                    format!("hardware refused the command: {e}"),
+                );
+            }
+            let at_rest = cycle.reference.velocities.iter().all(|v| *v == 0.0);
+            if topic && at_rest && !self.rest_sent && !self.driver_ready() {
+                self.log(
+                    LogLevel::Warn,
+                    "the robot is commanded to rest; commands to the driver pause until good \
+                     joint states come back"
+                        .into(),
+                );
+            }
+            self.rest_sent = at_rest;
         }
         self.after_write(now);
         let header = Header {
@@ -589,20 +833,25 @@ impl ControlLoop {
             ..Default::default()
         };
         let f = &mut self.publish_failures;
-        Self::publish(
-            &self.streams.joint_states,
-            js,
-            f,
-            &self.reports,
-            "joint states",
-        );
-        Self::publish(
-            &self.streams.command,
-            cmd,
-            f,
-            &self.reports,
-            "joint command",
-        );
+        // A topic driver's states are republished as they come (`poll_driver`).
+        if !topic {
+            Self::publish(
+                &self.streams.joint_states,
+                js,
+                f,
+                &self.reports,
+                "joint states",
+            );
+        }
+        if send {
+            Self::publish(
+                &self.streams.command,
+                cmd,
+                f,
+                &self.reports,
+                "joint command",
+            );
+        }
         let cs = &self.streams.controller_state;
         Self::publish(cs, state, f, &self.reports, "controller state");
 

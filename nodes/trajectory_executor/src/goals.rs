@@ -92,14 +92,24 @@ impl ExecutorNode {
                 stamp: g.accepted,
             });
             // A goal still being prepared ends when its preparation comes back; one handed to
-            // the control thread is canceled there (after its start, if that is still queued).
+            // the control thread is canceled there (after its start, if that is still queued);
+            // one forwarded to an external server (`hardware: jtc`) is canceled there.
             if let Some(ticket) = g.ticket {
-                to_control.push(ticket);
+                to_control.push((ticket, g.exec_id));
             }
         }
-        for ticket in to_control {
-            if !self.jobs.contains_key(&ticket) {
-                let _ = self.commands.send(control::Command::Cancel { tag: ticket });
+        for (ticket, exec_id) in to_control {
+            if self.jobs.contains_key(&ticket) {
+                continue;
+            }
+            match (self.jtc.as_mut(), exec_id) {
+                (Some(f), Some(exec_id)) => {
+                    f.cancel(exec_id);
+                }
+                (Some(_), None) => {}
+                (None, _) => {
+                    let _ = self.commands.send(control::Command::Cancel { tag: ticket });
+                }
             }
         }
         if !canceling.is_empty() {

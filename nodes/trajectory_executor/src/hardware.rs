@@ -1,11 +1,13 @@
-//! The hardware the control loop drives: the mock (`hardware: mock`) or the simulated cell
-//! (`hardware: sim`, `kerf_cell`). The control loop is the same for both: read the state,
-//! write a command for one control period.
+//! The hardware the control loop drives: the mock (`hardware: mock`), the simulated cell
+//! (`hardware: sim`, `kerf_cell`) or a real robot's driver over topics (`hardware: topic`,
+//! [`crate::driver`]). The control loop is the same for all: read the state, write a command
+//! for one control period. (`hardware: jtc` has no control loop: trajectories go to an
+//! external FollowJointTrajectory server, [`crate::jtc`].)
 
 use kerf_cell::{Cell, CellError, CellSettings, CellState};
 use kerf_executor::{JointLimits, JointSample, MockHardware};
 
-use crate::{config::SimConfig, NodeConfig, NodeError};
+use crate::{config::SimConfig, driver::TopicDriver, NodeConfig, NodeError};
 
 /// The hardware behind the control loop.
 #[derive(Debug)]
@@ -14,6 +16,8 @@ pub enum Hardware {
     Mock(MockHardware),
     /// A simulated cell on rapier, stepped in lock-step with the control loop.
     Sim(Box<SimHardware>),
+    /// A real robot's driver: commands out, measured joint states in.
+    Topic(Box<TopicDriver>),
 }
 
 /// The simulated cell and its state as the executor measures it.
@@ -83,8 +87,17 @@ impl Hardware {
     /// The hardware `cfg` asks for, at rest at its initial positions.
     ///
     /// # Errors
-    /// See [`load_cell`]; for the mock, an invalid lag time constant.
+    /// See [`load_cell`]; for the mock, an invalid lag time constant; `hardware: topic` and
+    /// `jtc` are refused (their endpoints are made by the node: [`TopicDriver`]).
     pub fn build(cfg: &NodeConfig) -> Result<Self, NodeError> {
+        if cfg.driver.is_some() {
+            return Err(NodeError::Config {
+                name: "hardware".into(),
+                reason: "a real robot's driver is reached through the node's DDS endpoints; \
+                         Hardware::build makes the mock or the simulated cell only"
+                    .into(),
+            });
+        }
         match &cfg.sim {
             None => Ok(Self::Mock(MockHardware::with_lag(
                 cfg.initial_positions.clone(),
@@ -100,18 +113,20 @@ impl Hardware {
         Self::Sim(Box::new(SimHardware { cell, measured }))
     }
 
-    /// The measured state (positions, velocities, accelerations), model order.
+    /// The measured state (positions, velocities, accelerations), model order. For a topic
+    /// driver: the latest good joint state (velocities when it gives them, no accelerations).
     pub fn state(&self) -> &JointSample {
         match self {
             Self::Mock(m) => m.state(),
             Self::Sim(s) => &s.measured,
+            Self::Topic(d) => d.monitor().measured(),
         }
     }
 
     /// Measured efforts (N or N m), model order; empty for the mock (it has none).
     pub fn efforts(&self) -> &[f64] {
         match self {
-            Self::Mock(_) => &[],
+            Self::Mock(_) | Self::Topic(_) => &[],
             Self::Sim(s) => &s.cell.state().efforts,
         }
     }
@@ -119,13 +134,21 @@ impl Hardware {
     /// The simulated cell's state (contacts, tracking error, time); `None` for the mock.
     pub fn sim_state(&self) -> Option<&CellState> {
         match self {
-            Self::Mock(_) => None,
+            Self::Mock(_) | Self::Topic(_) => None,
             Self::Sim(s) => Some(s.cell.state()),
         }
     }
 
+    /// The topic driver, if that is the hardware.
+    pub fn topic(&mut self) -> Option<&mut TopicDriver> {
+        match self {
+            Self::Topic(d) => Some(d),
+            _ => None,
+        }
+    }
+
     /// Applies `command` for one control period `dt` (s): the mock follows it, the cell runs
-    /// its physics sub-steps towards it.
+    /// its physics sub-steps towards it, a topic driver gets it on its command topic.
     ///
     /// # Returns
     /// The measured state at the end of the period.
@@ -143,6 +166,10 @@ impl Hardware {
                 m.write(limits, command, dt).map_err(|e| e.to_string())?;
                 Ok(m.state())
             }
+            Self::Topic(d) => match d.send(command) {
+                Some(warning) => Err(warning),
+                None => Ok(d.monitor().measured()),
+            },
             Self::Sim(s) => {
                 let state = s.cell.step(command, dt).map_err(|e| e.to_string())?;
                 s.measured.positions.clone_from(&state.positions);

@@ -15,6 +15,9 @@
 //! | `~/trajectory_status` | `kerf_msgs/msg/TrajectoryStatus` | accepted / rejected / finished |
 //! | `/clock` | `rosgraph_msgs/msg/Clock` | simulated time, every control cycle (`hardware: sim`) |
 //! | `~/contacts` | `kerf_msgs/msg/CellContacts` | the cell's contacts, every control cycle (`hardware: sim`) |
+//! | `hardware.command_topic` | `std_msgs/msg/Float64MultiArray` or `sensor_msgs/msg/JointState` | commands to a robot driver, every control cycle (`hardware: topic`) |
+//! | `hardware.state_topic` | `sensor_msgs/msg/JointState` | subscription: the driver's measured state (`hardware: topic`; optional with `jtc`) |
+//! | `hardware.jtc_action` | `control_msgs/action/FollowJointTrajectory` | action client: an external trajectory controller (`hardware: jtc`) |
 //!
 //! # Hardware
 //! `hardware: mock` (the default) drives `kerf_executor::MockHardware`; `hardware: sim`
@@ -31,6 +34,21 @@
 //!   stop within the limits and the goal is aborted (PATH_TOLERANCE_VIOLATED) with a message
 //!   naming the links, the objects and the depths. Contacts present when a motion starts are
 //!   tolerated while they do not get deeper, so that the robot can be moved out of them.
+//!
+//!
+//! `hardware: topic` drives a real robot's driver ([`driver`], issue 27): the command of every
+//! control cycle goes to `hardware.command_topic` (ros2_control's `forward_command_controller`
+//! or a topic-based driver), the measured state comes from `hardware.state_topic`, and path
+//! and goal tolerances are judged on it. Goals wait for the driver's first state, which
+//! becomes the robot's start; a watchdog (`hardware.feedback_timeout_periods`), refused states
+//! (NaN, a missing joint), stamps that go back, unreadable samples and driver topics of
+//! another type abort the running goal (PATH_TOLERANCE_VIOLATED, the fault named) with a
+//! controlled stop and refuse new goals until good states come back. `joint_states`
+//! republishes the driver's good states as received.
+//!
+//! `hardware: jtc` forwards each validated trajectory to an external FollowJointTrajectory
+//! server ([`jtc`]) and relays acceptance, feedback, results and cancels; there is no control
+//! loop then.
 //!
 //! # Threads
 //! * **control** ([`control::ControlLoop`]): read → update → write every control period. It
@@ -58,8 +76,10 @@ pub mod action;
 pub mod config;
 pub mod control;
 pub mod convert;
+pub mod driver;
 mod goals;
 pub mod hardware;
+pub mod jtc;
 pub mod memory;
 mod validate_service;
 
@@ -88,7 +108,7 @@ use kerf_msgs::{
     rosgraph_msgs::Clock as ClockMsg,
     sensor_msgs::JointState,
     srv::{ValidateTrajectoryRequest, ValidateTrajectoryResponse},
-    std_msgs::Header,
+    std_msgs::{Float64MultiArray, Header},
     trajectory_msgs::JointTrajectory,
     RosType,
 };
@@ -102,8 +122,10 @@ use ros2_client::{
     RmwRequestId, Server,
 };
 
+use config::{CommandType, DriverConfig, JtcConfig, TopicConfig};
 pub use config::{NodeConfig, KNOWN_PARAMS};
 use convert::{Clock, Rejection};
+use driver::{CommandStream, FeedbackMonitor, TopicDriver, TopicRole};
 
 /// Default node name.
 pub const DEFAULT_NAME: &str = "trajectory_executor";
@@ -115,7 +137,9 @@ const STREAM_QUEUE: usize = 64;
 /// polls its DDS endpoints again.
 const REQUEST_POLL: StdDuration = StdDuration::from_millis(1);
 
-/// Why the node could not start.
+/// What goes wrong in the node: why it could not start, and the faults of a real robot's
+/// driver (`hardware: topic` or `jtc`), which abort goals and refuse new ones but never end
+/// the node.
 #[derive(Debug, thiserror::Error)]
 pub enum NodeError {
     /// Environment, arguments, names or DDS.
@@ -133,6 +157,86 @@ pub enum NodeError {
         /// Parameter.
         name: String,
         /// What is wrong.
+        reason: String,
+    },
+    /// No joint state has come from the driver yet.
+    #[error("waiting for the driver: no joint state on {topic} yet")]
+    WaitingForDriver {
+        /// The driver's joint-state topic.
+        topic: String,
+    },
+    /// The driver's joint states stopped coming ([`kerf_executor::FeedbackWatchdog`]).
+    #[error(
+        "feedback stale: no joint state on {topic} for {age_ms:.1} ms ({periods:.1} control \
+         periods; hardware.feedback_timeout_periods allows {allowed})"
+    )]
+    FeedbackStale {
+        /// The driver's joint-state topic.
+        topic: String,
+        /// Time since the last state (ms).
+        age_ms: f64,
+        /// The same in control periods.
+        periods: f64,
+        /// The periods allowed.
+        allowed: u32,
+    },
+    /// A joint state's stamp is older than the previous one's.
+    #[error(
+        "feedback stamp went back on {topic}: stamp {got} after {previous} (the driver's clock \
+         stepped back, or a sample came out of order); the state was not used"
+    )]
+    FeedbackStampBack {
+        /// The driver's joint-state topic.
+        topic: String,
+        /// The previous stamp (`sec.nanosec`).
+        previous: String,
+        /// The new stamp (`sec.nanosec`).
+        got: String,
+    },
+    /// A joint state that `kerf_executor::measured_state` refuses (NaN, a missing joint, wrong
+    /// lengths), or a position outside the robot's limits.
+    #[error("bad joint state on {topic}: {reason}")]
+    BadFeedback {
+        /// The driver's joint-state topic.
+        topic: String,
+        /// What is wrong, naming the joint.
+        reason: String,
+    },
+    /// A sample on the driver's joint-state topic could not be read.
+    #[error("could not read a joint state on {topic} (is it a {expected}?): {reason}")]
+    UnreadableFeedback {
+        /// The driver's joint-state topic.
+        topic: String,
+        /// The type the executor reads.
+        expected: &'static str,
+        /// The reader's error.
+        reason: String,
+    },
+    /// A driver topic has an endpoint of another type on the domain.
+    #[error(
+        "driver topic {topic} has a {endpoint} of type {found}, but the executor {role} \
+         {expected} there; fix the driver's or the executor's configuration \
+         (hardware.command_type, hardware.state_topic, hardware.command_topic)"
+    )]
+    WrongTopicType {
+        /// The topic.
+        topic: String,
+        /// "publisher" or "subscription".
+        endpoint: &'static str,
+        /// Its type.
+        found: String,
+        /// "reads" or "publishes".
+        role: &'static str,
+        /// The executor's type.
+        expected: &'static str,
+    },
+    /// The external FollowJointTrajectory server of `hardware: jtc` refused a goal, did not
+    /// answer, or went away.
+    #[error("external FollowJointTrajectory server {action}: {reason}")]
+    ExternalServer {
+        /// The external action.
+        action: String,
+        /// What happened.
         reason: String,
     },
 }
@@ -251,11 +355,178 @@ struct ExecutorNode {
     reports: Receiver<control::Report>,
     control_running: Arc<AtomicBool>,
     control: Option<JoinHandle<()>>,
+    /// `hardware: jtc`: the external server (no control thread then).
+    jtc: Option<Box<jtc::Forwarder>>,
+    jtc_events: Vec<jtc::JtcEvent>,
+    /// `hardware: topic`: the check of the driver topics' types.
+    driver_types: Option<TypeWatch>,
     statuses_changed: bool,
     publish_failures: u64,
     clock: Clock,
     log: Logger,
     node: KerfNode,
+}
+
+/// What runs the trajectories: the control loop (mock, simulated cell, topic driver), or an
+/// external FollowJointTrajectory server.
+enum Backend {
+    Control {
+        hw: hardware::Hardware,
+        joint_states: Streamer<JointState>,
+    },
+    Jtc(Box<jtc::Forwarder>),
+}
+
+/// How often the request thread checks the types of a topic driver's endpoints (discovery
+/// changes at DDS's pace: a second or so).
+const TYPE_CHECK_PERIOD: StdDuration = StdDuration::from_millis(200);
+
+/// The check of a topic driver's topics for endpoints of another type
+/// ([`driver::check_topic_types`]), run on the request thread.
+struct TypeWatch {
+    state_topic: String,
+    command_topic: String,
+    command_type: &'static str,
+    last: Option<String>,
+    next: std::time::Instant,
+}
+
+/// The executor's own topics, resolved: a driver topic must be none of them.
+fn own_topics(node: &KerfNode) -> Result<Vec<String>, NodeError> {
+    [
+        "joint_states",
+        "~/joint_command",
+        "~/controller_state",
+        "~/trajectory_status",
+        "~/joint_trajectory",
+        "~/contacts",
+        "/clock",
+    ]
+    .iter()
+    .map(|t| node.resolve(t).map_err(NodeError::from))
+    .collect()
+}
+
+/// A driver topic parameter resolved as the node sees it, refused when it is one of the
+/// executor's own topics.
+fn driver_topic(node: &KerfNode, param: &str, topic: &str) -> Result<String, NodeError> {
+    let resolved = node.resolve(topic).map_err(|e| NodeError::Config {
+        name: param.into(),
+        reason: e.to_string(),
+    })?;
+    if own_topics(node)?.contains(&resolved) {
+        return Err(NodeError::Config {
+            name: param.into(),
+            reason: format!(
+                "'{topic}' resolves to {resolved}, a topic of the executor itself; the driver \
+                 needs topics of its own (e.g. /driver/joint_states, with ros2_control's \
+                 joint_state_broadcaster remapped there)"
+            ),
+        });
+    }
+    Ok(resolved)
+}
+
+/// The endpoints of `hardware: topic`: the joint-state inbox, the command stream, the
+/// feedback monitor, and the type check of both topics.
+fn topic_driver(
+    node: &mut KerfNode,
+    cfg: &NodeConfig,
+    t: &TopicConfig,
+    clock: &Clock,
+) -> Result<(TopicDriver, TypeWatch), NodeError> {
+    let state_topic = driver_topic(node, "hardware.state_topic", &t.state_topic)?;
+    let command_topic = driver_topic(node, "hardware.command_topic", &t.command_topic)?;
+    if state_topic == command_topic {
+        return Err(NodeError::Config {
+            name: "hardware.state_topic".into(),
+            reason: format!(
+                "{state_topic} is also hardware.command_topic; the driver's joint states and \
+                 the commands need two topics"
+            ),
+        });
+    }
+    let (q, rate) = (STREAM_QUEUE, cfg.control_rate);
+    let states = node.inbox(&state_topic, JointState::ROS_TYPE, qos::state())?;
+    let command = match t.command_type {
+        CommandType::Float64MultiArray => CommandStream::Array(node.streamer(
+            &command_topic,
+            Float64MultiArray::ROS_TYPE,
+            qos::state(),
+            q,
+            rate,
+        )?),
+        CommandType::JointState => CommandStream::State(node.streamer(
+            &command_topic,
+            JointState::ROS_TYPE,
+            qos::state(),
+            q,
+            rate,
+        )?),
+    };
+    let monitor = FeedbackMonitor::new(
+        &state_topic,
+        cfg.limits.clone(),
+        cfg.executor.control_period,
+        t.feedback_timeout_periods,
+        cfg.executor.start_tolerance,
+    )?;
+    let names = cfg.limits.iter().map(|l| l.name.clone()).collect();
+    let watch = TypeWatch {
+        state_topic: state_topic.clone(),
+        command_topic,
+        command_type: t.command_type.ros_type(),
+        last: None,
+        next: std::time::Instant::now(),
+    };
+    Ok((
+        TopicDriver::new(monitor, states, command, names, clock.clone()),
+        watch,
+    ))
+}
+
+/// The external server's client and the optional joint-state inbox of `hardware: jtc`.
+fn jtc_forwarder(
+    node: &mut KerfNode,
+    cfg: &NodeConfig,
+    j: &JtcConfig,
+    joint_states: Streamer<JointState>,
+) -> Result<jtc::Forwarder, NodeError> {
+    let action = node.resolve(&j.action).map_err(|e| NodeError::Config {
+        name: "hardware.jtc_action".into(),
+        reason: e.to_string(),
+    })?;
+    if action == node.resolve("~/follow_joint_trajectory")? {
+        return Err(NodeError::Config {
+            name: "hardware.jtc_action".into(),
+            reason: format!(
+                "'{}' resolves to {action}, the executor's own action: goals would be forwarded \
+                 to itself",
+                j.action
+            ),
+        });
+    }
+    let states = match &j.state_topic {
+        None => None,
+        Some(t) => {
+            let topic = driver_topic(node, "hardware.state_topic", t)?;
+            Some((
+                node.inbox(&topic, JointState::ROS_TYPE, qos::state())?,
+                topic,
+            ))
+        }
+    };
+    let client = node.action_client(&action, "control_msgs/action/FollowJointTrajectory")?;
+    Ok(jtc::Forwarder::new(
+        client,
+        action,
+        j.timeout,
+        cfg.limits.clone(),
+        cfg.executor.clone(),
+        states,
+        joint_states,
+        cfg.initial_positions.clone(),
+    ))
 }
 
 impl ExecutorNode {
@@ -265,7 +536,6 @@ impl ExecutorNode {
             cfg.executor.clone(),
             cfg.initial_positions.clone(),
         )?;
-        let hw = hardware::Hardware::build(&cfg)?;
         // Read on its own thread: deserializing a large trajectory takes milliseconds.
         let traj_sub = node.inbox(
             "~/joint_trajectory",
@@ -278,48 +548,31 @@ impl ExecutorNode {
         )?;
         let validate_srv =
             node.service_server("~/validate_trajectory", "kerf_msgs/srv/ValidateTrajectory")?;
-        // Outgoing streams leave the control thread through bounded queues: a stalled
-        // subscriber can cost samples but never blocks the control loop. Each is published
-        // once per control period at most, and its writer's send window outlasts the lease of
-        // a reader that stops acknowledging (`kerf_ros::qos::send_window`): a dead reader
-        // never stalls the others.
+        let clock = if cfg.sim.is_some() {
+            Clock::simulated()
+        } else {
+            Clock::start()
+        };
         let (q, rate) = (STREAM_QUEUE, cfg.control_rate);
-        let streams = control::Streams {
-            joint_states: node.streamer(
-                "joint_states",
-                JointState::ROS_TYPE,
-                qos::state(),
-                q,
-                rate,
-            )?,
-            controller_state: node.streamer(
-                "~/controller_state",
-                JointTrajectoryControllerState::ROS_TYPE,
-                qos::state(),
-                q,
-                rate,
-            )?,
-            command: node.streamer(
-                "~/joint_command",
-                JointState::ROS_TYPE,
-                qos::state(),
-                q,
-                rate,
-            )?,
-            sim: match &cfg.sim {
-                None => None,
-                Some(_) => Some(control::SimStreams {
-                    clock: node.streamer("/clock", ClockMsg::ROS_TYPE, qos::state(), q, rate)?,
-                    contacts: node.streamer(
-                        "~/contacts",
-                        CellContacts::ROS_TYPE,
-                        qos::state(),
-                        q,
-                        rate,
-                    )?,
-                    frame_id: cfg.robot.root_link().to_string(),
-                }),
+        let joint_states =
+            node.streamer("joint_states", JointState::ROS_TYPE, qos::state(), q, rate)?;
+        let mut driver_types = None;
+        let backend = match &cfg.driver {
+            None => Backend::Control {
+                hw: hardware::Hardware::build(&cfg)?,
+                joint_states,
             },
+            Some(DriverConfig::Topic(t)) => {
+                let (driver, watch) = topic_driver(&mut node, &cfg, t, &clock)?;
+                driver_types = Some(watch);
+                Backend::Control {
+                    hw: hardware::Hardware::Topic(Box::new(driver)),
+                    joint_states,
+                }
+            }
+            Some(DriverConfig::Jtc(j)) => {
+                Backend::Jtc(Box::new(jtc_forwarder(&mut node, &cfg, j, joint_states)?))
+            }
         };
         let status = node.streamer(
             "~/trajectory_status",
@@ -329,11 +582,6 @@ impl ExecutorNode {
             rate,
         )?;
         let log = node.logger();
-        let clock = if cfg.sim.is_some() {
-            Clock::simulated()
-        } else {
-            Clock::start()
-        };
         let (limits, exec_cfg) = (cfg.limits.clone(), cfg.executor.clone());
         let prep_clock = clock.clone();
         let prep = Worker::spawn("prepare", 1, move |incoming: Incoming| {
@@ -367,74 +615,93 @@ impl ExecutorNode {
         let (commands, command_rx) = channel();
         let (report_tx, reports) = channel();
         let control_running = Arc::new(AtomicBool::new(true));
-        let loop_cfg = control::LoopConfig {
-            limits: cfg.limits.clone(),
-            control_rate: cfg.control_rate,
-            action_monitor_rate: cfg.action_monitor_rate,
-            control_period: cfg.executor.control_period,
-        };
-        let mut control_loop = control::ControlLoop::new(
-            exec,
-            hw,
-            loop_cfg,
-            streams,
-            command_rx,
-            report_tx,
-            Arc::clone(&control_running),
-            clock.clone(),
-        );
-        let priority = cfg.realtime_priority;
-        // Ok(a warning) once the loop runs, Err(why) if it cannot.
-        let (started_tx, started_rx) = channel::<Result<Option<String>, String>>();
-        let control = std::thread::Builder::new()
-            .name("control".into())
-            .spawn(move || {
-                let mut warning = None;
-                if priority > 0 {
-                    if let Err(reason) = kerf_ros::set_realtime_priority(priority) {
-                        let _ = started_tx.send(Err(reason));
-                        return;
-                    }
-                    // As ros2_control's `lock_memory`: no major page fault in the loop.
-                    warning = kerf_ros::lock_memory().err();
-                }
-                let _ = started_tx.send(Ok(warning));
-                control_loop.run();
-            })
-            .map_err(|e| RosError::Dds {
-                what: "control thread".into(),
-                reason: e.to_string(),
-            })?;
-        let refused = |reason: String| {
-            log.error(&format!("cannot start: {reason}"));
-            NodeError::Config {
-                name: "realtime_priority".into(),
-                reason,
+        let (control, jtc) = match backend {
+            // No control loop: the external server commands the robot.
+            Backend::Jtc(forwarder) => (None, Some(forwarder)),
+            Backend::Control { hw, joint_states } => {
+                // Outgoing streams leave the control thread through bounded queues: a stalled
+                // subscriber can cost samples but never blocks the control loop. Each is published
+                // once per control period at most, and its writer's send window outlasts the lease of
+                // a reader that stops acknowledging (`kerf_ros::qos::send_window`): a dead reader
+                // never stalls the others.
+                let streams = control::Streams {
+                    joint_states,
+                    controller_state: node.streamer(
+                        "~/controller_state",
+                        JointTrajectoryControllerState::ROS_TYPE,
+                        qos::state(),
+                        q,
+                        rate,
+                    )?,
+                    command: node.streamer(
+                        "~/joint_command",
+                        JointState::ROS_TYPE,
+                        qos::state(),
+                        q,
+                        rate,
+                    )?,
+                    sim: match &cfg.sim {
+                        None => None,
+                        Some(_) => Some(control::SimStreams {
+                            clock: node.streamer(
+                                "/clock",
+                                ClockMsg::ROS_TYPE,
+                                qos::state(),
+                                q,
+                                rate,
+                            )?,
+                            contacts: node.streamer(
+                                "~/contacts",
+                                CellContacts::ROS_TYPE,
+                                qos::state(),
+                                q,
+                                rate,
+                            )?,
+                            frame_id: cfg.robot.root_link().to_string(),
+                        }),
+                    },
+                };
+                let loop_cfg = control::LoopConfig {
+                    limits: cfg.limits.clone(),
+                    control_rate: cfg.control_rate,
+                    action_monitor_rate: cfg.action_monitor_rate,
+                    control_period: cfg.executor.control_period,
+                };
+                let control_loop = control::ControlLoop::new(
+                    exec,
+                    hw,
+                    loop_cfg,
+                    streams,
+                    command_rx,
+                    report_tx,
+                    Arc::clone(&control_running),
+                    clock.clone(),
+                );
+                let control = spawn_control(control_loop, cfg.realtime_priority, &log)?;
+                (Some(control), None)
             }
         };
-        match started_rx.recv() {
-            Ok(Ok(None)) => {}
-            Ok(Ok(Some(warning))) => log.warn(&format!(
-                "control thread: {warning}; it may take page faults"
-            )),
-            Ok(Err(reason)) => {
-                let _ = control.join();
-                return Err(refused(reason));
-            }
-            Err(_) => {
-                let _ = control.join();
-                return Err(refused("the control thread ended at start-up".into()));
-            }
-        }
-        if priority > 0 {
-            log.info(&format!(
-                "control thread runs SCHED_FIFO at priority {priority}, process memory locked"
-            ));
-        }
         let names: Vec<&str> = cfg.limits.iter().map(|l| l.name.as_str()).collect();
-        let hardware = match &cfg.sim {
-            None => "mock hardware".to_string(),
-            Some(sim) => format!(
+        let hardware = match (&cfg.sim, &cfg.driver) {
+            (_, Some(DriverConfig::Topic(t))) => format!(
+                "robot driver: commands ({}) on {}, joint states on {}, stale after {} control \
+                 periods",
+                t.command_type.ros_type(),
+                node.resolve(&t.command_topic)?,
+                node.resolve(&t.state_topic)?,
+                t.feedback_timeout_periods
+            ),
+            (_, Some(DriverConfig::Jtc(j))) => format!(
+                "external FollowJointTrajectory server {} (timeout {} s){}",
+                node.resolve(&j.action)?,
+                j.timeout,
+                match &j.state_topic {
+                    Some(t) => format!(", joint states on {}", node.resolve(t)?),
+                    None => String::new(),
+                }
+            ),
+            (None, None) => "mock hardware".to_string(),
+            (Some(sim), None) => format!(
                 "simulated cell {} ({}, physics {} Hz)",
                 sim.cell_file.display(),
                 match sim.mode {
@@ -452,6 +719,14 @@ impl ExecutorNode {
             node.resolve("~/joint_trajectory")?,
             node.resolve("~/follow_joint_trajectory")?,
         ));
+        if matches!(cfg.driver, Some(DriverConfig::Topic(_)))
+            && node.params().get("initial_positions").is_some()
+        {
+            log.info(
+                "initial_positions is not used with hardware: topic: the robot starts where the \
+                 driver's first joint state says",
+            );
+        }
         Ok(Self {
             traj_sub,
             action,
@@ -465,7 +740,10 @@ impl ExecutorNode {
             commands,
             reports,
             control_running,
-            control: Some(control),
+            control,
+            jtc,
+            jtc_events: Vec::new(),
+            driver_types,
             statuses_changed: false,
             publish_failures: 0,
             clock,
@@ -478,7 +756,7 @@ impl ExecutorNode {
     fn spin(&mut self) -> Result<(), NodeError> {
         let mut result = Ok(());
         while !self.node.should_stop() {
-            if self.control.as_ref().is_none_or(|h| h.is_finished()) {
+            if self.jtc.is_none() && self.control.as_ref().is_none_or(|h| h.is_finished()) {
                 result = Err(NodeError::Config {
                     name: "control thread".into(),
                     reason: "the control loop ended unexpectedly; the node stops".into(),
@@ -491,7 +769,11 @@ impl ExecutorNode {
             self.poll_result_requests();
             self.poll_validate();
             self.poll_prepared();
-            if let Ok(r) = self.reports.recv_timeout(REQUEST_POLL) {
+            self.check_driver_types();
+            if self.jtc.is_some() {
+                self.poll_jtc();
+                std::thread::sleep(REQUEST_POLL);
+            } else if let Ok(r) = self.reports.recv_timeout(REQUEST_POLL) {
                 self.on_report(r);
             }
             while let Ok(r) = self.reports.try_recv() {
@@ -657,9 +939,126 @@ impl ExecutorNode {
         }
     }
 
+    /// `hardware: topic`: checks the driver's topics for endpoints of another type (at most
+    /// every [`TYPE_CHECK_PERIOD`]) and tells the control thread when the answer changes.
+    fn check_driver_types(&mut self) {
+        let Some(w) = self.driver_types.as_mut() else {
+            return;
+        };
+        let now = std::time::Instant::now();
+        if now < w.next {
+            return;
+        }
+        w.next = now + TYPE_CHECK_PERIOD;
+        let roles = [
+            TopicRole {
+                topic: &w.state_topic,
+                expected: JointState::ROS_TYPE,
+                executor_reads: true,
+            },
+            TopicRole {
+                topic: &w.command_topic,
+                expected: w.command_type,
+                executor_reads: false,
+            },
+        ];
+        let found = driver::check_topic_types(
+            &roles,
+            &self.node.discovered_topics(),
+            &self.node.discovered_subscriptions(),
+        );
+        if found == w.last {
+            return;
+        }
+        if found.is_none() {
+            self.log.info("the driver topics' types are right again");
+        }
+        w.last.clone_from(&found);
+        let _ = self
+            .commands
+            .send(control::Command::DriverTypes { fault: found });
+    }
+
+    /// `hardware: jtc`: the external server's answers, feedback and results, relayed.
+    fn poll_jtc(&mut self) {
+        let Some(f) = self.jtc.as_mut() else {
+            return;
+        };
+        let mut events = std::mem::take(&mut self.jtc_events);
+        f.poll(self.clock.now(), &mut events);
+        for event in events.drain(..) {
+            match event {
+                jtc::JtcEvent::Accepted { exec_id } => {
+                    if let Some(source) = self.sources.get(&exec_id).cloned() {
+                        let action = self.jtc.as_ref().map_or("", |f| f.action()).to_string();
+                        self.log.info(&format!(
+                            "{} accepted by the external server {action}",
+                            source.describe()
+                        ));
+                        self.trajectory_status(
+                            &source,
+                            TrajectoryStatus::ACCEPTED,
+                            SUCCESSFUL,
+                            "accepted",
+                        );
+                    }
+                }
+                jtc::JtcEvent::Finished { exec_id, outcome } => self.finish(exec_id, outcome),
+                jtc::JtcEvent::Feedback { exec_id, feedback } => {
+                    if let Some(Source::Action { id, .. }) = self.sources.get(&exec_id) {
+                        if let Err(e) = self.action.send_feedback(*id, *feedback) {
+                            self.log.debug(&format!("feedback not sent: {e:?}"));
+                        }
+                    }
+                }
+                jtc::JtcEvent::Log { level, message } => self.log.log(level, &message),
+            }
+        }
+        self.jtc_events = events;
+    }
+
+    /// `hardware: jtc`: validates a prepared trajectory from the robot's state and forwards
+    /// its goal to the external server.
+    fn forward(&mut self, ticket: u64, source: Source, prepared: Prepared) {
+        let Some(f) = self.jtc.as_mut() else {
+            return;
+        };
+        let started = prepared.and_then(|(prepared, tolerances)| {
+            f.start(ticket, &prepared, &tolerances, self.clock.now())
+        });
+        f.forget(ticket);
+        match started {
+            Ok(exec_id) => {
+                if let Source::Action { id, .. } = &source {
+                    if let Some(g) = self.goals.get_mut(id) {
+                        g.exec_id = Some(exec_id);
+                    }
+                }
+                self.log.info(&format!(
+                    "{}: valid, forwarded to the external server",
+                    source.describe()
+                ));
+                self.sources.insert(exec_id, source);
+            }
+            Err(rej) => self.rejected(&source, rej),
+        }
+    }
+
     /// Hands a request to the preparation worker; results come back in order.
     fn enqueue(&mut self, job: Job, incoming: Incoming) {
+        // `hardware: jtc`: the message is forwarded once it is valid.
+        let forwarded = match (&job, &incoming, self.jtc.is_some()) {
+            (Job::Run(_), Incoming::Goal(goal), true) => Some((**goal).clone()),
+            (Job::Run(_), Incoming::Trajectory(msg), true) => Some(FollowJointTrajectoryGoal {
+                trajectory: msg.clone(),
+                ..Default::default()
+            }),
+            _ => None,
+        };
         let ticket = self.prep.submit(incoming);
+        if let (Some(goal), Some(f)) = (forwarded, self.jtc.as_mut()) {
+            f.keep(ticket, goal);
+        }
         if let Job::Run(Source::Action { id, .. }) = &job {
             if let Some(g) = self.goals.get_mut(id) {
                 g.ticket = Some(ticket);
@@ -704,9 +1103,35 @@ impl ExecutorNode {
                 })),
             };
             match job {
+                Job::Stop(source) if self.jtc.is_some() => {
+                    let n = self.jtc.as_mut().map_or(0, |f| f.cancel_all());
+                    let message = if n == 0 {
+                        "empty trajectory: no active motion to stop".to_string()
+                    } else {
+                        format!("empty trajectory: canceling {n} goal(s) of the external server")
+                    };
+                    self.log.info(&message);
+                    self.trajectory_status(
+                        &source,
+                        TrajectoryStatus::ACCEPTED,
+                        SUCCESSFUL,
+                        &message,
+                    );
+                }
                 Job::Stop(source) => {
                     let command = control::Command::Stop { tag: ticket };
                     self.dispatch(ticket, Job::Stop(source), command);
+                }
+                Job::Validate(req_id) if self.jtc.is_some() => {
+                    let now = self.clock.now();
+                    let answer = match (prepared.unwrap_or_else(|| Err(missing())), &self.jtc) {
+                        (Ok((prepared, tolerances)), Some(f)) => {
+                            f.validate(&prepared, &tolerances, now)
+                        }
+                        (Ok(_), None) => Err(missing()),
+                        (Err(rej), _) => Err(rej),
+                    };
+                    self.answer_validate(req_id, answer);
                 }
                 Job::Validate(req_id) => match prepared.unwrap_or_else(|| Err(missing())) {
                     Ok((prepared, tolerances)) => {
@@ -733,6 +1158,9 @@ impl ExecutorNode {
                 .get(id)
                 .is_some_and(|g| g.status == GoalStatusEnum::Canceling)
             {
+                if let Some(f) = self.jtc.as_mut() {
+                    f.forget(ticket);
+                }
                 let message = "canceled before it started".to_string();
                 self.log.info(&format!("goal {id:?} {message}"));
                 self.trajectory_status(&source, TrajectoryStatus::CANCELED, SUCCESSFUL, &message);
@@ -747,6 +1175,10 @@ impl ExecutorNode {
                 self.statuses_changed = true;
                 return;
             }
+        }
+        if self.jtc.is_some() {
+            self.forward(ticket, source, prepared);
+            return;
         }
         match prepared {
             Ok((prepared, tolerances)) => {
@@ -817,6 +1249,67 @@ impl ExecutorNode {
             self.statuses_changed = true;
         }
     }
+}
+
+/// Starts the control thread running `control_loop`, with `SCHED_FIFO` at `priority` when it
+/// is > 0.
+///
+/// # Errors
+/// [`NodeError::Config`] naming `realtime_priority` when the priority is refused, or the
+/// thread could not start.
+fn spawn_control(
+    mut control_loop: control::ControlLoop,
+    priority: i64,
+    log: &Logger,
+) -> Result<JoinHandle<()>, NodeError> {
+    // Ok(a warning) once the loop runs, Err(why) if it cannot.
+    let (started_tx, started_rx) = channel::<Result<Option<String>, String>>();
+    let control = std::thread::Builder::new()
+        .name("control".into())
+        .spawn(move || {
+            let mut warning = None;
+            if priority > 0 {
+                if let Err(reason) = kerf_ros::set_realtime_priority(priority) {
+                    let _ = started_tx.send(Err(reason));
+                    return;
+                }
+                // As ros2_control's `lock_memory`: no major page fault in the loop.
+                warning = kerf_ros::lock_memory().err();
+            }
+            let _ = started_tx.send(Ok(warning));
+            control_loop.run();
+        })
+        .map_err(|e| RosError::Dds {
+            what: "control thread".into(),
+            reason: e.to_string(),
+        })?;
+    let refused = |reason: String| {
+        log.error(&format!("cannot start: {reason}"));
+        NodeError::Config {
+            name: "realtime_priority".into(),
+            reason,
+        }
+    };
+    match started_rx.recv() {
+        Ok(Ok(None)) => {}
+        Ok(Ok(Some(warning))) => log.warn(&format!(
+            "control thread: {warning}; it may take page faults"
+        )),
+        Ok(Err(reason)) => {
+            let _ = control.join();
+            return Err(refused(reason));
+        }
+        Err(_) => {
+            let _ = control.join();
+            return Err(refused("the control thread ended at start-up".into()));
+        }
+    }
+    if priority > 0 {
+        log.info(&format!(
+            "control thread runs SCHED_FIFO at priority {priority}, process memory locked"
+        ));
+    }
+    Ok(control)
 }
 
 /// Takes every sample or request available now, in arrival order.

@@ -232,3 +232,131 @@ fn sim_cell_refusals_are_clear() {
     check_joints(&loaded, &c.limits).unwrap();
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// Issue 27: `hardware: topic` and `hardware: jtc` read their parameters with defaults, and
+/// refuse each bad one by name (a `hardware.*` parameter of another hardware among them).
+#[test]
+fn driver_parameters_have_defaults_and_are_checked_by_name() {
+    use kerf_trajectory_executor::config::{
+        CommandType, DriverConfig, DEFAULT_COMMAND_TOPIC, DEFAULT_JTC_ACTION, DEFAULT_STATE_TOPIC,
+    };
+    let c = config("laser_cutter", &["hardware:=topic"]).unwrap();
+    let Some(DriverConfig::Topic(t)) = &c.driver else {
+        panic!("{:?}", c.driver)
+    };
+    assert_eq!(t.command_topic, DEFAULT_COMMAND_TOPIC);
+    assert_eq!(t.command_type, CommandType::Float64MultiArray);
+    assert_eq!(t.state_topic, DEFAULT_STATE_TOPIC);
+    assert_eq!(t.feedback_timeout_periods, 5);
+    // The mock's builder does not make a driver.
+    assert!(Hardware::build(&c).is_err());
+    let c = config(
+        "irb6660",
+        &[
+            "hardware:=topic",
+            "hardware.command_topic:=/d/commands",
+            "hardware.command_type:=sensor_msgs/msg/JointState",
+            "hardware.state_topic:=/d/joint_states",
+            "hardware.feedback_timeout_periods:=3",
+        ],
+    )
+    .unwrap();
+    let Some(DriverConfig::Topic(t)) = &c.driver else {
+        panic!("{:?}", c.driver)
+    };
+    assert_eq!(
+        (
+            t.command_topic.as_str(),
+            t.command_type,
+            t.state_topic.as_str()
+        ),
+        ("/d/commands", CommandType::JointState, "/d/joint_states")
+    );
+    assert_eq!(t.feedback_timeout_periods, 3);
+    let c = config("irb6660", &["hardware:=jtc"]).unwrap();
+    let Some(DriverConfig::Jtc(j)) = &c.driver else {
+        panic!("{:?}", c.driver)
+    };
+    assert_eq!(
+        (j.action.as_str(), j.state_topic.as_ref(), j.timeout),
+        (DEFAULT_JTC_ACTION, None, 1.0)
+    );
+
+    let cases: &[(&[&str], &str)] = &[
+        (
+            &[
+                "hardware:=topic",
+                "hardware.command_type:=std_msgs/msg/String",
+            ],
+            "hardware.command_type",
+        ),
+        (
+            &["hardware:=topic", "hardware.feedback_timeout_periods:=0"],
+            "hardware.feedback_timeout_periods",
+        ),
+        (
+            &["hardware:=topic", "hardware.feedback_timeout_periods:=2.5"],
+            "hardware.feedback_timeout_periods",
+        ),
+        (
+            &["hardware:=topic", "hardware.feedback_timeout_periods:=251"],
+            "hardware.feedback_timeout_periods",
+        ),
+        (
+            &["hardware:=topic", "hardware.state_topic:=/bad topic"],
+            "hardware.state_topic",
+        ),
+        (
+            &["hardware:=topic", "hardware.command_topic:=~x"],
+            "hardware.command_topic",
+        ),
+        (
+            &["hardware:=topic", "hardware.jtc_action:=/a"],
+            "hardware.jtc_action",
+        ),
+        (
+            &["hardware:=topic", "hardware.lag_time_constant:=0.1"],
+            "hardware.lag_time_constant",
+        ),
+        (
+            &["hardware:=mock", "hardware.state_topic:=/a"],
+            "hardware.state_topic",
+        ),
+        (&["hardware.command_topic:=/a"], "hardware.command_topic"),
+        (
+            &[
+                "hardware:=jtc",
+                "hardware.command_type:=sensor_msgs/msg/JointState",
+            ],
+            "hardware.command_type",
+        ),
+        (
+            &["hardware:=jtc", "hardware.feedback_timeout_periods:=5"],
+            "hardware.feedback_timeout_periods",
+        ),
+        (
+            &["hardware:=jtc", "hardware.jtc_timeout:=0.0"],
+            "hardware.jtc_timeout",
+        ),
+        (
+            &["hardware:=jtc", "hardware.jtc_timeout:=100.0"],
+            "hardware.jtc_timeout",
+        ),
+        (
+            &["hardware:=jtc", "hardware.jtc_action:=no//action"],
+            "hardware.jtc_action",
+        ),
+        (&["hardware:=topic", "sim_mode:=dynamic"], "sim_mode"),
+        (&["hardware:=robot"], "hardware"),
+        (&["hardware.gain:=1.0"], "hardware.gain"),
+    ];
+    for (p, needle) in cases {
+        let err = config("irb6660", p)
+            .err()
+            .unwrap_or_else(|| panic!("{p:?} accepted"));
+        assert!(
+            err.to_string().contains(&format!("'{needle}'")),
+            "{p:?}: {err}"
+        );
+    }
+}

@@ -95,6 +95,7 @@ impl Saddle {
     pub fn request(&self, mesh: &str, feedrate: f64) -> CutRequest {
         let (points, axes) = self.path();
         CutRequest {
+            start: Default::default(),
             request_id: "saddle".into(),
             points,
             axes,

@@ -301,9 +301,15 @@ mod tests {
         goals.add(b, RosTime::from_nanos(20), true);
         assert!(goals.take_changed());
         assert!(!goals.take_changed());
-        assert_eq!(goals.get(&a).map(|g| g.status), Some(GoalStatusEnum::Accepted));
+        assert_eq!(
+            goals.get(&a).map(|g| g.status),
+            Some(GoalStatusEnum::Accepted)
+        );
         goals.set_stage(&a, Stage::Planning);
-        assert_eq!(goals.get(&a).map(|g| g.status), Some(GoalStatusEnum::Executing));
+        assert_eq!(
+            goals.get(&a).map(|g| g.status),
+            Some(GoalStatusEnum::Executing)
+        );
         // A result request waits for the end; an unknown goal is answered at once.
         goals.wait_for_result(a, RmwRequestId::default());
         goals.wait_for_result(id(9), RmwRequestId::default());

@@ -45,6 +45,10 @@ pub struct PlanFeedback {
     pub elapsed: f64,
 }
 
+impl<M: Serialize + serde::de::DeserializeOwned> ros2_client::Message for PlanGoal<M> {}
+impl<A: Serialize + serde::de::DeserializeOwned> ros2_client::Message for PlanResult<A> {}
+impl ros2_client::Message for PlanFeedback {}
+
 /// What a goal is doing.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Stage {

@@ -1,16 +1,24 @@
-//! The planner-node loop: requests in (message and text), one worker in arrival order, one
-//! answer per request, latched answers, the trajectory on success, clean shutdown.
+//! The planner-node loop: requests in (message and text, and goals of the planning action:
+//! [`actions`]), one worker in arrival order, one answer per request, latched answers, the
+//! trajectory on success, clean shutdown.
 
-use std::{collections::VecDeque, fmt::Display, sync::Arc, time::Duration};
+mod actions;
+
+use std::{
+    collections::VecDeque,
+    fmt::Display,
+    sync::Arc,
+    time::{Duration, Instant},
+};
 
 use kerf_isolate::{Outcome, Supervisor, SupervisorSettings};
 use kerf_msgs::{
-    numbers::NumberFields, sensor_msgs::JointState, std_msgs::StringMsg,
-    trajectory_msgs::JointTrajectory, RosType,
+    sensor_msgs::JointState, std_msgs::StringMsg, trajectory_msgs::JointTrajectory, RosType,
 };
 use ros2_client::Publisher;
 
 use super::{
+    action::Origin,
     check_answer, check_text_size, leading_request_id,
     start::{CurrentState, JOINT_STATES_TOPIC},
     work::{HarnessWork, PlanJob, RawRequest},
@@ -139,10 +147,23 @@ enum Queued<M, A> {
     Answer(Box<A>),
 }
 
+/// A queue entry of a node serving `S`, with its origin.
+type Entry<S> = (
+    Queued<<S as PlanningService>::RequestMsg, <S as PlanningService>::Answer>,
+    Origin,
+);
+
 /// The job the worker process runs now.
 struct Running {
     id: u64,
     key: AnswerKey,
+    /// Who asked: a request topic or a goal.
+    origin: Origin,
+    /// When it was handed to the worker, and its time limit (a goal's progress).
+    started: Instant,
+    limit: Duration,
+    /// When its goal's client canceled it ([`actions::ACTION_CANCEL_GRACE`]).
+    canceled_at: Option<Instant>,
 }
 
 /// The node's state. Fields drop in declaration order: DDS endpoints and the worker process
@@ -160,10 +181,14 @@ struct PlannerNode<S: PlanningService> {
     current: Option<(JointState, std::time::Instant)>,
     /// `joint_states` resolved, for messages.
     joint_states_topic: String,
+    /// The planning action: server, goals, executor client.
+    actions: actions::ActionSide<S>,
     supervisor: Supervisor<HarnessWork<S>>,
+    /// The worker's work, for a fresh worker when a cancelled plan's worker is stopped.
+    work: Arc<HarnessWork<S>>,
     service: Arc<S>,
-    /// Requests and answers in arrival order, behind the running job.
-    queue: VecDeque<Queued<S::RequestMsg, S::Answer>>,
+    /// Requests and answers in arrival order, behind the running job, with their origin.
+    queue: VecDeque<Entry<S>>,
     running: Option<Running>,
     next_id: u64,
     /// When the node subscribed to its requests (ns since the epoch): older requests are
@@ -192,6 +217,7 @@ impl<S: PlanningService> PlannerNode<S> {
             node.publisher(TRAJECTORY_TOPIC, JointTrajectory::ROS_TYPE, qos::commands())?;
         let joint_states = node.inbox(JOINT_STATES_TOPIC, JointState::ROS_TYPE, qos::state())?;
         let joint_states_topic = node.resolve(JOINT_STATES_TOPIC)?;
+        let actions = actions::ActionSide::new(&mut node, topics.noun, &settings.execute_action)?;
         let log = node.logger();
         settings
             .framing
@@ -212,11 +238,12 @@ impl<S: PlanningService> PlannerNode<S> {
                 reason: format!("{e} (the robot cannot reach it)"),
             })?;
         let service = Arc::new(service);
+        let work = Arc::new(HarnessWork {
+            service: Arc::clone(&service),
+            framing: settings.framing.clone(),
+        });
         let mut supervisor = Supervisor::new(
-            Arc::new(HarnessWork {
-                service: Arc::clone(&service),
-                framing: settings.framing.clone(),
-            }),
+            Arc::clone(&work),
             SupervisorSettings::new(settings.plan_memory),
         );
         // The worker is forked now, with the service loaded: the first request does not wait.
@@ -225,11 +252,14 @@ impl<S: PlanningService> PlannerNode<S> {
             reason: e.to_string(),
         })?;
         log.info(&format!(
-            "serving {} requests on {} and {}; plans on {}, trajectories on {}; {}; queue_depth {}, \
-             plan_timeout {} s, plan_memory {} (plans run in worker process {})",
+            "serving {} requests on {} and {} and goals on {} (executed on {}); plans on {}, \
+             trajectories on {}; {}; queue_depth {}, plan_timeout {} s, plan_memory {} (plans \
+             run in worker process {})",
             topics.noun,
             node.resolve(&topics.request)?,
             node.resolve(&topics.request_text)?,
+            actions.name,
+            actions.execute_action,
             node.resolve(&topics.plan)?,
             node.resolve(TRAJECTORY_TOPIC)?,
             service.startup_note(),
@@ -247,7 +277,9 @@ impl<S: PlanningService> PlannerNode<S> {
             joint_states,
             current: None,
             joint_states_topic,
+            actions,
             supervisor,
+            work,
             service,
             queue: VecDeque::new(),
             running: None,
@@ -271,6 +303,7 @@ impl<S: PlanningService> PlannerNode<S> {
             self.poll_joint_states();
             let mut busy = self.poll_requests();
             busy |= self.poll_text_requests();
+            busy |= self.poll_action();
             busy |= self.advance();
             if !busy {
                 self.give_back_memory_when_idle();
@@ -323,7 +356,9 @@ impl<S: PlanningService> PlannerNode<S> {
     /// it); queued requests are answered "stopped" without planning: no request is left
     /// without an answer, and the node stops within 2 s whatever it plans.
     fn shut_down(&mut self) {
-        let answered_at_shutdown = self.pending() > 0;
+        // Goals arriving from now on end at once; executions are cancelled on the executor.
+        self.stop_actions();
+        let answered_at_shutdown = self.pending() > 0 || self.actions_active();
         if answered_at_shutdown {
             self.log.warn(&format!(
                 "shutting down: cancelling the plan in progress and answering {} request(s)",
@@ -338,7 +373,7 @@ impl<S: PlanningService> PlannerNode<S> {
                 }
             }
         }
-        while let Some(q) = self.queue.pop_front() {
+        while let Some((q, origin)) = self.queue.pop_front() {
             let answer = match q {
                 Queued::Answer(a) => *a,
                 Queued::Plan { key, .. } => self.service.failure(
@@ -347,11 +382,12 @@ impl<S: PlanningService> PlannerNode<S> {
                     "the planner node stopped before planning this request".into(),
                 ),
             };
-            self.publish(answer);
+            self.publish_from(answer, origin);
         }
         if answered_at_shutdown {
-            // Let the reliable writers deliver (and repair) the answers just written.
-            std::thread::sleep(SHUTDOWN_LINGER);
+            // Let the reliable writers deliver (and repair) the answers just written, while
+            // the action answers result requests, ends new goals and sees executions end.
+            self.linger_actions(SHUTDOWN_LINGER);
         }
         self.log.info("shutting down");
     }
@@ -394,17 +430,7 @@ impl<S: PlanningService> PlannerNode<S> {
                 Ok((_, stamp)) if self.published_before_start(stamp, S::RequestMsg::NAME) => {
                     continue
                 }
-                Ok((m, _)) => match m.check_numbers() {
-                    Err(e) => Queued::Answer(Box::new(self.service.failure(
-                        &self.service.msg_key(&m),
-                        Failure::BadNumber,
-                        format!("invalid request: {e}"),
-                    ))),
-                    Ok(()) => match self.service.request_from_msg(&m) {
-                        Ok(r) => self.plan_job(r, RawRequest::Msg(m), "message"),
-                        Err(answer) => Queued::Answer(answer),
-                    },
-                },
+                Ok((m, _)) => self.queued_msg(m, "message"),
                 Err(e) => self.unreadable(S::RequestMsg::NAME, e),
             };
             self.submit(queued);
@@ -488,8 +514,13 @@ impl<S: PlanningService> PlannerNode<S> {
         Queued::Plan { key, raw, limit }
     }
 
-    /// Queues an entry, or answers at once when the queue is full.
+    /// Queues an entry from a request topic, or answers at once when the queue is full.
     fn submit(&mut self, queued: Queued<S::RequestMsg, S::Answer>) {
+        self.submit_from(queued, Origin::Topic);
+    }
+
+    /// Queues an entry, or answers at once when the queue is full.
+    fn submit_from(&mut self, queued: Queued<S::RequestMsg, S::Answer>, origin: Origin) {
         let mut key = match &queued {
             Queued::Plan { key, .. } => key.clone(),
             Queued::Answer(m) => m.key(),
@@ -528,10 +559,10 @@ impl<S: PlanningService> PlannerNode<S> {
                     ),
                 ),
             };
-            self.publish(answer);
+            self.publish_from(answer, origin);
             return;
         }
-        self.queue.push_back(queued);
+        self.queue.push_back((queued, origin));
     }
 
     /// Publishes the running job's answer when it has one; `true` if it did.
@@ -548,9 +579,20 @@ impl<S: PlanningService> PlannerNode<S> {
                 running.id
             ));
         }
-        let answer = self.answer_of(&running.key, outcome);
-        self.publish(answer);
+        let answer = if running.canceled_at.is_some() {
+            self.canceled_answer(&running, matches!(outcome, Outcome::Stopped))
+        } else {
+            self.answer_of(&running.key, outcome)
+        };
+        self.publish_from(answer, running.origin);
         true
+    }
+
+    /// Stops the worker process now (SIGKILL, reaped) and puts a fresh supervisor in its
+    /// place; the next plan forks a new worker.
+    fn replace_worker(&mut self) {
+        let settings = self.supervisor.settings();
+        self.supervisor = Supervisor::new(Arc::clone(&self.work), settings);
     }
 
     /// The answer of a finished job.
@@ -616,12 +658,18 @@ impl<S: PlanningService> PlannerNode<S> {
     fn advance(&mut self) -> bool {
         let mut any = self.running.is_some() && self.poll_worker();
         while self.running.is_none() {
-            let Some(next) = self.queue.pop_front() else {
+            // A goal that executes waits for an earlier goal's execution to end.
+            if self.queue.front().is_some_and(|(q, o)| {
+                matches!(q, Queued::Plan { .. }) && self.actions.must_wait(*o)
+            }) {
+                break;
+            }
+            let Some((next, origin)) = self.queue.pop_front() else {
                 break;
             };
             any = true;
             match next {
-                Queued::Answer(a) => self.publish(*a),
+                Queued::Answer(a) => self.publish_from(*a, origin),
                 Queued::Plan { key, raw, limit } => {
                     let id = self.next_id;
                     self.next_id += 1;
@@ -633,14 +681,24 @@ impl<S: PlanningService> PlannerNode<S> {
                         current: self.current_state(),
                     };
                     match self.supervisor.submit(id, &job, limit) {
-                        Ok(()) => self.running = Some(Running { id, key }),
+                        Ok(()) => {
+                            self.running = Some(Running {
+                                id,
+                                key,
+                                origin,
+                                started: Instant::now(),
+                                limit,
+                                canceled_at: None,
+                            });
+                            self.goal_planning(origin);
+                        }
                         Err(e) => {
                             let answer = self.service.failure(
                                 &key,
                                 Failure::Panicked,
                                 format!("the plan could not be started: {e}"),
                             );
-                            self.publish(answer);
+                            self.publish_from(answer, origin);
                         }
                     }
                 }
@@ -649,10 +707,12 @@ impl<S: PlanningService> PlannerNode<S> {
         any
     }
 
-    /// Publishes one answer on the plan topics and, on success, the trajectory; logs it. An
-    /// answer with a sample over [`super::MAX_ANSWER_BYTES`] is replaced by
-    /// [`Failure::TooLarge`] (one large sample would block every later one of its topic).
-    fn publish(&self, plan: S::Answer) {
+    /// Publishes one answer on the plan topics and, on success of a topic request, the
+    /// trajectory; logs it; a goal's answer then ends the goal or starts its execution
+    /// ([`Self::goal_answered`]). An answer with a sample over [`super::MAX_ANSWER_BYTES`] is
+    /// replaced by [`Failure::TooLarge`] (one large sample would block every later one of its
+    /// topic).
+    fn publish_from(&mut self, plan: S::Answer, origin: Origin) {
         self.answered_since_trim.set(true);
         let mut text = answer_text(&plan);
         let plan = match check_answer(&plan, &text, plan.trajectory()) {
@@ -667,9 +727,12 @@ impl<S: PlanningService> PlannerNode<S> {
         if plan.is_success() {
             self.log
                 .info(&format!("request '{id}': {}", plan.message()));
-            if let Err(e) = self.trajectories.publish(plan.trajectory().clone()) {
-                self.log
-                    .error(&format!("request '{id}': trajectory not published: {e}"));
+            // A goal's trajectory runs only when the goal says so (`execute`).
+            if origin == Origin::Topic {
+                if let Err(e) = self.trajectories.publish(plan.trajectory().clone()) {
+                    self.log
+                        .error(&format!("request '{id}': trajectory not published: {e}"));
+                }
             }
         } else {
             self.log.warn(&format!(
@@ -679,6 +742,10 @@ impl<S: PlanningService> PlannerNode<S> {
             ));
         }
         let text = StringMsg { data: text };
+        let for_goal = match origin {
+            Origin::Goal(goal) => Some((goal, plan.clone())),
+            Origin::Topic => None,
+        };
         if let Err(e) = self.plans.publish(plan) {
             self.log.error(&format!(
                 "request '{id}': {} not published: {e}",
@@ -688,6 +755,9 @@ impl<S: PlanningService> PlannerNode<S> {
         if let Err(e) = self.plan_texts.publish(text) {
             self.log
                 .error(&format!("request '{id}': plan text not published: {e}"));
+        }
+        if let Some((goal, plan)) = for_goal {
+            self.goal_answered(goal, plan);
         }
     }
 }

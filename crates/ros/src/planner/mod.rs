@@ -36,12 +36,20 @@
 //!   the plan in progress is cancelled through its budget and answered (the planner's
 //!   cancellation status; a plan that does not answer within 0.2 s is stopped and answered
 //!   [`Failure::Stopped`]), queued requests are answered [`Failure::Stopped`] without planning,
-//!   the answers are given [`SHUTDOWN_LINGER`] to be delivered, and the node returns within 2 s.
+//!   the answers are given [`SHUTDOWN_LINGER`] to be delivered, and the node returns within 2 s;
+//! * the planning action (issue 27, item 3): `~/plan_<noun>` (`kerf_msgs/action/Plan<Noun>`,
+//!   [`goal_msgs`]), whose goals are requests in the same queue, cancellable ([`action`]:
+//!   queued goals leave the queue, a plan in progress is cancelled through its worker, which
+//!   is stopped when it has not answered within 80 ms), and, with `execute`, executed on the
+//!   executor's `FollowJointTrajectory` action (the `execute_action` parameter, [`execute`]).
 
+pub mod action;
 mod answers;
 mod error;
 mod executable;
+pub mod execute;
 pub mod framing;
+pub mod goal_msgs;
 mod harness;
 mod main;
 mod service;
@@ -99,6 +107,7 @@ pub const HARNESS_PARAMS: &[&str] = &[
     "queue_depth",
     "plan_timeout",
     "plan_memory",
+    "execute_action",
     "approach.clearance",
     "approach.lead_distance",
     "approach.lead_clearance",
@@ -120,6 +129,9 @@ pub struct HarnessSettings {
     pub plan_memory: u64,
     /// How a plan with a start is framed by its approach and retract (issue 27).
     pub framing: kerf_approach::FrameSettings,
+    /// The executor's `control_msgs/action/FollowJointTrajectory` action that runs the plans
+    /// of goals with `execute` (issue 27, item 3); resolved against the node's namespace.
+    pub execute_action: String,
 }
 
 impl Default for HarnessSettings {
@@ -129,6 +141,7 @@ impl Default for HarnessSettings {
             plan_timeout: std::time::Duration::from_secs_f64(DEFAULT_PLAN_TIMEOUT),
             plan_memory: kerf_budget::DEFAULT_PLAN_MEMORY,
             framing: kerf_approach::FrameSettings::default(),
+            execute_action: execute::DEFAULT_EXECUTE_ACTION.into(),
         }
     }
 }
@@ -138,7 +151,9 @@ impl HarnessSettings {
     /// (0, [`kerf_budget::MAX_BUDGET_SECONDS`]], default [`DEFAULT_PLAN_TIMEOUT`]) and
     /// `plan_memory` (bytes, an integer in [[`kerf_budget::MIN_PLAN_MEMORY`],
     /// [`kerf_budget::MAX_PLAN_MEMORY`]], default [`kerf_budget::DEFAULT_PLAN_MEMORY`], 1 GiB),
-    /// and the framing of plans with a start ([`framing_from_params`]).
+    /// the framing of plans with a start ([`framing_from_params`]), and `execute_action` (the
+    /// executor's `FollowJointTrajectory` action; a non-empty ROS name, default
+    /// [`execute::DEFAULT_EXECUTE_ACTION`]; checked again when the node resolves it).
     ///
     /// # Errors
     /// [`RosError::Param`] naming the parameter for a wrong type or a value out of range.
@@ -166,11 +181,23 @@ impl HarnessSettings {
                 name: "plan_memory".into(),
                 reason,
             })?;
+        let execute_action = params
+            .string("execute_action")?
+            .unwrap_or_else(|| execute::DEFAULT_EXECUTE_ACTION.into());
+        crate::names::expand(&execute_action, "/", "node").map_err(|e| RosError::Param {
+            name: "execute_action".into(),
+            reason: format!(
+                "'{execute_action}' is not a valid action name ({e}); it names the executor's \
+                 FollowJointTrajectory action (default {})",
+                execute::DEFAULT_EXECUTE_ACTION
+            ),
+        })?;
         Ok(Self {
             queue_depth,
             plan_timeout,
             plan_memory,
             framing: framing_from_params(params)?,
+            execute_action,
         })
     }
 }

@@ -91,6 +91,10 @@ pub enum Failure {
     /// No collision-free approach or retract exists, or the start is too close to an
     /// obstacle (issue 27): the message names the stage, obstacle, time and configuration.
     NoApproach,
+    /// The request's goal of the planning action was canceled by its client (issue 27, item
+    /// 3): taken out of the queue, or its plan stopped. Answered like [`Failure::Stopped`] by
+    /// the answer messages that have no canceled status; the message says "canceled".
+    Canceled,
 }
 
 /// An answer message (`kerf_msgs/msg/CutPlan`, `MillPlan`, …): what the harness reads of it.
@@ -124,7 +128,8 @@ pub trait PlanningService: Send + Sync + 'static {
     ///
     /// Its numbers are checked against their declared rules ([`NumberFields`]) by the harness
     /// before [`Self::request_from_msg`] sees it ([`Failure::BadNumber`]).
-    type RequestMsg: RosType + NumberFields + Serialize + DeserializeOwned + Send + 'static;
+    /// It is also the goal's `request` of the planning action (`~/plan_<noun>`).
+    type RequestMsg: RosType + NumberFields + Serialize + DeserializeOwned + Clone + Send + 'static;
     /// A request as the planner takes it (converted, not yet planned).
     type Request: Send + 'static;
     /// The answer message.

@@ -78,7 +78,11 @@ pub fn plan_checked<S: PlanningService>(
                 Err(answer) => return *answer,
             };
             let c = world.clearance(q, false);
-            if !(c.distance >= framing.clearance()) {
+            // NaN is not clear either.
+            if !matches!(
+                c.distance.partial_cmp(&framing.clearance()),
+                Some(std::cmp::Ordering::Greater | std::cmp::Ordering::Equal)
+            ) {
                 return service.failure(
                     &key,
                     Failure::NoApproach,

@@ -62,7 +62,8 @@ pub(super) fn make_request(
         }
     }
     let workpiece_pose = workpiece_pose(&path.points, &path.axes, &rotation, m_center);
-    Ok(CutRequest { start: Default::default(),
+    Ok(CutRequest {
+        start: Default::default(),
         request_id: id.to_owned(),
         points: path.points,
         axes: path.axes,

@@ -133,7 +133,8 @@ pub(super) fn make_request(
     if !workpiece_pose.position.iter().all(|v| v.is_finite()) {
         return Err(TestPartError::invalid(id, "empty or non-finite path"));
     }
-    Ok(CutRequest { start: Default::default(),
+    Ok(CutRequest {
+        start: Default::default(),
         request_id: format!("jobshop-{id}"),
         points: path.points,
         axes: path.axes,
