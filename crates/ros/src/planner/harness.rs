@@ -35,6 +35,14 @@ fn now_ns() -> i64 {
         .unwrap_or(0)
 }
 
+/// How long after its start a planner node waits for the robot's first joint state before it
+/// plans a request whose start may be the robot's current state (`start` left out or
+/// `current`): DDS discovery of the executor's `joint_states` writer takes up to a second or two
+/// on a busy machine, and a request sent right after a launch must still start where the robot
+/// is. After it, such a request plans at once (`start` left out: from the process's first
+/// point; `current`: refused, no joint state).
+pub const START_STATE_GRACE: Duration = Duration::from_secs(3);
+
 /// How long the node loop sleeps when there is nothing to do.
 const POLL: Duration = Duration::from_millis(2);
 
@@ -142,6 +150,10 @@ enum Queued<M, A> {
         key: AnswerKey,
         raw: RawRequest<M>,
         limit: Duration,
+        /// Whether its start may be the robot's current state (`start` left out or
+        /// `current`): it waits for the robot's first joint state, up to
+        /// [`START_STATE_GRACE`] after the node's start.
+        wants_state: bool,
     },
     /// Already answered (conversion error, refused before planning).
     Answer(Box<A>),
@@ -181,6 +193,8 @@ struct PlannerNode<S: PlanningService> {
     current: Option<(JointState, std::time::Instant)>,
     /// `joint_states` resolved, for messages.
     joint_states_topic: String,
+    /// Until when a plan that may start from the robot's state waits for its first one.
+    state_grace_until: Instant,
     /// The planning action: server, goals, executor client.
     actions: actions::ActionSide<S>,
     supervisor: Supervisor<HarnessWork<S>>,
@@ -277,6 +291,7 @@ impl<S: PlanningService> PlannerNode<S> {
             joint_states,
             current: None,
             joint_states_topic,
+            state_grace_until: Instant::now() + START_STATE_GRACE,
             actions,
             supervisor,
             work,
@@ -511,7 +526,16 @@ impl<S: PlanningService> PlannerNode<S> {
                 self.pending()
             ));
         }
-        Queued::Plan { key, raw, limit }
+        let wants_state = matches!(
+            self.service.start_of(&request),
+            kerf_approach::StartSpec::Default | kerf_approach::StartSpec::Current
+        );
+        Queued::Plan {
+            key,
+            raw,
+            limit,
+            wants_state,
+        }
     }
 
     /// Queues an entry from a request topic, or answers at once when the queue is full.
@@ -664,13 +688,31 @@ impl<S: PlanningService> PlannerNode<S> {
             }) {
                 break;
             }
+            // Right after start-up the robot's joint state may not have arrived yet (DDS
+            // discovery): a plan that would start from it waits for it, a little.
+            if self.current.is_none()
+                && self.state_grace_until > Instant::now()
+                && self.queue.front().is_some_and(|(q, _)| {
+                    matches!(
+                        q,
+                        Queued::Plan {
+                            wants_state: true,
+                            ..
+                        }
+                    )
+                })
+            {
+                break;
+            }
             let Some((next, origin)) = self.queue.pop_front() else {
                 break;
             };
             any = true;
             match next {
                 Queued::Answer(a) => self.publish_from(*a, origin),
-                Queued::Plan { key, raw, limit } => {
+                Queued::Plan {
+                    key, raw, limit, ..
+                } => {
                     let id = self.next_id;
                     self.next_id += 1;
                     // The robot's state when its plan begins: a request queued behind others
