@@ -142,13 +142,31 @@ impl Node {
         self != Node::TrajectoryExecutor
     }
 
-    /// The parameters the node reads.
+    /// The parameters the node reads: a planner's own and the planner harness's
+    /// (`kerf_ros::planner::HARNESS_PARAMS`: `plan_memory`, `approach.*`, `retract.*`, …,
+    /// which every planner node knows).
     fn known(self) -> &'static [&'static str] {
+        use std::sync::LazyLock;
+        fn with_harness(own: &[&'static str]) -> Vec<&'static str> {
+            let mut all = own.to_vec();
+            all.extend(
+                kerf_ros::planner::HARNESS_PARAMS
+                    .iter()
+                    .filter(|p| !own.contains(p)),
+            );
+            all
+        }
+        static MJTO: LazyLock<Vec<&'static str>> =
+            LazyLock::new(|| with_harness(kerf_mjto_planner::KNOWN_PARAMS));
+        static MILL: LazyLock<Vec<&'static str>> =
+            LazyLock::new(|| with_harness(kerf_milling_planner::KNOWN_PARAMS));
+        static GCODE: LazyLock<Vec<&'static str>> =
+            LazyLock::new(|| with_harness(kerf_gcode_planner::KNOWN_PARAMS));
         match self {
             Node::TrajectoryExecutor => kerf_trajectory_executor::KNOWN_PARAMS,
-            Node::MjtoPlanner => kerf_mjto_planner::KNOWN_PARAMS,
-            Node::MillingPlanner => kerf_milling_planner::KNOWN_PARAMS,
-            Node::GcodePlanner => kerf_gcode_planner::KNOWN_PARAMS,
+            Node::MjtoPlanner => &MJTO,
+            Node::MillingPlanner => &MILL,
+            Node::GcodePlanner => &GCODE,
         }
     }
 
@@ -1129,5 +1147,35 @@ mod tests {
         let gcode = Node::GcodePlanner.known();
         assert!(knows(gcode, "machine"));
         assert!(!knows(exec, "machine") && !knows(planner, "machine") && !knows(mill, "machine"));
+        // The planner harness's parameters (issue 27's approach, plan_memory) go to every
+        // planner and not to the executor.
+        let words: Vec<String> = [
+            "--ros-args",
+            "-p",
+            "approach.clearance:=0.02",
+            "-p",
+            "plan_memory:=1000000000",
+        ]
+        .map(String::from)
+        .to_vec();
+        let user = UserArgs::split(&words);
+        let nodes = [
+            Node::TrajectoryExecutor,
+            Node::MjtoPlanner,
+            Node::GcodePlanner,
+        ];
+        let all: Vec<&[&str]> = nodes.iter().map(|n| n.known()).collect();
+        for n in nodes {
+            let (_, others) = user.for_node(n.known(), &all);
+            let got: Vec<&str> = others
+                .chunks(2)
+                .map(|c| c[1].split_once(":=").unwrap().0)
+                .collect();
+            if n.is_planner() {
+                assert_eq!(got, ["approach.clearance", "plan_memory"], "{n:?}");
+            } else {
+                assert!(got.is_empty(), "{got:?}");
+            }
+        }
     }
 }

@@ -10,11 +10,13 @@ use kerf_ros::Params;
 const ROOT: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../..");
 
 fn config(params: &[&str]) -> Result<NodeConfig, NodeError> {
-    NodeConfig::from_params(&Params::from_assignments(
-        "mjto_planner",
-        KNOWN_PARAMS,
-        params,
-    )?)
+    // The node knows its own parameters and the planner harness's.
+    let known: Vec<&str> = KNOWN_PARAMS
+        .iter()
+        .chain(kerf_ros::planner::HARNESS_PARAMS)
+        .copied()
+        .collect();
+    NodeConfig::from_params(&Params::from_assignments("mjto_planner", &known, params)?)
 }
 
 #[test]
@@ -70,4 +72,49 @@ fn bad_parameters_are_refused_by_name() {
     assert!(e.to_string().contains("q1"), "{e}");
     let e = config(&["urdf_file:=/nonexistent/machine.urdf"]).unwrap_err();
     assert!(matches!(e, NodeError::Setup(SetupError::Machine(_))), "{e}");
+}
+
+/// Issue 27: the approach and retract parameters are read and checked like every other; a
+/// safe pose the machine cannot reach stops the node naming the parameter.
+#[test]
+fn approach_parameters_are_checked_and_safe_poses_must_be_reachable() {
+    let c = config(&[
+        "approach.clearance:=0.02",
+        "approach.lead_distance:=0.05",
+        "retract.distance:=0.1",
+        "approach.safe_pose:=[0.8, 0.7, 1.6, 0.0, 0.0, -0.05]",
+    ])
+    .unwrap();
+    assert_eq!(c.harness.framing.clearance(), 0.02);
+    assert_eq!(c.harness.framing.lead_distance(), 0.05);
+    assert_eq!(c.harness.framing.retract_distance(), 0.1);
+    let service =
+        kerf_mjto_planner::CutService::new(c.machine.clone(), c.machine_source.clone()).unwrap();
+    use kerf_ros::planner::PlanningService;
+    c.harness.check_reach(service.approach_limits()).unwrap();
+
+    for (bad, name) in [
+        ("approach.clearance:=0.0", "approach.clearance"),
+        ("approach.lead_distance:=-1.0", "approach.lead_distance"),
+        ("retract.distance:=0.0", "retract.distance"),
+        ("approach.control_period:=0.0", "approach.control_period"),
+    ] {
+        let e = config(&[bad]).unwrap_err().to_string();
+        assert!(e.contains(&format!("'{name}'")), "{bad}: {e}");
+    }
+    // q6's stroke is [-0.1, 0.02] m: a retract pose at q6 = 0.5 m is out of reach.
+    let far = config(&["retract.safe_pose:=[0.8, 0.7, 1.6, 0.0, 0.0, 0.5]"]).unwrap();
+    let e = far
+        .harness
+        .check_reach(service.approach_limits())
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("'retract.safe_pose'") && e.contains("q6"), "{e}");
+    let short = config(&["approach.safe_pose:=[0.8, 0.7]"]).unwrap();
+    let e = short
+        .harness
+        .check_reach(service.approach_limits())
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("'approach.safe_pose'"), "{e}");
 }

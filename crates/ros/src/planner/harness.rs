@@ -107,7 +107,7 @@ where
             return Err(e);
         }
     };
-    let mut n = PlannerNode::new(node, service, settings)?;
+    let mut n = PlannerNode::new(node, env, service, settings)?;
     n.spin();
     Ok(())
 }
@@ -217,7 +217,12 @@ struct PlannerNode<S: PlanningService> {
 }
 
 impl<S: PlanningService> PlannerNode<S> {
-    fn new(mut node: KerfNode, service: S, settings: HarnessSettings) -> Result<Self, RosError> {
+    fn new(
+        mut node: KerfNode,
+        env: &RosEnv,
+        service: S,
+        settings: HarnessSettings,
+    ) -> Result<Self, RosError> {
         let topics = service.topics();
         let started_ns = now_ns();
         let requests = node.inbox(&topics.request, S::RequestMsg::ROS_TYPE, qos::commands())?;
@@ -231,26 +236,16 @@ impl<S: PlanningService> PlannerNode<S> {
             node.publisher(TRAJECTORY_TOPIC, JointTrajectory::ROS_TYPE, qos::commands())?;
         let joint_states = node.inbox(JOINT_STATES_TOPIC, JointState::ROS_TYPE, qos::state())?;
         let joint_states_topic = node.resolve(JOINT_STATES_TOPIC)?;
-        let actions = actions::ActionSide::new(&mut node, topics.noun, &settings.execute_action)?;
+        let plan_topic = node.resolve(&topics.plan)?;
+        let actions = actions::ActionSide::new(
+            &mut node,
+            topics.noun,
+            &settings.execute_action,
+            env.range,
+            plan_topic,
+        )?;
         let log = node.logger();
-        settings
-            .framing
-            .check_reach(service.approach_limits())
-            .map_err(|e| RosError::Param {
-                name: match e {
-                    kerf_approach::ApproachError::OutOfLimits {
-                        role: kerf_approach::Role::RetractTarget(_),
-                        ..
-                    } => "retract.safe_pose".into(),
-                    kerf_approach::ApproachError::JointCount { .. }
-                    | kerf_approach::ApproachError::OutOfLimits { .. }
-                    | kerf_approach::ApproachError::NonFinitePosition { .. } => {
-                        "approach.safe_pose / retract.safe_pose".into()
-                    }
-                    _ => "approach".into(),
-                },
-                reason: format!("{e} (the robot cannot reach it)"),
-            })?;
+        settings.check_reach(service.approach_limits())?;
         let service = Arc::new(service);
         let work = Arc::new(HarnessWork {
             service: Arc::clone(&service),

@@ -52,6 +52,7 @@ pub mod framing;
 pub mod goal_msgs;
 mod harness;
 mod main;
+pub mod result_fit;
 mod service;
 mod size;
 pub mod start;
@@ -198,6 +199,41 @@ impl HarnessSettings {
             plan_memory,
             framing: framing_from_params(params)?,
             execute_action,
+        })
+    }
+}
+
+impl HarnessSettings {
+    /// Checks the safe poses of [`Self::framing`] against the robot's limits (the service's
+    /// [`PlanningService::approach_limits`]): a safe pose the robot cannot reach stops the node
+    /// at start-up.
+    ///
+    /// # Errors
+    /// [`RosError::Param`] naming `approach.safe_pose` or `retract.safe_pose`.
+    pub fn check_reach(&self, limits: &[kerf_approach::JointLimit]) -> Result<(), RosError> {
+        use kerf_approach::{ApproachError as E, Role};
+        self.framing.check_reach(limits).map_err(|e| {
+            let role = match &e {
+                E::OutOfLimits { role, .. } | E::NonFinitePosition { role, .. } => Some(*role),
+                _ => None,
+            };
+            let name = match role {
+                Some(Role::RetractTarget(_)) => "retract.safe_pose",
+                Some(_) => "approach.safe_pose",
+                None if self
+                    .framing
+                    .safe_poses()
+                    .iter()
+                    .any(|p| p.len() != limits.len()) =>
+                {
+                    "approach.safe_pose"
+                }
+                None => "retract.safe_pose",
+            };
+            RosError::Param {
+                name: name.into(),
+                reason: format!("{e} (the robot cannot reach it)"),
+            }
         })
     }
 }
