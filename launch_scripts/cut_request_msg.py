@@ -7,7 +7,8 @@ kerf_mjto::CutRequest) as the YAML of a kerf_msgs/msg/CutRequest, for
 
 Fields map one to one (SI units); the GFD grid is flattened into gfd_*; the
 planner weights have no message field and must be the defaults (the script
-refuses a file that changes them). Needs PyYAML (Debian: python3-yaml).
+refuses a file that changes them); `start` (current, none or a list of joint
+positions) becomes start and start_positions. Needs PyYAML (Debian: python3-yaml).
 """
 import json
 import sys
@@ -15,6 +16,20 @@ import sys
 import yaml
 
 DEFAULT_WEIGHTS = {"k1": 1.0, "k2": 0.5, "k4": 1.0, "k5": 1.0, "k6": 100.0}
+
+
+def start_fields(path, start):
+    """The message's start and start_positions of a file's `start` (issue 27): left out,
+    current, none, or a list of joint positions (given)."""
+    if start is None or start == "":
+        return "", []
+    if start in ("current", "none"):
+        return start, []
+    if isinstance(start, list) and start and all(
+        isinstance(v, (int, float)) and not isinstance(v, bool) for v in start
+    ):
+        return "given", [float(v) for v in start]
+    sys.exit(f"{path}: start: {start!r} must be current, none or a list of joint positions")
 
 
 def main(path):
@@ -60,6 +75,7 @@ def main(path):
         "orientation_corridor": o.get("orientation_corridor", ""),
         "time_budget": r.get("time_budget", 0.0),
     }
+    msg["start"], msg["start_positions"] = start_fields(path, r.get("start"))
     # JSON is valid YAML, and ros2 topic pub reads it on one line.
     print(json.dumps(msg))
 

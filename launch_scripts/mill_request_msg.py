@@ -21,7 +21,7 @@ import yaml
 
 FIELDS = {
     "request_id", "points", "segments", "process", "limits", "initial", "planner", "policy_file",
-    "time_budget", "tolerances",
+    "time_budget", "tolerances", "start",
 }
 PROCESS = ["teeth", "tool_radius", "axial_depth", "kt", "kn", "entry_angle", "exit_angle"]
 INITIAL = {"spindle_rpm": 2000.0, "feed": 0.04, "g": 0.0}
@@ -68,6 +68,17 @@ def main(path):
         "time_budget": num(path, "time_budget", r.get("time_budget", 0.0)),
         "has_tolerances": "tolerances" in r,
     }
+    # Issue 27: where the trajectory starts: left out, current, none, or joint positions.
+    start = r.get("start")
+    if start is None or start == "":
+        msg["start"], msg["start_positions"] = "", []
+    elif start in ("current", "none"):
+        msg["start"], msg["start_positions"] = start, []
+    elif isinstance(start, list) and start:
+        msg["start"] = "given"
+        msg["start_positions"] = [num(path, f"start[{i}]", v) for i, v in enumerate(start)]
+    else:
+        fail(path, f"start: {start!r} must be current, none or a list of joint positions")
     # Every field, so the message is complete also for readers without defaults; the fields
     # of a group whose flag is false are ignored by the node.
     zeros = PROCESS + [
