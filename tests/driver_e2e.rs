@@ -579,7 +579,9 @@ fn max_diff(a: &[f64], b: &[f64]) -> f64 {
 fn assert_within_limits(cmds: &[JointState], limits: &[JointLimits], what: &str) -> f64 {
     let mut worst: f64 = 0.0;
     for w in cmds.windows(2) {
-        let dt = secs(&w[1]) - secs(&w[0]);
+        // From the integer stamps: as f64 seconds since 1970 they carry ±256 ns, and after a
+        // late cycle the loop catches up with cycles microseconds apart.
+        let dt = (w[1].header.stamp.as_nanos() - w[0].header.stamp.as_nanos()) as f64 * 1e-9;
         assert!(dt > 0.0, "{what}: command stamps do not increase");
         for (j, l) in limits.iter().enumerate() {
             let v = w[1].velocity[j];
@@ -592,9 +594,14 @@ fn assert_within_limits(cmds: &[JointState], limits: &[JointLimits], what: &str)
             );
             assert!(
                 a.abs() <= l.max_acceleration * (1.0 + 1e-3) + 1e-6,
-                "{what}: joint {} commanded an acceleration of {a} (limit {}) at {}",
+                "{what}: joint {} commanded an acceleration of {a} (limit {}) at {}: velocity {} \
+                 at {} then {} at {}",
                 l.name,
                 l.max_acceleration,
+                secs(&w[1]),
+                w[0].velocity[j],
+                secs(&w[0]),
+                w[1].velocity[j],
                 secs(&w[1])
             );
             worst = worst

@@ -293,12 +293,17 @@ fn run_setting(periods: u32, joints: &[String], rng: &mut u64) -> Vec<Trial> {
             std::thread::sleep(Duration::from_millis(1));
         }
     };
-    let measured_now = || loop {
-        if let Some(s) = measured.all().last() {
-            return s.position.clone();
+    let measured_now = || {
+        let deadline = Instant::now() + WAIT;
+        loop {
+            if let Some(s) = measured.all().last() {
+                return s.position.clone();
+            }
+            assert!(Instant::now() < deadline, "no joint state from the driver");
+            std::thread::sleep(Duration::from_millis(10));
         }
-        std::thread::sleep(Duration::from_millis(10));
     };
+    let mut retries = 0;
     let mut trials = Vec::new();
     let mut sign = 1.0;
     while trials.len() < TRIALS {
@@ -321,6 +326,12 @@ fn run_setting(periods: u32, joints: &[String], rng: &mut u64) -> Vec<Trial> {
         let (status, r) = result();
         if status != GoalStatusEnum::Aborted || !r.error_string.contains("feedback stale") {
             // Refused while coming to rest, or ended otherwise: try again.
+            retries += 1;
+            assert!(
+                retries <= 2 * TRIALS,
+                "too many failed trials: {status:?} {r:?}"
+            );
+            eprintln!("trial repeated: {status:?} {}", r.error_string);
             fault
                 .publish(StringMsg {
                     data: "resume".into(),

@@ -22,9 +22,11 @@
 //!   ([`check_topic_types`]). The running goal is aborted with PATH_TOLERANCE_VIOLATED and
 //!   the fault's message, the motion is brought to the executor's controlled stop
 //!   (`kerf_executor::StopProfile`, within the acceleration limits, commanded to the driver
-//!   as ever), and new goals are refused with the reason until good states come back. Then,
-//!   once the stop has ended, the hold moves to the measured state (a restarted driver may
-//!   report another position) and goals are accepted again.
+//!   as ever, then paused until good states come back), and new goals are refused with the
+//!   reason. Once good states are back and the stop has ended, goals are accepted again as
+//!   soon as the measured state is within the start tolerance of the hold; when it is not (a
+//!   driver restarted elsewhere), once it has been still for `control::SETTLE`, and the hold
+//!   moves to it ([`FeedbackMonitor::still_for`]).
 //!
 //! The executor's own `joint_states` republishes each good state as it was received (the
 //! driver's names, order, stamp, velocities and efforts), so that planners and tools see the
