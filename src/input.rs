@@ -292,6 +292,26 @@ pub(crate) fn check_file(arg: &str, file: &InputFile, cap: u64) -> Result<(), St
     Ok(())
 }
 
+/// Checks the `start` of a request file planned offline (`kerf plan cut`, `kerf plan mill`):
+/// the start is resolved and the plan framed with an approach and a retract by the planner
+/// nodes, against the robot's joint state and the cell (issue 27); offline there is neither,
+/// so a request asking for one is refused instead of planned without it.
+///
+/// # Errors
+/// A message naming `flag` for `start: current` or a list of positions.
+pub fn check_offline_start(flag: &str, start: &kerf_approach::StartSpec) -> Result<(), String> {
+    use kerf_approach::StartSpec;
+    match start {
+        StartSpec::Default | StartSpec::None => Ok(()),
+        StartSpec::Current | StartSpec::Given(_) => Err(format!(
+            "{flag}: start {:?} needs a planner node (kerf plans the approach and retract \
+             against the robot's joint state and the cell there); `kerf plan` plans the process \
+             alone: leave start out or set it to none",
+            start.to_fields().0
+        )),
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -355,25 +375,5 @@ mod tests {
             .unwrap_err()
             .contains("offset 1"));
         let _ = std::fs::remove_dir_all(&d);
-    }
-}
-
-/// Checks the `start` of a request file planned offline (`kerf plan cut`, `kerf plan mill`):
-/// the start is resolved and the plan framed with an approach and a retract by the planner
-/// nodes, against the robot's joint state and the cell (issue 27); offline there is neither,
-/// so a request asking for one is refused instead of planned without it.
-///
-/// # Errors
-/// A message naming `flag` for `start: current` or a list of positions.
-pub fn check_offline_start(flag: &str, start: &kerf_approach::StartSpec) -> Result<(), String> {
-    use kerf_approach::StartSpec;
-    match start {
-        StartSpec::Default | StartSpec::None => Ok(()),
-        StartSpec::Current | StartSpec::Given(_) => Err(format!(
-            "{flag}: start {:?} needs a planner node (kerf plans the approach and retract \
-             against the robot's joint state and the cell there); `kerf plan` plans the process \
-             alone: leave start out or set it to none",
-            start.to_fields().0
-        )),
     }
 }
