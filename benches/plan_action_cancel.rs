@@ -9,6 +9,11 @@
 //! measured from `cancel_goal` to the CANCELED result. Prints both distributions and how often
 //! the worker had to be stopped (the plan did not answer its cancel within 80 ms).
 //!
+//! Then the same for a plan that never checks its budget (a planning service whose plan spins,
+//! on its own node `stubborn_planner`): the harness stops its worker process 80 ms after the
+//! cancel and replaces it; measured from `cancel_goal` to the CANCELED result, and the next
+//! goal is answered by a fresh worker.
+//!
 //! Run: `cargo bench --bench plan_action_cancel`. Timings are reported, never asserted.
 #![allow(clippy::unwrap_used, clippy::expect_used)] // a bench reports failures by panicking
 
@@ -19,13 +24,20 @@ use std::{
 
 use kerf_mjto::CutRequest;
 use kerf_msgs::{
-    action::{PlanCutFeedback, PlanCutGoal, PlanCutResult},
     geometry_msgs::{Point, Pose, Quaternion, Vector3},
-    msg,
+    msg::{self, CutPlan},
 };
-use kerf_ros::ros2_client::{
-    action::{ActionClient, GoalId, GoalStatusEnum},
-    RmwRequestId, ServiceMapping,
+use kerf_msgs::{msg::GcodePlan, std_msgs::StringMsg};
+use kerf_ros::{
+    planner::{
+        self,
+        goal_msgs::{PlanFeedback, PlanGoal, PlanResult, Stage},
+        AnswerKey, AnswerSize, Failure, HarnessSettings, PlanningService, Topics,
+    },
+    ros2_client::{
+        action::{ActionClient, GoalId, GoalStatusEnum},
+        RmwRequestId, ServiceMapping,
+    },
 };
 
 // Shared with the end-to-end tests; the executor helpers are not used here.
@@ -33,7 +45,7 @@ use kerf_ros::ros2_client::{
 #[path = "../tests/support/mod.rs"]
 mod support;
 
-type PlanCut = ActionClient<PlanCutGoal, PlanCutResult, PlanCutFeedback>;
+type PlanCut = ActionClient<PlanGoal<msg::CutRequest>, PlanResult<CutPlan>, PlanFeedback>;
 
 const TIMEOUT: Duration = Duration::from_secs(30);
 
@@ -117,7 +129,7 @@ fn request(id: &str, long: bool) -> msg::CutRequest {
 /// Sends a goal, waits for its acceptance and asks for its result.
 fn send(client: &PlanCut, request: msg::CutRequest) -> (GoalId, RmwRequestId) {
     let (req, id) = client
-        .send_goal(PlanCutGoal {
+        .send_goal(PlanGoal {
             request,
             execute: false,
         })
@@ -135,28 +147,36 @@ fn send(client: &PlanCut, request: msg::CutRequest) -> (GoalId, RmwRequestId) {
 }
 
 /// Waits for a feedback of `goal` at `stage` (other goals' feedback is dropped).
-fn wait_stage(client: &PlanCut, goal: GoalId, stage: &str) {
+fn wait_stage(client: &PlanCut, goal: GoalId, stage: Stage) {
     let deadline = Instant::now() + TIMEOUT;
     loop {
         while let Ok(Some((m, _))) = client.feedback_subscription().take() {
-            if m.goal_id == goal && m.feedback.stage == stage {
+            if m.goal_id == goal && m.feedback.stage == stage.as_str() {
                 return;
             }
         }
-        assert!(Instant::now() < deadline, "no '{stage}' feedback");
+        assert!(Instant::now() < deadline, "no {stage:?} feedback");
         std::thread::sleep(Duration::from_millis(1));
     }
 }
 
 /// Cancels `goal`: the latency (ms) to its CANCELED result, and the result's plan message.
-fn cancel(client: &PlanCut, goal: GoalId, result: RmwRequestId) -> (f64, String) {
+fn cancel<G, A>(
+    client: &ActionClient<G, PlanResult<A>, impl kerf_ros::ros2_client::Message>,
+    goal: GoalId,
+    result: RmwRequestId,
+) -> (f64, String)
+where
+    G: kerf_ros::ros2_client::Message + Clone + 'static,
+    A: planner::PlanAnswer,
+{
     let at = Instant::now();
     client.cancel_goal(goal).expect("cancel");
     loop {
         if let Some((status, r)) = client.receive_result(result).expect("result") {
             let ms = at.elapsed().as_secs_f64() * 1e3;
-            assert_eq!(status, GoalStatusEnum::Canceled, "{}", r.plan.message);
-            return (ms, r.plan.message);
+            assert_eq!(status, GoalStatusEnum::Canceled, "{}", r.plan.message());
+            return (ms, r.plan.message().to_string());
         }
         assert!(at.elapsed() < TIMEOUT, "no result after the cancel");
         std::thread::sleep(Duration::from_micros(200));
@@ -191,11 +211,11 @@ fn main() {
     println!("|---:|---:|---:|---:|---|");
     for k in 0..runs {
         let (long, long_result) = send(&client, request(&format!("long-{k}"), true));
-        wait_stage(&client, long, PlanCutFeedback::STAGE_PLANNING);
+        wait_stage(&client, long, Stage::Planning);
         let into = 50 + 450 * k as u64 / runs.max(2).saturating_sub(1) as u64;
         std::thread::sleep(Duration::from_millis(into));
         let (short, short_result) = send(&client, request(&format!("short-{k}"), false));
-        wait_stage(&client, short, PlanCutFeedback::STAGE_QUEUED);
+        wait_stage(&client, short, Stage::Queued);
         let (q, _) = cancel(&client, short, short_result);
         let (r, message) = cancel(&client, long, long_result);
         let killed = message.contains("worker process was stopped");
@@ -223,4 +243,148 @@ fn main() {
     drop(node);
     stop.stop();
     let _ = planner.join();
+    stubborn(runs);
+}
+
+/// A planning service whose plans never check their budget (`spin-*`); anything else is
+/// answered at once (PROGRAM_ERROR: it plans nothing).
+struct Stubborn;
+
+impl PlanningService for Stubborn {
+    type RequestMsg = StringMsg;
+    type Request = String;
+    type Answer = GcodePlan;
+
+    fn topics(&self) -> Topics {
+        Topics::new("fake")
+    }
+    fn request_from_msg(&self, msg: &StringMsg) -> Result<String, Box<GcodePlan>> {
+        Ok(msg.data.clone())
+    }
+    fn msg_key(&self, msg: &StringMsg) -> AnswerKey {
+        AnswerKey {
+            request_id: msg.data.clone(),
+            label: String::new(),
+        }
+    }
+    fn request_from_text(&self, text: &str) -> Result<String, Box<GcodePlan>> {
+        Ok(text.to_string())
+    }
+    fn key(&self, request: &String) -> AnswerKey {
+        AnswerKey {
+            request_id: request.clone(),
+            label: String::new(),
+        }
+    }
+    fn describe(&self, request: &String) -> String {
+        request.clone()
+    }
+    fn answer_size(&self, _: &String) -> Option<AnswerSize> {
+        None
+    }
+    fn requested_budget(&self, _: &String) -> Option<Duration> {
+        None
+    }
+    fn plan(&self, request: String, _: &kerf_budget::Budget) -> GcodePlan {
+        if request.starts_with("spin") {
+            let mut x = 0u64;
+            loop {
+                x = std::hint::black_box(x.wrapping_add(1));
+            }
+        }
+        self.failure(
+            &self.key(&request),
+            Failure::Unreadable,
+            "planned nothing".into(),
+        )
+    }
+    fn failure(&self, key: &AnswerKey, failure: Failure, message: String) -> GcodePlan {
+        let status = match failure {
+            Failure::Stopped | Failure::Canceled | Failure::Panicked => GcodePlan::INTERNAL_ERROR,
+            _ => GcodePlan::PROGRAM_ERROR,
+        };
+        GcodePlan {
+            request_id: key.request_id.clone(),
+            status,
+            message,
+            ..GcodePlan::default()
+        }
+    }
+    fn joint_limits(&self) -> &[kerf_executor::JointLimits] {
+        &[]
+    }
+    fn start_of(&self, _: &String) -> kerf_approach::StartSpec {
+        kerf_approach::StartSpec::None
+    }
+    fn approach_limits(&self) -> &[kerf_approach::JointLimit] {
+        &[]
+    }
+    fn surroundings(
+        &self,
+        request: &String,
+    ) -> Result<Box<dyn kerf_approach::Surroundings>, Box<GcodePlan>> {
+        Err(Box::new(self.failure(
+            &self.key(request),
+            Failure::Unreadable,
+            "no robot".into(),
+        )))
+    }
+    fn startup_note(&self) -> String {
+        "never checks its budget on purpose".into()
+    }
+}
+
+type PlanFake = ActionClient<PlanGoal<StringMsg>, PlanResult<GcodePlan>, PlanFeedback>;
+
+/// The cancel of a plan that never checks its budget, `runs` times.
+fn stubborn(runs: usize) {
+    let env = support::loopback(208, ServiceMapping::Enhanced);
+    let words = vec!["--ros-args".to_string(), "--disable-rosout-logs".into()];
+    let (stop, node) = support::spawn_node(&env, words, |args, env, stop| {
+        planner::run("stubborn_planner", &[], args, env, stop, |node| {
+            let settings = HarnessSettings::from_params(node.params())?;
+            Ok::<_, kerf_ros::RosError>((Stubborn, settings))
+        })
+        .map_err(|e| e.to_string())
+    });
+    let mut client_node = support::client_node("stubborn_client", &env);
+    let client: PlanFake = client_node
+        .action_client("/stubborn_planner/plan_fake", "kerf_msgs/action/PlanFake")
+        .expect("action client");
+    assert!(client_node.wait_for_action_server(&client, TIMEOUT));
+    let mut latency = Vec::new();
+    for k in 0..runs {
+        let (req, id) = client
+            .send_goal(PlanGoal {
+                request: StringMsg {
+                    data: format!("spin-{k}"),
+                },
+                execute: false,
+            })
+            .expect("send goal");
+        let deadline = Instant::now() + TIMEOUT;
+        while client
+            .receive_goal_response(req)
+            .expect("goal response")
+            .is_none()
+        {
+            assert!(Instant::now() < deadline, "no goal response");
+            std::thread::sleep(Duration::from_millis(1));
+        }
+        let result = client.request_result(id).expect("request result");
+        std::thread::sleep(Duration::from_millis(200));
+        let (ms, message) = cancel(&client, id, result);
+        assert!(message.contains("worker process was stopped"), "{message}");
+        latency.push(ms);
+    }
+    println!(
+        "cancel → CANCELED of a plan that never checks its budget, {runs} rounds: p50 {:.1} \
+         ms, max {:.1} ms (worker stopped 80 ms after the cancel, every time)",
+        percentile(&mut latency, 0.5),
+        percentile(&mut latency, 1.0),
+    );
+    drop(client);
+    drop(client_node);
+    stop.stop();
+    let _ = node.join();
 }

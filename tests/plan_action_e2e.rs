@@ -13,9 +13,11 @@
 //!   is ABORTED with QUEUE_FULL; a goal sent while the node stops is ABORTED saying so;
 //! * with a planning service that never checks its budget, a cancelled plan's worker process
 //!   is stopped after the harness's 80 ms grace, the goal is CANCELED, and the next goal is
-//!   planned by a fresh worker.
+//!   planned by a fresh worker;
+//! * a goal with `execute` and no executor is ABORTED after the 3 s discovery timeout, with its
+//!   plan and a message naming the action.
 //!
-//! Each test runs its own nodes (in this process, own Contexts) on its own domain (200-205).
+//! Each test runs its own nodes (in this process, own Contexts) on its own domain (200-206).
 #![allow(clippy::unwrap_used, clippy::expect_used)] // tests report failures by panicking
 
 use std::{
@@ -356,7 +358,6 @@ fn a_goal_is_planned_with_feedback_and_published() {
     );
     assert_eq!(status, GoalStatusEnum::Succeeded, "{}", result.plan.message);
     expect(&result.plan, "action-case1", CutPlan::SUCCESS, &["planned"]);
-    assert_starts_at_home(&result.plan);
     assert!(!result.executed);
     assert_eq!(result.execution_error_code, 0);
     assert!(
@@ -380,10 +381,40 @@ fn a_goal_is_planned_with_feedback_and_published() {
             assert_eq!(f.queue_position, 0, "{f:?}");
         }
     }
-    // The same answer on the plan topic; no trajectory on ~/joint_trajectory (a goal executes
-    // only by its execute flag).
+    // The answer on the plan topic, whole: framed from the robot's state. The result carries
+    // all of it but the trajectory's points (over the 60 000 bytes one loopback datagram
+    // carries: kerf_ros::planner::result_fit), and says so.
     let on_topic = planner.next_plan(QUICK);
-    assert_eq!(on_topic, result.plan);
+    assert_starts_at_home(&on_topic);
+    assert!(result.plan.trajectory.points.is_empty());
+    assert!(
+        result
+            .plan
+            .message
+            .contains("trajectory's points left out of this action result")
+            && result
+                .plan
+                .message
+                .contains("the full answer is on /mjto_planner/cut_plan"),
+        "{}",
+        result.plan.message
+    );
+    let mut without_points = on_topic.clone();
+    without_points.trajectory.points.clear();
+    without_points.message = result.plan.message.clone();
+    assert_eq!(without_points, result.plan);
+    assert!(result.plan.message.starts_with(&on_topic.message));
+
+    // A plan that fits one datagram (no approach: start "none") comes whole.
+    let mut request = short_request("action-short");
+    request.start = msg::CutRequest::START_NONE.into();
+    let sent = goals.send(request, false);
+    let (_, status, result) = goals.result(&sent, PLANNING);
+    assert_eq!(status, GoalStatusEnum::Succeeded, "{}", result.plan.message);
+    assert!(!result.plan.trajectory.points.is_empty());
+    assert_eq!(planner.next_plan(QUICK), result.plan);
+
+    // No trajectory on ~/joint_trajectory: a goal executes only by its execute flag.
     std::thread::sleep(Duration::from_millis(300));
     assert_eq!(planner.trajectories_received(), 0);
 
@@ -426,7 +457,10 @@ fn a_goal_with_execute_runs_on_the_executor() {
         CutPlan::SUCCESS,
         &["planned"],
     );
-    assert_starts_at_home(&result.plan);
+    // What ran: the plan framed from where the robot stood.
+    let on_topic = planner.next_plan(QUICK);
+    assert_eq!(on_topic.request_id, "action-case1-execute");
+    assert_starts_at_home(&on_topic);
     assert!(result.executed, "{}", result.execution_message);
     assert_eq!(result.execution_error_code, 0);
     assert!(
@@ -558,6 +592,43 @@ fn a_goal_with_a_nan_is_aborted_naming_the_field() {
     // As on the topic: the same answers on ~/cut_plan, in arrival order.
     assert_eq!(planner.next_plan(QUICK).request_id, "nan-feedrate");
     assert_eq!(planner.next_plan(QUICK).request_id, "nan-point");
+
+    drop(goals);
+    planner.finish();
+}
+
+#[test]
+fn execute_without_an_executor_is_aborted() {
+    let env = support::loopback(206, ServiceMapping::Enhanced);
+    let planner = PlannerClient::start(&mjto(), &env, &[]);
+    let goals = Goals::connect(&env);
+
+    let mut request = short_request("no-executor");
+    request.start = msg::CutRequest::START_NONE.into();
+    let t = Instant::now();
+    let sent = goals.send(request, true);
+    let (_, status, result) = goals.result(&sent, QUICK);
+    println!(
+        "no executor: ABORTED {:.2} s after the goal",
+        t.elapsed().as_secs_f64()
+    );
+    assert_eq!(
+        status,
+        GoalStatusEnum::Aborted,
+        "{}",
+        result.execution_message
+    );
+    expect(&result.plan, "no-executor", CutPlan::SUCCESS, &["planned"]);
+    assert!(!result.executed);
+    assert!(
+        result.execution_message.contains(
+            "no FollowJointTrajectory server was discovered on \
+             /trajectory_executor/follow_joint_trajectory within 3.0 s"
+        ),
+        "{}",
+        result.execution_message
+    );
+    assert!(t.elapsed() >= Duration::from_secs(3));
 
     drop(goals);
     planner.finish();

@@ -35,6 +35,17 @@ macro_rules! plan_answer {
             fn message(&self) -> &str {
                 &self.message
             }
+            fn set_message(&mut self, message: String) {
+                self.message = message;
+            }
+            fn summary(&self) -> Self {
+                Self {
+                    request_id: self.request_id.clone(),
+                    status: self.status,
+                    message: self.message.clone(),
+                    ..Self::default()
+                }
+            }
             fn trajectory(&self) -> &JointTrajectory {
                 &self.trajectory
             }

@@ -364,11 +364,13 @@ impl<S: PlanningService> PlannerNode<S> {
     /// The plan in progress (if any) is cancelled through its budget and answered (or, when it
     /// does not answer within the cancel grace, its worker is stopped and the harness answers
     /// it); queued requests are answered "stopped" without planning: no request is left
-    /// without an answer, and the node stops within 2 s whatever it plans.
+    /// without an answer, and the node stops within 2 s whatever it plans. Goals end with
+    /// their answers (ABORTED), executions are cancelled on the executor, and while the node
+    /// lingers the action answers result requests and ends new goals at once.
     fn shut_down(&mut self) {
+        let answered_at_shutdown = self.pending() > 0 || self.actions_active();
         // Goals arriving from now on end at once; executions are cancelled on the executor.
         self.stop_actions();
-        let answered_at_shutdown = self.pending() > 0 || self.actions_active();
         if answered_at_shutdown {
             self.log.warn(&format!(
                 "shutting down: cancelling the plan in progress and answering {} request(s)",

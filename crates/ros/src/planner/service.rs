@@ -111,6 +111,12 @@ pub trait PlanAnswer: RosType + Serialize + DeserializeOwned + Clone + Send + 's
     fn status_name(&self) -> &'static str;
     /// The human-readable message.
     fn message(&self) -> &str;
+    /// Replaces the message (an action result that had to leave something out says so).
+    fn set_message(&mut self, message: String);
+    /// Only the request id, status and message (and the service's label), every other field
+    /// at its default: what an action result carries when the answer does not fit one
+    /// datagram ([`super::result_fit`]).
+    fn summary(&self) -> Self;
     /// The planned trajectory (empty on failure).
     fn trajectory(&self) -> &JointTrajectory;
     /// Replaces the trajectory (the harness frames it with approach and retract).

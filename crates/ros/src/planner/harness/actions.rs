@@ -29,9 +29,10 @@ use crate::{
         action::{cancel_target, Origin, PlanGoals},
         execute::{ExecutionEnd, ExecutionEvent, Executions, FJT_TYPE},
         goal_msgs::{action_name, action_type, PlanFeedback, PlanGoal, PlanResult, Stage},
+        result_fit::{fit_result, result_limit},
         Failure, PlanAnswer, PlanningService,
     },
-    KerfNode, RosError,
+    DiscoveryRange, KerfNode, RosError,
 };
 
 /// How long a plan whose goal was cancelled may take to answer before its worker process is
@@ -58,6 +59,9 @@ pub(super) struct ActionSide<S: PlanningService> {
     pub(super) name: String,
     /// The executor's action resolved, for log lines.
     pub(super) execute_action: String,
+    /// The largest result sent whole ([`result_limit`]), and where the full answers are.
+    result_limit: usize,
+    plan_topic: String,
     next_feedback: Instant,
     /// The node is stopping: new goals end at once, no execution starts.
     stopping: bool,
@@ -74,6 +78,8 @@ impl<S: PlanningService> ActionSide<S> {
         node: &mut KerfNode,
         noun: &str,
         execute_action: &str,
+        range: DiscoveryRange,
+        plan_topic: String,
     ) -> Result<Self, RosError> {
         let local = action_name(noun);
         let server = node.action_server(&local, &action_type(noun))?;
@@ -89,6 +95,8 @@ impl<S: PlanningService> ActionSide<S> {
             executions: Executions::new(client, resolved.clone()),
             name,
             execute_action: resolved,
+            result_limit: result_limit(range),
+            plan_topic,
             next_feedback: Instant::now(),
             stopping: false,
         })
@@ -150,8 +158,10 @@ impl<S: PlanningService> PlannerNode<S> {
             };
             any = true;
             let accepted = RosTime::now();
+            // A goal id already known is refused, as rcl_action does.
+            let duplicate = self.actions.goals.get(&goal_id).is_some();
             let response = SendGoalResponse {
-                accepted: true,
+                accepted: !duplicate,
                 stamp: accepted,
             };
             if let Err(e) = self.actions.server.send_goal_response(request_id, response) {
@@ -159,6 +169,13 @@ impl<S: PlanningService> PlannerNode<S> {
                     "{}: could not answer goal {goal_id:?}: {e:?}",
                     self.actions.name
                 ));
+            }
+            if duplicate {
+                self.log.warn(&format!(
+                    "{}: goal {goal_id:?} refused: its id is already used by another goal",
+                    self.actions.name
+                ));
+                continue;
             }
             self.actions.goals.add(goal_id, accepted, goal.execute);
             let origin = Origin::Goal(goal_id);
@@ -172,7 +189,8 @@ impl<S: PlanningService> PlannerNode<S> {
                 self.publish_from(answer, origin);
                 continue;
             }
-            self.feedback(&goal_id, Stage::Queued, 0.0, self.pending() as u32);
+            let ahead = u32::try_from(self.pending()).unwrap_or(u32::MAX);
+            self.feedback(&goal_id, Stage::Queued, 0.0, ahead);
             let queued = self.queued_msg(goal.request, "goal");
             self.submit_from(queued, origin);
         }
@@ -427,6 +445,8 @@ impl<S: PlanningService> PlannerNode<S> {
         self.replace_worker();
         let answer = self.canceled_answer(&running, true);
         self.publish_from(answer, running.origin);
+        // The result first, then the fork of the next worker.
+        self.answer_results();
         if let Err(e) = self.supervisor.warm() {
             self.log
                 .error(&format!("no new planner worker process yet: {e}"));
@@ -461,6 +481,8 @@ impl<S: PlanningService> PlannerNode<S> {
     /// Answers the result requests whose goal has ended.
     fn answer_results(&mut self) {
         for (request_id, status, result) in self.actions.goals.take_ready_results() {
+            let result =
+                result.map(|r| fit_result(r, self.actions.result_limit, &self.actions.plan_topic));
             let result = result.unwrap_or_else(|| PlanResult {
                 plan: self.service.failure(
                     &Default::default(),
