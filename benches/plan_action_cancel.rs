@@ -32,7 +32,7 @@ use kerf_ros::{
     planner::{
         self,
         goal_msgs::{PlanFeedback, PlanGoal, PlanResult, Stage},
-        AnswerKey, AnswerSize, Failure, HarnessSettings, PlanningService, Topics,
+        HarnessSettings,
     },
     ros2_client::{
         action::{ActionClient, GoalId, GoalStatusEnum},
@@ -246,94 +246,6 @@ fn main() {
     stubborn(runs);
 }
 
-/// A planning service whose plans never check their budget (`spin-*`); anything else is
-/// answered at once (PROGRAM_ERROR: it plans nothing).
-struct Stubborn;
-
-impl PlanningService for Stubborn {
-    type RequestMsg = StringMsg;
-    type Request = String;
-    type Answer = GcodePlan;
-
-    fn topics(&self) -> Topics {
-        Topics::new("fake")
-    }
-    fn request_from_msg(&self, msg: &StringMsg) -> Result<String, Box<GcodePlan>> {
-        Ok(msg.data.clone())
-    }
-    fn msg_key(&self, msg: &StringMsg) -> AnswerKey {
-        AnswerKey {
-            request_id: msg.data.clone(),
-            label: String::new(),
-        }
-    }
-    fn request_from_text(&self, text: &str) -> Result<String, Box<GcodePlan>> {
-        Ok(text.to_string())
-    }
-    fn key(&self, request: &String) -> AnswerKey {
-        AnswerKey {
-            request_id: request.clone(),
-            label: String::new(),
-        }
-    }
-    fn describe(&self, request: &String) -> String {
-        request.clone()
-    }
-    fn answer_size(&self, _: &String) -> Option<AnswerSize> {
-        None
-    }
-    fn requested_budget(&self, _: &String) -> Option<Duration> {
-        None
-    }
-    fn plan(&self, request: String, _: &kerf_budget::Budget) -> GcodePlan {
-        if request.starts_with("spin") {
-            let mut x = 0u64;
-            loop {
-                x = std::hint::black_box(x.wrapping_add(1));
-            }
-        }
-        self.failure(
-            &self.key(&request),
-            Failure::Unreadable,
-            "planned nothing".into(),
-        )
-    }
-    fn failure(&self, key: &AnswerKey, failure: Failure, message: String) -> GcodePlan {
-        let status = match failure {
-            Failure::Stopped | Failure::Canceled | Failure::Panicked => GcodePlan::INTERNAL_ERROR,
-            _ => GcodePlan::PROGRAM_ERROR,
-        };
-        GcodePlan {
-            request_id: key.request_id.clone(),
-            status,
-            message,
-            ..GcodePlan::default()
-        }
-    }
-    fn joint_limits(&self) -> &[kerf_executor::JointLimits] {
-        &[]
-    }
-    fn start_of(&self, _: &String) -> kerf_approach::StartSpec {
-        kerf_approach::StartSpec::None
-    }
-    fn approach_limits(&self) -> &[kerf_approach::JointLimit] {
-        &[]
-    }
-    fn surroundings(
-        &self,
-        request: &String,
-    ) -> Result<Box<dyn kerf_approach::Surroundings>, Box<GcodePlan>> {
-        Err(Box::new(self.failure(
-            &self.key(request),
-            Failure::Unreadable,
-            "no robot".into(),
-        )))
-    }
-    fn startup_note(&self) -> String {
-        "never checks its budget on purpose".into()
-    }
-}
-
 type PlanFake = ActionClient<PlanGoal<StringMsg>, PlanResult<GcodePlan>, PlanFeedback>;
 
 /// The cancel of a plan that never checks its budget, `runs` times.
@@ -343,7 +255,7 @@ fn stubborn(runs: usize) {
     let (stop, node) = support::spawn_node(&env, words, |args, env, stop| {
         planner::run("stubborn_planner", &[], args, env, stop, |node| {
             let settings = HarnessSettings::from_params(node.params())?;
-            Ok::<_, kerf_ros::RosError>((Stubborn, settings))
+            Ok::<_, kerf_ros::RosError>((support::stubborn::Stubborn, settings))
         })
         .map_err(|e| e.to_string())
     });

@@ -7,6 +7,7 @@
 //! * [`motion`]: joint states and trajectory statuses against a plan.
 //! * [`planner`]: a planner node and its client ([`PlannerClient`]), answers ([`expect`]).
 //! * [`take`], [`scratch`]: reading a subscription with a deadline, scratch directories.
+//! * [`stubborn`]: a planning service whose plans never check their budget.
 //! * [`Killed`], [`interrupt`], [`assert_clean_exit`]: `kerf` child processes.
 
 use std::time::Duration;
@@ -25,6 +26,8 @@ mod process;
 pub mod rss;
 #[allow(dead_code)] // not every crate including this module needs it
 mod scratch;
+#[allow(dead_code)] // the planning-action tests and the cancel bench
+pub mod stubborn;
 #[allow(dead_code)] // not every crate including this module needs it
 mod take;
 
