@@ -93,15 +93,14 @@ fn case1_planned_on_one_host_runs_on_another() {
     };
     let env = subnet(130);
     let (text, request) = case1();
-    // Where the executor starts: the plan's first point (the first point is due at once).
+    // The cell starts at the laser cutter's start pose (launch_scripts/params/laser_cutter.yaml);
+    // the planner on host B plans from the robot's joint state on host A (issue 27).
+    let home = vec![0.8, 0.7, 1.5, 0.0, 0.0, -0.05];
     let offline =
         kerf_mjto::planner::Planner::new(kerf_mjto::LaserMachine::default_machine().unwrap())
             .unwrap()
             .plan(&request)
             .unwrap_or_else(|e| panic!("case 1 does not plan offline: {e}"));
-    let first = offline.positions[0].to_vec();
-    let last = offline.positions.last().unwrap().to_vec();
-    let largest_step = support::largest_step(&offline.positions);
 
     // Host B: the planner, its trajectory going to the executor on host A.
     let (planner_stop, planner) = hosts.on(Host::B, {
@@ -125,7 +124,7 @@ fn case1_planned_on_one_host_runs_on_another() {
         let env = env.clone();
         move || {
             let started = Instant::now();
-            let mut params = vec![support::initial_positions(&first)];
+            let mut params = vec![support::initial_positions(&home)];
             params.extend(cell_hardware());
             let (exec_stop, executor) =
                 support::spawn_robot_executor(&env, "laser_cutter", &params);
@@ -150,7 +149,7 @@ fn case1_planned_on_one_host_runs_on_another() {
                 controller.wait_for_subscriber(&requests, 3 * QUICK),
                 "the planner on host B was not discovered from host A"
             );
-            let (watch, states, statuses) = support::watch_cell(&env, "cut_watch", &first);
+            let (watch, states, statuses) = support::watch_cell(&env, "cut_watch", &home);
             let discovery = started.elapsed();
 
             requests
@@ -159,14 +158,24 @@ fn case1_planned_on_one_host_runs_on_another() {
             let plan = take(&plans, PLANNING, "cut plan");
             expect(&plan, &request.request_id, CutPlan::SUCCESS, &["planned"]);
             let points = &plan.trajectory.points;
-            assert_eq!(points.len(), offline.times.len(), "plan length");
-            let planned_last = &points.last().expect("a planned point").positions;
-            for (a, b) in planned_last.iter().zip(&last) {
-                assert!(
-                    (a - b).abs() < 1e-9,
-                    "the node's plan ends at {planned_last:?}"
-                );
+            // It starts where the robot on host A is, and its process stretch is the cut.
+            assert_eq!(plan.stretches.start, "current", "{:?}", plan.stretches);
+            assert_eq!(points[0].positions, home);
+            let at = points
+                .iter()
+                .position(|p| {
+                    (p.time_from_start.as_secs_f64() - plan.stretches.process_start_time).abs()
+                        < 1e-9
+                })
+                .expect("a point at process_start_time");
+            for (k, q) in offline.positions.iter().enumerate() {
+                for (a, b) in points[at + k].positions.iter().zip(q) {
+                    assert!((a - b).abs() < 1e-9, "process point {k} differs");
+                }
             }
+            let planned: Vec<Vec<f64>> = points.iter().map(|p| p.positions.clone()).collect();
+            let largest_step = support::largest_step(&planned);
+            let last = planned.last().expect("a planned point").clone();
 
             // The executor on A runs the trajectory that came from B, to its end.
             let deadline = Instant::now() + RUNNING;
@@ -177,13 +186,13 @@ fn case1_planned_on_one_host_runs_on_another() {
                 succeeded |= support::drain_statuses(&statuses, "case 1")
                     .contains(&TrajectoryStatus::SUCCEEDED);
                 while let Ok(Some((s, _))) = states.take() {
-                    let off = support::off_plan(&offline.positions, &s.position);
+                    let off = support::off_plan(&planned, &s.position);
                     assert!(
                         off <= largest_step + 1e-6,
                         "state {:?} is {off} off the plan",
                         s.position
                     );
-                    moved = moved.max((s.position[0] - first[0]).abs());
+                    moved = moved.max((s.position[0] - home[0]).abs());
                     states_seen += 1;
                 }
                 std::thread::sleep(Duration::from_millis(5));
@@ -192,8 +201,9 @@ fn case1_planned_on_one_host_runs_on_another() {
                 succeeded,
                 "the executor did not finish the cut within {RUNNING:?}"
             );
+            let cut_start = &offline.positions[0];
             assert!(
-                moved > 0.5 * (last[0] - first[0]).abs(),
+                moved > 0.5 * (cut_start[0] - home[0]).abs(),
                 "q1 moved only {moved} m"
             );
             assert!(
