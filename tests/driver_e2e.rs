@@ -23,12 +23,10 @@
 #![allow(clippy::unwrap_used, clippy::expect_used)] // tests report failures by panicking
 
 use std::{
-    io::{BufRead, BufReader},
-    path::{Path, PathBuf},
-    process::{Child, Command, Stdio},
+    path::Path,
     sync::{
         atomic::{AtomicBool, Ordering},
-        Arc, Mutex, OnceLock,
+        Arc, Mutex,
     },
     thread::JoinHandle,
     time::{Duration, Instant},
@@ -55,6 +53,7 @@ use ros2_client::{
 
 #[allow(dead_code)] // shared with the other end-to-end tests
 mod support;
+use support::driver::Driver;
 
 const ROOT: &str = env!("CARGO_MANIFEST_DIR");
 /// Waiting for discovery, a first state, an answer.
@@ -70,112 +69,6 @@ type Fjt = ActionClient<
 >;
 
 // ----- the driver process ------------------------------------------------------------------
-
-/// `target/<profile>/sim_driver`, next to this test's `deps/` directory; built once with
-/// `cargo build -p sim_driver` (the same profile) when it is missing. A test of the root
-/// package cannot name another package's binary with `CARGO_BIN_EXE_*`.
-fn sim_driver_exe() -> &'static Path {
-    static EXE: OnceLock<PathBuf> = OnceLock::new();
-    EXE.get_or_init(|| {
-        let me = std::env::current_exe().expect("test executable");
-        // target/<profile>/deps/driver_e2e-<hash>
-        let profile_dir = me
-            .parent()
-            .and_then(Path::parent)
-            .expect("target/<profile>")
-            .to_path_buf();
-        let exe = profile_dir.join("sim_driver");
-        if exe.is_file() {
-            return exe;
-        }
-        let profile = profile_dir
-            .file_name()
-            .and_then(|n| n.to_str())
-            .unwrap_or("debug")
-            .to_string();
-        let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
-        let mut cmd = Command::new(cargo);
-        cmd.args(["build", "-p", "sim_driver"]).current_dir(ROOT);
-        match profile.as_str() {
-            "debug" => {}
-            "release" => {
-                cmd.arg("--release");
-            }
-            other => {
-                cmd.args(["--profile", other]);
-            }
-        }
-        let status = cmd.status().expect("run cargo build -p sim_driver");
-        assert!(status.success(), "cargo build -p sim_driver failed");
-        assert!(exe.is_file(), "{} missing after the build", exe.display());
-        exe
-    })
-}
-
-/// The simulated driver, killed and reaped when dropped.
-struct Driver {
-    child: Child,
-    log: PathBuf,
-}
-
-impl Driver {
-    /// Starts `sim_driver` on `domain` (loopback only) with `args`, and waits for its ready line.
-    fn start(domain: u16, name: &str, args: &[String]) -> Driver {
-        let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("driver_e2e");
-        std::fs::create_dir_all(&dir).unwrap();
-        let log = dir.join(format!("{name}.log"));
-        let mut child = Command::new(sim_driver_exe())
-            .args(args)
-            .env("ROS_DOMAIN_ID", domain.to_string())
-            .env("ROS_AUTOMATIC_DISCOVERY_RANGE", "LOCALHOST")
-            .env_remove("ROS_STATIC_PEERS")
-            .env_remove("RMW_IMPLEMENTATION")
-            .stdout(Stdio::piped())
-            .stderr(std::fs::File::create(&log).unwrap())
-            .spawn()
-            .expect("start sim_driver");
-        let stdout = child.stdout.take().unwrap();
-        let (tx, rx) = std::sync::mpsc::channel();
-        std::thread::spawn(move || {
-            for line in BufReader::new(stdout).lines().map_while(Result::ok) {
-                let _ = tx.send(line);
-            }
-        });
-        let deadline = Instant::now() + QUICK;
-        loop {
-            let left = deadline.saturating_duration_since(Instant::now());
-            match rx.recv_timeout(left) {
-                Ok(line) if line.starts_with("sim_driver ready:") => break,
-                Ok(_) => {}
-                Err(_) => panic!(
-                    "sim_driver did not get ready; its log ({}):\n{}",
-                    log.display(),
-                    std::fs::read_to_string(&log).unwrap_or_default()
-                ),
-            }
-        }
-        Driver { child, log }
-    }
-
-    /// SIGKILL: a driver crash without any goodbye.
-    fn kill(&mut self) {
-        let _ = self.child.kill();
-        let _ = self.child.wait();
-    }
-}
-
-impl Drop for Driver {
-    fn drop(&mut self) {
-        self.kill();
-        if std::thread::panicking() {
-            eprintln!(
-                "sim_driver log {}:\n{}",
-                self.log.display(),
-                std::fs::read_to_string(&self.log).unwrap_or_default()
-            );
-        }
-    }
-}
 
 /// The driver's arguments for `robot`'s joints, starting at `initial`, with `extra`.
 fn driver_args(robot: &Robot, initial: &[f64], extra: &[&str]) -> Vec<String> {

@@ -30,7 +30,7 @@ use std::{
 use kerf_mjto::CutRequest;
 use kerf_msgs::{
     action::{PlanCutFeedback, PlanCutGoal, PlanCutResult},
-    geometry_msgs::{Point, Pose, Quaternion, Vector3},
+    geometry_msgs::{Point, Pose, Vector3},
     msg::{self, CutPlan, TrajectoryStatus},
 };
 use kerf_msgs::{msg::GcodePlan, std_msgs::StringMsg};
@@ -76,7 +76,7 @@ fn long_request(id: &str) -> msg::CutRequest {
     r.options.gfd.q6_steps = 15;
     r.options.rto_indices.clear();
     r.options.rto_spacing = 0.02;
-    msg_of(&r)
+    support::requests::cut_msg(&r)
 }
 
 /// Nine CL points 5 mm apart on the B-pillar's flange, in case 1's workpiece pose: planned in
@@ -111,74 +111,7 @@ fn short_request(id: &str) -> msg::CutRequest {
 }
 
 fn case1_pose() -> Pose {
-    msg_of(&case1()).workpiece_pose
-}
-
-/// The message form of a planner request (as `tests/mjto_e2e.rs` converts it).
-fn msg_of(r: &CutRequest) -> msg::CutRequest {
-    let o = &r.options;
-    let [px, py, pz] = r.workpiece_pose.position;
-    let [qx, qy, qz, qw] = r.workpiece_pose.orientation;
-    msg::CutRequest {
-        request_id: r.request_id.clone(),
-        points: r
-            .points
-            .iter()
-            .map(|p| Point {
-                x: p[0],
-                y: p[1],
-                z: p[2],
-            })
-            .collect(),
-        axes: r
-            .axes
-            .iter()
-            .map(|a| Vector3 {
-                x: a[0],
-                y: a[1],
-                z: a[2],
-            })
-            .collect(),
-        feedrate: r.feedrate,
-        feed_acceleration: r.feed_acceleration,
-        feed_jerk: r.feed_jerk,
-        sample_period: r.sample_period,
-        max_lead_angle: r.max_lead_angle,
-        max_tilt_angle: r.max_tilt_angle,
-        mesh: r.mesh.clone(),
-        workpiece_pose: Pose {
-            position: Point {
-                x: px,
-                y: py,
-                z: pz,
-            },
-            orientation: Quaternion {
-                x: qx,
-                y: qy,
-                z: qz,
-                w: qw,
-            },
-        },
-        control_points: o.control_points as u32,
-        max_iterations: o.max_iterations as u32,
-        gfd_q4_steps: o.gfd.q4_steps as u32,
-        gfd_q5_steps: o.gfd.q5_steps as u32,
-        gfd_q6_steps: o.gfd.q6_steps as u32,
-        gfd_q4_half_range: o.gfd.q4_half_range,
-        gfd_q5_half_range: o.gfd.q5_half_range,
-        rto_indices: o.rto_indices.iter().map(|&i| i as u32).collect(),
-        rto_spacing: o.rto_spacing,
-        rto_angle: o.rto_angle,
-        has_reference_standoff: true,
-        reference_standoff: o.reference_standoff,
-        clearance: o.clearance,
-        cl_tolerance: o.cl_tolerance,
-        feed_law: o.feed_law.as_str().into(),
-        rto_constraint: o.rto_constraint.as_str().into(),
-        orientation_corridor: o.orientation_corridor.as_str().into(),
-        time_budget: r.time_budget,
-        ..msg::CutRequest::default()
-    }
+    support::requests::cut_msg(&case1()).workpiece_pose
 }
 
 /// A goal sent: its id and its result request.
@@ -348,7 +281,7 @@ fn a_goal_is_planned_with_feedback_and_published() {
     std::thread::sleep(Duration::from_millis(500));
 
     let t = Instant::now();
-    let mut request = msg_of(&case1());
+    let mut request = support::requests::cut_msg(&case1());
     request.request_id = "action-case1".into();
     let sent = goals.send(request, false);
     let (_, status, result) = goals.result(&sent, PLANNING);
@@ -436,7 +369,7 @@ fn a_goal_with_execute_runs_on_the_executor() {
     std::thread::sleep(Duration::from_millis(500));
 
     let t = Instant::now();
-    let mut request = msg_of(&case1());
+    let mut request = support::requests::cut_msg(&case1());
     request.request_id = "action-case1-execute".into();
     let sent = goals.send(request, true);
     let (_, status, result) = goals.result(&sent, PLANNING);

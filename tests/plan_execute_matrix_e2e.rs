@@ -24,17 +24,14 @@
 #![allow(clippy::unwrap_used, clippy::expect_used)] // tests report failures by panicking
 
 use std::{
-    io::{BufRead, BufReader},
     panic::{catch_unwind, AssertUnwindSafe},
-    path::{Path, PathBuf},
-    process::{Child, Command, Stdio},
-    sync::OnceLock,
+    path::Path,
     thread::JoinHandle,
     time::{Duration, Instant},
 };
 
 use kerf_msgs::{
-    geometry_msgs::{Point, Pose, Quaternion, Vector3},
+    geometry_msgs::Point,
     msg::{self, CutPlan, MillPlan, PlanStretches},
     sensor_msgs::JointState,
     RosType,
@@ -99,111 +96,20 @@ const IRB: Robot = Robot {
     cell: "urdf/cells/irb6660_plate.yaml",
 };
 
-// ----- the driver process (as tests/driver_e2e.rs) -----------------------------------------
+// ----- the driver process --------------------------------------------------------------------
 
-/// `target/<profile>/sim_driver`, next to this test's `deps/` directory; built once with
-/// `cargo build -p sim_driver` (the same profile) when it is missing.
-fn sim_driver_exe() -> &'static Path {
-    static EXE: OnceLock<PathBuf> = OnceLock::new();
-    EXE.get_or_init(|| {
-        let me = std::env::current_exe().expect("test executable");
-        let profile_dir = me
-            .parent()
-            .and_then(Path::parent)
-            .expect("target/<profile>")
-            .to_path_buf();
-        let exe = profile_dir.join("sim_driver");
-        if exe.is_file() {
-            return exe;
-        }
-        let profile = profile_dir
-            .file_name()
-            .and_then(|n| n.to_str())
-            .unwrap_or("debug")
-            .to_string();
-        let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
-        let mut cmd = Command::new(cargo);
-        cmd.args(["build", "-p", "sim_driver"]).current_dir(ROOT);
-        match profile.as_str() {
-            "debug" => {}
-            "release" => {
-                cmd.arg("--release");
-            }
-            other => {
-                cmd.args(["--profile", other]);
-            }
-        }
-        let status = cmd.status().expect("run cargo build -p sim_driver");
-        assert!(status.success(), "cargo build -p sim_driver failed");
-        assert!(exe.is_file(), "{} missing after the build", exe.display());
-        exe
-    })
-}
-
-/// The simulated driver, killed and reaped when dropped.
-struct Driver {
-    child: Child,
-    log: PathBuf,
-}
-
-impl Driver {
-    /// Starts `sim_driver` for `robot` at its start pose in `/driver` on `domain` (loopback
-    /// only), and waits for its ready line.
-    fn start(domain: u16, robot: &Robot) -> Driver {
-        let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("plan_execute_matrix_e2e");
-        std::fs::create_dir_all(&dir).unwrap();
-        let log = dir.join(format!("{}_{domain}.log", robot.stem));
-        let q: Vec<String> = robot.start.iter().map(|v| format!("{v:?}")).collect();
-        let mut child = Command::new(sim_driver_exe())
-            .args([
-                "--joints".to_string(),
-                robot.joints.join(","),
-                "--initial".into(),
-                q.join(","),
-                "--namespace".into(),
-                "/driver".into(),
-            ])
-            .env("ROS_DOMAIN_ID", domain.to_string())
-            .env("ROS_AUTOMATIC_DISCOVERY_RANGE", "LOCALHOST")
-            .env_remove("ROS_STATIC_PEERS")
-            .env_remove("RMW_IMPLEMENTATION")
-            .stdout(Stdio::piped())
-            .stderr(std::fs::File::create(&log).unwrap())
-            .spawn()
-            .expect("start sim_driver");
-        let stdout = child.stdout.take().unwrap();
-        let (tx, rx) = std::sync::mpsc::channel();
-        std::thread::spawn(move || {
-            for line in BufReader::new(stdout).lines().map_while(Result::ok) {
-                let _ = tx.send(line);
-            }
-        });
-        let deadline = Instant::now() + QUICK;
-        let driver = Driver { child, log };
-        loop {
-            let left = deadline.saturating_duration_since(Instant::now());
-            match rx.recv_timeout(left) {
-                Ok(line) if line.starts_with("sim_driver ready:") => break,
-                Ok(_) => {}
-                Err(_) => panic!("sim_driver did not get ready"),
-            }
-        }
-        driver
-    }
-}
-
-impl Drop for Driver {
-    fn drop(&mut self) {
-        let _ = self.child.kill();
-        let _ = self.child.wait();
-        if std::thread::panicking() {
-            eprintln!(
-                "sim_driver log {}:\n{}",
-                self.log.display(),
-                std::fs::read_to_string(&self.log).unwrap_or_default()
-            );
-        }
-    }
+/// `sim_driver` for `robot` at its start pose in `/driver` on `domain`.
+fn start_driver(domain: u16, robot: &Robot) -> support::driver::Driver {
+    let q: Vec<String> = robot.start.iter().map(|v| format!("{v:?}")).collect();
+    let args = [
+        "--joints".to_string(),
+        robot.joints.join(","),
+        "--initial".into(),
+        q.join(","),
+        "--namespace".into(),
+        "/driver".into(),
+    ];
+    support::driver::Driver::start(domain, &format!("matrix_{}_{domain}", robot.stem), &args)
 }
 
 // ----- the executor ------------------------------------------------------------------------
@@ -303,73 +209,12 @@ impl<Req: RosType + Serialize + std::fmt::Debug, Plan: Answer> Drop for PlannerG
 
 // ----- requests ----------------------------------------------------------------------------
 
-/// Case 1 as a request message (as tests/plan_action_e2e.rs converts it).
+/// Case 1 as a request message.
 fn case1_msg(id: &str) -> msg::CutRequest {
     let path = Path::new(ROOT).join("crates/mjto/cases/case1.yaml");
-    let r = kerf_mjto::CutRequest::from_yaml(&std::fs::read_to_string(path).unwrap()).unwrap();
-    let o = &r.options;
-    let [px, py, pz] = r.workpiece_pose.position;
-    let [qx, qy, qz, qw] = r.workpiece_pose.orientation;
-    msg::CutRequest {
-        request_id: id.into(),
-        points: r
-            .points
-            .iter()
-            .map(|p| Point {
-                x: p[0],
-                y: p[1],
-                z: p[2],
-            })
-            .collect(),
-        axes: r
-            .axes
-            .iter()
-            .map(|a| Vector3 {
-                x: a[0],
-                y: a[1],
-                z: a[2],
-            })
-            .collect(),
-        feedrate: r.feedrate,
-        feed_acceleration: r.feed_acceleration,
-        feed_jerk: r.feed_jerk,
-        sample_period: r.sample_period,
-        max_lead_angle: r.max_lead_angle,
-        max_tilt_angle: r.max_tilt_angle,
-        mesh: r.mesh.clone(),
-        workpiece_pose: Pose {
-            position: Point {
-                x: px,
-                y: py,
-                z: pz,
-            },
-            orientation: Quaternion {
-                x: qx,
-                y: qy,
-                z: qz,
-                w: qw,
-            },
-        },
-        control_points: o.control_points as u32,
-        max_iterations: o.max_iterations as u32,
-        gfd_q4_steps: o.gfd.q4_steps as u32,
-        gfd_q5_steps: o.gfd.q5_steps as u32,
-        gfd_q6_steps: o.gfd.q6_steps as u32,
-        gfd_q4_half_range: o.gfd.q4_half_range,
-        gfd_q5_half_range: o.gfd.q5_half_range,
-        rto_indices: o.rto_indices.iter().map(|&i| i as u32).collect(),
-        rto_spacing: o.rto_spacing,
-        rto_angle: o.rto_angle,
-        has_reference_standoff: true,
-        reference_standoff: o.reference_standoff,
-        clearance: o.clearance,
-        cl_tolerance: o.cl_tolerance,
-        feed_law: o.feed_law.as_str().into(),
-        rto_constraint: o.rto_constraint.as_str().into(),
-        orientation_corridor: o.orientation_corridor.as_str().into(),
-        time_budget: r.time_budget,
-        ..msg::CutRequest::default()
-    }
+    let mut r = kerf_mjto::CutRequest::from_yaml(&std::fs::read_to_string(path).unwrap()).unwrap();
+    r.request_id = id.into();
+    support::requests::cut_msg(&r)
 }
 
 /// The default milling path (seed 004) with planner `naive` (as tests/mill_e2e.rs).
@@ -426,7 +271,7 @@ where
 {
     let what = format!("{} on {hw:?} (domain {domain})", robot.stem);
     let env = support::loopback(domain, ServiceMapping::Enhanced);
-    let _driver = (hw == Hardware::Topic).then(|| Driver::start(domain, robot));
+    let _driver = (hw == Hardware::Topic).then(|| start_driver(domain, robot));
     let executor = Executor::start(&env, robot, hw);
 
     let mut client = support::client_node("matrix_client", &env);

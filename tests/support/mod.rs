@@ -3,15 +3,19 @@
 //! the checks the tests make of what they publish.
 //!
 //! * [`nodes`]: the environment, client nodes, running a node, discovery.
+//! * [`driver`]: the simulated robot driver (`tools/sim_driver`) as a child process.
 //! * [`executor`]: the trajectory executor for a shipped robot.
 //! * [`motion`]: joint states and trajectory statuses against a plan.
 //! * [`planner`]: a planner node and its client ([`PlannerClient`]), answers ([`expect`]).
 //! * [`take`], [`scratch`]: reading a subscription with a deadline, scratch directories.
+//! * [`requests`]: request files as request messages.
 //! * [`stubborn`]: a planning service whose plans never check their budget.
 //! * [`Killed`], [`interrupt`], [`assert_clean_exit`]: `kerf` child processes.
 
 use std::time::Duration;
 
+#[allow(dead_code)] // not every crate including this module needs it
+pub mod driver;
 #[allow(dead_code)] // not every crate including this module needs it
 mod executor;
 #[allow(dead_code)] // the moving-robot checks; not every crate including this module needs them
@@ -22,6 +26,8 @@ mod nodes;
 pub mod planner;
 #[allow(dead_code)] // not every crate including this module needs it
 mod process;
+#[allow(dead_code)] // not every crate including this module needs it
+pub mod requests;
 #[allow(dead_code)] // not every crate including this module needs it
 pub mod rss;
 #[allow(dead_code)] // not every crate including this module needs it
