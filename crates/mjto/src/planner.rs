@@ -178,6 +178,18 @@ impl Planner {
         })
     }
 
+    /// The workpiece mesh `reference` names, from the planner's cache (loaded on first use):
+    /// what a plan of a request naming it will use, without reading the file again.
+    ///
+    /// # Errors
+    /// [`PlanError::Mesh`] for a mesh that does not load.
+    pub fn mesh(
+        &mut self,
+        reference: &str,
+    ) -> Result<std::sync::Arc<crate::mesh::MeshData>, PlanError> {
+        self.meshes.get(reference)
+    }
+
     /// The machine this planner plans for.
     pub fn machine(&self) -> &LaserMachine {
         &self.machine

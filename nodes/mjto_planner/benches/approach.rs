@@ -75,7 +75,13 @@ fn main() {
         let trajectory = plan.joint_trajectory();
         let process =
             process_samples(&kerf_ros::planner::trajectory_msg(&trajectory).unwrap()).unwrap();
-        let world = LaserSurroundings::new(&machine, limits.clone(), &request).unwrap();
+        let world = LaserSurroundings::new(
+            &machine,
+            limits.clone(),
+            &request,
+            &kerf_mjto::mesh::load(&request.mesh).unwrap(),
+        )
+        .unwrap();
         let first = process[0].q.clone();
         for (label, start) in &starts {
             let mut times = Vec::new();

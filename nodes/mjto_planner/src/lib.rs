@@ -256,9 +256,23 @@ impl PlanningService for CutService {
         &self,
         request: &CutRequest,
     ) -> Result<Box<dyn kerf_approach::Surroundings>, Box<CutPlan>> {
-        surroundings::LaserSurroundings::new(&self.machine, self.approach_limits.clone(), request)
-            .map(|s| Box::new(s) as Box<dyn kerf_approach::Surroundings>)
-            .map_err(|e| Box::new(convert::error_to_msg(&request.request_id, &e)))
+        // The mesh through the planner's cache: the plan that follows (in this worker) uses it
+        // without reading the file again. A poisoned planner is replaced by the plan; here the
+        // mesh is read directly.
+        let mesh = match self.planner.lock() {
+            Ok(mut planner) => planner.mesh(&request.mesh),
+            Err(_) => kerf_mjto::mesh::load(&request.mesh).map(std::sync::Arc::new),
+        };
+        mesh.and_then(|mesh| {
+            surroundings::LaserSurroundings::new(
+                &self.machine,
+                self.approach_limits.clone(),
+                request,
+                &mesh,
+            )
+        })
+        .map(|s| Box::new(s) as Box<dyn kerf_approach::Surroundings>)
+        .map_err(|e| Box::new(convert::error_to_msg(&request.request_id, &e)))
     }
 
     fn startup_note(&self) -> String {

@@ -6,7 +6,8 @@
 use kerf_approach::{ApproachError, Clearance, JointLimit, Surroundings};
 use kerf_mjto::{
     collision::{CollisionWorld, HeadModel},
-    mesh, CutRequest, LaserMachine, PlanError,
+    mesh::MeshData,
+    CutRequest, LaserMachine, PlanError,
 };
 
 /// Distances are exact up to this far (m); farther ones count as this far (a lower bound,
@@ -23,21 +24,22 @@ pub struct LaserSurroundings {
 }
 
 impl LaserSurroundings {
-    /// The surroundings of `request` on `machine`: its mesh at its workpiece pose.
+    /// The surroundings of `request` on `machine`: `mesh` (the request's workpiece, as loaded)
+    /// at its workpiece pose.
     ///
     /// # Errors
-    /// [`PlanError`] for a request that does not validate, a mesh that does not load, a head
+    /// [`PlanError`] for a request that does not validate, a mesh parry cannot use, a head
     /// model the URDF does not give.
     pub fn new(
         machine: &LaserMachine,
         limits: Vec<JointLimit>,
         request: &CutRequest,
+        mesh: &MeshData,
     ) -> Result<Self, PlanError> {
         let v = request.validate()?;
         let head = HeadModel::from_urdf(machine.robot().urdf())?;
         let lipschitz = head.lipschitz().to_vec();
-        let data = mesh::load(&request.mesh)?;
-        let world = CollisionWorld::new(head, &data, &v.workpiece_pose, 0.0)?;
+        let world = CollisionWorld::new(head, mesh, &v.workpiece_pose, 0.0)?;
         Ok(Self {
             world,
             lipschitz,

@@ -103,6 +103,7 @@ fn case_1_starts_where_the_robot_is_and_ends_backed_off() {
         &LaserMachine::default_machine().unwrap(),
         service.approach_limits().to_vec(),
         &request,
+        &kerf_mjto::mesh::load(&request.mesh).unwrap(),
     )
     .unwrap();
     let lead = FrameSettings::default().lead_distance();
