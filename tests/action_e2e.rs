@@ -22,10 +22,11 @@ use kerf_msgs::{
     },
     sensor_msgs::JointState,
     srv::{ValidateTrajectoryRequest, ValidateTrajectoryResponse},
-    trajectory_msgs::{JointTrajectory, JointTrajectoryPoint},
+    trajectory_msgs::JointTrajectory,
     RosType,
 };
 mod support;
+use support::{max_diff, min_jerk};
 
 use kerf_ros::{qos, KerfNode, StopToken};
 use ros2_client::{
@@ -192,45 +193,11 @@ impl Drop for Cell {
     }
 }
 
-/// Minimum-jerk rest-to-rest motion `from` → `to` over `t` seconds, `n` segments, with exact
-/// velocities and accelerations (quintic interpolation in the executor reproduces it).
-fn min_jerk(names: &[&str], from: &[f64], to: &[f64], t: f64, n: usize) -> JointTrajectory {
-    let points = (1..=n)
-        .map(|k| {
-            let s = k as f64 / n as f64;
-            let (p, v, a) = (
-                10.0 * s.powi(3) - 15.0 * s.powi(4) + 6.0 * s.powi(5),
-                (30.0 * s.powi(2) - 60.0 * s.powi(3) + 30.0 * s.powi(4)) / t,
-                (60.0 * s - 180.0 * s.powi(2) + 120.0 * s.powi(3)) / (t * t),
-            );
-            JointTrajectoryPoint {
-                positions: from.iter().zip(to).map(|(f, g)| f + (g - f) * p).collect(),
-                velocities: from.iter().zip(to).map(|(f, g)| (g - f) * v).collect(),
-                accelerations: from.iter().zip(to).map(|(f, g)| (g - f) * a).collect(),
-                effort: vec![],
-                time_from_start: RosDuration::from_secs_f64(s * t).unwrap(),
-            }
-        })
-        .collect();
-    JointTrajectory {
-        joint_names: names.iter().map(|s| s.to_string()).collect(),
-        points,
-        ..Default::default()
-    }
-}
-
 fn goal(trajectory: JointTrajectory) -> FollowJointTrajectoryGoal {
     FollowJointTrajectoryGoal {
         trajectory,
         ..Default::default()
     }
-}
-
-fn max_diff(a: &[f64], b: &[f64]) -> f64 {
-    a.iter()
-        .zip(b)
-        .map(|(x, y)| (x - y).abs())
-        .fold(0.0, f64::max)
 }
 
 #[test]

@@ -53,7 +53,7 @@ use ros2_client::{
 
 #[allow(dead_code)] // shared with the other end-to-end tests
 mod support;
-use support::driver::Driver;
+use support::{driver::Driver, max_diff, min_jerk};
 
 const ROOT: &str = env!("CARGO_MANIFEST_DIR");
 /// Waiting for discovery, a first state, an answer.
@@ -399,33 +399,6 @@ impl Drop for Rig {
 
 // ----- motions and checks ------------------------------------------------------------------
 
-/// Minimum-jerk rest-to-rest motion `from` → `to` over `t` seconds, `n` segments with exact
-/// velocities and accelerations, the first point after the start (from the current state).
-fn min_jerk(names: &[String], from: &[f64], to: &[f64], t: f64, n: usize) -> JointTrajectory {
-    let points = (1..=n)
-        .map(|k| {
-            let s = k as f64 / n as f64;
-            let (p, v, a) = (
-                10.0 * s.powi(3) - 15.0 * s.powi(4) + 6.0 * s.powi(5),
-                (30.0 * s.powi(2) - 60.0 * s.powi(3) + 30.0 * s.powi(4)) / t,
-                (60.0 * s - 180.0 * s.powi(2) + 120.0 * s.powi(3)) / (t * t),
-            );
-            JointTrajectoryPoint {
-                positions: from.iter().zip(to).map(|(f, g)| f + (g - f) * p).collect(),
-                velocities: from.iter().zip(to).map(|(f, g)| (g - f) * v).collect(),
-                accelerations: from.iter().zip(to).map(|(f, g)| (g - f) * a).collect(),
-                effort: vec![],
-                time_from_start: RosDuration::from_secs_f64(s * t).unwrap(),
-            }
-        })
-        .collect();
-    JointTrajectory {
-        joint_names: names.to_vec(),
-        points,
-        ..Default::default()
-    }
-}
-
 /// `trajectory` with a first point at `time_from_start` 0 at rest at `start` (a driver's
 /// FollowJointTrajectory server starts goals from its current position, as JTC does).
 fn from_rest_at(mut trajectory: JointTrajectory, start: &[f64]) -> JointTrajectory {
@@ -458,13 +431,6 @@ fn wait_measured_at(rig: &Rig, q: &[f64], tolerance: f64, what: &str) {
 
 fn offset(q: &[f64], d: &[f64]) -> Vec<f64> {
     q.iter().zip(d).map(|(a, b)| a + b).collect()
-}
-
-fn max_diff(a: &[f64], b: &[f64]) -> f64 {
-    a.iter()
-        .zip(b)
-        .map(|(x, y)| (x - y).abs())
-        .fold(0.0, f64::max)
 }
 
 /// Every command of `cmds` within the velocity and acceleration limits (accelerations as the

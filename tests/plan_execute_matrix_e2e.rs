@@ -49,6 +49,7 @@ use serde::{de::DeserializeOwned, Serialize};
 #[allow(dead_code)] // shared with the other end-to-end tests
 mod support;
 use support::{
+    max_diff,
     planner::{mill, mjto, Answer, Planner},
     take, take_newest, PlannerClient, QUICK,
 };
@@ -242,13 +243,6 @@ struct Timing {
     planning: f64,
     duration: f64,
     execution: f64,
-}
-
-fn max_diff(a: &[f64], b: &[f64]) -> f64 {
-    a.iter()
-        .zip(b)
-        .map(|(x, y)| (x - y).abs())
-        .fold(0.0, f64::max)
 }
 
 /// One plan-and-execute run of `robot` on `hw` in `domain`: the executor (and, on topic

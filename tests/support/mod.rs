@@ -41,8 +41,8 @@ mod take;
 pub use {
     executor::{initial_positions, spawn_executor, spawn_robot_executor, stop_and_join},
     motion::{
-        assert_rests_at, assert_starts_at, drain_statuses, executor_input, largest_step, off_plan,
-        watch_cell, watch_executor,
+        assert_rests_at, assert_starts_at, drain_statuses, executor_input, largest_step, max_diff,
+        min_jerk, off_plan, watch_cell, watch_executor,
     },
     nodes::{client_node, loopback, spawn_node, wait_for_writer},
     planner::{expect, PlannerClient},

@@ -3,7 +3,11 @@
 use std::time::Duration;
 
 use kerf_msgs::{
-    msg::TrajectoryStatus, sensor_msgs::JointState, trajectory_msgs::JointTrajectory, RosType,
+    builtin_interfaces::Duration as RosDuration,
+    msg::TrajectoryStatus,
+    sensor_msgs::JointState,
+    trajectory_msgs::{JointTrajectory, JointTrajectoryPoint},
+    RosType,
 };
 use kerf_ros::{qos, KerfNode, RosEnv};
 use ros2_client::{Publisher, Subscription};
@@ -137,4 +141,46 @@ pub fn off_plan<Q: AsRef<[f64]>>(points: &[Q], position: &[f64]) -> f64 {
                 .fold(0.0, f64::max)
         })
         .fold(f64::INFINITY, f64::min)
+}
+
+/// Minimum-jerk rest-to-rest motion `from` → `to` over `t` seconds, `n` segments with exact
+/// velocities and accelerations (the executor's quintic interpolation reproduces it), the
+/// first point after the start (the motion starts from the current state).
+pub fn min_jerk<S: AsRef<str>>(
+    names: &[S],
+    from: &[f64],
+    to: &[f64],
+    t: f64,
+    n: usize,
+) -> JointTrajectory {
+    let points = (1..=n)
+        .map(|k| {
+            let s = k as f64 / n as f64;
+            let (p, v, a) = (
+                10.0 * s.powi(3) - 15.0 * s.powi(4) + 6.0 * s.powi(5),
+                (30.0 * s.powi(2) - 60.0 * s.powi(3) + 30.0 * s.powi(4)) / t,
+                (60.0 * s - 180.0 * s.powi(2) + 120.0 * s.powi(3)) / (t * t),
+            );
+            JointTrajectoryPoint {
+                positions: from.iter().zip(to).map(|(f, g)| f + (g - f) * p).collect(),
+                velocities: from.iter().zip(to).map(|(f, g)| (g - f) * v).collect(),
+                accelerations: from.iter().zip(to).map(|(f, g)| (g - f) * a).collect(),
+                effort: vec![],
+                time_from_start: RosDuration::from_secs_f64(s * t).expect("a finite time"),
+            }
+        })
+        .collect();
+    JointTrajectory {
+        joint_names: names.iter().map(|s| s.as_ref().to_string()).collect(),
+        points,
+        ..Default::default()
+    }
+}
+
+/// The largest absolute difference between two configurations.
+pub fn max_diff(a: &[f64], b: &[f64]) -> f64 {
+    a.iter()
+        .zip(b)
+        .map(|(x, y)| (x - y).abs())
+        .fold(0.0, f64::max)
 }
