@@ -375,6 +375,52 @@ impl MillCell {
         ))
     }
 
+    /// The tool-tip pose at an arc length `s` of the path extended by straight lines along
+    /// its end tangents: [`MillCell::tool_pose_at_parameter`] inside [0, L]; before the
+    /// start, the start pose moved by `s` along the start tangent (s < 0); after the end,
+    /// the end pose moved by `s − L` along the end tangent. The orientation on an extension
+    /// is the end's (the path frame's tangent is constant on a line), so the pose is
+    /// continuous at both ends. The extensions are the straight run-in and run-out a cut
+    /// enters and leaves the material on ([`MillCell::path`] is the cut in the material).
+    ///
+    /// # Errors
+    /// As [`MillCell::tool_pose_at`], and [`MillError::InvalidParameter`] for a non-finite s.
+    pub fn tool_pose_on_extension(&self, s: f64, g: f64) -> Result<Isometry3<f64>, MillError> {
+        let s = check_finite("extended arc length s [m]", s)?;
+        let total = self.path.total_length();
+        let (u, beyond) = if s < 0.0 {
+            (0.0, s)
+        } else if s > total {
+            (1.0, s - total)
+        } else {
+            return self.tool_pose_at(s, g);
+        };
+        let mut pose = self.tool_pose_at_parameter(u, g)?;
+        let n = self.path.normal();
+        let d = self.path.derivative(u)?;
+        let d = d - d.dot(&n) * n;
+        pose.translation.vector += beyond * d.normalize();
+        Ok(pose)
+    }
+
+    /// The joint vector at an extended arc length ([`MillCell::tool_pose_on_extension`]):
+    /// the valid IK solution nearest `reference`, as [`MillCell::joints_at`].
+    ///
+    /// # Errors
+    /// As [`MillCell::joints_at`].
+    pub fn joints_on_extension(
+        &self,
+        s: f64,
+        g: f64,
+        reference: Option<&[f64; 6]>,
+    ) -> Result<[f64; 6], MillError> {
+        self.check_g(g)?;
+        let pose = self.tool_pose_on_extension(s, g)?;
+        self.kinematics
+            .ik_nearest(&pose, reference.unwrap_or(&self.reference))
+            .map_err(|e| e.with_context(None, Some(g)))
+    }
+
     /// The joint vector at arc length `s` and redundancy angle `g`: the
     /// valid IK solution of [`MillCell::tool_pose_at`] nearest `reference`
     /// (the YAML's reference joints for `None`), as [`MillCell::evaluate`]

@@ -114,12 +114,39 @@ const CLOSEST_ITERATIONS: usize = 12;
 /// Coarse samples of the path searched when the local guess lands far from it.
 const COARSE_SAMPLES: usize = 2000;
 
-/// Distance from `x` to the path curve, starting from parameter `u0`, and the parameter of
-/// the closest point.
+/// Distance from `x` to the path curve extended by straight lines along its end tangents
+/// (the run-in and run-out of [`crate::timing::Entry::RunIn`]), starting from parameter
+/// `u0`, and the parameter of the closest point on the curve (0 or 1 when the closest point
+/// is on an extension).
 ///
 /// Gauss–Newton on |P(u) − x|², stopped when the step is below 1e-13 in u; a guess that
 /// ends more than 1 mm away is retried from the best of a coarse scan of the whole curve.
+/// A closest point at an end of the curve with `x` beyond it (along the end tangent) is
+/// replaced by the foot point on the extension.
 pub(crate) fn distance_to_path(
+    cell: &MillCell,
+    x: &Vector3<f64>,
+    u0: f64,
+) -> Result<(f64, f64), MillPlanError> {
+    let (distance, u) = distance_to_curve(cell, x, u0)?;
+    if u > 0.0 && u < 1.0 {
+        return Ok((distance, u));
+    }
+    let path = cell.path();
+    let (p, d) = path.point_and_derivative(u)?;
+    // The tangent in the path's plane, as the extension's pose has it.
+    let normal = path.normal();
+    let tangent = (d - d.dot(&normal) * normal).normalize();
+    let along = (x - p).dot(&tangent);
+    let beyond = if u <= 0.0 { along < 0.0 } else { along > 0.0 };
+    if !beyond || !tangent.iter().all(|v| v.is_finite()) {
+        return Ok((distance, u));
+    }
+    Ok((((x - p) - along * tangent).norm().min(distance), u))
+}
+
+/// [`distance_to_path`] on the curve only (no extensions).
+fn distance_to_curve(
     cell: &MillCell,
     x: &Vector3<f64>,
     u0: f64,

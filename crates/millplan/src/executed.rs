@@ -10,6 +10,7 @@ use kerf_budget::Budget;
 use kerf_mill::MillCell;
 
 use crate::cache::IndicatorCache;
+use crate::chatter_judge::{judge, ChatterVerdict};
 use crate::error::MillPlanError;
 use crate::plan::{IndicatorProvenance, IndicatorSource, Plan};
 use crate::reward::RewardWeights;
@@ -31,6 +32,45 @@ pub struct Executed {
     pub cached_segments: Vec<usize>,
     /// The settings the trajectory was built with (tolerance, control period).
     pub settings: TrajectorySettings,
+    /// |μ|max at every control-period sample in the material, at the executed feed, speed and
+    /// g ([`crate::chatter_judge`]); `plan.chatter_free` and `plan.max_spectral_radius` include
+    /// it.
+    pub chatter: ChatterVerdict,
+}
+
+impl Executed {
+    /// The executed plan with the chatter judge of its trajectory
+    /// ([`crate::chatter_judge::judge`]) folded into its totals.
+    ///
+    /// # Errors
+    /// As [`crate::chatter_judge::judge`].
+    pub(crate) fn assemble(
+        cell: &MillCell,
+        (scaling, mut plan): (TimeScaling, Plan),
+        cached_segments: Vec<usize>,
+        settings: TrajectorySettings,
+        threads: usize,
+        budget: &Budget,
+    ) -> Result<Self, MillPlanError> {
+        let joints: Vec<[f64; 6]> = plan.segments.iter().map(|s| s.joints).collect();
+        let chatter = judge(
+            cell,
+            &scaling,
+            &joints,
+            settings.control_period,
+            threads,
+            budget,
+        )?;
+        plan.chatter_free &= chatter.chatter_free;
+        plan.max_spectral_radius = plan.max_spectral_radius.max(chatter.max_spectral_radius);
+        Ok(Self {
+            scaling,
+            plan,
+            cached_segments,
+            settings,
+            chatter,
+        })
+    }
 }
 
 /// What the robot runs of a plan evaluated outside the planner (e.g. the DP
@@ -95,10 +135,12 @@ pub(crate) fn executed(
         cache,
         budget,
     )?;
-    Ok(Executed {
-        scaling,
-        plan,
+    Executed::assemble(
+        cell,
+        (scaling, plan),
         cached_segments,
-        settings: *settings,
-    })
+        *settings,
+        threads,
+        budget,
+    )
 }

@@ -37,6 +37,7 @@ pub mod time_law;
 pub mod timing;
 
 // The joint trajectory (the executor's type), as planned and as executed.
+pub mod chatter_judge;
 pub mod deviation;
 pub mod executed;
 pub mod planned;

@@ -934,12 +934,14 @@ impl MillPlanner {
                                 &indicator,
                                 reevaluation,
                             )?;
-                            Executed {
-                                scaling,
-                                plan: executed_plan,
+                            Executed::assemble(
+                                &cell,
+                                (scaling, executed_plan),
                                 cached_segments,
                                 settings,
-                            }
+                                self.eval_threads,
+                                budget,
+                            )?
                         }
                         // Not run (only when the evaluation failed, which returned above).
                         None => executed(

@@ -143,6 +143,11 @@ impl TimeLaw {
         self.ramp_time
     }
 
+    /// The length L the law runs over \[m\].
+    pub fn length(&self) -> f64 {
+        self.length
+    }
+
     /// R(t) and dR/dt.
     fn ramp(&self, t: f64) -> (f64, f64) {
         let (a, da, _) = smootherstep(t / self.ramp_time);

@@ -157,6 +157,51 @@ pub struct TrajectorySettings {
     /// (default 1; the planner uses its evaluation threads). The result is
     /// the same for every count.
     pub threads: usize,
+    /// Where the tool starts and stops from rest (default [`Entry::RunIn`]).
+    pub entry: Entry,
+}
+
+/// Where the executed trajectory starts and stops from rest (issue 28, item 1).
+///
+/// # What a real cell does
+/// A milling program enters the stock at cutting feed: the CAM system's lead-in starts
+/// outside the material, the machine accelerates in the air and the tool meets the material
+/// already at the programmed feed and spindle speed; at the end it leaves the material at
+/// feed and stops in the air. A start from rest inside the material passes every feed from 0,
+/// and below the lower feed bound of seed 004 Fig. 4/7 the cut chatters (kerf's model with the
+/// power-law force of the cell file chatters as f → 0 at every spindle speed: the chip
+/// stiffness grows as h^(−0.25)); `kerf lobes` shows the bound per segment.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Entry {
+    /// The path is the cut in the material, and the tool enters it at feed: the trajectory
+    /// starts from rest on a straight run-in along the path's start tangent, outside the
+    /// material, long enough for the start ramp to end before the path starts, and stops on
+    /// a run-out along the end tangent ([`kerf_mill::MillCell::tool_pose_on_extension`]).
+    /// The run-in and run-out carry the first and last segment's Ω, f and g.
+    #[default]
+    RunIn,
+    /// The ramps from and to rest lie on the path (the tool starts and stops in the
+    /// material); kerf's behaviour before issue 28, kept to show why a cell does not cut so.
+    InMaterial,
+}
+
+impl Entry {
+    /// `run_in` or `in_material`.
+    pub fn name(self) -> &'static str {
+        match self {
+            Entry::RunIn => "run_in",
+            Entry::InMaterial => "in_material",
+        }
+    }
+
+    /// The entry of a name ([`Entry::name`]).
+    pub fn from_name(name: &str) -> Option<Self> {
+        match name {
+            "run_in" => Some(Entry::RunIn),
+            "in_material" => Some(Entry::InMaterial),
+            _ => None,
+        }
+    }
 }
 
 impl Default for TrajectorySettings {
@@ -167,6 +212,7 @@ impl Default for TrajectorySettings {
             ramp_time: 0.5,
             max_points: 6000,
             threads: 1,
+            entry: Entry::RunIn,
         }
     }
 }
@@ -193,6 +239,12 @@ impl TrajectorySettings {
     /// With the threads of the measurement (0 is taken as 1).
     pub fn with_threads(mut self, threads: usize) -> Self {
         self.threads = threads.max(1);
+        self
+    }
+
+    /// With the entry ([`Entry`]).
+    pub fn with_entry(mut self, entry: Entry) -> Self {
+        self.entry = entry;
         self
     }
 
@@ -277,6 +329,13 @@ pub struct TimeScaling {
     /// The tool path as the executor runs the trajectory, at every control
     /// period (step 7): within the path tolerance.
     pub deviation: PathDeviation,
+    /// Length of the straight run-in before the path \[m\] (0 for [`Entry::InMaterial`]).
+    pub run_in: f64,
+    /// Length of the straight run-out after the path \[m\].
+    pub run_out: f64,
+    /// The time law s(t) the trajectory was built on, in the law's arc length: the path's
+    /// arc length plus [`TimeScaling::run_in`] ([`TimeScaling::path_state`]).
+    pub law: TimeLaw,
 }
 
 impl TimeScaling {
@@ -296,6 +355,23 @@ impl TimeScaling {
     /// Σ of [`TimeScaling::segment_times`]: the machining time as run \[s\].
     pub fn machining_time(&self) -> f64 {
         self.segment_times.iter().sum()
+    }
+
+    /// The tool's state on the law at time `t` (clamped to the trajectory), its arc length
+    /// on the path: negative on the run-in, beyond the path's length on the run-out.
+    pub fn path_state(&self, t: f64) -> crate::time_law::PathState {
+        let mut p = self.law.at_time(t);
+        p.s -= self.run_in;
+        p
+    }
+
+    /// The times the tool enters and leaves the material (the path's start and end) \[s\].
+    pub fn material_times(&self) -> (f64, f64) {
+        let length = self.law.length() - self.run_in - self.run_out;
+        (
+            self.law.at_arc_length(self.run_in).time,
+            self.law.at_arc_length(self.run_in + length).time,
+        )
     }
 }
 
@@ -363,6 +439,63 @@ pub(crate) fn time_scale_inputs(
     budget: &Budget,
 ) -> Result<TimeScaling, MillPlanError> {
     settings.validate()?;
+    let (Some(first), Some(last)) = (segments.first(), segments.last()) else {
+        return Err(MillPlanError::InvalidConfig {
+            name: "executed trajectory".to_string(),
+            reason: "a plan without segments".to_string(),
+        });
+    };
+    if settings.entry == Entry::InMaterial {
+        return scale_on(cell, segments, limits, settings, budget, (0.0, 0.0));
+    }
+    // The ramps' distance at the planned end feeds (f T_r / 2 for the smootherstep ramp),
+    // with a margin; lengthened when the settled law's ramps end on the path.
+    let distance = |feed: f64| 0.6 * feed.abs() * settings.ramp_time;
+    let mut run = (distance(first.feed), distance(last.feed));
+    for _ in 0..RUN_IN_TRIES {
+        let scaling = scale_on(cell, segments, limits, settings, budget, run)?;
+        let (enter, leave) = scaling.material_times();
+        let ramp = scaling.law.ramp_time();
+        let end = scaling.law.duration();
+        if enter >= ramp && leave <= end - ramp {
+            return Ok(scaling);
+        }
+        // Where the ramps end, on the path's arc length: the run lengthened by that much
+        // and a half again.
+        let length = cell.path().total_length();
+        let ramp_end = scaling.path_state(ramp).s;
+        let ramp_start = scaling.path_state(end - ramp).s;
+        if enter < ramp {
+            run.0 += 1.5 * ramp_end.max(0.0) + 1e-3;
+        }
+        if leave > end - ramp {
+            run.1 += 1.5 * (length - ramp_start).max(0.0) + 1e-3;
+        }
+    }
+    Err(MillPlanError::NotExecutable {
+        reason: format!(
+            "the start and stop ramps do not fit on a run-in and run-out of {:.1} and {:.1} mm \
+             after {RUN_IN_TRIES} tries",
+            run.0 * 1e3,
+            run.1 * 1e3
+        ),
+    })
+}
+
+/// Tries of [`time_scale_inputs`] at a longer run-in or run-out.
+const RUN_IN_TRIES: usize = 4;
+
+/// [`time_scale_inputs`] with a run-in of `run.0` and a run-out of `run.1` \[m\] (0: the
+/// ramps on the path).
+fn scale_on(
+    cell: &MillCell,
+    segments: &[SegmentInput],
+    limits: &[JointLimit],
+    settings: &TrajectorySettings,
+    budget: &Budget,
+    run: (f64, f64),
+) -> Result<TimeScaling, MillPlanError> {
+    let (run_in, run_out) = run;
     let bad = |reason: String| MillPlanError::InvalidConfig {
         name: "executed trajectory".to_string(),
         reason,
@@ -431,23 +564,54 @@ pub(crate) fn time_scale_inputs(
         feed: StepProfile::new("f(s)", &x, &ends(&|i| segments[i].feed))?,
         rpm: StepProfile::new("spindle speed(s)", &x, &ends(&|i| segments[i].rpm))?,
     };
-    let (g, feed) = (&profiles.g, &profiles.feed);
-    // Step 2: initial knots at every segment's ends and midpoint.
-    let mut knots: Vec<GeoKnot> = Vec::with_capacity(2 * n + 1);
-    let mut reference = segments[0].joints;
+    let g = &profiles.g;
+    // The law runs over the run-in, the path and the run-out: its arc length is the path's
+    // plus `run_in`, and the feed is the first and last segment's on the run-in and run-out
+    // (the profile is constant outside its knots).
+    let law_length = run_in + length + run_out;
+    let shifted: Vec<f64> = x.iter().map(|v| v + run_in).collect();
+    let law_feed = StepProfile::new("f(s)", &shifted, &ends(&|i| segments[i].feed))?;
+    let feed = &law_feed;
+    // The knot at path arc length s (negative on the run-in, beyond the length on the
+    // run-out), its IK solution nearest `reference`.
+    let knot_at = |s: f64, reference: &[f64; 6]| -> Result<GeoKnot, MillPlanError> {
+        let g_s = g.eval(s.clamp(0.0, length)).value;
+        if (0.0..=length).contains(&s) {
+            let u = path.parameter_at(s)?;
+            let q = cell.joints_at_parameter(u, g_s, Some(reference))?;
+            Ok(GeoKnot { s, u, q })
+        } else {
+            let u = if s < 0.0 { 0.0 } else { 1.0 };
+            let q = cell.joints_on_extension(s, g_s, Some(reference))?;
+            Ok(GeoKnot { s, u, q })
+        }
+    };
+    // Step 2: initial knots at every segment's ends and midpoint, and at the middle and far
+    // end of the run-in and run-out.
+    let mut places = Vec::with_capacity(2 * n + 5);
+    if run_in > 0.0 {
+        places.extend([-run_in, -0.5 * run_in]);
+    }
     for k in 0..=2 * n {
-        let s = if k % 2 == 0 {
+        places.push(if k % 2 == 0 {
             boundaries[k / 2]
         } else {
             x[k / 2 + 1]
-        };
-        let u = path.parameter_at(s.min(length))?;
-        let q = cell.joints_at_parameter(u, g.eval(s).value, Some(&reference))?;
-        reference = q;
-        knots.push(GeoKnot { s, u, q });
+        });
     }
-    let mut slowdown =
-        SlowdownField::new(length, n).ok_or_else(|| bad(format!("path length {length} m")))?;
+    if run_out > 0.0 {
+        places.extend([length + 0.5 * run_out, length + run_out]);
+    }
+    let mut knots: Vec<GeoKnot> = Vec::with_capacity(places.len());
+    let mut reference = segments[0].joints;
+    for s in places {
+        let knot = knot_at(s, &reference)?;
+        reference = knot.q;
+        knots.push(knot);
+    }
+    let cells = ((law_length / (length / n as f64)).round() as usize).max(n);
+    let mut slowdown = SlowdownField::new(law_length, cells)
+        .ok_or_else(|| bad(format!("path length {length} m")))?;
     let mut ramp_time = settings.ramp_time;
     let mut uniform = false;
     let mut rounds = 0;
@@ -463,7 +627,7 @@ pub(crate) fn time_scale_inputs(
             });
         }
         let step = settings.control_period.min(ramp_time / 64.0);
-        let Some(law) = TimeLaw::new(feed, &slowdown, length, ramp_time, step) else {
+        let Some(law) = TimeLaw::new(feed, &slowdown, law_length, ramp_time, step) else {
             ramp_time *= 0.5;
             if ramp_time < MIN_RAMP_TIME {
                 return Err(MillPlanError::NotExecutable {
@@ -475,7 +639,7 @@ pub(crate) fn time_scale_inputs(
             }
             continue;
         };
-        let eval = evaluate(cell, &knots, &law, limits)?;
+        let eval = evaluate(cell, &knots, &law, run_in, limits)?;
         let mut split: Vec<usize> = (0..knots.len() - 1)
             .filter(|&k| eval.deviation[k] > SPLIT_FRACTION * settings.path_tolerance)
             .collect();
@@ -486,8 +650,8 @@ pub(crate) fn time_scale_inputs(
                 cell,
                 segments,
                 &knots,
-                &boundaries,
-                &x,
+                (&boundaries, &x),
+                (run_in, run_out),
                 &law,
                 &eval,
                 &profiles,
@@ -545,13 +709,12 @@ pub(crate) fn time_scale_inputs(
                     ),
                 });
             }
-            let s = law.at_time(0.5 * (ta + tb)).s;
+            let s = law.at_time(0.5 * (ta + tb)).s - run_in;
             if !(s > knots[k].s && s < knots[k + 1].s) {
                 continue;
             }
-            let u = path.parameter_at(s)?;
-            let q = cell.joints_at_parameter(u, g.eval(s).value, Some(&knots[k].q))?;
-            knots.insert(k + 1, GeoKnot { s, u, q });
+            let knot = knot_at(s, &knots[k].q)?;
+            knots.insert(k + 1, knot);
         }
         // Step 6: slow down.
         if worst > 1.0 {
@@ -561,7 +724,7 @@ pub(crate) fn time_scale_inputs(
                 for (k, r) in eval.need.iter().enumerate() {
                     if *r > 1.0 {
                         let factor = (r * (1.0 + MARGIN)).min(MAX_ROUND_FACTOR);
-                        spans.push((knots[k].s, knots[k + 1].s, factor));
+                        spans.push((knots[k].s + run_in, knots[k + 1].s + run_in, factor));
                         let (ta, tb) = (eval.times[k], eval.times[k + 1]);
                         if ta < law.ramp_time() || tb > law.duration() - law.ramp_time() {
                             ramp_need = ramp_need.max(factor);
@@ -586,6 +749,7 @@ fn evaluate(
     cell: &MillCell,
     knots: &[GeoKnot],
     law: &TimeLaw,
+    run_in: f64,
     limits: &[JointLimit],
 ) -> Result<Evaluation, MillPlanError> {
     let m = knots.len();
@@ -605,7 +769,7 @@ fn evaluate(
         } else if k + 1 == m {
             law.at_time(law.duration())
         } else {
-            law.at_arc_length(knot.s)
+            law.at_arc_length(knot.s + run_in)
         };
         let mut v = [0.0; 6];
         let mut a = [0.0; 6];
@@ -736,8 +900,8 @@ fn finish(
     cell: &MillCell,
     segments: &[SegmentInput],
     knots: &[GeoKnot],
-    boundaries: &[f64],
-    midpoints: &[f64],
+    (boundaries, midpoints): (&[f64], &[f64]),
+    (run_in, run_out): (f64, f64),
     law: &TimeLaw,
     eval: &Evaluation,
     profiles: &ExecutedProfiles,
@@ -776,10 +940,12 @@ fn finish(
     // The time at each segment boundary, once (each inner one ends a segment and starts the next).
     let at: Vec<f64> = boundaries
         .iter()
-        .map(|b| law.at_arc_length(*b).time)
+        .map(|b| law.at_arc_length(*b + run_in).time)
         .collect();
     let segment_times = at.windows(2).map(|w| w[1] - w[0]).collect();
-    let segment_slowdown: Vec<f64> = (0..n).map(|i| slowdown.eval(midpoints[i + 1]).0).collect();
+    let segment_slowdown: Vec<f64> = (0..n)
+        .map(|i| slowdown.eval(midpoints[i + 1] + run_in).0)
+        .collect();
     let segment_feeds = segments
         .iter()
         .zip(&segment_slowdown)
@@ -806,6 +972,9 @@ fn finish(
         sampled_deviation,
         min_condition_indicator: min_ci,
         deviation: PathDeviation::default(),
+        run_in,
+        run_out,
+        law: law.clone(),
     })
 }
 
