@@ -168,9 +168,11 @@ fn request_for(a: &MillArgs, request: &MillRequest, kind: PlannerKind) -> MillRe
         } else {
             None
         }),
-        PlannerKind::Dp | PlannerKind::Naive | PlannerKind::Greedy | PlannerKind::GreedyBestG => {
-            None
-        }
+        PlannerKind::Dp
+        | PlannerKind::Naive
+        | PlannerKind::Greedy
+        | PlannerKind::GreedyBestG
+        | PlannerKind::Best => None,
     };
     r
 }
@@ -212,12 +214,21 @@ pub fn run(a: MillArgs) -> Result<(), String> {
     let request = parsed.map_err(|e| format!("--request {}: {}", a.request, describe(&e)))?;
     crate::input::check_offline_start(&format!("--request {}", a.request), &request.start)?;
     let kinds = planner_list(&a, &request)?;
-    let planner = MillPlanner::with_default_cell()
+    let mut planner = MillPlanner::with_default_cell()
         .map_err(|e| format!("milling cell: {}", describe(&e)))?
         .with_indicator_source(match a.indicator {
             IndicatorArg::Direct => IndicatorSource::Direct,
             IndicatorArg::Cache => IndicatorSource::Cache,
         });
+    // `best` runs ddpg and fixed_g with these policies.
+    for (kind, f) in [
+        (PlannerKind::Ddpg, &a.ddpg_policy),
+        (PlannerKind::FixedG, &a.fixed_g_policy),
+    ] {
+        if let Some(f) = f {
+            planner = planner.with_default_policy(kind, f.path().to_path_buf());
+        }
+    }
 
     let mut outputs: Vec<MillPlanOutput> = Vec::new();
     let mut failures: Vec<(PlannerKind, MillPlanError)> = Vec::new();

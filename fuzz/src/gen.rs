@@ -246,6 +246,8 @@ pub fn mill_request(u: &mut Unstructured) -> Result<msg::MillRequest> {
         min_condition_indicator: float(u)?,
         start: start_word,
         start_positions,
+        allow_chatter: u.arbitrary()?,
+        entry: string(u, &["", "run_in", "in_material"])?,
     })
 }
 

@@ -92,37 +92,6 @@ pub fn executed_line(o: &MillPlanOutput) -> String {
     )
 }
 
-/// The chatter judge's line of a plan as executed ([`kerf_millplan::chatter_judge`]): the
-/// trajectory's duration with its run-in and run-out, the samples in the material, the
-/// evaluations, the worst sample and the lowest feed in the material.
-pub fn judge_line(o: &MillPlanOutput) -> String {
-    let (v, sc) = (&o.executed.chatter, &o.executed.scaling);
-    let sample = |s: &kerf_millplan::chatter_judge::JudgedSample| {
-        format!(
-            "segment {} (s = {:.4} m, t = {:.3} s: {:.0} rpm, {:.2} mm/s, g = {:.4} rad)",
-            s.segment,
-            s.arc_length,
-            s.time,
-            s.rpm,
-            s.feed * 1e3,
-            s.g
-        )
-    };
-    format!(
-        "trajectory {:.6} s from rest to rest (run-in {:.1} mm, run-out {:.1} mm); chatter \
-         judged at {} control periods in the material ({} evaluations): worst |μ|max {:.6} at \
-         {}; lowest feed in the material {}",
-        sc.duration(),
-        sc.run_in * 1e3,
-        sc.run_out * 1e3,
-        v.samples,
-        v.evaluations,
-        v.max_spectral_radius,
-        v.worst.as_ref().map_or("-".to_string(), sample),
-        v.lowest_feed.as_ref().map_or("-".to_string(), sample)
-    )
-}
-
 /// The printed report of one plan: header, table, totals as planned and as executed, branch
 /// jumps.
 pub fn plan_report(o: &MillPlanOutput, all_rows: bool) -> String {
@@ -180,7 +149,10 @@ pub fn plan_report(o: &MillPlanOutput, all_rows: bool) -> String {
     }
     let _ = writeln!(s, "  {}", totals_line(p));
     let _ = writeln!(s, "  {}", executed_line(o));
-    let _ = writeln!(s, "  {}", judge_line(o));
+    let _ = writeln!(s, "  {}", o.judge_text());
+    if !o.candidates.is_empty() {
+        let _ = writeln!(s, "  {}", o.candidates_text());
+    }
     if o.plan.chatter_free && !o.executed.plan.chatter_free {
         let _ = writeln!(
             s,

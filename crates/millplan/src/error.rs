@@ -74,8 +74,62 @@ pub enum MillPlanError {
         /// The requested minimum.
         minimum: f64,
     },
+    /// The plan chatters as executed (issue 28, item 1): a control-period sample in the
+    /// material reaches |μ|max ≥ 1 ([`crate::chatter_judge`]). Status CHATTER.
+    #[error("{}", chattering_message(planner, worst, lowest.as_ref(), reason))]
+    Chattering {
+        /// The planner whose plan chatters (`best`: every candidate).
+        planner: String,
+        /// The worst executed sample of that plan.
+        worst: crate::chatter_judge::JudgedSample,
+        /// The lowest executed |μ|max any planner reached on the path, and that planner.
+        lowest: Option<(String, f64)>,
+        /// Why no chatter-free plan exists, or which planner has one.
+        reason: String,
+    },
+    /// The planner cannot plan this valid path (issue 28, item 2): e.g. `fixed_g` or `greedy`
+    /// where g = g0 leaves a joint's limit or the reach on some segment. Status INFEASIBLE.
+    #[error("{planner}: no plan on this path: {reason}")]
+    Infeasible {
+        /// The planner.
+        planner: String,
+        /// Why (segment, joint or reach, and what another planner can do).
+        reason: String,
+    },
     /// Planning stopped before its end: the request's time budget ran out (status TIMEOUT) or
     /// the planner was cancelled (the node is stopping; INTERNAL_ERROR).
     #[error("{0}")]
     Interrupted(#[from] kerf_budget::Interrupt),
+}
+
+/// The message of [`MillPlanError::Chattering`].
+fn chattering_message(
+    planner: &str,
+    worst: &crate::chatter_judge::JudgedSample,
+    lowest: Option<&(String, f64)>,
+    reason: &str,
+) -> String {
+    let mu = if worst.spectral_radius.is_finite() {
+        format!("{:.4}", worst.spectral_radius)
+    } else {
+        "undefined (no equilibrium of the chatter model)".to_string()
+    };
+    let lowest = lowest.map_or(String::new(), |(p, v)| {
+        format!("; the lowest |μ|max any planner reached on this path is {v:.4} ({p})")
+    });
+    let reason = if reason.is_empty() {
+        String::new()
+    } else {
+        format!("; {reason}")
+    };
+    format!(
+        "{planner}: the plan chatters as executed: |μ|max {mu} at segment {} (arc length {:.4} m, \
+         t = {:.3} s, {:.2} mm/s, {:.0} rpm, g = {:.4} rad){lowest}{reason}",
+        worst.segment,
+        worst.arc_length,
+        worst.time,
+        worst.feed * 1e3,
+        worst.rpm,
+        worst.g
+    )
 }

@@ -72,7 +72,7 @@ pub use dp::{DpResult, DpSpec};
 pub use env::{EnvConfig, MillEnv, PhysicalState, Rollout, StepInfo};
 pub use executed::{execute, Executed};
 pub use naive::NaiveResult;
-pub use output::{MillPlanOutput, PlanningPhases};
+pub use output::{Candidate, MillPlanOutput, PlanningPhases};
 pub use plan::{comparison_table, ComparisonRow, Plan};
 pub use planner::{default_policy_path, MillPlanner};
 pub use request::{MillRequest, PlannerKind};

@@ -142,7 +142,7 @@ use crate::rl::Environment;
 use crate::timing::{joint_limits, time_scale_inputs, TrajectorySettings};
 
 pub use crate::executed::{execute, Executed};
-pub use crate::output::{MillPlanOutput, PlanningPhases};
+pub use crate::output::{Candidate, MillPlanOutput, PlanningPhases};
 pub use crate::status::{self, status_name, status_of};
 
 /// The shipped policy of a planner: `crates/millplan/policies/ddpg.safetensors`
@@ -155,9 +155,11 @@ pub fn default_policy_path(planner: PlannerKind) -> Option<PathBuf> {
     match planner {
         PlannerKind::Ddpg => Some(dir.join("ddpg.safetensors")),
         PlannerKind::FixedG => Some(dir.join("fixed_g.safetensors")),
-        PlannerKind::Dp | PlannerKind::Naive | PlannerKind::Greedy | PlannerKind::GreedyBestG => {
-            None
-        }
+        PlannerKind::Dp
+        | PlannerKind::Naive
+        | PlannerKind::Greedy
+        | PlannerKind::GreedyBestG
+        | PlannerKind::Best => None,
     }
 }
 
@@ -256,6 +258,47 @@ impl ShieldRound {
     }
 }
 
+/// The smallest condition indicator 1/K along the trajectory [`PlannerKind::Best`] accepts
+/// when the request asks for none (issue 28, item 3).
+pub const BEST_MIN_CONDITION_INDICATOR: f64 = 0.3;
+
+/// [`MillPlanError::Chattering`] of the plan `out` (its worst executed sample).
+fn chattering(out: &MillPlanOutput, planner: &str, reason: String) -> MillPlanError {
+    let worst = out
+        .executed
+        .chatter
+        .worst
+        .unwrap_or(crate::chatter_judge::JudgedSample {
+            time: 0.0,
+            arc_length: 0.0,
+            segment: 0,
+            rpm: 0.0,
+            feed: 0.0,
+            g: 0.0,
+            spectral_radius: out.executed.plan.max_spectral_radius,
+        });
+    MillPlanError::Chattering {
+        planner: planner.to_string(),
+        worst,
+        lowest: Some((
+            out.planner.name().to_string(),
+            out.executed.plan.max_spectral_radius,
+        )),
+        reason,
+    }
+}
+
+/// The plan segment at the trajectory point of arc length `arc_length` (0 if none).
+fn segment_at(executed: &Executed, arc_length: f64) -> usize {
+    let points = &executed.scaling.trajectory;
+    points
+        .arc_length
+        .iter()
+        .position(|s| *s == arc_length)
+        .and_then(|k| points.segment.get(k).copied())
+        .unwrap_or(0)
+}
+
 /// Moves held before a segment slowed into chatter ([`ShieldRound::next`]):
 /// the executed g(s) is a cubic spline through the midpoints, so a move
 /// shapes the neighbouring intervals too.
@@ -303,6 +346,7 @@ pub struct MillPlanner {
     models: Mutex<Vec<(RequestModel, Arc<MillCell>, bool)>>,
     policies: Mutex<HashMap<PathBuf, CachedPolicy>>,
     path_caches: PathCaches,
+    default_policies: HashMap<PlannerKind, PathBuf>,
 }
 
 fn file_stamp(path: &Path) -> Option<(SystemTime, u64)> {
@@ -352,6 +396,7 @@ impl MillPlanner {
             models: Mutex::new(Vec::new()),
             policies: Mutex::new(HashMap::new()),
             path_caches: PathCaches::new(),
+            default_policies: HashMap::new(),
         })
     }
 
@@ -406,6 +451,14 @@ impl MillPlanner {
         }
         self.eval_threads = threads;
         Ok(self)
+    }
+
+    /// The policy a `ddpg` or `fixed_g` plan uses when its request names none, instead of
+    /// [`default_policy_path`] (a node's configured policies; also the candidates of
+    /// [`PlannerKind::Best`]).
+    pub fn with_default_policy(mut self, kind: PlannerKind, path: PathBuf) -> Self {
+        self.default_policies.insert(kind, path);
+        self
     }
 
     /// The number of threads of the plan evaluation.
@@ -637,6 +690,274 @@ impl MillPlanner {
         budget: &Budget,
     ) -> Result<MillPlanOutput, MillPlanError> {
         let start = Instant::now();
+        request.validate_with(self.cell.state_limits())?;
+        let budget = &budget.tightened(request.time_limit()?);
+        let mut out = match request.planner_kind()? {
+            PlannerKind::Best => self.plan_best(request, budget)?,
+            _ => {
+                let out = self.plan_shielded(request, budget)?;
+                self.refuse_chatter(request, out, budget)?
+            }
+        };
+        out.planning_seconds = start.elapsed().as_secs_f64();
+        Ok(out)
+    }
+
+    /// [`PlannerKind::Best`] (issue 28, item 3): every planner of
+    /// [`PlannerKind::BEST_CANDIDATES`] plans the request in turn (each with its shield
+    /// rounds, under the request's one budget); the answer is the fastest as executed (the
+    /// trajectory's duration from rest to rest) among those chatter-free at every executed
+    /// sample whose trajectory keeps 1/K at or above the request's minimum, else
+    /// [`BEST_MIN_CONDITION_INDICATOR`]. Its [`MillPlanOutput::candidates`] say how every
+    /// planner did.
+    ///
+    /// # Errors
+    /// Without such a plan: [`MillPlanError::Chattering`] when every plan chatters (the one
+    /// with the lowest |μ|max is answered instead when the request allows chatter);
+    /// [`MillPlanError::IllConditioned`] when the chatter-free ones fall below the 1/K
+    /// minimum; when no candidate planned, the error of the first whose status is a path
+    /// property (INVALID_REQUEST, UNREACHABLE, INFEASIBLE), else the first error. A
+    /// cancellation ends the search with its error; a timeout ends it with the plans in hand.
+    fn plan_best(
+        &self,
+        request: &MillRequest,
+        budget: &Budget,
+    ) -> Result<MillPlanOutput, MillPlanError> {
+        if let Some(p) = &request.policy_file {
+            return Err(MillPlanError::InvalidConfig {
+                name: "policy_file".to_string(),
+                reason: format!(
+                    "{p:?} was given for planner best, which runs both policy planners (ddpg and \
+                     fixed_g) with their default policies; leave policy_file empty or name \
+                     the planner"
+                ),
+            });
+        }
+        let minimum = request
+            .min_condition_indicator()
+            .unwrap_or(BEST_MIN_CONDITION_INDICATOR);
+        let mut candidates = Vec::new();
+        let mut planned: Vec<MillPlanOutput> = Vec::new();
+        let mut errors = Vec::new();
+        for kind in PlannerKind::BEST_CANDIDATES {
+            let mut one = request.clone();
+            one.planner = kind.name().to_string();
+            match self.plan_shielded(&one, budget) {
+                Ok(out) => {
+                    candidates.push(Candidate::planned(&out));
+                    planned.push(out);
+                }
+                Err(e @ MillPlanError::Interrupted(kerf_budget::Interrupt::Cancelled { .. })) => {
+                    return Err(e)
+                }
+                Err(e) => {
+                    let timeout = matches!(e, MillPlanError::Interrupted(_));
+                    candidates.push(Candidate::failed(kind, &e));
+                    errors.push(e);
+                    if timeout {
+                        break;
+                    }
+                }
+            }
+        }
+        let duration = |o: &MillPlanOutput| o.executed.scaling.duration();
+        let conditioned =
+            |o: &MillPlanOutput| o.executed.scaling.min_condition_indicator.0 >= minimum;
+        let chosen = planned
+            .iter()
+            .enumerate()
+            .filter(|(_, o)| o.executed.plan.chatter_free && conditioned(o))
+            .min_by(|a, b| duration(a.1).total_cmp(&duration(b.1)))
+            .map(|(k, _)| k);
+        if let Some(k) = chosen {
+            let mut out = planned.swap_remove(k);
+            out.candidates = candidates;
+            return Ok(out);
+        }
+        let free = planned
+            .iter()
+            .filter(|o| o.executed.plan.chatter_free)
+            .max_by(|a, b| {
+                let (x, y) = (
+                    a.executed.scaling.min_condition_indicator.0,
+                    b.executed.scaling.min_condition_indicator.0,
+                );
+                x.total_cmp(&y)
+            });
+        if let Some(o) = free {
+            let (value, arc_length) = o.executed.scaling.min_condition_indicator;
+            return Err(MillPlanError::IllConditioned {
+                value,
+                arc_length,
+                segment: segment_at(&o.executed, arc_length),
+                minimum,
+            });
+        }
+        let lowest = planned.iter().enumerate().min_by(|a, b| {
+            let (x, y) = (
+                a.1.executed.plan.max_spectral_radius,
+                b.1.executed.plan.max_spectral_radius,
+            );
+            x.total_cmp(&y)
+        });
+        let Some((k, _)) = lowest else {
+            let path_property = errors.iter().position(|e| {
+                matches!(
+                    status_of(e),
+                    status::INVALID_REQUEST | status::UNREACHABLE | status::INFEASIBLE
+                )
+            });
+            let k = path_property.unwrap_or(0);
+            return Err(if k < errors.len() {
+                errors.swap_remove(k)
+            } else {
+                MillPlanError::InvalidConfig {
+                    name: "planner best".to_string(),
+                    reason: "no candidate planner ran".to_string(),
+                }
+            });
+        };
+        let mut out = planned.swap_remove(k);
+        if request.allow_chatter {
+            out.candidates = candidates;
+            return Ok(out);
+        }
+        let reason = self.why_no_stable_plan(request, &out)?;
+        Err(chattering(&out, "best", reason))
+    }
+
+    /// A plan of an explicit planner that chatters as executed becomes
+    /// [`MillPlanError::Chattering`] unless the request allows chatter: the other planners of
+    /// [`PlannerKind::BEST_CANDIDATES`] plan the path (under the same budget) so that the
+    /// message gives the lowest |μ|max any of them reached and, when one is chatter-free,
+    /// names it.
+    fn refuse_chatter(
+        &self,
+        request: &MillRequest,
+        out: MillPlanOutput,
+        budget: &Budget,
+    ) -> Result<MillPlanOutput, MillPlanError> {
+        if out.executed.plan.chatter_free || request.allow_chatter {
+            return Ok(out);
+        }
+        let mut lowest = (
+            out.planner.name().to_string(),
+            out.executed.plan.max_spectral_radius,
+        );
+        let mut stable: Option<(PlannerKind, f64)> = None;
+        for kind in PlannerKind::BEST_CANDIDATES {
+            if kind == out.planner {
+                continue;
+            }
+            let mut one = request.clone();
+            one.planner = kind.name().to_string();
+            match self.plan_shielded(&one, budget) {
+                Ok(other) => {
+                    let mu = other.executed.plan.max_spectral_radius;
+                    if mu < lowest.1 {
+                        lowest = (kind.name().to_string(), mu);
+                    }
+                    let d = other.executed.scaling.duration();
+                    if other.executed.plan.chatter_free && stable.is_none_or(|(_, b)| d < b) {
+                        stable = Some((kind, d));
+                    }
+                }
+                Err(e @ MillPlanError::Interrupted(kerf_budget::Interrupt::Cancelled { .. })) => {
+                    return Err(e)
+                }
+                Err(MillPlanError::Interrupted(_)) => break,
+                Err(_) => {}
+            }
+        }
+        let reason = match stable {
+            Some((kind, d)) => format!(
+                "{} plans this path chatter-free ({d:.2} s as executed): ask for planner {} or \
+                 best",
+                kind.name(),
+                kind.name()
+            ),
+            None => self.why_no_stable_plan(request, &out)?,
+        };
+        let mut error = chattering(&out, out.planner.name(), reason);
+        if let MillPlanError::Chattering { lowest: l, .. } = &mut error {
+            *l = Some(lowest);
+        }
+        Err(error)
+    }
+
+    /// Why no planner finds a chatter-free plan for `request`, read from the plan with the
+    /// lowest |μ|max (`out`): the entry in the material, the initial state (the IVP)
+    /// chattering where the step bounds keep the first segments near it, the joints slowing
+    /// the worst sample below its planned feed, or the cell's state limits.
+    fn why_no_stable_plan(
+        &self,
+        request: &MillRequest,
+        out: &MillPlanOutput,
+    ) -> Result<String, MillPlanError> {
+        let Some(worst) = out.executed.chatter.worst else {
+            return Ok(String::new());
+        };
+        if out.executed.settings.entry == crate::timing::Entry::InMaterial {
+            return Ok(format!(
+                "the tool starts and stops from rest in the material (entry in_material), so \
+                 the ramps pass every feed from 0; the lowest feed in the material is {:.2} mm/s; \
+                 a cell enters the material at feed (entry run_in)",
+                out.executed
+                    .chatter
+                    .lowest_feed
+                    .map_or(0.0, |l| l.feed * 1e3)
+            ));
+        }
+        let limits = request.effective_limits(self.cell.state_limits());
+        let (cell, _) = self.request_cell(request, limits)?;
+        let [rpm0, feed0, g0] = request.initial_state();
+        let start = cell.evaluate(0, g0, None)?;
+        let ivp = kerf_chatter::chatter_indicator(
+            &start.modal,
+            &cell.milling_process(),
+            rpm0,
+            feed0,
+            cell.indicator_settings(),
+        )
+        .map(|i| i.spectral_radius)
+        .unwrap_or(f64::INFINITY);
+        if ivp >= 1.0 {
+            return Ok(format!(
+                "the initial state itself chatters: |μ|max {ivp:.4} at segment 0 ({rpm0:.0} \
+                 rpm, {:.2} mm/s, g = {g0:.4} rad), and the step bounds keep the first segments \
+                 near it; start from a stable spindle speed and feed (initial)",
+                feed0 * 1e3
+            ));
+        }
+        let planned = out
+            .plan
+            .segments
+            .get(worst.segment)
+            .map_or(worst.feed, |s| s.feed);
+        if worst.feed < planned * (1.0 - 1e-3) {
+            return Ok(format!(
+                "the joints' limits slow segment {} to {:.2} mm/s where {:.2} mm/s was planned, \
+                 and the cut chatters at that feed",
+                worst.segment,
+                worst.feed * 1e3,
+                planned * 1e3
+            ));
+        }
+        Ok(format!(
+            "no planner found a stable plan within the spindle speeds {:.0}–{:.0} rpm, feeds \
+             {:.3}–{:.3} m/s and the step bounds of the request",
+            limits.spindle_rpm[0], limits.spindle_rpm[1], limits.feed[0], limits.feed[1]
+        ))
+    }
+
+    /// The plan of `request`'s planner (not [`PlannerKind::Best`]) with the chatter shield's
+    /// rounds (step 9), whether or not it chatters as executed.
+    fn plan_shielded(
+        &self,
+        request: &MillRequest,
+        budget: &Budget,
+    ) -> Result<MillPlanOutput, MillPlanError> {
+        let start = Instant::now();
         let shield = self.env_config.chatter_shield;
         let mut out = self.plan_attempt(request, budget, &ShieldRound::first(shield))?;
         // The chatter shield's rounds (SHIELD_ROUNDS): a policy plan that
@@ -721,12 +1042,15 @@ impl MillPlanner {
             PlannerKind::Ddpg | PlannerKind::FixedG => {
                 let path = match &request.policy_file {
                     Some(p) => resolve_policy_file(p)?,
-                    None => {
-                        default_policy_path(kind).ok_or_else(|| MillPlanError::InvalidConfig {
-                            name: "policy_file".to_string(),
-                            reason: "no default policy".to_string(),
-                        })?
-                    }
+                    None => match self.default_policies.get(&kind) {
+                        Some(p) => p.clone(),
+                        None => default_policy_path(kind).ok_or_else(|| {
+                            MillPlanError::InvalidConfig {
+                                name: "policy_file".to_string(),
+                                reason: "no default policy".to_string(),
+                            }
+                        })?,
+                    },
                 };
                 // A request's minimum 1/K raises the environment's (with the
                 // same margin for the dip between midpoints as the default,
@@ -829,6 +1153,13 @@ impl MillPlanner {
             PlannerKind::Greedy => {
                 greedy::solve_within(&cell, [rpm0, feed0, g0], g0, budget)?.states
             }
+            PlannerKind::Best => {
+                return Err(MillPlanError::InvalidConfig {
+                    name: "planner".to_string(),
+                    reason: "`best` chooses among the other planners (MillPlanner::plan_within)"
+                        .to_string(),
+                })
+            }
             PlannerKind::GreedyBestG => {
                 greedy::best_fixed_g_within(
                     &cell,
@@ -847,6 +1178,9 @@ impl MillPlanner {
         let mut settings = self.trajectory_settings.with_threads(self.eval_threads);
         if let Some(tolerance) = request.path_tolerance() {
             settings.path_tolerance = tolerance;
+        }
+        if request.entry.is_some() {
+            settings.entry = request.entry()?;
         }
         let (plan, indicator, trajectory, branch_jumps, executed) =
             match (self.indicator_source, &cache) {
@@ -962,13 +1296,7 @@ impl MillPlanner {
         if let Some(minimum) = request.min_condition_indicator() {
             let (value, arc_length) = executed.scaling.min_condition_indicator;
             if value < minimum {
-                let points = &executed.scaling.trajectory;
-                let segment = points
-                    .arc_length
-                    .iter()
-                    .position(|s| *s == arc_length)
-                    .and_then(|k| points.segment.get(k).copied())
-                    .unwrap_or(0);
+                let segment = segment_at(&executed, arc_length);
                 return Err(MillPlanError::IllConditioned {
                     value,
                     arc_length,
@@ -989,6 +1317,7 @@ impl MillPlanner {
             planning_seconds: start.elapsed().as_secs_f64(),
             phases,
             indicator,
+            candidates: Vec::new(),
         })
     }
 }

@@ -17,8 +17,10 @@
 //!   redundancy_angle: [-3.14, 3.14]   # rad
 //!   step_bounds: {spindle_rpm: 20, feed: 0.001, redundancy_angle: 0.2}
 //! initial: {spindle_rpm: 2000, feed: 0.04, g: 0.0}   # optional, each field optional
-//! planner: ddpg            # ddpg | fixed_g | dp | naive | greedy | greedy_best_g (default ddpg)
+//! planner: best            # best | ddpg | fixed_g | dp | naive | greedy | greedy_best_g (default best)
 //! policy_file: crates/millplan/policies/ddpg.safetensors   # optional
+//! allow_chatter: false     # optional: answer a plan that chatters as executed (status CHATTER)
+//! entry: run_in            # optional: run_in (default) | in_material
 //! ```
 //!
 //! The path is machined from the +z side ([`REQUEST_UP`], tool pointing
@@ -74,14 +76,32 @@ pub enum PlannerKind {
     /// The greedy ramp with the best fixed g, reached from the initial g at
     /// the step bound ([`crate::greedy::best_fixed_g_within`]).
     GreedyBestG,
+    /// The fastest plan as executed among [`PlannerKind::BEST_CANDIDATES`] that is
+    /// chatter-free at every executed sample and keeps 1/K at or above
+    /// [`crate::planner::BEST_MIN_CONDITION_INDICATOR`] (or the request's minimum) along the
+    /// trajectory (issue 28, item 3): the default.
+    Best,
 }
 
 impl PlannerKind {
     /// Every planner, in the order of the comparison table.
-    pub const ALL: [PlannerKind; 6] = [
+    pub const ALL: [PlannerKind; 7] = [
         Self::Ddpg,
         Self::FixedG,
         Self::Dp,
+        Self::Naive,
+        Self::Greedy,
+        Self::GreedyBestG,
+        Self::Best,
+    ];
+
+    /// The planners [`PlannerKind::Best`] chooses among: every planner but `dp`, whose grid
+    /// search costs seconds to minutes on a new path (its cache is built per path) and whose
+    /// plans are slower as executed on every path measured (`BENCHMARKS.md`, "Milling: the
+    /// fastest stable plan").
+    pub const BEST_CANDIDATES: [PlannerKind; 5] = [
+        Self::Ddpg,
+        Self::FixedG,
         Self::Naive,
         Self::Greedy,
         Self::GreedyBestG,
@@ -97,6 +117,7 @@ impl PlannerKind {
             Self::Naive => "naive",
             Self::Greedy => "greedy",
             Self::GreedyBestG => "greedy_best_g",
+            Self::Best => "best",
         }
     }
 
@@ -112,8 +133,8 @@ impl PlannerKind {
             .ok_or_else(|| MillPlanError::InvalidConfig {
                 name: "planner".to_string(),
                 reason: format!(
-                    "unknown planner `{name}`: must be ddpg, fixed_g, dp, naive, greedy or \
-                     greedy_best_g"
+                    "unknown planner `{name}`: must be best, ddpg, fixed_g, dp, naive, greedy \
+                     or greedy_best_g"
                 ),
             })
     }
@@ -259,9 +280,18 @@ pub struct MillRequest {
     /// Initial state (seed 004's IVP when absent).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub initial: Option<RequestInitial>,
-    /// `ddpg`, `fixed_g`, `dp`, `naive`, `greedy` or `greedy_best_g`.
+    /// `best` (the default), `ddpg`, `fixed_g`, `dp`, `naive`, `greedy` or `greedy_best_g`.
     #[serde(default = "default_planner")]
     pub planner: String,
+    /// Answer a plan that chatters as executed (status CHATTER, with its trajectory) instead
+    /// of refusing it (issue 28, item 1). kerf never sends such a plan to the robot on its own.
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub allow_chatter: bool,
+    /// Where the tool enters the material ([`crate::timing::Entry`]): `run_in` (absent: the
+    /// path is the cut in the material and the tool enters it at feed from a straight run-in)
+    /// or `in_material` (the ramps from and to rest on the path).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub entry: Option<String>,
     /// The policy file of `ddpg`/`fixed_g`: a path (relative paths: to the working
     /// directory), a local `file://` URI or `package://kerf/<path>`
     /// ([`crate::policy::resolve_policy_file`]); the planner's default policy when absent.
@@ -284,7 +314,7 @@ pub struct MillRequest {
 }
 
 fn default_planner() -> String {
-    PlannerKind::Ddpg.name().to_string()
+    PlannerKind::Best.name().to_string()
 }
 
 impl Default for MillRequest {
@@ -300,6 +330,8 @@ impl Default for MillRequest {
             limits: None,
             initial: None,
             planner: default_planner(),
+            allow_chatter: false,
+            entry: None,
             policy_file: None,
             time_budget: None,
             tolerances: None,
@@ -477,6 +509,7 @@ impl MillRequest {
     pub fn validate(&self) -> Result<(), MillPlanError> {
         self.time_limit()?;
         self.check_tolerances()?;
+        self.entry()?;
         if self.points.len() < 2 {
             return Err(MillPlanError::InvalidParameter {
                 name: "points (count)".to_string(),
@@ -640,6 +673,22 @@ impl MillRequest {
             value: seconds,
             reason,
         })
+    }
+
+    /// The request's entry ([`crate::timing::Entry`]; `run_in` when absent).
+    ///
+    /// # Errors
+    /// [`MillPlanError::InvalidConfig`] naming `entry` for an unknown name.
+    pub fn entry(&self) -> Result<crate::timing::Entry, MillPlanError> {
+        match self.entry.as_deref() {
+            None | Some("") => Ok(crate::timing::Entry::default()),
+            Some(name) => {
+                crate::timing::Entry::from_name(name).ok_or_else(|| MillPlanError::InvalidConfig {
+                    name: "entry".to_string(),
+                    reason: format!("unknown entry `{name}`: must be run_in or in_material"),
+                })
+            }
+        }
     }
 
     /// The request's path tolerance \[m\], if it gives one.

@@ -29,6 +29,12 @@ pub const TIMEOUT: u8 = 7;
 pub const ILL_CONDITIONED: u8 = 8;
 /// The plan would need more memory than its budget (the node's `plan_memory`) allows.
 pub const RESOURCE_LIMIT: u8 = 9;
+/// The plan chatters as executed: a control-period sample in the material reaches
+/// |μ|max ≥ 1 (segment, |μ|max and the lowest |μ|max any planner reached in the message).
+/// Value 10 is the planner node's NO_APPROACH.
+pub const CHATTER: u8 = 11;
+/// The planner cannot plan this valid path (the reason in the message).
+pub const INFEASIBLE: u8 = 12;
 
 /// The name of a status value, `None` for an unknown one.
 pub fn status_name(value: u8) -> Option<&'static str> {
@@ -42,6 +48,8 @@ pub fn status_name(value: u8) -> Option<&'static str> {
         TIMEOUT => Some("TIMEOUT"),
         ILL_CONDITIONED => Some("ILL_CONDITIONED"),
         RESOURCE_LIMIT => Some("RESOURCE_LIMIT"),
+        CHATTER => Some("CHATTER"),
+        INFEASIBLE => Some("INFEASIBLE"),
         _ => None,
     }
 }
@@ -58,6 +66,8 @@ pub fn status_name(value: u8) -> Option<&'static str> {
 /// | `Interrupted` by the time budget | TIMEOUT 7 |
 /// | `IllConditioned` | ILL_CONDITIONED 8 |
 /// | `Interrupted` by the memory budget | RESOURCE_LIMIT 9 |
+/// | `Chattering` | CHATTER 11 |
+/// | `Infeasible` | INFEASIBLE 12 |
 ///
 /// Value 5 (`QUEUE_FULL` of `kerf_msgs/msg/MillPlan`) belongs to the node
 /// (its request queue) and is not produced here.
@@ -89,6 +99,8 @@ pub fn status_of(error: &MillPlanError) -> u8 {
         MillPlanError::Interrupted(i) if i.is_timeout() => TIMEOUT,
         MillPlanError::Interrupted(i) if i.is_over_memory() => RESOURCE_LIMIT,
         MillPlanError::IllConditioned { .. } => ILL_CONDITIONED,
+        MillPlanError::Chattering { .. } => CHATTER,
+        MillPlanError::Infeasible { .. } => INFEASIBLE,
         MillPlanError::Interrupted(_) => INTERNAL_ERROR,
     }
 }

@@ -90,6 +90,8 @@ fn full_request() -> MillRequest {
             g: Some(0.5),
         }),
         planner: "fixed_g".to_string(),
+        allow_chatter: true,
+        entry: Some("in_material".to_string()),
         policy_file: Some("policies/x.safetensors".to_string()),
         time_budget: Some(12.5),
         tolerances: Some(RequestTolerances {

@@ -209,6 +209,8 @@ fn mill_request() -> msg::MillRequest {
         min_condition_indicator: 0.1,
         start: msg::MillRequest::START_NONE.into(),
         start_positions: Vec::new(),
+        allow_chatter: false,
+        entry: String::new(),
     }
 }
 

@@ -1,7 +1,7 @@
 //! kerf's own messages (`kerf_msgs/msg`, defined in `msgs/msg/`): the trajectory executor's
 //! [`TrajectoryStatus`], the MJTO planner's [`CutRequest`] / [`CutPlan`] (with [`CutRto`], [`CutFeedLimit`],
 //! [`CutMetrics`], [`CutCollision`]) and the milling planner's [`MillRequest`] / [`MillPlan`]
-//! (with [`MillSegment`]) and the G-code planner's [`GcodeRequest`] / [`GcodePlan`] (with
+//! (with [`MillSegment`], [`MillCandidate`]) and the G-code planner's [`GcodeRequest`] / [`GcodePlan`] (with
 //! [`GcodeToolEvent`]), and the simulated cell's [`CellContacts`] (with [`CellContact`]).
 
 use serde::{Deserialize, Serialize};
@@ -453,8 +453,21 @@ pub struct MillRequest {
     pub start: String,
     /// The start configuration with `start = "given"` (the trajectory's joint order).
     pub start_positions: Vec<f64>,
+    /// Answer a plan that chatters as executed (status CHATTER, with its trajectory) instead
+    /// of refusing it (issue 28).
+    pub allow_chatter: bool,
+    /// Where the tool enters the material: `""` = [`ENTRY_RUN_IN`](Self::ENTRY_RUN_IN),
+    /// or [`ENTRY_IN_MATERIAL`](Self::ENTRY_IN_MATERIAL).
+    pub entry: String,
 }
 impl_ros_type!(MillRequest, "kerf_msgs", msg, "MillRequest");
+
+impl MillRequest {
+    /// `entry`: a straight run-in along the start tangent, the material entered at feed.
+    pub const ENTRY_RUN_IN: &'static str = "run_in";
+    /// `entry`: the ramps from and to rest on the path.
+    pub const ENTRY_IN_MATERIAL: &'static str = "in_material";
+}
 
 impl MillRequest {
     /// `start`: the robot's latest joint state.
@@ -478,7 +491,30 @@ impl MillRequest {
     pub const PLANNER_GREEDY: &'static str = "greedy";
     /// The greedy ramp with the best fixed g, reached from the initial g at the step bound.
     pub const PLANNER_GREEDY_BEST_G: &'static str = "greedy_best_g";
+    /// The fastest chatter-free plan as executed among the other planners but dp (issue 28).
+    pub const PLANNER_BEST: &'static str = "best";
 }
+
+/// `kerf_msgs/msg/MillCandidate`: how one candidate planner did in the `best` choice of a
+/// [`MillPlan`] (issue 28).
+#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
+pub struct MillCandidate {
+    /// The planner (a `MillRequest::PLANNER_*` value).
+    pub planner: String,
+    /// Its [`MillPlan`] status had it been asked alone.
+    pub status: u8,
+    /// The error's message; empty for a plan.
+    pub message: String,
+    /// The executed trajectory's duration from rest to rest (s).
+    pub trajectory_duration: f64,
+    /// Chatter-free at every executed sample in the material.
+    pub chatter_free: bool,
+    /// The largest executed |μ|max.
+    pub max_mu: f64,
+    /// The smallest 1/K along the trajectory.
+    pub min_condition_indicator: f64,
+}
+impl_ros_type!(MillCandidate, "kerf_msgs", msg, "MillCandidate");
 
 /// `kerf_msgs/msg/MillSegment`: one planned segment of a [`MillPlan`], with the model's
 /// figures evaluated directly.
@@ -544,6 +580,18 @@ pub struct MillPlan {
     pub min_condition_arc_length: f64,
     /// Where the trajectory starts and its approach, process and retract stretches.
     pub stretches: PlanStretches,
+    /// The milling trajectory's duration from rest to rest, run-in and run-out included (s).
+    pub trajectory_duration: f64,
+    /// Length of the run-in before the path (m).
+    pub run_in: f64,
+    /// Length of the run-out after the path (m).
+    pub run_out: f64,
+    /// Control-period samples in the material judged for chatter.
+    pub judged_samples: u32,
+    /// Direct evaluations of the chatter model the judge took.
+    pub judge_evaluations: u32,
+    /// With planner `best`: every candidate's outcome.
+    pub candidates: Vec<MillCandidate>,
 }
 impl_ros_type!(MillPlan, "kerf_msgs", msg, "MillPlan");
 
@@ -571,6 +619,10 @@ impl MillPlan {
     /// No collision-free approach or retract exists (or the start is too close to an
     /// obstacle); no trajectory is sent.
     pub const NO_APPROACH: u8 = 10;
+    /// The plan chatters as executed (issue 28).
+    pub const CHATTER: u8 = 11;
+    /// The requested planner cannot plan this valid path.
+    pub const INFEASIBLE: u8 = 12;
 
     /// Name of a status value (`"SUCCESS"` …), or `None` for an unknown value.
     pub fn status_name(status: u8) -> Option<&'static str> {
@@ -586,6 +638,8 @@ impl MillPlan {
             Self::ILL_CONDITIONED => Some("ILL_CONDITIONED"),
             Self::RESOURCE_LIMIT => Some("RESOURCE_LIMIT"),
             Self::NO_APPROACH => Some("NO_APPROACH"),
+            Self::CHATTER => Some("CHATTER"),
+            Self::INFEASIBLE => Some("INFEASIBLE"),
             _ => None,
         }
     }

@@ -205,6 +205,7 @@ fn all_mirrors() -> Vec<Mirror> {
         msg::CutCollision,
         msg::MillRequest,
         msg::MillSegment,
+        msg::MillCandidate,
         msg::MillPlan,
         msg::GcodeRequest,
         msg::GcodeToolEvent,
@@ -507,9 +508,12 @@ fn rust_constants() -> ConstantTable {
                 c_str("PLANNER_NAIVE", Mr::PLANNER_NAIVE),
                 c_str("PLANNER_GREEDY", Mr::PLANNER_GREEDY),
                 c_str("PLANNER_GREEDY_BEST_G", Mr::PLANNER_GREEDY_BEST_G),
+                c_str("PLANNER_BEST", Mr::PLANNER_BEST),
                 c_str("START_CURRENT", Mr::START_CURRENT),
                 c_str("START_GIVEN", Mr::START_GIVEN),
                 c_str("START_NONE", Mr::START_NONE),
+                c_str("ENTRY_RUN_IN", Mr::ENTRY_RUN_IN),
+                c_str("ENTRY_IN_MATERIAL", Mr::ENTRY_IN_MATERIAL),
             ],
         ),
         (
@@ -526,6 +530,8 @@ fn rust_constants() -> ConstantTable {
                 c_u8("ILL_CONDITIONED", Mp::ILL_CONDITIONED),
                 c_u8("RESOURCE_LIMIT", Mp::RESOURCE_LIMIT),
                 c_u8("NO_APPROACH", Mp::NO_APPROACH),
+                c_u8("CHATTER", Mp::CHATTER),
+                c_u8("INFEASIBLE", Mp::INFEASIBLE),
             ],
         ),
         (
@@ -734,6 +740,7 @@ fn ros_types_name_their_files() {
     check::<rosgraph_msgs::Clock>();
     check::<msg::MillRequest>();
     check::<msg::MillSegment>();
+    check::<msg::MillCandidate>();
     check::<msg::MillPlan>();
     check::<action::PlanCutGoal>();
     check::<action::PlanCutResult>();

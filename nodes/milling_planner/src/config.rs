@@ -203,7 +203,10 @@ impl NodeConfig {
         let surroundings =
             kerf_cell::milling_surroundings(planner.cell(), collision_cell_file.as_deref())
                 .map_err(|e| NodeError::config("collision_cell_file", e.to_string()))?;
-        let mut planner = planner.with_indicator_source(indicator_source);
+        let mut planner = planner
+            .with_indicator_source(indicator_source)
+            .with_default_policy(PlannerKind::Ddpg, ddpg_policy_file.clone())
+            .with_default_policy(PlannerKind::FixedG, fixed_g_policy_file.clone());
         if let Some(n) = eval_threads {
             planner = planner.with_eval_threads(n).map_err(NodeError::setup)?;
         }
@@ -229,7 +232,8 @@ impl NodeConfig {
             PlannerKind::Dp
             | PlannerKind::Naive
             | PlannerKind::Greedy
-            | PlannerKind::GreedyBestG => None,
+            | PlannerKind::GreedyBestG
+            | PlannerKind::Best => None,
         }
     }
 }

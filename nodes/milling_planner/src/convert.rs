@@ -35,10 +35,10 @@ fn to_u32(v: usize) -> u32 {
     u32::try_from(v).unwrap_or(u32::MAX)
 }
 
-/// The planner name of a request's `planner` field as the message means it: empty = `ddpg`.
+/// The planner name of a request's `planner` field as the message means it: empty = `best`.
 pub fn planner_name(field: &str) -> &str {
     if field.is_empty() {
-        msg::MillRequest::PLANNER_DDPG
+        msg::MillRequest::PLANNER_BEST
     } else {
         field
     }
@@ -134,7 +134,8 @@ pub fn check_text_numbers(r: &MillRequest) -> Result<(), MillPlanError> {
 /// * `has_process` → `process` (every field of the group), else `None` (the cell's).
 /// * `has_limits` → `limits` with every range and step bound given, else `None`.
 /// * `has_initial_state` → `initial` with the three values, else `None` (seed 004's IVP).
-/// * `planner` "" → `ddpg`; `policy_file` "" → `None` (the node's default policy).
+/// * `planner` "" → `best`; `policy_file` "" → `None` (the node's default policy).
+/// * `allow_chatter` → `allow_chatter`; `entry` "" → `None` (run_in).
 /// * `has_tolerances` → `tolerances` with both values (a `min_condition_indicator` of 0 is no
 ///   minimum), else `None` (the node's).
 ///
@@ -207,6 +208,8 @@ pub fn request_from_msg(m: &msg::MillRequest) -> Result<MillRequest, MillPlanErr
         limits,
         initial,
         planner,
+        allow_chatter: m.allow_chatter,
+        entry: (!m.entry.is_empty()).then(|| m.entry.clone()),
         policy_file,
         time_budget: (m.time_budget != 0.0).then_some(m.time_budget),
         tolerances: m.has_tolerances.then_some(RequestTolerances {
@@ -339,33 +342,25 @@ pub fn segments_msg(out: &MillPlanOutput) -> Vec<msg::MillSegment> {
 
 /// The chatter part of [`success_message`] for a plan as executed (`executed`) and as
 /// planned (`planned`).
-fn chatter_text(executed: &kerf_millplan::Plan, planned: &kerf_millplan::Plan) -> String {
-    if executed.chatter_free {
-        return "chatter-free".to_string();
+fn chatter_text(out: &MillPlanOutput) -> String {
+    let v = &out.executed.chatter;
+    if out.executed.plan.chatter_free {
+        return "chatter-free at every executed sample in the material".to_string();
     }
-    let unstable: Vec<usize> = executed
-        .segments
-        .iter()
-        .filter(|s| s.spectral_radius >= 1.0)
-        .map(|s| s.segment)
-        .collect();
-    let which = match unstable.as_slice() {
-        [] => "some segment's |mu|max is within the indicator cache's error bound of 1".to_string(),
-        [only] => format!("segment {only} has |mu|max >= 1"),
-        [first, ..] => format!(
-            "{} segments have |mu|max >= 1 (first: segment {first})",
-            unstable.len()
-        ),
-    };
-    if planned.chatter_free {
+    let at = v.first_chatter.or(v.worst).map_or(String::new(), |s| {
         format!(
-            "CHATTER as executed: {which}; WARNING: the plan is chatter-free at its planned feeds \
-             but NOT as executed: the joints' velocity/acceleration limits slow it to feeds where \
-             it chatters"
+            " from segment {} (|mu|max {:.4} at {:.2} mm/s, {:.0} rpm)",
+            s.segment,
+            s.spectral_radius,
+            s.feed * 1e3,
+            s.rpm
         )
-    } else {
-        format!("CHATTER: {which}")
-    }
+    });
+    format!(
+        "CHATTERS as executed{at} in {} segment(s); answered only because the request allows \
+         chatter (allow_chatter): kerf does not send this trajectory to the robot",
+        v.chattering_segments.len().max(1)
+    )
 }
 
 /// A one-line summary of a successful plan, for the `message` field and logs: the totals AS
@@ -414,7 +409,7 @@ pub fn success_message(out: &MillPlanOutput) -> String {
          max |mu| {:.4} as executed \
          ({:.4} as planned) ({}), min condition indicator {:.3}, total reward {:.3} as executed \
          ({:.3} as planned); indicator cache {} for planning; {}{executed_cache}; planning took \
-         {:.3} s{jumps}",
+         {:.3} s{jumps}; {}{}",
         e.segments.len(),
         out.planner.name(),
         e.total_time,
@@ -429,13 +424,19 @@ pub fn success_message(out: &MillPlanOutput) -> String {
         out.executed.settings.path_tolerance * 1e3,
         e.max_spectral_radius,
         p.max_spectral_radius,
-        chatter_text(e, p),
+        chatter_text(out),
         e.min_condition_indicator,
         e.total_reward,
         p.total_reward,
         if out.cache_used { "used" } else { "not used" },
         out.indicator.note.trim_end_matches('.'),
         out.planning_seconds,
+        out.judge_text(),
+        if out.candidates.is_empty() {
+            String::new()
+        } else {
+            format!("; {}", out.candidates_text())
+        },
     )
 }
 
@@ -460,9 +461,15 @@ pub fn output_to_msg(out: &MillPlanOutput) -> msg::MillPlan {
         }
     };
     let p = &out.executed.plan;
+    let v = &out.executed.chatter;
     msg::MillPlan {
         request_id: out.request_id.clone(),
-        status: status::SUCCESS,
+        // A chattering plan reaches here only when the request allows chatter.
+        status: if p.chatter_free {
+            status::SUCCESS
+        } else {
+            status::CHATTER
+        },
         message: success_message(out),
         planner: planner.to_string(),
         trajectory,
@@ -479,6 +486,24 @@ pub fn output_to_msg(out: &MillPlanOutput) -> msg::MillPlan {
         min_condition_arc_length: out.executed.scaling.min_condition_indicator.1,
         // Set by the planner-node harness when it frames the plan (issue 27).
         stretches: msg::PlanStretches::default(),
+        trajectory_duration: out.executed.scaling.duration(),
+        run_in: out.executed.scaling.run_in,
+        run_out: out.executed.scaling.run_out,
+        judged_samples: to_u32(v.samples),
+        judge_evaluations: to_u32(v.evaluations),
+        candidates: out
+            .candidates
+            .iter()
+            .map(|c| msg::MillCandidate {
+                planner: c.planner.name().to_string(),
+                status: c.status,
+                message: c.message.clone(),
+                trajectory_duration: c.duration,
+                chatter_free: c.chatter_free,
+                max_mu: c.max_spectral_radius,
+                min_condition_indicator: c.min_condition_indicator,
+            })
+            .collect(),
     }
 }
 

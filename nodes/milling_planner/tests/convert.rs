@@ -40,7 +40,9 @@ fn flags_off_means_the_cell_and_empty_means_the_default() {
             process: None,
             limits: None,
             initial: None,
-            planner: "ddpg".into(),
+            planner: "best".into(),
+            allow_chatter: false,
+            entry: None,
             policy_file: None,
             time_budget: None,
             tolerances: None,
@@ -48,6 +50,13 @@ fn flags_off_means_the_cell_and_empty_means_the_default() {
             start: kerf_approach::StartSpec::Default,
         }
     );
+    // allow_chatter and entry are passed on (issue 28).
+    let mut m = message();
+    m.allow_chatter = true;
+    m.entry = "in_material".into();
+    let r = convert::request_from_msg(&m).unwrap();
+    assert!(r.allow_chatter);
+    assert_eq!(r.entry().unwrap(), kerf_millplan::timing::Entry::InMaterial);
     let mut m = message();
     m.time_budget = 4.0;
     assert_eq!(
