@@ -39,6 +39,14 @@ pub struct Executed {
 }
 
 impl Executed {
+    /// Whether the plan chatters as executed: a sample in the material at |μ|max ≥ 1
+    /// ([`Executed::chatter`]) or a segment's |μ|max ≥ 1. A plan whose cached segments are
+    /// only not proven chatter-free (|μ|max + the cache's bound ≥ 1, `plan.chatter_free`
+    /// false) does not chatter here: the judge evaluated its samples directly.
+    pub fn chatters(&self) -> bool {
+        !self.chatter.chatter_free || self.plan.segments.iter().any(|s| s.spectral_radius >= 1.0)
+    }
+
     /// The executed plan with the chatter judge of its trajectory
     /// ([`crate::chatter_judge::judge`]) folded into its totals.
     ///

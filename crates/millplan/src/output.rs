@@ -143,7 +143,7 @@ pub struct Candidate {
 impl Candidate {
     /// The candidate of a plan.
     pub fn planned(out: &MillPlanOutput) -> Self {
-        let free = out.executed.plan.chatter_free;
+        let free = !out.executed.chatters();
         Self {
             planner: out.planner,
             status: if free {

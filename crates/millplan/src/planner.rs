@@ -35,7 +35,9 @@
 //!    distribution of planar paths ([`crate::path_distribution`]) and
 //!    evaluated on held-out ones (`BENCHMARKS.md`, "Milling: a policy that
 //!    generalizes"). A rollout that leaves the feasible set is a
-//!    [`MillPlanError::Policy`] error. The policy's moves pass the chatter
+//!    [`MillPlanError::Infeasible`] error (status INFEASIBLE: the path is valid, this planner
+//!    cannot finish it); so is a path on which `fixed_g`, `greedy` or `naive`, which hold g
+//!    at g0, find a segment infeasible at g0 (checked before planning, IK chained). The policy's moves pass the chatter
 //!    shield ([`EnvConfig::chatter_shield`], [`crate::env::PLANNER_CHATTER_SHIELD`]).
 //! 5. [`Plan::evaluate_with_threads`]: every segment evaluated directly
 //!    (|μ|max never from the cache) on [`MillPlanner::eval_threads`]
@@ -642,7 +644,9 @@ impl MillPlanner {
     /// Validation errors (INVALID_REQUEST); the cell's
     /// [`MillError::Unreachable`] / [`MillError::JointLimit`] with the
     /// segment (UNREACHABLE); [`MillPlanError::Policy`] for a missing or
-    /// incompatible policy file or a rollout that leaves the feasible set;
+    /// incompatible policy file; [`MillPlanError::Infeasible`] for a rollout that leaves the
+    /// feasible set or a held g infeasible on some segment; [`MillPlanError::Chattering`] for a
+    /// plan that chatters as executed (unless the request allows chatter);
     /// [`MillPlanError::InvalidConfig`] when `greedy_best_g` finds no
     /// fixed g feasible on every segment, or `dp`/`naive` find no plan on
     /// their grid; chatter-model errors; see [`status_of`].
@@ -766,7 +770,7 @@ impl MillPlanner {
         let chosen = planned
             .iter()
             .enumerate()
-            .filter(|(_, o)| o.executed.plan.chatter_free && conditioned(o))
+            .filter(|(_, o)| !o.executed.chatters() && conditioned(o))
             .min_by(|a, b| duration(a.1).total_cmp(&duration(b.1)))
             .map(|(k, _)| k);
         if let Some(k) = chosen {
@@ -776,7 +780,7 @@ impl MillPlanner {
         }
         let free = planned
             .iter()
-            .filter(|o| o.executed.plan.chatter_free)
+            .filter(|o| !o.executed.chatters())
             .max_by(|a, b| {
                 let (x, y) = (
                     a.executed.scaling.min_condition_indicator.0,
@@ -837,7 +841,7 @@ impl MillPlanner {
         out: MillPlanOutput,
         budget: &Budget,
     ) -> Result<MillPlanOutput, MillPlanError> {
-        if out.executed.plan.chatter_free || request.allow_chatter {
+        if !out.executed.chatters() || request.allow_chatter {
             return Ok(out);
         }
         let mut lowest = (
@@ -858,7 +862,7 @@ impl MillPlanner {
                         lowest = (kind.name().to_string(), mu);
                     }
                     let d = other.executed.scaling.duration();
-                    if other.executed.plan.chatter_free && stable.is_none_or(|(_, b)| d < b) {
+                    if !other.executed.chatters() && stable.is_none_or(|(_, b)| d < b) {
                         stable = Some((kind, d));
                     }
                 }
@@ -1026,6 +1030,12 @@ impl MillPlanner {
         let (cell, cache_applies) = self.request_cell(request, limits)?;
         let [rpm0, feed0, g0] = request.initial_state();
         check_reachable(&cell, g0, budget)?;
+        if matches!(
+            kind,
+            PlannerKind::FixedG | PlannerKind::Greedy | PlannerKind::Naive
+        ) {
+            check_held_g(&cell, kind, g0, budget)?;
+        }
         let mut phases = PlanningPhases {
             setup: start.elapsed().as_secs_f64(),
             ..PlanningPhases::default()
@@ -1117,12 +1127,14 @@ impl MillPlanner {
                     })?;
                 }
                 if !rollout.completed {
+                    // A valid path the policy cannot finish: the planner's limit on this path
+                    // (issue 28, item 2), not a defect of the policy file.
                     let why = rollout.stop_reason();
-                    return Err(MillPlanError::Policy {
-                        path: path.display().to_string(),
+                    return Err(MillPlanError::Infeasible {
+                        planner: kind.name().to_string(),
                         reason: format!(
-                            "the greedy rollout left the feasible set at {why} (a policy trained \
-                             for another cell or limits?)"
+                            "the policy's greedy rollout left the feasible set at {why}; \
+                             planner best (or greedy_best_g, dp) plans it another way"
                         ),
                     });
                 }
@@ -1349,6 +1361,36 @@ const REACH_SAMPLES: usize = 64;
 /// The cell's error of the least-violating g of the first segment without
 /// a feasible g (a joint-limit error beats an unreachable one; among
 /// those, the smallest excess or distance).
+/// A planner that holds g at the initial g0 (`fixed_g`, `greedy`, `naive`) can plan the path
+/// only where every segment is feasible at g0 on the IK branch continued from the previous
+/// segment (as [`Plan::evaluate`] chains it): else [`MillPlanError::Infeasible`] naming the
+/// segment and the cell's reason (issue 28, item 2).
+fn check_held_g(
+    cell: &MillCell,
+    kind: PlannerKind,
+    g0: f64,
+    budget: &Budget,
+) -> Result<(), MillPlanError> {
+    let mut reference: Option<[f64; 6]> = None;
+    for segment in 0..cell.path().segments().len() {
+        budget.check("the held g's feasibility")?;
+        match cell.evaluate(segment, g0, reference.as_ref()) {
+            Ok(state) => reference = Some(state.joints),
+            Err(e) if is_infeasible(&e) => {
+                return Err(MillPlanError::Infeasible {
+                    planner: kind.name().to_string(),
+                    reason: format!(
+                        "it holds g at the initial {g0} rad, and segment {segment} is not \
+                         feasible there ({e}); ddpg, greedy_best_g, dp and best move g"
+                    ),
+                })
+            }
+            Err(e) => return Err(e.into()),
+        }
+    }
+    Ok(())
+}
+
 fn check_reachable(cell: &MillCell, g0: f64, budget: &Budget) -> Result<(), MillPlanError> {
     let [lo, hi] = cell.state_limits().redundancy_angle;
     let mut sweep = vec![g0];

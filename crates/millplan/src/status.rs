@@ -14,8 +14,8 @@ pub const SUCCESS: u8 = 0;
 pub const INVALID_REQUEST: u8 = 1;
 /// A path point or segment is out of reach or beyond a joint limit.
 pub const UNREACHABLE: u8 = 2;
-/// The policy file is missing, unreadable or incompatible, or the
-/// policy drove the state out of the feasible set.
+/// The policy file is missing, unreadable or incompatible (issue 28: a
+/// rollout that leaves the feasible set is INFEASIBLE).
 pub const POLICY_ERROR: u8 = 3;
 /// The chatter model failed (non-convergence, NaN).
 pub const CHATTER_MODEL_ERROR: u8 = 4;

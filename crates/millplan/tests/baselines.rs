@@ -79,6 +79,7 @@ fn greedy_ramps_from_the_initial_state_at_the_step_bounds() {
             g: Some(-0.2),
         }),
         planner: "greedy".to_string(),
+        allow_chatter: true,
         ..MillRequest::default()
     };
     let out = planner.plan(&request).unwrap();

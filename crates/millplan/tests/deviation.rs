@@ -40,6 +40,7 @@ fn every_planner_keeps_the_tool_on_the_path() {
     ] {
         let request = MillRequest {
             planner: kind.into(),
+            allow_chatter: true,
             limits,
             ..MillRequest::default()
         };

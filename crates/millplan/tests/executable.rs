@@ -75,6 +75,7 @@ fn planner_outputs_pass_the_executors_validation() {
     ] {
         let request = MillRequest {
             planner: kind.to_string(),
+            allow_chatter: true,
             limits,
             ..MillRequest::default()
         };

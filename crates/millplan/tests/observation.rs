@@ -228,6 +228,7 @@ fn write_policy(path: &Path, observation_dim: usize, layout: Vec<String>) {
 fn plan_with(planner: &MillPlanner, path: &Path) -> MillPlanError {
     planner
         .plan(&MillRequest {
+            planner: "ddpg".to_string(),
             policy_file: Some(path.display().to_string()),
             ..MillRequest::default()
         })

@@ -16,6 +16,7 @@ use kerf_millplan::request::{
     RequestInitial, RequestLimits, RequestProcess, RequestStepBounds, RequestTolerances,
 };
 use kerf_millplan::rng::Rng;
+use kerf_millplan::timing::Entry;
 use kerf_millplan::{
     default_policy_path, status_of, MillPlanError, MillPlanner, MillRequest, PlannerKind, Policy,
 };
@@ -115,7 +116,9 @@ fn yaml_and_json_round_trip_and_unknown_fields() {
     // Minimal request: defaults.
     let min = MillRequest::from_yaml_str("points: [[1.4, -0.3, 1.7], [2.1, 0.3, 1.7]]\n")
         .expect("minimal");
-    assert_eq!(min.planner, "ddpg");
+    assert_eq!(min.planner, "best");
+    assert!(!min.allow_chatter);
+    assert_eq!(min.entry().expect("entry"), Entry::RunIn);
     assert_eq!(min.initial_state(), [2000.0, 0.04, 0.0]);
     assert_eq!(min.request_id, "");
     min.validate().expect("valid");

@@ -12,7 +12,7 @@ use kerf_millplan::deviation::executed_deviation;
 use kerf_millplan::plan::SegmentPlan;
 use kerf_millplan::spline1d::Profile;
 use kerf_millplan::timing::{
-    joint_limits, three_point_velocity, time_scale, JointLimit, TrajectorySettings,
+    joint_limits, three_point_velocity, time_scale, Entry, JointLimit, TrajectorySettings,
 };
 use kerf_millplan::{MillPlanError, Plan, RewardParts, TimeScaling};
 
@@ -117,14 +117,34 @@ fn a_slow_constant_plan_runs_at_its_feed() {
     assert_eq!(sc.slowed_segments(), 0);
     assert_eq!((sc.rounds, sc.uniform), (1, false));
     assert!(sc.segment_feeds.iter().all(|f| *f == 0.02));
-    // Each ramp of the time law loses half its ramp time: T = L/f + T_r.
-    let expected = cell.path().total_length() / 0.02 + settings.ramp_time;
+    // The ramps lie on the run-in and run-out (Entry::RunIn, the default), each losing half
+    // its ramp time: T = (run-in + L + run-out)/f + T_r, and the path itself is machined at
+    // the feed throughout: L/f.
+    let length = cell.path().total_length();
+    let expected = (sc.run_in + length + sc.run_out) / 0.02 + settings.ramp_time;
     assert!(
         (sc.duration() - expected).abs() < 1e-6,
         "{} vs {expected}",
         sc.duration()
     );
-    assert!((sc.machining_time() - sc.duration()).abs() < 1e-9);
+    assert!(
+        (sc.machining_time() - length / 0.02).abs() < 1e-6,
+        "{}",
+        sc.machining_time()
+    );
+    let (enter, leave) = sc.material_times();
+    assert!(enter >= settings.ramp_time && leave <= sc.duration() - settings.ramp_time);
+    assert!(sc.run_in > 0.0 && sc.run_out > 0.0);
+    // With the ramps in the material: T = L/f + T_r, all of it machining.
+    let inside = scale(&cell, &p, &settings.with_entry(Entry::InMaterial));
+    let expected = length / 0.02 + settings.ramp_time;
+    assert!(
+        (inside.duration() - expected).abs() < 1e-6,
+        "{} vs {expected}",
+        inside.duration()
+    );
+    assert!((inside.machining_time() - inside.duration()).abs() < 1e-9);
+    assert_eq!((inside.run_in, inside.run_out), (0.0, 0.0));
     let d = executed_deviation(&cell, &sc.trajectory, settings.control_period).unwrap();
     assert!(d.max_off_path <= 5e-5 && d.max_off_plane <= 5e-5, "{d:?}");
     assert_eq!(d, sc.deviation);

@@ -344,8 +344,14 @@ pub fn segments_msg(out: &MillPlanOutput) -> Vec<msg::MillSegment> {
 /// planned (`planned`).
 fn chatter_text(out: &MillPlanOutput) -> String {
     let v = &out.executed.chatter;
-    if out.executed.plan.chatter_free {
-        return "chatter-free at every executed sample in the material".to_string();
+    if !out.executed.chatters() {
+        return if out.executed.plan.chatter_free {
+            "chatter-free at every executed sample in the material".to_string()
+        } else {
+            "no executed sample chatters; some cached segment's |mu|max is within the indicator \
+             cache's error bound of 1"
+                .to_string()
+        };
     }
     let at = v.first_chatter.or(v.worst).map_or(String::new(), |s| {
         format!(
@@ -465,7 +471,7 @@ pub fn output_to_msg(out: &MillPlanOutput) -> msg::MillPlan {
     msg::MillPlan {
         request_id: out.request_id.clone(),
         // A chattering plan reaches here only when the request allows chatter.
-        status: if p.chatter_free {
+        status: if !out.executed.chatters() {
             status::SUCCESS
         } else {
             status::CHATTER
