@@ -6,7 +6,7 @@
 //!
 //! ```sh
 //! cargo bench -p kerf_millplan --bench fastest_stable -- --no-dp     # without the per-path DP
-//! cargo bench -p kerf_millplan --bench fastest_stable                # with it (slow: a cache per path)
+//! cargo bench -p kerf_millplan --bench fastest_stable                # with dp (a cache per path)
 //! cargo bench -p kerf_millplan --bench fastest_stable -- --paths 1 --planners dp
 //! cargo bench -p kerf_millplan --bench fastest_stable -- --planners ddpg,naive,greedy,fixed_g
 //! cargo bench -p kerf_millplan --bench fastest_stable -- --check     # only the paths' checks
@@ -49,6 +49,7 @@ use std::time::Instant;
 
 use kerf_mill::{MillCell, PathSpec};
 use kerf_millplan::path_distribution::{check_path, held_out_paths, PathDistribution};
+use kerf_millplan::planner::BEST_MIN_CONDITION_INDICATOR;
 use kerf_millplan::status::status_name;
 use kerf_millplan::{status_of, MillPlanOutput, MillPlanner, MillRequest};
 
@@ -142,6 +143,13 @@ impl Outcome {
             .map(|o| o.executed.scaling.duration())
     }
 
+    /// The executed duration of a chatter-free plan whose 1/K stays at or above `min`.
+    fn acceptable_duration(&self, min: f64) -> Option<f64> {
+        self.plan()
+            .filter(|o| o.executed.scaling.min_condition_indicator.0 >= min)
+            .and(self.chatter_free_duration())
+    }
+
     /// The table cell.
     fn cell(&self) -> String {
         match self {
@@ -167,7 +175,7 @@ impl Outcome {
                 }
             }
             Self::Failed { status, message } => {
-                format!("{status}: {}", message.replace('|', "/"))
+                format!("{status}: {}", truncate(message, 80).replace('|', "/"))
             }
         }
     }
@@ -278,7 +286,7 @@ fn main() {
                 Ok(out) => Outcome::Plan(Box::new(out)),
                 Err(e) => Outcome::Failed {
                     status: status_name(status_of(&e)).unwrap_or("UNKNOWN_STATUS"),
-                    message: truncate(&e.to_string(), 80),
+                    message: e.to_string(),
                 },
             };
             eprintln!(
@@ -346,39 +354,52 @@ fn main() {
 
     // ddpg against the fastest chatter-free other, per path.
     let column = |p: &str| planners.iter().position(|k| *k == p);
-    println!("\nddpg / fastest chatter-free of naive, greedy, fixed_g (executed durations):");
+    println!(
+        "\nddpg / fastest chatter-free of naive, greedy, fixed_g (executed durations); in \
+         brackets: / the fastest of them that is chatter-free and keeps 1/K >= \
+         {BEST_MIN_CONDITION_INDICATOR} (`best`'s criterion):"
+    );
     let mut held = 0;
     let mut free_where_any = 0;
     let mut faster = 0;
+    let mut faster_conditioned = 0;
+    let mut no_other = 0;
     for ((name, _, held_out), row) in paths.iter().zip(&outcomes) {
         let Some(d) = column("ddpg").map(|c| &row[c]) else {
             println!("- {name}: ddpg not run");
             continue;
         };
-        let other = OTHERS
-            .iter()
-            .filter_map(|p| column(p).map(|c| (*p, &row[c])))
-            .filter_map(|(p, o)| o.chatter_free_duration().map(|t| (p, t)))
-            .min_by(|a, b| a.1.total_cmp(&b.1));
+        let fastest = |duration: &dyn Fn(&Outcome) -> Option<f64>| {
+            OTHERS
+                .iter()
+                .filter_map(|p| column(p).map(|c| (*p, &row[c])))
+                .filter_map(|(p, o)| duration(o).map(|t| (p, t)))
+                .min_by(|a, b| a.1.total_cmp(&b.1))
+        };
+        let other = fastest(&Outcome::chatter_free_duration);
+        let conditioned =
+            fastest(&|o: &Outcome| o.acceptable_duration(BEST_MIN_CONDITION_INDICATOR));
         let any_free = row.iter().any(|o| o.chatter_free_duration().is_some());
         let ddpg_free = d.chatter_free_duration();
-        let ratio = match (d.plan(), other) {
+        let ratio_to = |other: Option<(&str, f64)>| match (d.plan(), other) {
             (Some(o), Some((p, t))) => {
                 let r = o.executed.scaling.duration() / t;
                 format!(
                     "{:.2} s / {t:.2} s ({p}) = {r:.3}{}",
                     o.executed.scaling.duration(),
-                    if r <= GOAL_RATIO { " (≤ 0.97)" } else { "" }
+                    if r <= GOAL_RATIO { " (<= 0.97)" } else { "" }
                 )
             }
             (Some(o), None) => format!(
-                "{:.2} s / none of them chatter-free",
+                "{:.2} s / none of them qualifies",
                 o.executed.scaling.duration()
             ),
             (None, _) => format!("ddpg {}", d.status()),
         };
         println!(
-            "- {name}: {ratio}; ddpg chatter-free: {}",
+            "- {name}: {} [{}]; ddpg chatter-free: {}",
+            ratio_to(other),
+            ratio_to(conditioned),
             if ddpg_free.is_some() { "yes" } else { "no" }
         );
         if *held_out {
@@ -386,9 +407,17 @@ fn main() {
             if ddpg_free.is_some() || !any_free {
                 free_where_any += 1;
             }
+            if other.is_none() {
+                no_other += 1;
+            }
             if let (Some(t), Some((_, best))) = (ddpg_free, other) {
                 if t <= GOAL_RATIO * best {
                     faster += 1;
+                }
+            }
+            if let (Some(t), Some((_, best))) = (ddpg_free, conditioned) {
+                if t <= GOAL_RATIO * best {
+                    faster_conditioned += 1;
                 }
             }
         }
@@ -396,9 +425,11 @@ fn main() {
     if column("ddpg").is_some() && held > 0 {
         println!(
             "\nheld-out paths where ddpg is chatter-free wherever any planner is: {free_where_any} \
-             of {held}; where ddpg is chatter-free and its duration ≤ {GOAL_RATIO} × the fastest \
+             of {held}; where ddpg is chatter-free and its duration <= {GOAL_RATIO} x the fastest \
              chatter-free of naive, greedy and fixed_g: {faster} of {held} (goal of issue 28 item \
-             4: ≥ 8 of 10)"
+             4: >= 8 of 10; {no_other} of the {held} have no chatter-free naive, greedy or \
+             fixed_g to compare with); against those of them with 1/K >= \
+             {BEST_MIN_CONDITION_INDICATOR} too: {faster_conditioned} of {held}"
         );
     }
 
@@ -423,6 +454,25 @@ fn main() {
                 format!("{}: {}", others.len(), others.join("; "))
             }
         );
+    }
+    let failures: Vec<String> = paths
+        .iter()
+        .zip(&outcomes)
+        .flat_map(|((name, _, _), row)| {
+            planners
+                .iter()
+                .zip(row)
+                .filter_map(move |(kind, o)| match o {
+                    Outcome::Failed { status, message } => {
+                        Some(format!("- {name}, {kind}: {status}: {message}"))
+                    }
+                    Outcome::Plan(_) => None,
+                })
+        })
+        .collect();
+    if !failures.is_empty() {
+        println!("\nplans that failed, with their messages in full:\n");
+        println!("{}", failures.join("\n"));
     }
     println!(
         "\nwall time of the run: {:.1} s",

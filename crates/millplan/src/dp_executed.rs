@@ -17,9 +17,12 @@
 //!    slowed by more than [`SLOWDOWN_TOLERANCE`] ([`HOLD_REACH`]), and go to 1,
 //!    until no new move is held or after [`DP_EXECUTED_ROUNDS`] rounds.
 //!
-//! The answer is the round whose plan AS EXECUTED has the largest eq. 12
-//! total (|μ|max and rewards re-evaluated at the executed feeds, the
-//! objective of the DP as the robot runs it); every round is reported.
+//! The answer is the round whose plan AS EXECUTED does not chatter
+//! ([`Executed::chatters`]: the judge of every executed sample, issue 28) and
+//! has the largest eq. 12 total (|μ|max and rewards re-evaluated at the
+//! executed feeds, the objective of the DP as the robot runs it), else the
+//! chattering round with the largest total; every round is reported. This is
+//! the `dp` planner of [`crate::MillPlanner`] (issue 28, item 5).
 //! What the rounds cannot express: a g move that is slowed only because of
 //! its neighbours' moves (jerk over four midpoints) is held rather than
 //! re-timed, so the result is the best plan among those whose slowed moves
@@ -133,10 +136,12 @@ pub fn solve_executed(
         .iter()
         .enumerate()
         .max_by(|(_, a), (_, b)| {
-            a.executed
-                .plan
-                .total_reward
-                .total_cmp(&b.executed.plan.total_reward)
+            (!a.executed.chatters()).cmp(&!b.executed.chatters()).then(
+                a.executed
+                    .plan
+                    .total_reward
+                    .total_cmp(&b.executed.plan.total_reward),
+            )
         })
         .map_or(0, |(k, _)| k);
     Ok(ExecutedDp { rounds, best })

@@ -81,7 +81,7 @@ pub enum MillPlanError {
         /// The planner whose plan chatters (`best`: every candidate).
         planner: String,
         /// The worst executed sample of that plan.
-        worst: crate::chatter_judge::JudgedSample,
+        worst: Box<crate::chatter_judge::JudgedSample>,
         /// The lowest executed |μ|max any planner reached on the path, and that planner.
         lowest: Option<(String, f64)>,
         /// Why no chatter-free plan exists, or which planner has one.

@@ -18,8 +18,9 @@
 //!    The initial state itself must be feasible at segment 0.
 //! 4. The planner: `ddpg`/`fixed_g` — greedy rollout of the policy in
 //!    [`MillEnv`] (α and weights of [`MillPlanner::env_config`]); `dp` —
-//!    [`crate::dp::solve`] over the full state ranges from the request's
-//!    initial state; `naive` — [`crate::naive::solve`] at g = g0;
+//!    the DP over the full state ranges from the request's initial state with
+//!    the executed timing in its loop ([`crate::dp_executed::solve_executed`]:
+//!    its answer holds as executed; issue 28, item 5); `naive` — [`crate::naive::solve`] at g = g0;
 //!    `greedy` — [`crate::greedy::solve_within`] from the initial state at
 //!    g = g0; `greedy_best_g` — [`crate::greedy::best_fixed_g_within`]
 //!    (direct |μ|max, no cache: any path).
@@ -260,6 +261,9 @@ impl ShieldRound {
     }
 }
 
+/// One candidate planner and its plan or error ([`MillPlanner::plan_each`]).
+type CandidatePlan = (PlannerKind, Result<MillPlanOutput, MillPlanError>);
+
 /// The smallest condition indicator 1/K along the trajectory [`PlannerKind::Best`] accepts
 /// when the request asks for none (issue 28, item 3).
 pub const BEST_MIN_CONDITION_INDICATOR: f64 = 0.3;
@@ -281,7 +285,7 @@ fn chattering(out: &MillPlanOutput, planner: &str, reason: String) -> MillPlanEr
         });
     MillPlanError::Chattering {
         planner: planner.to_string(),
-        worst,
+        worst: Box::new(worst),
         lowest: Some((
             out.planner.name().to_string(),
             out.executed.plan.max_spectral_radius,
@@ -718,8 +722,8 @@ impl MillPlanner {
     /// # Errors
     /// Without such a plan: [`MillPlanError::Chattering`] when every plan chatters (the one
     /// with the lowest |μ|max is answered instead when the request allows chatter);
-    /// [`MillPlanError::IllConditioned`] when the chatter-free ones fall below the 1/K
-    /// minimum; when no candidate planned, the error of the first whose status is a path
+    /// [`MillPlanError::Infeasible`] when the chatter-free ones fall below the 1/K minimum
+    /// (naming the best of them and the best-conditioned plan's |μ|max); when no candidate planned, the error of the first whose status is a path
     /// property (INVALID_REQUEST, UNREACHABLE, INFEASIBLE), else the first error. A
     /// cancellation ends the search with its error; a timeout ends it with the plans in hand.
     fn plan_best(
@@ -743,10 +747,8 @@ impl MillPlanner {
         let mut candidates = Vec::new();
         let mut planned: Vec<MillPlanOutput> = Vec::new();
         let mut errors = Vec::new();
-        for kind in PlannerKind::BEST_CANDIDATES {
-            let mut one = request.clone();
-            one.planner = kind.name().to_string();
-            match self.plan_shielded(&one, budget) {
+        for (kind, result) in self.plan_each(request, &PlannerKind::BEST_CANDIDATES, budget) {
+            match result {
                 Ok(out) => {
                     candidates.push(Candidate::planned(&out));
                     planned.push(out);
@@ -755,12 +757,8 @@ impl MillPlanner {
                     return Err(e)
                 }
                 Err(e) => {
-                    let timeout = matches!(e, MillPlanError::Interrupted(_));
                     candidates.push(Candidate::failed(kind, &e));
                     errors.push(e);
-                    if timeout {
-                        break;
-                    }
                 }
             }
         }
@@ -789,12 +787,35 @@ impl MillPlanner {
                 x.total_cmp(&y)
             });
         if let Some(o) = free {
+            // Chatter-free plans exist, but none keeps 1/K: say both sides.
             let (value, arc_length) = o.executed.scaling.min_condition_indicator;
-            return Err(MillPlanError::IllConditioned {
-                value,
-                arc_length,
-                segment: segment_at(&o.executed, arc_length),
-                minimum,
+            let conditioned_one = planned.iter().filter(|p| conditioned(p)).min_by(|a, b| {
+                a.executed
+                    .plan
+                    .max_spectral_radius
+                    .total_cmp(&b.executed.plan.max_spectral_radius)
+            });
+            let other = match conditioned_one {
+                Some(p) => format!(
+                    "; {} keeps 1/K at {:.3} but chatters (|μ|max {:.4})",
+                    p.planner.name(),
+                    p.executed.scaling.min_condition_indicator.0,
+                    p.executed.plan.max_spectral_radius
+                ),
+                None => "; no candidate keeps 1/K that high".to_string(),
+            };
+            return Err(MillPlanError::Infeasible {
+                planner: "best".to_string(),
+                reason: format!(
+                    "no candidate is both chatter-free as executed and at 1/K >= {minimum}: {} is \
+                     chatter-free ({:.2} s) but 1/K falls to {value:.3} at arc length \
+                     {arc_length:.4} m (segment {}){other}; ask for {} by name, or for a lower \
+                     tolerances.min_condition_indicator",
+                    o.planner.name(),
+                    o.executed.scaling.duration(),
+                    segment_at(&o.executed, arc_length),
+                    o.planner.name()
+                ),
             });
         }
         let lowest = planned.iter().enumerate().min_by(|a, b| {
@@ -830,6 +851,57 @@ impl MillPlanner {
         Err(chattering(&out, "best", reason))
     }
 
+    /// `request` planned by each of `kinds` ([`Self::plan_shielded`]), on up to
+    /// [`Self::eval_threads`] threads at once (each plan is the same on any thread: the
+    /// results are in the order of `kinds` whatever the scheduling).
+    fn plan_each(
+        &self,
+        request: &MillRequest,
+        kinds: &[PlannerKind],
+        budget: &Budget,
+    ) -> Vec<CandidatePlan> {
+        let plan = |kind: PlannerKind| {
+            let mut one = request.clone();
+            one.planner = kind.name().to_string();
+            (kind, self.plan_shielded(&one, budget))
+        };
+        let workers = self.eval_threads.clamp(1, kinds.len().max(1));
+        if workers == 1 {
+            return kinds.iter().map(|k| plan(*k)).collect();
+        }
+        let next = std::sync::atomic::AtomicUsize::new(0);
+        let work = || {
+            let mut done = Vec::new();
+            loop {
+                let k = next.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+                let Some(kind) = kinds.get(k) else {
+                    break done;
+                };
+                done.push((k, plan(*kind)));
+            }
+        };
+        let mut all: Vec<(usize, CandidatePlan)> = std::thread::scope(|scope| {
+            let helpers: Vec<_> = (1..workers)
+                .filter_map(|w| {
+                    std::thread::Builder::new()
+                        .name(format!("plan-candidate-{w}"))
+                        .spawn_scoped(scope, work)
+                        .ok()
+                })
+                .collect();
+            let mut all = work();
+            for h in helpers {
+                match h.join() {
+                    Ok(done) => all.extend(done),
+                    Err(panic) => std::panic::resume_unwind(panic),
+                }
+            }
+            all
+        });
+        all.sort_by_key(|(k, _)| *k);
+        all.into_iter().map(|(_, r)| r).collect()
+    }
+
     /// A plan of an explicit planner that chatters as executed becomes
     /// [`MillPlanError::Chattering`] unless the request allows chatter: the other planners of
     /// [`PlannerKind::BEST_CANDIDATES`] plan the path (under the same budget) so that the
@@ -849,13 +921,12 @@ impl MillPlanner {
             out.executed.plan.max_spectral_radius,
         );
         let mut stable: Option<(PlannerKind, f64)> = None;
-        for kind in PlannerKind::BEST_CANDIDATES {
-            if kind == out.planner {
-                continue;
-            }
-            let mut one = request.clone();
-            one.planner = kind.name().to_string();
-            match self.plan_shielded(&one, budget) {
+        let others: Vec<PlannerKind> = PlannerKind::BEST_CANDIDATES
+            .into_iter()
+            .filter(|k| *k != out.planner)
+            .collect();
+        for (kind, result) in self.plan_each(request, &others, budget) {
+            match result {
                 Ok(other) => {
                     let mu = other.executed.plan.max_spectral_radius;
                     if mu < lowest.1 {
@@ -869,7 +940,6 @@ impl MillPlanner {
                 Err(e @ MillPlanError::Interrupted(kerf_budget::Interrupt::Cancelled { .. })) => {
                     return Err(e)
                 }
-                Err(MillPlanError::Interrupted(_)) => break,
                 Err(_) => {}
             }
         }
@@ -1157,7 +1227,19 @@ impl MillPlanner {
                         initial: [rpm0, feed0, g0],
                         ..DpSpec::full(&cell, self.env_config.weights, false)
                     };
-                    dp::solve_within(&cell, &cache, &spec, budget)?.states
+                    // The DP with the executed timing in its loop (issue 28, item 5): its
+                    // answer holds as executed.
+                    let solved = crate::dp_executed::solve_executed(
+                        &cell,
+                        &cache,
+                        &spec,
+                        self.eval_threads,
+                        budget,
+                    )?;
+                    match solved.best() {
+                        Some(round) => round.result.states.clone(),
+                        None => dp::solve_within(&cell, &cache, &spec, budget)?.states,
+                    }
                 } else {
                     naive::solve_within(&cell, &cache, g0, budget)?.states
                 }

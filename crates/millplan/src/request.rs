@@ -66,7 +66,8 @@ pub enum PlannerKind {
     /// Greedy rollout of a DDPG policy trained with g fixed at g0 (the
     /// paper's ablation).
     FixedG,
-    /// The dynamic-programming optimum ([`crate::dp`]).
+    /// The dynamic-programming optimum ([`crate::dp`]) with the executed timing in its loop
+    /// ([`crate::dp_executed`]): the best plan as executed among the DP's rounds.
     Dp,
     /// Constant spindle speed and feed ([`crate::naive`]).
     Naive,

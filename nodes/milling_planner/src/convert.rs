@@ -448,8 +448,8 @@ pub fn success_message(out: &MillPlanOutput) -> String {
 
 /// The `MillPlan` message of a successful plan (status SUCCESS): the executed trajectory
 /// ([`trajectory_msg`]), and the segments and totals of the plan as executed
-/// (`out.executed.plan`, consistent with that trajectory: `machining_time` is its duration
-/// from rest to rest).
+/// (`out.executed.plan`, consistent with that trajectory: `machining_time` is its time in the
+/// material, `trajectory_duration` its duration from rest to rest with the run-in and run-out).
 ///
 /// A plan whose executed trajectory fails [`check_trajectory`] is answered INTERNAL_ERROR
 /// with the defect instead, so a planner bug never reaches the executor.

@@ -249,7 +249,7 @@ fn errors_carry_their_status_and_the_planner_name() {
     };
     let m = convert::error_to_msg("e1", "", &policy);
     assert_eq!(m.status, msg::MillPlan::POLICY_ERROR);
-    assert_eq!(m.planner, "ddpg");
+    assert_eq!(m.planner, "best");
     assert_eq!(m.message, "policy /p/x.safetensors: missing");
     assert!(m.trajectory.points.is_empty() && m.segments.is_empty());
     let bad = MillPlanError::InvalidParameter {
@@ -405,12 +405,17 @@ fn assert_published_as_executed(m: &msg::MillPlan, out: &MillPlanOutput) {
     }
     assert!((time - m.machining_time).abs() < 1e-9);
     assert_eq!(m.machining_time, x.total_time);
+    // The trajectory runs the run-in, the path and the run-out (issue 28): its duration is
+    // `trajectory_duration`; the machining time is the part in the material.
     let end = t.points[last].time_from_start.as_secs_f64();
     assert!(
-        (end - m.machining_time).abs() <= 1e-9 * end.max(1.0),
-        "trajectory {end} s, machining time {} s",
-        m.machining_time
+        (end - m.trajectory_duration).abs() <= 1e-9 * end.max(1.0),
+        "trajectory {end} s, duration {} s",
+        m.trajectory_duration
     );
+    let (enter, leave) = out.executed.scaling.material_times();
+    assert!((m.machining_time - (leave - enter)).abs() <= 1e-9 * end);
+    assert!(m.machining_time < end && m.run_in > 0.0 && m.run_out > 0.0);
     assert!(m.machining_time > out.plan.total_time, "ramps at least");
     assert_eq!(m.chatter_free, x.chatter_free);
     let max_mu = m.segments.iter().map(|s| s.mu_max).fold(0.0, f64::max);
@@ -537,23 +542,29 @@ fn ddpg_and_dp_plans_are_published_as_executed() {
 
 /// A plan chatter-free as planned but not as executed is said so, with a WARNING; one that
 /// chatters in both says CHATTER without it.
+/// Issue 28: a plan that chatters as executed is never SUCCESS. Refused, it is CHATTER with
+/// the segment, its |μ|max and the lowest |μ|max any planner reached; allowed
+/// (`allow_chatter`), it is CHATTER with its trajectory and the message says kerf does not send
+/// it. Planner `best` names the planner it chose and lists every candidate.
 #[test]
-fn chatter_only_as_executed_is_a_warning() {
-    let mut out = naive_output().clone();
-    assert!(out.plan.chatter_free && out.executed.plan.chatter_free);
-    let x = &mut out.executed.plan;
-    for i in [40, 41] {
-        x.segments[i].spectral_radius = 1.02;
-    }
-    x.max_spectral_radius = 1.02;
-    x.chatter_free = false;
-    let m = convert::output_to_msg(&out);
-    assert_eq!(m.status, msg::MillPlan::SUCCESS);
-    assert!(!m.chatter_free && m.max_mu == 1.02);
+fn a_plan_that_chatters_as_executed_is_chatter_not_success() {
+    let p = MillPlanner::with_default_cell().expect("planner");
+    let request = MillRequest {
+        request_id: "chatter".into(),
+        planner: "fixed_g".into(),
+        ..MillRequest::default()
+    };
+    let e = p
+        .plan(&request)
+        .expect_err("fixed_g chatters on the default path");
+    let m = convert::error_to_msg("chatter", "fixed_g", &e);
+    assert_eq!(m.status, msg::MillPlan::CHATTER, "{}", m.message);
+    assert_eq!(msg::MillPlan::status_name(m.status), Some("CHATTER"));
+    assert!(m.trajectory.points.is_empty());
     for needle in [
-        "CHATTER as executed: 2 segments have |mu|max >= 1 (first: segment 40)",
-        "WARNING: the plan is chatter-free at its planned feeds but NOT as executed",
-        "max |mu| 1.0200 as executed",
+        "fixed_g: the plan chatters as executed: |μ|max 1.0",
+        "at segment",
+        "the lowest |μ|max any planner reached on this path is 0.9",
     ] {
         assert!(
             m.message.contains(needle),
@@ -561,11 +572,48 @@ fn chatter_only_as_executed_is_a_warning() {
             m.message
         );
     }
-    out.plan.chatter_free = false;
-    let m = convert::output_to_msg(&out);
+    let allowed = p
+        .plan(&MillRequest {
+            allow_chatter: true,
+            ..request
+        })
+        .expect("allowed");
+    let m = convert::output_to_msg(&allowed);
+    assert_eq!(m.status, msg::MillPlan::CHATTER, "{}", m.message);
+    assert!(!m.chatter_free && m.max_mu >= 1.0);
+    assert!(!m.trajectory.points.is_empty());
     assert!(
-        m.message.contains("CHATTER: 2 segments have |mu|max >= 1")
-            && !m.message.contains("WARNING"),
+        m.message.contains("CHATTERS as executed from segment")
+            && m.message
+                .contains("kerf does not send this trajectory to the robot"),
+        "{}",
+        m.message
+    );
+    assert!(m.judged_samples > 1000 && m.judge_evaluations > 0);
+    assert!(m.run_in > 0.0 && m.run_out > 0.0);
+    assert!(m.trajectory_duration > m.machining_time);
+    // best: the planner that produced the answer and every candidate.
+    let best = p
+        .plan(&MillRequest {
+            request_id: "best".into(),
+            ..MillRequest::default()
+        })
+        .expect("best");
+    let m = convert::output_to_msg(&best);
+    assert_eq!(m.status, msg::MillPlan::SUCCESS, "{}", m.message);
+    assert_eq!(m.planner, best.planner.name());
+    assert_ne!(m.planner, "best");
+    assert_eq!(m.candidates.len(), 5);
+    let names: Vec<&str> = m.candidates.iter().map(|c| c.planner.as_str()).collect();
+    assert_eq!(
+        names,
+        ["ddpg", "fixed_g", "naive", "greedy", "greedy_best_g"]
+    );
+    let fixed_g = &m.candidates[1];
+    assert_eq!(fixed_g.status, msg::MillPlan::CHATTER);
+    assert!(!fixed_g.chatter_free && fixed_g.max_mu >= 1.0);
+    assert!(
+        m.message.contains("best of 5 candidates: ") && m.message.contains("ddpg "),
         "{}",
         m.message
     );
