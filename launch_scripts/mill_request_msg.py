@@ -21,7 +21,7 @@ import yaml
 
 FIELDS = {
     "request_id", "points", "segments", "process", "limits", "initial", "planner", "policy_file",
-    "time_budget", "tolerances", "start",
+    "time_budget", "tolerances", "start", "allow_chatter", "entry",
 }
 PROCESS = ["teeth", "tool_radius", "axial_depth", "kt", "kn", "entry_angle", "exit_angle"]
 INITIAL = {"spindle_rpm": 2000.0, "feed": 0.04, "g": 0.0}
@@ -63,11 +63,19 @@ def main(path):
         "has_process": "process" in r,
         "has_limits": "limits" in r,
         "has_initial_state": "initial" in r,
-        "planner": r.get("planner", "ddpg"),
+        "planner": r.get("planner", "best"),
         "policy_file": r.get("policy_file", ""),
         "time_budget": num(path, "time_budget", r.get("time_budget", 0.0)),
         "has_tolerances": "tolerances" in r,
     }
+    # Issue 28: answer a plan that chatters as executed; where the tool enters the material.
+    allow = r.get("allow_chatter", False)
+    if not isinstance(allow, bool):
+        fail(path, f"allow_chatter: {allow!r} must be true or false")
+    entry = r.get("entry", "")
+    if entry not in ("", "run_in", "in_material"):
+        fail(path, f"entry: {entry!r} must be run_in or in_material")
+    msg["allow_chatter"], msg["entry"] = allow, entry
     # Issue 27: where the trajectory starts: left out, current, none, or joint positions.
     start = r.get("start")
     if start is None or start == "":

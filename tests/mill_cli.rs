@@ -302,7 +302,7 @@ fn trains_a_policy_and_plans_with_it_as_the_library_does() {
         &dir,
         "fixed.yaml",
         &format!(
-            "request_id: cli-test\n{POINTS}planner: fixed_g\npolicy_file: {}\n",
+            "request_id: cli-test\n{POINTS}planner: fixed_g\npolicy_file: {}\nallow_chatter: true\n",
             s(&weights)
         ),
     );
@@ -413,10 +413,19 @@ fn trains_a_policy_and_plans_with_it_as_the_library_does() {
         run.last().map(|p| f(&p["time_from_start_s"])),
         Some(lib_out.executed.scaling.duration())
     );
+    // The machining time is the time in the material; the trajectory adds its run-in and
+    // run-out (issue 28).
     assert!(
-        (f(&p0["executed"]["totals"]["machining_time_s"]) - lib_out.executed.scaling.duration())
-            .abs()
+        (f(&p0["executed"]["totals"]["machining_time_s"]) - lib_out.executed.plan.total_time).abs()
             <= 1e-9
+    );
+    assert_eq!(
+        f(&p0["executed"]["time_scaling"]["duration_s"]),
+        lib_out.executed.scaling.duration()
+    );
+    assert_eq!(
+        p0["executed"]["chatter_judge"]["samples"].as_u64(),
+        Some(lib_out.executed.chatter.samples as u64)
     );
     for k in [0, run.len() - 1] {
         assert!(run[k]["velocities_rad_per_s"]

@@ -25,6 +25,8 @@ limits:
 initial: {spindle_rpm: 2500, feed: 0.03}
 planner: fixed_g
 policy_file: /policies/fixed.safetensors
+allow_chatter: true
+entry: in_material
 ";
 
 fn script(file: &Path) -> std::process::Output {
@@ -82,6 +84,8 @@ fn request_files_become_equivalent_mill_request_messages() {
         assert_eq!(from_msg.initial.is_some(), file.initial.is_some(), "{name}");
         assert_eq!(from_msg.planner, file.planner, "{name}");
         assert_eq!(from_msg.policy_file, file.policy_file, "{name}");
+        assert_eq!(from_msg.allow_chatter, file.allow_chatter, "{name}");
+        assert_eq!(from_msg.entry().unwrap(), file.entry().unwrap(), "{name}");
         from_msg.validate().unwrap();
     }
     let full: msg::MillRequest =
@@ -107,6 +111,11 @@ fn what_the_message_cannot_carry_is_refused() {
             "unknown.yaml",
             "points: [[1.4, -0.3, 1.7], [2.1, 0.3, 1.7]]\nspeed: 3\n",
             "unknown field(s) speed",
+        ),
+        (
+            "entry.yaml",
+            "points: [[1.4, -0.3, 1.7], [2.1, 0.3, 1.7]]\nentry: plunge\n",
+            "entry: 'plunge' must be run_in or in_material",
         ),
         ("no_points.yaml", "planner: dp\n", "missing field points"),
         (

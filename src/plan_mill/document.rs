@@ -95,6 +95,15 @@ pub fn document(
                         "ramp_time_s": sc.ramp_time,
                         "duration_s": sc.duration(),
                         "points": sc.trajectory.points().len(),
+                        "run_in_m": sc.run_in,
+                        "run_out_m": sc.run_out,
+                    },
+                    "chatter_judge": {
+                        "chatter_free": o.executed.chatter.chatter_free,
+                        "max_spectral_radius": o.executed.chatter.max_spectral_radius,
+                        "samples": o.executed.chatter.samples,
+                        "evaluations": o.executed.chatter.evaluations,
+                        "chattering_segments": o.executed.chatter.chattering_segments,
                     },
                     "tool_path": {
                         "max_off_path_m": o.executed.scaling.deviation.max_off_path,

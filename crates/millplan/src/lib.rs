@@ -28,6 +28,7 @@ pub mod observation;
 pub mod path_cache;
 pub mod path_distribution;
 pub mod plan;
+pub mod propose_refine;
 pub mod provenance;
 pub mod reward;
 pub mod rollout;

@@ -44,8 +44,9 @@ pub struct MillPlanOutput {
     /// ([`crate::MillPlanner::with_indicator_source`]); its `note` belongs in the
     /// answer's message.
     pub indicator: IndicatorProvenance,
-    /// How every planner of [`PlannerKind::BEST_CANDIDATES`] did when the request asked for
-    /// [`PlannerKind::Best`] (in that order; empty for another planner).
+    /// How every planner of [`PlannerKind::BEST_CANDIDATES`] that ran did when the request
+    /// asked for [`PlannerKind::Best`] (in that order; `greedy_best_g` only where `greedy` has
+    /// no chatter-free plan; empty for another planner).
     pub candidates: Vec<Candidate>,
 }
 
@@ -110,9 +111,18 @@ impl MillPlanOutput {
                 }
             })
             .collect();
+        let skipped = if self
+            .candidates
+            .iter()
+            .any(|c| c.planner == PlannerKind::GreedyBestG)
+        {
+            ""
+        } else {
+            "; greedy_best_g not run (greedy is chatter-free)"
+        };
         format!(
             "best of {} candidates: {} (the fastest chatter-free plan as executed with 1/K at or \
-             above its minimum); {}",
+             above its minimum); {}{skipped}",
             self.candidates.len(),
             self.planner.name(),
             list.join("; ")

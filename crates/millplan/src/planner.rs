@@ -747,7 +747,21 @@ impl MillPlanner {
         let mut candidates = Vec::new();
         let mut planned: Vec<MillPlanOutput> = Vec::new();
         let mut errors = Vec::new();
-        for (kind, result) in self.plan_each(request, &PlannerKind::BEST_CANDIDATES, budget) {
+        // greedy_best_g replans greedy for each fixed g (seconds): only where greedy (g held at
+        // g0) has no chatter-free plan. Where greedy has one, greedy_best_g chose greedy's g on
+        // every path measured (BENCHMARKS.md, "Milling: no chattering plan as SUCCESS").
+        let first: Vec<PlannerKind> = PlannerKind::BEST_CANDIDATES
+            .into_iter()
+            .filter(|k| *k != PlannerKind::GreedyBestG)
+            .collect();
+        let mut results = self.plan_each(request, &first, budget);
+        let greedy_stable = results.iter().any(|(k, r)| {
+            *k == PlannerKind::Greedy && r.as_ref().is_ok_and(|o| !o.executed.chatters())
+        });
+        if !greedy_stable {
+            results.extend(self.plan_each(request, &[PlannerKind::GreedyBestG], budget));
+        }
+        for (kind, result) in results {
             match result {
                 Ok(out) => {
                     candidates.push(Candidate::planned(&out));

@@ -98,8 +98,9 @@ impl PlannerKind {
 
     /// The planners [`PlannerKind::Best`] chooses among: every planner but `dp`, whose grid
     /// search costs seconds to minutes on a new path (its cache is built per path) and whose
-    /// plans are slower as executed on every path measured (`BENCHMARKS.md`, "Milling: the
-    /// fastest stable plan").
+    /// plans are slower as executed on every path measured (`BENCHMARKS.md`, "Milling: no
+    /// chattering plan as SUCCESS"). `greedy_best_g` runs only where `greedy` has no
+    /// chatter-free plan.
     pub const BEST_CANDIDATES: [PlannerKind; 5] = [
         Self::Ddpg,
         Self::FixedG,

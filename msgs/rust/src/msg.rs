@@ -904,14 +904,16 @@ mod tests {
         assert_eq!(MillPlan::status_name(8), Some("ILL_CONDITIONED"));
         assert_eq!(MillPlan::status_name(9), Some("RESOURCE_LIMIT"));
         assert_eq!(MillPlan::status_name(10), Some("NO_APPROACH"));
-        assert_eq!(MillPlan::status_name(11), None);
+        assert_eq!(MillPlan::status_name(11), Some("CHATTER"));
+        assert_eq!(MillPlan::status_name(12), Some("INFEASIBLE"));
+        assert_eq!(MillPlan::status_name(13), None);
         // Every name is distinct and round-trips through its code.
         let names: Vec<&str> = (0..=u8::MAX).filter_map(MillPlan::status_name).collect();
-        assert_eq!(names.len(), 11);
+        assert_eq!(names.len(), 13);
         let mut sorted = names.clone();
         sorted.sort_unstable();
         sorted.dedup();
-        assert_eq!(sorted.len(), 11);
+        assert_eq!(sorted.len(), 13);
     }
 }
 

@@ -418,8 +418,12 @@ fn assert_published_as_executed(m: &msg::MillPlan, out: &MillPlanOutput) {
     assert!(m.machining_time < end && m.run_in > 0.0 && m.run_out > 0.0);
     assert!(m.machining_time > out.plan.total_time, "ramps at least");
     assert_eq!(m.chatter_free, x.chatter_free);
+    // max_mu is the largest of the segments' values and of the judge's samples (issue 28).
     let max_mu = m.segments.iter().map(|s| s.mu_max).fold(0.0, f64::max);
-    assert_eq!(m.max_mu, max_mu);
+    assert_eq!(
+        m.max_mu,
+        max_mu.max(out.executed.chatter.max_spectral_radius)
+    );
     assert_eq!(m.max_mu, x.max_spectral_radius);
     let min_ci = m
         .segments
@@ -603,17 +607,17 @@ fn a_plan_that_chatters_as_executed_is_chatter_not_success() {
     assert_eq!(m.status, msg::MillPlan::SUCCESS, "{}", m.message);
     assert_eq!(m.planner, best.planner.name());
     assert_ne!(m.planner, "best");
-    assert_eq!(m.candidates.len(), 5);
+    // greedy is chatter-free on the default path: greedy_best_g is not run.
     let names: Vec<&str> = m.candidates.iter().map(|c| c.planner.as_str()).collect();
-    assert_eq!(
-        names,
-        ["ddpg", "fixed_g", "naive", "greedy", "greedy_best_g"]
-    );
+    assert_eq!(names, ["ddpg", "fixed_g", "naive", "greedy"]);
     let fixed_g = &m.candidates[1];
     assert_eq!(fixed_g.status, msg::MillPlan::CHATTER);
     assert!(!fixed_g.chatter_free && fixed_g.max_mu >= 1.0);
     assert!(
-        m.message.contains("best of 5 candidates: ") && m.message.contains("ddpg "),
+        m.message.contains("best of 4 candidates: ")
+            && m.message.contains("ddpg ")
+            && m.message
+                .contains("greedy_best_g not run (greedy is chatter-free)"),
         "{}",
         m.message
     );

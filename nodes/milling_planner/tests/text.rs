@@ -18,9 +18,9 @@ fn yaml_and_json_parse() {
     assert_eq!(r.limits.unwrap().feed, Some([0.01, 0.05]));
     assert_eq!(r.initial_state(), [2000.0, 0.02, 0.0]);
     r.validate().unwrap();
-    // JSON is YAML; the planner defaults to ddpg.
+    // JSON is YAML; the planner defaults to best (issue 28).
     let r = text::parse_request(r#"{"points": [[1.4, -0.3, 1.7], [2.1, 0.3, 1.7]]}"#).unwrap();
-    assert_eq!((r.request_id.as_str(), r.planner.as_str()), ("", "ddpg"));
+    assert_eq!((r.request_id.as_str(), r.planner.as_str()), ("", "best"));
 }
 
 #[test]
