@@ -92,6 +92,8 @@ pub struct ChatterVerdict {
     pub samples: usize,
     /// Direct evaluations of the chatter indicator.
     pub evaluations: usize,
+    /// Wall time of the judge \[s\] (its evaluations run on the planner's threads).
+    pub seconds: f64,
 }
 
 /// A sample's state before its |μ|max is known.
@@ -161,6 +163,7 @@ pub fn judge(
             reason: "must be finite and > 0".into(),
         });
     }
+    let started = std::time::Instant::now();
     let path = cell.path();
     let length = path.total_length();
     let n = joints.len();
@@ -260,6 +263,7 @@ pub fn judge(
         lowest_feed: None,
         samples,
         evaluations,
+        seconds: 0.0,
     };
     for (i, list) in per_segment.iter().enumerate() {
         for (state, value) in list.iter().zip(&values[i]) {
@@ -290,6 +294,7 @@ pub fn judge(
             .unwrap_or(f64::NAN);
         l.judged(mu)
     });
+    verdict.seconds = started.elapsed().as_secs_f64();
     Ok(verdict)
 }
 

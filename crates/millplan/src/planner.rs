@@ -937,9 +937,18 @@ impl MillPlanner {
         let mut stable: Option<(PlannerKind, f64)> = None;
         let others: Vec<PlannerKind> = PlannerKind::BEST_CANDIDATES
             .into_iter()
-            .filter(|k| *k != out.planner)
+            .filter(|k| *k != out.planner && *k != PlannerKind::GreedyBestG)
             .collect();
-        for (kind, result) in self.plan_each(request, &others, budget) {
+        let mut results = self.plan_each(request, &others, budget);
+        // greedy_best_g only where greedy has no chatter-free plan (as `best`).
+        // (`out` chatters: refused only then.)
+        let greedy_stable = results.iter().any(|(k, r)| {
+            *k == PlannerKind::Greedy && r.as_ref().is_ok_and(|o| !o.executed.chatters())
+        });
+        if !greedy_stable && out.planner != PlannerKind::GreedyBestG {
+            results.extend(self.plan_each(request, &[PlannerKind::GreedyBestG], budget));
+        }
+        for (kind, result) in results {
             match result {
                 Ok(other) => {
                     let mu = other.executed.plan.max_spectral_radius;
