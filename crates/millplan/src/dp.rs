@@ -214,7 +214,7 @@ pub struct DpResult {
 /// # Errors
 /// [`MillPlanError::InvalidParameter`] for an initial state outside its
 /// range; [`MillPlanError::InvalidConfig`] when the initial state is
-/// forbidden or no feasible plan exists; cell-model errors other than
+/// forbidden; [`MillPlanError::Infeasible`] when no feasible plan exists; cell-model errors other than
 /// infeasibility.
 ///
 /// # Performance
@@ -497,9 +497,11 @@ pub fn solve_holding(
     if let Some(e) = error {
         return Err(e);
     }
-    let path = path.ok_or_else(|| MillPlanError::InvalidConfig {
-        name: "DP".to_string(),
-        reason: "no feasible plan from the initial state on this grid".to_string(),
+    let path = path.ok_or_else(|| MillPlanError::Infeasible {
+        planner: "dp".to_string(),
+        reason: "no feasible plan from the initial state on its grid (every sequence of grid \
+                 states within the step bounds leaves the feasible set)"
+            .to_string(),
     })?;
     let states = path
         .nodes

@@ -332,10 +332,10 @@ pub fn fixed_g_candidates_within(
         }
     }
     if feasible.is_empty() {
-        return Err(MillPlanError::InvalidConfig {
-            name: "planner greedy_best_g".to_string(),
+        return Err(MillPlanError::Infeasible {
+            planner: "greedy_best_g".to_string(),
             reason: "no fixed redundancy angle reachable from the initial g is feasible on every \
-                     segment of this path"
+                     segment of this path; ddpg, dp and best move g along it"
                 .to_string(),
         });
     }
@@ -410,7 +410,7 @@ pub fn fixed_g_candidates_within(
 ///   planner's).
 ///
 /// # Errors
-/// [`MillPlanError::InvalidConfig`] when no target g* is feasible on every
+/// [`MillPlanError::Infeasible`] when no target g* is feasible on every
 /// segment or none has a trajectory; as [`solve_within`] otherwise.
 pub fn best_fixed_g_within(
     cell: &MillCell,
@@ -443,8 +443,8 @@ pub fn best_fixed_g_within(
             best = Some(r);
         }
     }
-    let mut best = best.ok_or_else(|| MillPlanError::InvalidConfig {
-        name: "planner greedy_best_g".to_string(),
+    let mut best = best.ok_or_else(|| MillPlanError::Infeasible {
+        planner: "greedy_best_g".to_string(),
         reason: "no candidate's trajectory could be built (time scaling)".to_string(),
     })?;
     best.evaluations = evaluations;

@@ -1107,11 +1107,41 @@ impl MillPlanner {
 
     /// One plan of [`Self::plan_within`]: steps 1–8 of the module
     /// documentation, the policy's chatter shield as `shield` says.
+    ///
+    /// Once the path is known to be reachable (step 3), an IK or joint-limit failure of the
+    /// planner's states or of their executed trajectory is the planner's, not the path's:
+    /// [`MillPlanError::Infeasible`] (issue 28, item 2), not UNREACHABLE.
     fn plan_attempt(
         &self,
         request: &MillRequest,
         budget: &Budget,
         shield: &ShieldRound,
+    ) -> Result<MillPlanOutput, MillPlanError> {
+        let mut reachable = false;
+        self.plan_attempt_checked(request, budget, shield, &mut reachable)
+            .map_err(|e| match e {
+                MillPlanError::Mill(
+                    ref m @ (MillError::JointLimit { .. }
+                    | MillError::Unreachable { .. }
+                    | MillError::Singular { .. }),
+                ) if reachable => MillPlanError::Infeasible {
+                    planner: request.planner.clone(),
+                    reason: format!(
+                        "the path is reachable, but this planner's plan or its executed \
+                         trajectory is not: {m}"
+                    ),
+                },
+                other => other,
+            })
+    }
+
+    /// [`Self::plan_attempt`]; `reachable` is set once step 3 passed.
+    fn plan_attempt_checked(
+        &self,
+        request: &MillRequest,
+        budget: &Budget,
+        shield: &ShieldRound,
+        reachable: &mut bool,
     ) -> Result<MillPlanOutput, MillPlanError> {
         let start = Instant::now();
         let base = *self.cell.state_limits();
@@ -1129,6 +1159,7 @@ impl MillPlanner {
         ) {
             check_held_g(&cell, kind, g0, budget)?;
         }
+        *reachable = true;
         let mut phases = PlanningPhases {
             setup: start.elapsed().as_secs_f64(),
             ..PlanningPhases::default()
