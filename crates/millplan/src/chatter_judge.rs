@@ -30,6 +30,12 @@
 //! boundary, or where |μ| moves, is evaluated directly; the count is
 //! [`ChatterVerdict::evaluations`].
 //!
+//! # Values already known
+//! A state bit-identical to its segment's state in the plan (Ω, f, g; the same cell state,
+//! IK nearest the previous segment's joints) takes the plan's |μ|max of that segment when it
+//! was evaluated directly ([`Known`]): the same function of the same inputs. A cruise between
+//! equal neighbours is such a state.
+//!
 //! # Undefined samples
 //! Where the chatter model has no solution at a sample's feed below the cell's lowest feed
 //! (the power-law force's equilibrium as f → 0), the sample counts as chattering
@@ -51,6 +57,17 @@ pub const JUDGE_MARGIN: f64 = 0.01;
 
 /// … that differ by at most `JUDGE_SPREAD` is accepted (module documentation).
 pub const JUDGE_SPREAD: f64 = 0.01;
+
+/// What the judge knows of one segment of the plan: its joints (the next segment's IK
+/// reference) and, when it was evaluated directly, its state and |μ|max.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Known {
+    /// The segment's joints \[rad\].
+    pub joints: [f64; 6],
+    /// (Ω \[rpm\], f \[m/s\], g \[rad\], |μ|max) of the segment, evaluated directly; `None`
+    /// when its value is not a direct evaluation (the indicator cache's).
+    pub direct: Option<[f64; 4]>,
+}
 
 /// One judged sample of the executed trajectory.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -92,6 +109,8 @@ pub struct ChatterVerdict {
     pub samples: usize,
     /// Direct evaluations of the chatter indicator.
     pub evaluations: usize,
+    /// States whose |μ|max was the plan's own value of the segment ([`Known`]).
+    pub reused: usize,
     /// Wall time of the judge \[s\] (its evaluations run on the planner's threads).
     pub seconds: f64,
 }
@@ -134,7 +153,8 @@ impl State {
 /// # Arguments
 /// * `cell` — the request's cell (path, dynamics, process, limits).
 /// * `scaling` — the executed trajectory ([`crate::timing::time_scale`]).
-/// * `joints` — the plan's joints per segment (the IK references).
+/// * `known` — per segment of the plan: its joints (the IK references) and its directly
+///   evaluated state and |μ|max ([`Known`]).
 /// * `period` — the executor's control period \[s\], > 0.
 /// * `threads` — evaluation threads, ≥ 1.
 /// * `budget` — checked before each evaluation.
@@ -147,11 +167,12 @@ impl State {
 /// errors at a feed inside the cell's range; [`MillPlanError::Interrupted`].
 ///
 /// # Performance
-/// One IK and one indicator per evaluated state (0.4–0.7 ms), on `threads` threads.
+/// One IK and one indicator per evaluated state (0.4–0.7 ms), on `threads` threads; none for
+/// a state whose value is known.
 pub fn judge(
     cell: &MillCell,
     scaling: &TimeScaling,
-    joints: &[[f64; 6]],
+    known: &[Known],
     period: f64,
     threads: usize,
     budget: &Budget,
@@ -166,7 +187,7 @@ pub fn judge(
     let started = std::time::Instant::now();
     let path = cell.path();
     let length = path.total_length();
-    let n = joints.len();
+    let n = known.len();
     let mut boundaries = Vec::with_capacity(n + 1);
     let mut start = 0.0;
     boundaries.push(start);
@@ -216,6 +237,7 @@ pub fn judge(
         .collect();
     let min_feed = cell.state_limits().feed[0];
     let mut evaluations = 0;
+    let mut reused = 0;
     while !intervals.is_empty() {
         let mut wanted: Vec<(usize, usize)> = Vec::new();
         for &(i, a, b) in &intervals {
@@ -227,11 +249,16 @@ pub fn judge(
         }
         let results = parallel_map(wanted.len(), threads, |w| {
             let (i, j) = wanted[w];
-            evaluate(cell, joints, &per_segment[i][j], min_feed, budget)
+            evaluate(cell, known, &per_segment[i][j], min_feed, budget)
         });
-        evaluations += wanted.len();
         for ((i, j), r) in wanted.iter().zip(results) {
-            values[*i][*j] = Some(r?);
+            let (value, direct) = r?;
+            if direct {
+                evaluations += 1;
+            } else {
+                reused += 1;
+            }
+            values[*i][*j] = Some(value);
         }
         let mut next = Vec::new();
         for (i, a, b) in intervals {
@@ -263,6 +290,7 @@ pub fn judge(
         lowest_feed: None,
         samples,
         evaluations,
+        reused,
         seconds: 0.0,
     };
     for (i, list) in per_segment.iter().enumerate() {
@@ -298,18 +326,24 @@ pub fn judge(
     Ok(verdict)
 }
 
-/// |μ|max of one state: the segment's cell state at the state's g (IK nearest the previous
-/// segment's planned joints), the indicator at its Ω and feed; ∞ where the model has no
-/// solution at a feed below `min_feed`.
+/// |μ|max of one state and whether it was evaluated: the plan's value of the segment when
+/// the state is the segment's own ([`Known`]), else the segment's cell state at the state's g
+/// (IK nearest the previous segment's planned joints) and the indicator at its Ω and feed; ∞
+/// where the model has no solution at a feed below `min_feed`.
 fn evaluate(
     cell: &MillCell,
-    joints: &[[f64; 6]],
+    known: &[Known],
     state: &State,
     min_feed: f64,
     budget: &Budget,
-) -> Result<f64, MillPlanError> {
+) -> Result<(f64, bool), MillPlanError> {
+    if let Some([rpm, feed, g, mu]) = known[state.segment].direct {
+        if [rpm, feed, g].map(f64::to_bits) == [state.rpm, state.feed, state.g].map(f64::to_bits) {
+            return Ok((mu, false));
+        }
+    }
     budget.check("the chatter judge of the executed trajectory")?;
-    let reference = state.segment.checked_sub(1).map(|p| joints[p]);
+    let reference = state.segment.checked_sub(1).map(|p| known[p].joints);
     let cell_state: CellState = cell.evaluate(state.segment, state.g, reference.as_ref())?;
     match chatter_indicator(
         &cell_state.modal,
@@ -318,8 +352,8 @@ fn evaluate(
         state.feed,
         cell.indicator_settings(),
     ) {
-        Ok(i) => Ok(i.spectral_radius),
-        Err(_) if state.feed < min_feed => Ok(f64::INFINITY),
+        Ok(i) => Ok((i.spectral_radius, true)),
+        Err(_) if state.feed < min_feed => Ok((f64::INFINITY, true)),
         Err(e) => Err(e.into()),
     }
 }

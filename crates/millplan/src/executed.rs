@@ -10,7 +10,7 @@ use kerf_budget::Budget;
 use kerf_mill::MillCell;
 
 use crate::cache::IndicatorCache;
-use crate::chatter_judge::{judge, ChatterVerdict};
+use crate::chatter_judge::{judge, ChatterVerdict, Known};
 use crate::error::MillPlanError;
 use crate::plan::{IndicatorProvenance, IndicatorSource, Plan};
 use crate::reward::RewardWeights;
@@ -60,11 +60,22 @@ impl Executed {
         threads: usize,
         budget: &Budget,
     ) -> Result<Self, MillPlanError> {
-        let joints: Vec<[f64; 6]> = plan.segments.iter().map(|s| s.joints).collect();
+        // The segments' values are direct unless the indicator cache gave them.
+        let known: Vec<Known> = plan
+            .segments
+            .iter()
+            .map(|s| Known {
+                joints: s.joints,
+                direct: cached_segments
+                    .binary_search(&s.segment)
+                    .is_err()
+                    .then_some([s.rpm, s.feed, s.g, s.spectral_radius]),
+            })
+            .collect();
         let chatter = judge(
             cell,
             &scaling,
-            &joints,
+            &known,
             settings.control_period,
             threads,
             budget,

@@ -69,13 +69,14 @@ impl MillPlanOutput {
         };
         format!(
             "trajectory {:.3} s from rest to rest (run-in {:.1} mm, run-out {:.1} mm); chatter \
-             judged at {} control periods in the material ({} evaluations, {:.3} s): worst \
-             |mu|max {:.4} at {}; lowest feed in the material {}",
+             judged at {} control periods in the material ({} evaluations, {} segment values \
+             reused, {:.3} s): worst |mu|max {:.4} at {}; lowest feed in the material {}",
             sc.duration(),
             sc.run_in * 1e3,
             sc.run_out * 1e3,
             v.samples,
             v.evaluations,
+            v.reused,
             v.seconds,
             v.max_spectral_radius,
             v.worst.as_ref().map_or("-".to_string(), sample),

@@ -258,6 +258,12 @@ fn ramps_in_the_material_cannot_be_stable() {
     assert!(!out.executed.chatters());
     let sc = &out.executed.scaling;
     assert!(sc.run_in > 0.0 && sc.run_out > 0.0);
+    // A constant plan cruises at its segments' own states: the judge reuses their values.
+    let v = &out.executed.chatter;
+    assert!(
+        v.reused > 0 && v.evaluations + v.reused <= v.samples,
+        "{v:?}"
+    );
     let lowest = out.executed.chatter.lowest_feed.unwrap();
     let slowest_segment = out
         .executed
