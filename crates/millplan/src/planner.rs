@@ -1109,8 +1109,9 @@ impl MillPlanner {
     /// documentation, the policy's chatter shield as `shield` says.
     ///
     /// Once the path is known to be reachable (step 3), an IK or joint-limit failure of the
-    /// planner's states or of their executed trajectory is the planner's, not the path's:
-    /// [`MillPlanError::Infeasible`] (issue 28, item 2), not UNREACHABLE.
+    /// planner's states or of their executed trajectory, and an executed trajectory that
+    /// cannot be built ([`MillPlanError::NotExecutable`]), are the planner's on this path:
+    /// [`MillPlanError::Infeasible`] (issue 28, item 2), not UNREACHABLE or INTERNAL_ERROR.
     fn plan_attempt(
         &self,
         request: &MillRequest,
@@ -1130,6 +1131,12 @@ impl MillPlanner {
                         "the path is reachable, but this planner's plan or its executed \
                          trajectory is not: {m}"
                     ),
+                },
+                // No time law, no settling within the rounds or the point limit: the executed
+                // trajectory of this plan on this path cannot be built.
+                MillPlanError::NotExecutable { reason } if reachable => MillPlanError::Infeasible {
+                    planner: request.planner.clone(),
+                    reason: format!("its executed trajectory cannot be built: {reason}"),
                 },
                 other => other,
             })

@@ -552,6 +552,17 @@ fn status_values_and_names() {
     assert_eq!(status_name(8), Some("ILL_CONDITIONED"));
     assert_eq!(status_name(2), Some("UNREACHABLE"));
     assert_eq!(status_name(5), None);
+    // Issue 28 (10 is the node's NO_APPROACH).
+    assert_eq!((status::CHATTER, status::INFEASIBLE), (11, 12));
+    assert_eq!(status_name(11), Some("CHATTER"));
+    assert_eq!(status_name(12), Some("INFEASIBLE"));
+    assert_eq!(status_name(10), None);
+    let infeasible = MillPlanError::Infeasible {
+        planner: "fixed_g".to_string(),
+        reason: "x".to_string(),
+    };
+    assert_eq!(status_of(&infeasible), status::INFEASIBLE);
+    assert_eq!(infeasible.to_string(), "fixed_g: no plan on this path: x");
     let chatter = kerf_chatter::ChatterError::NotConverged {
         what: "x".to_string(),
         iterations: 3,
