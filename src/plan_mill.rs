@@ -265,8 +265,25 @@ pub fn run(a: MillArgs) -> Result<(), String> {
         );
         print!("{}", comparison_table(&rows));
         let executed: Vec<_> = outputs.iter().map(|o| o.executed.plan.row()).collect();
-        println!("\nas executed (time-scaled to the joint limits, from rest to rest):");
+        println!(
+            "\nas executed (time-scaled to the joint limits; machining time in the material):"
+        );
         print!("{}", comparison_table(&executed));
+        println!(
+            "\ntrajectory from rest to rest (run-in, the path, run-out), as compared by best:"
+        );
+        for o in &outputs {
+            println!(
+                "{}: {:.3} s, {}",
+                o.planner.name(),
+                o.executed.scaling.duration(),
+                if o.executed.chatters() {
+                    "CHATTERS as executed"
+                } else {
+                    "chatter-free at every executed sample"
+                }
+            );
+        }
         for (kind, e) in &failures {
             println!("{}: failed: {}", kind.name(), describe(e));
         }

@@ -504,7 +504,9 @@ fn trains_a_policy_and_plans_with_it_as_the_library_does() {
     // Both Markdown rows, with the library's formatting, as planned and (second table) as
     // executed.
     let (planned_table, executed_table) = stdout
-        .split_once("as executed (time-scaled to the joint limits, from rest to rest):\n")
+        .split_once(
+            "as executed (time-scaled to the joint limits; machining time in the material):\n",
+        )
         .unwrap_or_else(|| panic!("no executed comparison table in {stdout}"));
     for (table, plans) in [
         (planned_table, [lib, naive]),
@@ -518,6 +520,15 @@ fn trains_a_policy_and_plans_with_it_as_the_library_does() {
             let row = row.lines().nth(2).expect("row");
             assert!(table.contains(row), "{row} in {table}");
         }
+    }
+    // The trajectories' durations, each planner's on its own line.
+    for out in [&lib_out, &naive_out] {
+        let line = format!(
+            "{}: {:.3} s, ",
+            out.planner.name(),
+            out.executed.scaling.duration()
+        );
+        assert!(stdout.contains(&line), "{line} in {stdout}");
     }
     let cmp = std::fs::read_to_string(plots.join("mill_plan_comparison.svg")).expect("overlay");
     assert!(
