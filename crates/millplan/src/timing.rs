@@ -582,7 +582,17 @@ fn scale_on(
             Ok(GeoKnot { s, u, q })
         } else {
             let u = if s < 0.0 { 0.0 } else { 1.0 };
-            let q = cell.joints_on_extension(s, g_s, Some(reference))?;
+            let q = cell
+                .joints_on_extension(s, g_s, Some(reference))
+                .map_err(|e| MillPlanError::NotExecutable {
+                    reason: format!(
+                        "the {} ({:.1} mm along the path's {} tangent) is out of the robot's \
+                         reach or limits: {e}; entry in_material starts and stops on the path",
+                        if s < 0.0 { "run-in" } else { "run-out" },
+                        if s < 0.0 { -s } else { s - length } * 1e3,
+                        if s < 0.0 { "start" } else { "end" }
+                    ),
+                })?;
             Ok(GeoKnot { s, u, q })
         }
     };
