@@ -52,6 +52,16 @@
 //!    split and steps 2–7 repeat, so what is returned has been measured
 //!    within the tolerance ([`TimeScaling::deviation`]).
 //!
+//! # Run-in and run-out ([`Entry::RunIn`], the default; issue 28)
+//! The law runs over the path extended by a straight run-in along its start
+//! tangent and a run-out along its end tangent (knots there are IK solutions
+//! of [`kerf_mill::MillCell::tool_pose_on_extension`] at the first and last
+//! segment's g; the feed there is the first and last segment's), so both ramps
+//! lie outside the material and the path itself runs at the planned feeds
+//! (divided by c). The run lengths start at 0.6 f T_r and are lengthened when
+//! the settled law's ramps would end on the path ([`time_scale`] tries again,
+//! at most 4 times). With [`Entry::InMaterial`] the ramps lie on the path.
+//!
 //! The executed feed of a segment is the planned one divided by c at its
 //! midpoint ([`TimeScaling::segment_feeds`]; the ramps' passage through
 //! every feed from 0 is not counted, as a start from rest must); its time
