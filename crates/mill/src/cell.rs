@@ -12,7 +12,7 @@ use std::path::{Path, PathBuf};
 use kerf_chatter::indicator::IndicatorSettings;
 use kerf_chatter::{MillingProcess, Modal2};
 use kerf_robot::RobotModel;
-use nalgebra::Isometry3;
+use nalgebra::{Isometry3, Vector3};
 
 use crate::dynamics::{ComplianceModel, ToolTipDynamics};
 use crate::error::{check_finite, check_positive, MillError};
@@ -358,6 +358,26 @@ impl MillCell {
     /// outside [0, 1]; [`MillError::Singular`] for a zero tangent.
     pub fn tool_pose_at_parameter(&self, u: f64, g: f64) -> Result<Isometry3<f64>, MillError> {
         let g = check_finite("redundancy angle g [rad]", g)?;
+        let (p, tangent) = self.point_and_plane_tangent(u)?;
+        Ok(crate::path::tool_pose(
+            &p,
+            &tangent,
+            &self.path.approach(),
+            g,
+        ))
+    }
+
+    /// The path point P(u) and the unit tangent of the path frame there: P'(u) projected on
+    /// the path plane and normalized (the tangent of [`MillCell::tool_pose_at_parameter`] and
+    /// of the extensions of [`MillCell::tool_pose_on_extension`]).
+    ///
+    /// # Errors
+    /// [`MillError::Bspline`] for u outside [0, 1]; [`MillError::Singular`] for a zero
+    /// tangent.
+    pub fn point_and_plane_tangent(
+        &self,
+        u: f64,
+    ) -> Result<(Vector3<f64>, Vector3<f64>), MillError> {
         let (p, d) = self.path.point_and_derivative(u)?;
         let n = self.path.normal();
         let d = d - d.dot(&n) * n;
@@ -367,12 +387,7 @@ impl MillCell {
                 what: format!("path tangent at spline parameter {u} (zero speed)"),
             });
         }
-        Ok(crate::path::tool_pose(
-            &p,
-            &(d / norm),
-            &self.path.approach(),
-            g,
-        ))
+        Ok((p, d / norm))
     }
 
     /// The tool-tip pose at an arc length `s` of the path extended by straight lines along
@@ -396,10 +411,8 @@ impl MillCell {
             return self.tool_pose_at(s, g);
         };
         let mut pose = self.tool_pose_at_parameter(u, g)?;
-        let n = self.path.normal();
-        let d = self.path.derivative(u)?;
-        let d = d - d.dot(&n) * n;
-        pose.translation.vector += beyond * d.normalize();
+        let (_, tangent) = self.point_and_plane_tangent(u)?;
+        pose.translation.vector += beyond * tangent;
         Ok(pose)
     }
 
@@ -415,10 +428,7 @@ impl MillCell {
         reference: Option<&[f64; 6]>,
     ) -> Result<[f64; 6], MillError> {
         self.check_g(g)?;
-        let pose = self.tool_pose_on_extension(s, g)?;
-        self.kinematics
-            .ik_nearest(&pose, reference.unwrap_or(&self.reference))
-            .map_err(|e| e.with_context(None, Some(g)))
+        self.joints_at_pose(&self.tool_pose_on_extension(s, g)?, g, reference)
     }
 
     /// The joint vector at arc length `s` and redundancy angle `g`: the
@@ -452,9 +462,19 @@ impl MillCell {
         reference: Option<&[f64; 6]>,
     ) -> Result<[f64; 6], MillError> {
         self.check_g(g)?;
-        let pose = self.tool_pose_at_parameter(u, g)?;
+        self.joints_at_pose(&self.tool_pose_at_parameter(u, g)?, g, reference)
+    }
+
+    /// The valid IK solution of the tool-tip `pose` nearest `reference` (the YAML's reference
+    /// joints for `None`); an IK error carries `g` as its context.
+    fn joints_at_pose(
+        &self,
+        pose: &Isometry3<f64>,
+        g: f64,
+        reference: Option<&[f64; 6]>,
+    ) -> Result<[f64; 6], MillError> {
         self.kinematics
-            .ik_nearest(&pose, reference.unwrap_or(&self.reference))
+            .ik_nearest(pose, reference.unwrap_or(&self.reference))
             .map_err(|e| e.with_context(None, Some(g)))
     }
 

@@ -132,14 +132,15 @@ pub(crate) fn distance_to_path(
     if u > 0.0 && u < 1.0 {
         return Ok((distance, u));
     }
-    let path = cell.path();
-    let (p, d) = path.point_and_derivative(u)?;
-    // The tangent in the path's plane, as the extension's pose has it.
-    let normal = path.normal();
-    let tangent = (d - d.dot(&normal) * normal).normalize();
+    // The tangent in the path's plane, as the extension's pose has it (none: no extension).
+    let (p, tangent) = match cell.point_and_plane_tangent(u) {
+        Ok(pt) => pt,
+        Err(kerf_mill::MillError::Singular { .. }) => return Ok((distance, u)),
+        Err(e) => return Err(e.into()),
+    };
     let along = (x - p).dot(&tangent);
     let beyond = if u <= 0.0 { along < 0.0 } else { along > 0.0 };
-    if !beyond || !tangent.iter().all(|v| v.is_finite()) {
+    if !beyond {
         return Ok((distance, u));
     }
     Ok((((x - p) - along * tangent).norm().min(distance), u))
