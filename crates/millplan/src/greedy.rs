@@ -60,7 +60,7 @@ use std::sync::Mutex;
 
 use kerf_budget::Budget;
 use kerf_chatter::indicator::chatter_indicator;
-use kerf_mill::MillCell;
+use kerf_mill::{MillCell, StateLimits};
 
 use crate::cache::is_infeasible;
 use crate::env::{EnvConfig, PhysicalState};
@@ -120,6 +120,35 @@ fn distinct(v: [f64; 3]) -> Vec<f64> {
     out
 }
 
+/// The lowest feed a ramp moves to: the feed range's lower end, at least
+/// [`EnvConfig`]'s default `min_feed` (module documentation).
+pub(crate) fn feed_floor(lim: &StateLimits) -> f64 {
+    lim.feed[0]
+        .max(EnvConfig::default().min_feed)
+        .min(lim.feed[1])
+}
+
+/// The moves of −1/0/+1 step bounds of Ω and f from (`rpm`, `feed`), clipped to the state
+/// ranges (the feed to at least `floor`), exact duplicates removed, in the ramp's order:
+/// highest feed first, then highest spindle speed (module documentation). Returns (Ω, f)
+/// pairs.
+pub(crate) fn step_moves(lim: &StateLimits, floor: f64, rpm: f64, feed: f64) -> Vec<(f64, f64)> {
+    let feeds = distinct([
+        (feed + lim.max_feed_step).min(lim.feed[1]),
+        feed,
+        (feed - lim.max_feed_step).max(floor).min(feed),
+    ]);
+    let rpms = distinct([
+        (rpm + lim.max_spindle_step_rpm).min(lim.spindle_rpm[1]),
+        rpm,
+        (rpm - lim.max_spindle_step_rpm).max(lim.spindle_rpm[0]),
+    ]);
+    feeds
+        .iter()
+        .flat_map(|&f| rpms.iter().map(move |&r| (r, f)))
+        .collect()
+}
+
 /// The greedy ramp with g moving from `initial[2]` toward `g_target` at
 /// the step bound and then held (module documentation).
 ///
@@ -163,9 +192,7 @@ pub fn solve_within(
             reason: "must be > 0".to_string(),
         });
     }
-    let feed_floor = lim.feed[0]
-        .max(EnvConfig::default().min_feed)
-        .min(lim.feed[1]);
+    let feed_floor = feed_floor(&lim);
     let process = cell.milling_process();
     let settings = cell.indicator_settings();
     let segments = cell.path().segments();
@@ -193,28 +220,16 @@ pub fn solve_within(
         let chosen = if t == 0 {
             (rpm, feed, mu(rpm, feed)?)
         } else {
-            let feeds = distinct([
-                (feed + lim.max_feed_step).min(lim.feed[1]),
-                feed,
-                (feed - lim.max_feed_step).max(feed_floor).min(feed),
-            ]);
-            let rpms = distinct([
-                (rpm + lim.max_spindle_step_rpm).min(lim.spindle_rpm[1]),
-                rpm,
-                (rpm - lim.max_spindle_step_rpm).max(lim.spindle_rpm[0]),
-            ]);
             let mut best: Option<(f64, f64, f64)> = None;
             let mut stable = None;
-            'search: for &f in &feeds {
-                for &r in &rpms {
-                    let m = mu(r, f)?;
-                    if m < 1.0 {
-                        stable = Some((r, f, m));
-                        break 'search;
-                    }
-                    if best.is_none_or(|b| m < b.2) {
-                        best = Some((r, f, m));
-                    }
+            for (r, f) in step_moves(&lim, feed_floor, rpm, feed) {
+                let m = mu(r, f)?;
+                if m < 1.0 {
+                    stable = Some((r, f, m));
+                    break;
+                }
+                if best.is_none_or(|b| m < b.2) {
+                    best = Some((r, f, m));
                 }
             }
             match stable.or(best) {

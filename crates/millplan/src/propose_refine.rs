@@ -73,8 +73,9 @@ use kerf_chatter::indicator::chatter_indicator;
 use kerf_chatter::MillingProcess;
 use kerf_mill::{CellState, MillCell, StateLimits};
 
-use crate::env::{EnvConfig, PhysicalState};
+use crate::env::PhysicalState;
 use crate::error::MillPlanError;
+use crate::greedy::{feed_floor, step_moves};
 
 /// Relative tolerance of the sums that rank continuations.
 const TIE: f64 = 1e-12;
@@ -123,17 +124,6 @@ fn stable(m: f64) -> bool {
     m < 1.0
 }
 
-/// Distinct values of `v` in order (exact duplicates removed).
-fn distinct(v: [f64; 3]) -> Vec<f64> {
-    let mut out: Vec<f64> = Vec::with_capacity(3);
-    for x in v {
-        if !out.contains(&x) {
-            out.push(x);
-        }
-    }
-    out
-}
-
 /// The search state: the cell states, the memo and the limits.
 struct Search<'a> {
     cell: &'a MillCell,
@@ -169,21 +159,7 @@ impl Search<'_> {
     /// The moves from (`rpm`, `feed`) in greedy's order (module
     /// documentation).
     fn moves(&self, rpm: f64, feed: f64) -> Vec<(f64, f64)> {
-        let lim = &self.lim;
-        let feeds = distinct([
-            (feed + lim.max_feed_step).min(lim.feed[1]),
-            feed,
-            (feed - lim.max_feed_step).max(self.feed_floor).min(feed),
-        ]);
-        let rpms = distinct([
-            (rpm + lim.max_spindle_step_rpm).min(lim.spindle_rpm[1]),
-            rpm,
-            (rpm - lim.max_spindle_step_rpm).max(lim.spindle_rpm[0]),
-        ]);
-        feeds
-            .iter()
-            .flat_map(|&f| rpms.iter().map(move |&r| (r, f)))
-            .collect()
+        step_moves(&self.lim, self.feed_floor, rpm, feed)
     }
 
     /// The best continuation from the stable state (`rpm`, `feed`) at
@@ -332,9 +308,7 @@ pub fn refine_with_g_report(
         let reference = cell_states.last().map(|c| c.joints);
         cell_states.push(cell.evaluate(t, g, reference.as_ref())?);
     }
-    let feed_floor = lim.feed[0]
-        .max(EnvConfig::default().min_feed)
-        .min(lim.feed[1]);
+    let feed_floor = feed_floor(&lim);
     let mut search = Search {
         cell,
         process: cell.milling_process(),
