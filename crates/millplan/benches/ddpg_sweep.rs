@@ -43,7 +43,9 @@ use std::time::Instant;
 
 use kerf_budget::Budget;
 use kerf_mill::{MillCell, PathSpec};
-use kerf_millplan::path_distribution::{held_out_paths, PathDistribution};
+#[allow(dead_code)] // each bench uses some of the shared helpers
+mod common;
+
 use kerf_millplan::propose_refine::refine_with_g_report;
 use kerf_millplan::status::status_name;
 use kerf_millplan::{
@@ -225,15 +227,7 @@ fn main() {
     let args: Vec<String> = std::env::args().skip(1).collect();
 
     let base = MillCell::default_cell().unwrap();
-    let dist = PathDistribution::default();
-    let mut paths = vec![("default".to_string(), MillRequest::default().points, false)];
-    for p in held_out_paths(&base, &dist).unwrap() {
-        paths.push((
-            format!("{} ({:.2} m)", p.seed, p.cell.path().total_length()),
-            p.spec.points.clone(),
-            true,
-        ));
-    }
+    let mut paths = common::default_and_held_out_paths();
     if let Some(i) = args.iter().position(|a| a == "--paths") {
         let n: usize = args
             .get(i + 1)

@@ -47,8 +47,11 @@
 use std::f64::consts::PI;
 use std::time::Instant;
 
+#[allow(dead_code)] // each bench uses some of the shared helpers
+mod common;
+
 use kerf_mill::{MillCell, PathSpec};
-use kerf_millplan::path_distribution::{check_path, held_out_paths, PathDistribution};
+use kerf_millplan::path_distribution::{check_path, PathDistribution};
 use kerf_millplan::planner::BEST_MIN_CONDITION_INDICATOR;
 use kerf_millplan::status::status_name;
 use kerf_millplan::{status_of, MillPlanOutput, MillPlanner, MillRequest};
@@ -214,14 +217,7 @@ fn main() {
 
     let base = MillCell::default_cell().unwrap();
     let dist = PathDistribution::default();
-    let mut paths = vec![("default".to_string(), MillRequest::default().points, false)];
-    for p in held_out_paths(&base, &dist).unwrap() {
-        paths.push((
-            format!("{} ({:.2} m)", p.seed, p.cell.path().total_length()),
-            p.spec.points.clone(),
-            true,
-        ));
-    }
+    let mut paths = common::default_and_held_out_paths();
     for (name, points) in [
         ("arc", arc()),
         ("S", s_curve()),

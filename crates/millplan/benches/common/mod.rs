@@ -1,5 +1,6 @@
 //! Shared by the kerf_millplan benches: CPU clocks, so that figures taken on
-//! the shared machine can be read as what an idle core would take.
+//! the shared machine can be read as what an idle core would take; the paths
+//! the planners are compared on.
 
 /// `struct timespec` of Linux (64-bit).
 #[cfg(target_os = "linux")]
@@ -46,4 +47,26 @@ pub fn thread_cpu_time() -> Option<f64> {
 /// Linux: all threads).
 pub fn process_cpu_time() -> Option<f64> {
     cpu_clock(2)
+}
+
+/// The default path of seed 004 and the ten held-out paths of
+/// `kerf_millplan::path_distribution` (`HELD_OUT_SEEDS`), in that order: a label
+/// (`default`, or `seed (length m)`), the points, and whether the path is held out.
+pub fn default_and_held_out_paths() -> Vec<(String, Vec<[f64; 3]>, bool)> {
+    use kerf_mill::MillCell;
+    use kerf_millplan::path_distribution::{held_out_paths, PathDistribution};
+    let base = MillCell::default_cell().expect("the default cell loads");
+    let mut paths = vec![(
+        "default".to_string(),
+        kerf_millplan::MillRequest::default().points,
+        false,
+    )];
+    for p in held_out_paths(&base, &PathDistribution::default()).expect("held-out paths") {
+        paths.push((
+            format!("{} ({:.2} m)", p.seed, p.cell.path().total_length()),
+            p.spec.points.clone(),
+            true,
+        ));
+    }
+    paths
 }
