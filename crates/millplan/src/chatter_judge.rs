@@ -43,13 +43,12 @@
 //! stable ([`kerf_chatter::feed_lower_bound`]). A model failure at a feed inside the cell's
 //! range is an error.
 
-use std::sync::atomic::{AtomicUsize, Ordering};
-
 use kerf_budget::Budget;
 use kerf_chatter::chatter_indicator;
 use kerf_mill::{CellState, MillCell};
 
 use crate::error::MillPlanError;
+use crate::parallel::map_ordered;
 use crate::timing::TimeScaling;
 
 /// A run between two evaluated states below 1 − `JUDGE_MARGIN` … (module documentation).
@@ -247,7 +246,7 @@ pub fn judge(
                 }
             }
         }
-        let results = parallel_map(wanted.len(), threads, |w| {
+        let results = map_ordered(wanted.len(), threads, "chatter-judge", |w| {
             let (i, j) = wanted[w];
             evaluate(cell, known, &per_segment[i][j], min_feed, budget)
         });
@@ -356,39 +355,4 @@ fn evaluate(
         Err(_) if state.feed < min_feed => Ok((f64::INFINITY, true)),
         Err(e) => Err(e.into()),
     }
-}
-
-/// `f(0..n)` on up to `threads` threads, results in order.
-fn parallel_map<T: Send>(n: usize, threads: usize, f: impl Fn(usize) -> T + Sync) -> Vec<T> {
-    let workers = threads.clamp(1, n.max(1));
-    if workers == 1 {
-        return (0..n).map(f).collect();
-    }
-    let next = AtomicUsize::new(0);
-    let mut slots: Vec<Option<T>> = (0..n).map(|_| None).collect();
-    let done: Vec<Vec<(usize, T)>> = std::thread::scope(|scope| {
-        let work = || {
-            let mut out = Vec::new();
-            loop {
-                let k = next.fetch_add(1, Ordering::Relaxed);
-                if k >= n {
-                    break out;
-                }
-                out.push((k, f(k)));
-            }
-        };
-        let helpers: Vec<_> = (1..workers).map(|_| scope.spawn(work)).collect();
-        let mut all = vec![work()];
-        for h in helpers {
-            match h.join() {
-                Ok(done) => all.push(done),
-                Err(panic) => std::panic::resume_unwind(panic),
-            }
-        }
-        all
-    });
-    for (k, v) in done.into_iter().flatten() {
-        slots[k] = Some(v);
-    }
-    slots.into_iter().flatten().collect()
 }

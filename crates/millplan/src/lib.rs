@@ -46,6 +46,7 @@ pub mod trajectory;
 
 // The planner node's ROS-free front half: requests and planning.
 pub mod output;
+mod parallel;
 pub mod planner;
 pub mod request;
 pub mod status;

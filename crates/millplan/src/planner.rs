@@ -874,46 +874,12 @@ impl MillPlanner {
         kinds: &[PlannerKind],
         budget: &Budget,
     ) -> Vec<CandidatePlan> {
-        let plan = |kind: PlannerKind| {
+        crate::parallel::map_ordered(kinds.len(), self.eval_threads, "plan-candidate", |k| {
+            let kind = kinds[k];
             let mut one = request.clone();
             one.planner = kind.name().to_string();
             (kind, self.plan_shielded(&one, budget))
-        };
-        let workers = self.eval_threads.clamp(1, kinds.len().max(1));
-        if workers == 1 {
-            return kinds.iter().map(|k| plan(*k)).collect();
-        }
-        let next = std::sync::atomic::AtomicUsize::new(0);
-        let work = || {
-            let mut done = Vec::new();
-            loop {
-                let k = next.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
-                let Some(kind) = kinds.get(k) else {
-                    break done;
-                };
-                done.push((k, plan(*kind)));
-            }
-        };
-        let mut all: Vec<(usize, CandidatePlan)> = std::thread::scope(|scope| {
-            let helpers: Vec<_> = (1..workers)
-                .filter_map(|w| {
-                    std::thread::Builder::new()
-                        .name(format!("plan-candidate-{w}"))
-                        .spawn_scoped(scope, work)
-                        .ok()
-                })
-                .collect();
-            let mut all = work();
-            for h in helpers {
-                match h.join() {
-                    Ok(done) => all.extend(done),
-                    Err(panic) => std::panic::resume_unwind(panic),
-                }
-            }
-            all
-        });
-        all.sort_by_key(|(k, _)| *k);
-        all.into_iter().map(|(_, r)| r).collect()
+        })
     }
 
     /// A plan of an explicit planner that chatters as executed becomes
