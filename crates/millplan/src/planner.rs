@@ -747,21 +747,7 @@ impl MillPlanner {
         let mut candidates = Vec::new();
         let mut planned: Vec<MillPlanOutput> = Vec::new();
         let mut errors = Vec::new();
-        // greedy_best_g replans greedy for each fixed g (seconds): only where greedy (g held at
-        // g0) has no chatter-free plan. Where greedy has one, greedy_best_g chose greedy's g on
-        // every path measured (BENCHMARKS.md, "Milling: no chattering plan as SUCCESS").
-        let first: Vec<PlannerKind> = PlannerKind::BEST_CANDIDATES
-            .into_iter()
-            .filter(|k| *k != PlannerKind::GreedyBestG)
-            .collect();
-        let mut results = self.plan_each(request, &first, budget);
-        let greedy_stable = results.iter().any(|(k, r)| {
-            *k == PlannerKind::Greedy && r.as_ref().is_ok_and(|o| !o.executed.chatters())
-        });
-        if !greedy_stable {
-            results.extend(self.plan_each(request, &[PlannerKind::GreedyBestG], budget));
-        }
-        for (kind, result) in results {
+        for (kind, result) in self.plan_candidates(request, &PlannerKind::BEST_CANDIDATES, budget) {
             match result {
                 Ok(out) => {
                     candidates.push(Candidate::planned(&out));
@@ -865,6 +851,32 @@ impl MillPlanner {
         Err(chattering(&out, "best", reason))
     }
 
+    /// `request` planned by each of `kinds` ([`Self::plan_each`]), except that greedy_best_g,
+    /// which replans greedy for each fixed g (seconds), runs only where greedy (g held at g0)
+    /// has no chatter-free plan among them: where greedy has one, greedy_best_g chose greedy's
+    /// g on every path measured (BENCHMARKS.md, "Milling: no chattering plan as SUCCESS").
+    /// Results in the order of `kinds`, greedy_best_g last.
+    fn plan_candidates(
+        &self,
+        request: &MillRequest,
+        kinds: &[PlannerKind],
+        budget: &Budget,
+    ) -> Vec<CandidatePlan> {
+        let first: Vec<PlannerKind> = kinds
+            .iter()
+            .copied()
+            .filter(|k| *k != PlannerKind::GreedyBestG)
+            .collect();
+        let mut results = self.plan_each(request, &first, budget);
+        let greedy_stable = results.iter().any(|(k, r)| {
+            *k == PlannerKind::Greedy && r.as_ref().is_ok_and(|o| !o.executed.chatters())
+        });
+        if !greedy_stable && kinds.contains(&PlannerKind::GreedyBestG) {
+            results.extend(self.plan_each(request, &[PlannerKind::GreedyBestG], budget));
+        }
+        results
+    }
+
     /// `request` planned by each of `kinds` ([`Self::plan_shielded`]), on up to
     /// [`Self::eval_threads`] threads at once (each plan is the same on any thread: the
     /// results are in the order of `kinds` whatever the scheduling).
@@ -903,18 +915,9 @@ impl MillPlanner {
         let mut stable: Option<(PlannerKind, f64)> = None;
         let others: Vec<PlannerKind> = PlannerKind::BEST_CANDIDATES
             .into_iter()
-            .filter(|k| *k != out.planner && *k != PlannerKind::GreedyBestG)
+            .filter(|k| *k != out.planner)
             .collect();
-        let mut results = self.plan_each(request, &others, budget);
-        // greedy_best_g only where greedy has no chatter-free plan (as `best`).
-        // (`out` chatters: refused only then.)
-        let greedy_stable = results.iter().any(|(k, r)| {
-            *k == PlannerKind::Greedy && r.as_ref().is_ok_and(|o| !o.executed.chatters())
-        });
-        if !greedy_stable && out.planner != PlannerKind::GreedyBestG {
-            results.extend(self.plan_each(request, &[PlannerKind::GreedyBestG], budget));
-        }
-        for (kind, result) in results {
+        for (kind, result) in self.plan_candidates(request, &others, budget) {
             match result {
                 Ok(other) => {
                     let mu = other.executed.plan.max_spectral_radius;
