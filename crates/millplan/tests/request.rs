@@ -637,3 +637,39 @@ fn coordinates_beyond_any_cell_are_refused_by_name() {
         "{e}"
     );
 }
+
+/// Issue 28's request fields: an unknown `entry` is INVALID_REQUEST naming the field (also
+/// through the planner, which validates first), the two names parse, and `allow_chatter` takes
+/// a boolean only.
+#[test]
+fn entry_and_allow_chatter_are_validated() {
+    let points = "points: [[1.4, -0.3, 1.7], [2.1, 0.3, 1.7]]\n";
+    for (text, entry) in [
+        ("entry: run_in\n", Entry::RunIn),
+        ("entry: in_material\n", Entry::InMaterial),
+        ("entry: ''\n", Entry::RunIn),
+    ] {
+        let r = MillRequest::from_yaml_str(&format!("{points}{text}")).expect(text);
+        r.validate().expect(text);
+        assert_eq!(r.entry().expect(text), entry, "{text}");
+    }
+    for bad in ["plunge", "RUN_IN", "run_in "] {
+        let r = MillRequest {
+            entry: Some(bad.to_string()),
+            ..MillRequest::default()
+        };
+        expect_invalid(&r, "entry", "must be run_in or in_material");
+        let e = planner().plan(&r).expect_err(bad);
+        assert_eq!(status_of(&e), status::INVALID_REQUEST, "{e}");
+    }
+    for bad in [
+        "allow_chatter: 3\n",
+        "allow_chatter: yes please\n",
+        "allow_chatter: .nan\n",
+    ] {
+        let e = MillRequest::from_yaml_str(&format!("{points}{bad}")).expect_err(bad);
+        assert_eq!(status_of(&e), status::INVALID_REQUEST, "{bad}: {e}");
+    }
+    let r = MillRequest::from_yaml_str(&format!("{points}allow_chatter: true\n")).unwrap();
+    assert!(r.allow_chatter);
+}
