@@ -1,0 +1,30 @@
+//! Reference-point stepping for kerf (seed 002,
+//! `../shared/seeds/002_*.txt`, issue 29): a per-period feed controller
+//! that passes each reference point of a path within a target precision in
+//! as few control periods as it can (RPRO), its DDQN imitation, stepping
+//! along multi-axis paths, and a Ruckig reference.
+//!
+//! | module | what | source |
+//! |---|---|---|
+//! | [`lattice`] | exact jerk-per-period motion on an integer lattice | seed 002 eq. 1 |
+//! | [`tracker`] | exact jerk-limited velocity tracking and stop | |
+//! | [`course`] | reference points as windows of ± precision | seed 002 Table 1 |
+//! | [`rpro`] | kerf's reading of RPRO: greedy decisions with a viability look-ahead | seed 002 §2.A, ref. [6] |
+//! | [`run`] | the per-period loop, passes, steps and accuracy | seed 002 §3 |
+//! | [`database`] | the paths and limit grid of Table 1, the train/test split | seed 002 Table 1, §3 |
+
+pub mod course;
+pub mod database;
+pub mod error;
+pub mod lattice;
+pub mod limits;
+pub mod rpro;
+pub mod run;
+pub mod tracker;
+
+pub use course::Course;
+pub use error::StepError;
+pub use lattice::{Action, Lattice, State};
+pub use limits::Limits;
+pub use rpro::{Rpro, RproSettings};
+pub use run::{run, Controller, Decision, Pass, Run};
