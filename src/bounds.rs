@@ -132,18 +132,58 @@ impl Coordinates {
     /// # Errors
     /// Why the value is refused: not three numbers, or a coordinate as [`Real::check`] says.
     pub fn check(&self, text: &str) -> Result<Point3, String> {
+        Triple {
+            names: ["x", "y", "z"],
+            value: self.0,
+        }
+        .check(text)
+        .map(Point3)
+    }
+}
+
+/// The value parser of three named reals `a,b,c` in one range (`--limits V,A,J`).
+#[derive(Debug, Clone, Copy)]
+pub struct Triple {
+    /// The three names, as the refusal states them.
+    pub names: [&'static str; 3],
+    /// The range of each.
+    pub value: Real,
+}
+
+impl Triple {
+    /// Checks `text` (`a,b,c`).
+    ///
+    /// # Errors
+    /// Why the value is refused: not three numbers, or one as [`Real::check`] says.
+    pub fn check(&self, text: &str) -> Result<[f64; 3], String> {
         let parts: Vec<&str> = text.split(',').collect();
         if parts.len() != 3 {
             return Err(format!(
-                "{} value(s); three coordinates x,y,z separated by commas are required",
-                parts.len()
+                "{} value(s); three values {} separated by commas are required",
+                parts.len(),
+                self.names.join(",")
             ));
         }
         let mut p = [0.0; 3];
-        for (k, (part, axis)) in parts.iter().zip(["x", "y", "z"]).enumerate() {
-            p[k] = self.0.check(part).map_err(|why| format!("{axis}: {why}"))?;
+        for (k, (part, name)) in parts.iter().zip(self.names).enumerate() {
+            p[k] = self.value.check(part).map_err(|why| format!("{name}: {why}"))?;
         }
-        Ok(Point3(p))
+        Ok(p)
+    }
+}
+
+impl TypedValueParser for Triple {
+    type Value = [f64; 3];
+
+    fn parse_ref(
+        &self,
+        cmd: &Command,
+        arg: Option<&Arg>,
+        value: &OsStr,
+    ) -> Result<[f64; 3], clap::Error> {
+        let text = value.to_string_lossy();
+        self.check(&text)
+            .map_err(|why| refusal(cmd, arg, value, &why, &self.value.range()))
     }
 }
 

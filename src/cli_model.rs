@@ -4,7 +4,7 @@
 //!
 //! Each line: `path` (the subcommand names), `id`, `long` (or null), `positional`, `takes_value`,
 //! `kind` — `real` (`f64`), `count` (a whole number), `grid` (`MIN:MAX:COUNT`), `point`
-//! (`x,y,z`), `input` (an
+//! (`x,y,z`, or three named reals such as `V,A,J`), `input` (an
 //! [`InputFile`]: a file the command reads), `enum` (a fixed set of values), `other` — and
 //! `help`.
 
@@ -34,7 +34,7 @@ fn kind(arg: &Arg) -> &'static str {
         "count"
     } else if id == std::any::TypeId::of::<Grid>() {
         "grid"
-    } else if id == std::any::TypeId::of::<Point3>() {
+    } else if id == std::any::TypeId::of::<Point3>() || id == std::any::TypeId::of::<[f64; 3]>() {
         "point"
     } else if id == std::any::TypeId::of::<InputFile>() {
         "input"

@@ -59,6 +59,17 @@ impl Robot {
         }
     }
 
+    /// The robot's shipped model: `urdf/<robot>.urdf` with `urdf/<robot>_limits.yaml`.
+    ///
+    /// # Errors
+    /// The model's error, naming the file.
+    pub(crate) fn model(self) -> Result<kerf_robot::RobotModel, String> {
+        let data = |rel: String| kerf_robot::data::default_path(rel);
+        let urdf = data(format!("urdf/{}.urdf", self.stem()));
+        let limits = data(format!("urdf/{}_limits.yaml", self.stem()));
+        kerf_robot::RobotModel::from_files(&urdf, Some(&limits)).map_err(|e| e.to_string())
+    }
+
     /// The robot's shipped cell file, `urdf/cells/<cell>.yaml`.
     fn cell(self) -> &'static str {
         match self {

@@ -33,6 +33,7 @@ mod plan_gcode;
 mod plan_mill;
 mod plots;
 mod publish;
+mod step;
 mod topic_types;
 mod train_mill;
 
@@ -68,6 +69,9 @@ enum Command {
     /// (request → planner → executor → cell; prints time, tracking error, contacts, final
     /// state).
     Demo(demo::DemoArgs),
+    /// Step through reference points offline, seed 002 (`kerf step points.txt --out run.json`):
+    /// prints steps, time and accuracy per point, writes the per-step trajectory as JSON.
+    Step(step::StepArgs),
     /// Train a planner's policy (`kerf train mill --out policy.safetensors`).
     Train(Box<train_mill::TrainArgs>),
     /// Every argument of every command as JSON lines (for the bounds test).
@@ -89,6 +93,7 @@ fn main() -> ExitCode {
         Command::Lobes(_) => Some("lobes"),
         Command::Demo(_) => Some("demo"),
         Command::Train(_) => Some("train"),
+        Command::Step(_) => Some("step"),
         _ => None,
     };
     if let Some(name) = offline {
@@ -109,6 +114,7 @@ fn main() -> ExitCode {
         Command::Lobes(a) => lobes::run(a),
         Command::Train(a) => train_mill::run(*a),
         Command::Demo(a) => demo::run(a),
+        Command::Step(a) => step::run(a),
         Command::CliModel => {
             print!("{}", cli_model::model(&Cli::command()));
             Ok(())

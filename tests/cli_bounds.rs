@@ -47,6 +47,7 @@ const NOT_NUMBERS: &[(&str, &str)] = &[
     ("train mill", "history"),
     ("train mill", "plots"),
     ("train curve", "plots"),
+    ("step", "out"),
 ];
 
 fn kerf() -> Command {
@@ -399,6 +400,7 @@ fn input_invocation(path: &str, id: &str, dir: &Path) -> Option<Vec<String>> {
             .map(String::from)
             .collect(),
         ("plan gcode", "file") => vec!["plan".into(), "gcode".into(), "{}".into()],
+        ("step", "points") => vec!["step".into(), "{}".into(), "--out".into(), out],
         _ => return None,
     };
     Some(v)

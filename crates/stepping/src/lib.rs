@@ -11,6 +11,9 @@
 //! | [`course`] | reference points as windows of ± precision | seed 002 Table 1 |
 //! | [`rpro`] | kerf's reading of RPRO: greedy decisions with a viability look-ahead | seed 002 §2.A, ref. [6] |
 //! | [`run`] | the per-period loop, passes, steps and accuracy | seed 002 §3 |
+//! | [`spline`] | natural cubic spline through N-D points over chord length, derivative bounds | de Boor 1978 ch. IV |
+//! | [`multi`] | stepping along 2D/3D and joint paths: path limits from the axis limits | chain rule |
+//! | [`points`] | reference points as text (1 to 6 coordinates per line) | |
 //! | [`database`] | the paths and limit grid of Table 1, the train/test split | seed 002 Table 1, §3 |
 
 pub mod course;
@@ -18,8 +21,11 @@ pub mod database;
 pub mod error;
 pub mod lattice;
 pub mod limits;
+pub mod multi;
+pub mod points;
 pub mod rpro;
 pub mod run;
+pub mod spline;
 pub mod tracker;
 
 pub use course::Course;
