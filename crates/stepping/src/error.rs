@@ -59,6 +59,15 @@ pub enum StepError {
         /// Number of points.
         points: usize,
     },
+    /// The Ruckig solver (module `ruckig_ref`) refused or failed a section
+    /// of the reference trajectory.
+    #[error("Ruckig reference, section {section} (toward point {}): {reason}", section + 1)]
+    Ruckig {
+        /// Index of the section (0 = from the start to point 1).
+        section: usize,
+        /// Ruckig's message or result code.
+        reason: String,
+    },
     /// A network file or a learned model cannot be used.
     #[error("network: {reason}")]
     Network {

@@ -13,6 +13,7 @@
 //! | [`run`] | the per-period loop, passes, steps and accuracy | seed 002 §3 |
 //! | [`spline`] | natural cubic spline through N-D points over chord length, derivative bounds | de Boor 1978 ch. IV |
 //! | [`multi`] | stepping along 2D/3D and joint paths: path limits from the axis limits | chain rule |
+//! | [`ruckig_ref`] | jerk-limited reference through the same points (rsruckig), steps and accuracy | Berscheid & Kröger 2021 |
 //! | [`points`] | reference points as text (1 to 6 coordinates per line) | |
 //! | [`database`] | the paths and limit grid of Table 1, the train/test split | seed 002 Table 1, §3 |
 
@@ -24,6 +25,7 @@ pub mod limits;
 pub mod multi;
 pub mod points;
 pub mod rpro;
+pub mod ruckig_ref;
 pub mod run;
 pub mod spline;
 pub mod tracker;

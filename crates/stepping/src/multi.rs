@@ -151,21 +151,19 @@ impl MultiCourse {
             let (sd, sdd) = (lat.velocity(*st), lat.acceleration(*st));
             let sddd = r.actions.get(k).map_or(0.0, |a| lat.jerk(a.sign()));
             self.spline.eval(s, &mut buf);
-            let d = self.spline.axes();
-            let mut sample = AxisSample {
+            let [x, d1, d2, d3] = &buf;
+            samples.push(AxisSample {
                 time: k as f64 * lat.period,
-                position: buf[0].clone(),
-                velocity: vec![0.0; d],
-                acceleration: vec![0.0; d],
-                jerk: vec![0.0; d],
-            };
-            for i in 0..d {
-                sample.velocity[i] = buf[1][i] * sd;
-                sample.acceleration[i] = buf[2][i] * sd * sd + buf[1][i] * sdd;
-                sample.jerk[i] =
-                    buf[3][i] * sd.powi(3) + 3.0 * buf[2][i] * sd * sdd + buf[1][i] * sddd;
-            }
-            samples.push(sample);
+                position: x.clone(),
+                velocity: d1.iter().map(|v| v * sd).collect(),
+                acceleration: d2.iter().zip(d1).map(|(c, v)| c * sd * sd + v * sdd).collect(),
+                jerk: d3
+                    .iter()
+                    .zip(d2)
+                    .zip(d1)
+                    .map(|((t, c), v)| t * sd.powi(3) + 3.0 * c * sd * sdd + v * sddd)
+                    .collect(),
+            });
         }
         let passes = r
             .passes

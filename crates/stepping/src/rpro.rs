@@ -23,20 +23,27 @@
 //! * **Viable** (the look-ahead): a state is viable for target `i` at depth
 //!   `d` when one of the *tails* from it passes the windows of
 //!   `i, …, i + d`, each by a tail that tracks one velocity level
-//!   ([`crate::tracker`]), and then reaches the window of `i + d + 1` no
+//!   ([`crate::tracker`]), and then falls back: it slows to a level no
 //!   faster than the crawl velocity (one at which no window can be stepped
-//!   over). For the last point a tail must instead come to rest inside its
-//!   window: it tracks its level and stops ([`crate::tracker::stop`]) at a
-//!   sample from which the stop ends in the window.
+//!   over) before the window of `i + d + 1`, and at that level comes to
+//!   rest inside the last point's window. For the last point a tail must
+//!   come to rest inside its window: it tracks its level and stops
+//!   ([`crate::tracker::stop`]) at a sample from which the stop ends in
+//!   the window.
 //!
 //! The velocity levels are geometric from the crawl velocity to the limit
-//! ([`RproSettings::levels`]), plus 0 for the last point.
+//! ([`RproSettings::levels`]), then halve below the crawl down to the
+//! lattice's smallest (a last point closer than the crawl's stopping
+//! distance needs a slower approach), plus 0 for the last point.
 //!
 //! # The guarantee
 //! A viable state has a viable successor: the first action of its witness
-//! tail. After a window is left behind, the witness's crawl to the next
-//! window is itself a tail at the crawl level, and a crawl reaches every
-//! later window, so the witness extends by one point. Hence from rest at
+//! tail. After a window is left behind, the witness's fallback is itself a
+//! tail at its level for the next window, and its continuation is the same
+//! fallback, so the witness extends by one point. (A first version fell
+//! back to the crawl for the next window only, assuming a crawl can always
+//! stop on the last point; 20 of the 1200 Table 1 processes of 15 points
+//! broke that, where the last point is closer than the crawl's stop.) Hence from rest at
 //! the start, if the start is viable, RPRO passes every point and stops on
 //! the last one; [`crate::error::StepError::NoViableAction`] would mean a
 //! defect, and the tests run it over the whole Table 1 grid.
@@ -144,6 +151,13 @@ impl Rpro {
                 (n & !1).clamp(course.crawl, course.lattice.max_n)
             })
             .collect();
+        // The ladder below the crawl (crawl/2, crawl/4, … ≥ 2): slow enough to stop on a last
+        // point closer than the crawl's stopping distance.
+        let mut below = course.crawl / 2;
+        while below >= 2 {
+            levels.push(below & !1);
+            below /= 2;
+        }
         levels.sort_unstable_by(|a, b| b.cmp(a));
         levels.dedup();
         Ok(Self {
@@ -280,25 +294,39 @@ impl Rpro {
         self.crawls_into(course, y, j)
     }
 
-    /// Whether the crawl tail from `y` reaches target `j` no faster than
-    /// the crawl velocity (the last point: comes to rest in its window).
+    /// The fallback after a sample `y` of the deepest look-ahead point: a
+    /// tail at a level no faster than the crawl that becomes crawl-safe
+    /// (it then passes every later window) before it leaves target `j`'s
+    /// window, and comes to rest inside the last point's window.
     fn crawls_into(&mut self, course: &Course, y: State, j: usize) -> bool {
+        let last = course.targets() - 1;
         let crawl = course.crawl;
-        if j + 1 == course.targets() {
-            return self.tail(course, y, j, crawl, 0);
+        let slow: Vec<i64> = self.levels.iter().copied().filter(|l| *l <= crawl).collect();
+        if j == last {
+            return slow
+                .iter()
+                .chain(std::iter::once(&0))
+                .any(|&l| self.tail(course, y, last, l, 0));
         }
         let hi = course.windows[j].1;
         let lat = course.lattice;
-        let mut s = y;
-        for _ in 0..TAIL_CAP {
-            if s.q > hi {
-                return false;
+        for level in slow {
+            let mut s = y;
+            let mut safe = false;
+            for _ in 0..TAIL_CAP {
+                if s.q > hi {
+                    break;
+                }
+                let settle = s.settled_velocity();
+                if s.n <= crawl && (0..=crawl).contains(&settle) {
+                    safe = true;
+                    break;
+                }
+                s = s.step(track(&lat, s, level));
             }
-            let settle = s.settled_velocity();
-            if s.n <= crawl && (0..=crawl).contains(&settle) {
+            if safe && self.tail(course, s, last, level, 0) {
                 return true;
             }
-            s = s.step(track(&lat, s, crawl));
         }
         false
     }

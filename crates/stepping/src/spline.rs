@@ -180,10 +180,11 @@ impl Spline {
         let (s0, s1) = (self.knots[k], self.knots[k + 1]);
         let h = s1 - s0;
         let (l, r) = (s1 - s, s - s0);
-        for axis in 0..self.axes() {
-            let (m0, m1) = (self.second[k][axis], self.second[k + 1][axis]);
-            let c0 = self.points[k][axis] / h - m0 * h / 6.0;
-            let c1 = self.points[k + 1][axis] / h - m1 * h / 6.0;
+        let ends = self.second[k].iter().zip(&self.second[k + 1]);
+        let values = self.points[k].iter().zip(&self.points[k + 1]);
+        for (axis, ((m0, m1), (x0, x1))) in ends.zip(values).enumerate() {
+            let c0 = x0 / h - m0 * h / 6.0;
+            let c1 = x1 / h - m1 * h / 6.0;
             out[0][axis] = m0 * l.powi(3) / (6.0 * h) + m1 * r.powi(3) / (6.0 * h) + c0 * l + c1 * r;
             out[1][axis] = -m0 * l * l / (2.0 * h) + m1 * r * r / (2.0 * h) - c0 + c1;
             out[2][axis] = (m0 * l + m1 * r) / h;
