@@ -16,7 +16,12 @@
 use std::{path::PathBuf, time::Instant};
 
 use clap::{Args, ValueEnum};
-use kerf_stepping::{multi::MultiCourse, points::parse_points, Limits, Rpro, RproSettings};
+use kerf_stepping::{
+    multi::{AxisSample, MultiCourse},
+    points::parse_points,
+    ruckig_ref::{reference, Method},
+    Limits, Rpro, RproSettings,
+};
 use serde::Serialize;
 
 use crate::{
@@ -35,6 +40,12 @@ const LIMITS: Triple = Triple {
     value: Real::above(0.0, 1e6, "SI"),
 };
 
+/// Reference points, one `Vec` of coordinates each.
+type Points = Vec<Vec<f64>>;
+
+/// Joint ranges `(min, max)`.
+type Ranges = Vec<(f64, f64)>;
+
 /// Periods a run may take before it is refused (10⁷: 5.6 h at 2 ms).
 const MAX_STEPS: usize = 10_000_000;
 
@@ -43,6 +54,9 @@ const MAX_STEPS: usize = 10_000_000;
 pub enum ControllerArg {
     /// kerf's reading of seed 002's RPRO (greedy jerk decisions with a viability look-ahead).
     Rpro,
+    /// The Ruckig reference: time-optimal jerk-limited sections through the points (rsruckig),
+    /// each ending on a sample; per-axis limits, no spline.
+    Ruckig,
 }
 
 /// Unit of the points' numbers.
@@ -132,25 +146,53 @@ pub fn run(args: StepArgs) -> Result<(), String> {
         }
     };
     let started = Instant::now();
-    let course = MultiCourse::new(points.clone(), &limits, args.precision, args.period)
-        .map_err(name_point)?;
-    let mut rpro = Rpro::new(
-        &course.course,
-        RproSettings::default().lookahead_points(args.lookahead),
-    )
-    .map_err(|e| e.to_string())?;
-    let result = course
-        .run(&mut rpro, MAX_STEPS)
-        .map_err(|e| format!("rpro: {e}"))?;
+    let outcome = match args.controller {
+        ControllerArg::Rpro => {
+            let course = MultiCourse::new(points.clone(), &limits, args.precision, args.period)
+                .map_err(name_point)?;
+            let mut rpro = Rpro::new(
+                &course.course,
+                RproSettings::default().lookahead_points(args.lookahead),
+            )
+            .map_err(|e| e.to_string())?;
+            let result = course
+                .run(&mut rpro, MAX_STEPS)
+                .map_err(|e| format!("rpro: {e}"))?;
+            Outcome {
+                passes: result
+                    .passes
+                    .iter()
+                    .map(|p| (p.point, p.step, p.error))
+                    .collect(),
+                samples: result.samples,
+                axis_limits: course.axis_limits.clone(),
+                path_limits: Some(course.course.lattice.limits),
+            }
+        }
+        ControllerArg::Ruckig => {
+            ruckig_outcome(&points, &limits, args.period).map_err(name_point)?
+        }
+    };
     let seconds = started.elapsed().as_secs_f64();
     if let Some(ranges) = &ranges {
-        check_ranges(ranges, &result.samples)?;
+        check_ranges(ranges, &outcome.samples)?;
     }
-    let micro = if args.joints.is_some() { "µrad" } else { "µm" };
-    let steps = result.run.steps();
+    let missed: Vec<usize> = outcome
+        .passes
+        .iter()
+        .filter(|(_, _, e)| *e > args.precision)
+        .map(|(p, _, _)| *p)
+        .collect();
+    let micro = if args.joints.is_some() {
+        "µrad"
+    } else {
+        "µm"
+    };
+    let steps = outcome.samples.len() - 1;
     let duration = steps as f64 * args.period;
-    let mean = result.passes.iter().map(|p| p.error).sum::<f64>() / result.passes.len() as f64;
-    let max = result.passes.iter().map(|p| p.error).fold(0.0, f64::max);
+    let count = outcome.passes.len().max(1) as f64;
+    let mean = outcome.passes.iter().map(|p| p.2).sum::<f64>() / count;
+    let max = outcome.passes.iter().map(|p| p.2).fold(0.0, f64::max);
     println!(
         "{}: {} points on {} axes, {steps} steps of {} s = {duration:.3} s; accuracy mean {:.2} \
          {micro}, max {:.2} {micro} (precision {} {micro}); planned in {:.3} s",
@@ -163,11 +205,15 @@ pub fn run(args: StepArgs) -> Result<(), String> {
         args.precision * 1e6,
         seconds
     );
-    let path = course.course.lattice.limits;
-    println!(
-        "path limits: {:.6} /s, {:.6} /s², {:.6} /s³ along the chord length",
-        path.velocity, path.acceleration, path.jerk
-    );
+    if let Some(path) = outcome.path_limits {
+        println!(
+            "path limits: {:.6} /s, {:.6} /s², {:.6} /s³ along the chord length",
+            path.velocity, path.acceleration, path.jerk
+        );
+    }
+    if !missed.is_empty() {
+        println!("points not passed within the precision: {missed:?}");
+    }
     println!(
         "{:>6} {:>8} {:>10} {:>12}",
         "point",
@@ -175,37 +221,36 @@ pub fn run(args: StepArgs) -> Result<(), String> {
         "time [s]",
         format!("error [{micro}]")
     );
-    for p in &result.passes {
+    for (point, step, error) in &outcome.passes {
         println!(
-            "{:>6} {:>8} {:>10.3} {:>12.3}",
-            p.point,
-            p.step,
-            p.step as f64 * args.period,
-            p.error * 1e6
+            "{point:>6} {step:>8} {:>10.3} {:>12.3}",
+            *step as f64 * args.period,
+            error * 1e6
         );
     }
     let doc = Document {
         controller: controller_name(args.controller),
         period: args.period,
         precision: args.precision,
-        axis_limits: course.axis_limits.clone(),
-        path_limits: path,
+        axis_limits: outcome.axis_limits.clone(),
+        path_limits: outcome.path_limits,
         steps,
         duration,
         mean_error: mean,
         max_error: max,
-        points: result
+        points: outcome
             .passes
             .iter()
-            .map(|p| PointDoc {
-                index: p.point,
-                position: points[p.point].clone(),
-                step: p.step,
-                time: p.step as f64 * args.period,
-                error: p.error,
+            .map(|&(index, step, error)| PointDoc {
+                index,
+                position: points[index].clone(),
+                step,
+                time: step as f64 * args.period,
+                error,
+                within_precision: error <= args.precision,
             })
             .collect(),
-        samples: &result.samples,
+        samples: &outcome.samples,
     };
     let json = serde_json::to_string(&doc).map_err(|e| format!("--out: {e}"))?;
     std::fs::write(&args.out, json)
@@ -217,6 +262,7 @@ pub fn run(args: StepArgs) -> Result<(), String> {
 fn controller_name(c: ControllerArg) -> &'static str {
     match c {
         ControllerArg::Rpro => "rpro",
+        ControllerArg::Ruckig => "ruckig",
     }
 }
 
@@ -227,13 +273,13 @@ struct Document<'a> {
     period: f64,
     precision: f64,
     axis_limits: Vec<Limits>,
-    path_limits: Limits,
+    path_limits: Option<Limits>,
     steps: usize,
     duration: f64,
     mean_error: f64,
     max_error: f64,
     points: Vec<PointDoc>,
-    samples: &'a [kerf_stepping::multi::AxisSample],
+    samples: &'a [AxisSample],
 }
 
 /// One point of `--out`: where it is, and the step that passed it.
@@ -244,11 +290,67 @@ struct PointDoc {
     step: usize,
     time: f64,
     error: f64,
+    within_precision: bool,
+}
+
+/// What a controller produced: samples in axis space and each point's closest sample.
+struct Outcome {
+    samples: Vec<AxisSample>,
+    /// (point, step, distance), points 1.. in order.
+    passes: Vec<(usize, usize, f64)>,
+    axis_limits: Vec<Limits>,
+    /// The path-parameter limits (RPRO along the spline).
+    path_limits: Option<Limits>,
+}
+
+/// The Ruckig reference through `points` as an [`Outcome`]: jerk per period from the
+/// accelerations' differences (the mean jerk over the period).
+fn ruckig_outcome(
+    points: &[Vec<f64>],
+    limits: &[Limits],
+    period: f64,
+) -> Result<Outcome, kerf_stepping::StepError> {
+    let dim = points[0].len();
+    let axis_limits: Vec<Limits> = if limits.len() == 1 {
+        vec![limits[0]; dim]
+    } else {
+        limits.to_vec()
+    };
+    let r = reference(points, &axis_limits, period, Method::default())?;
+    let n = r.samples();
+    let samples = (0..n)
+        .map(|k| AxisSample {
+            time: k as f64 * period,
+            position: r.position(k).to_vec(),
+            velocity: r.velocity(k).to_vec(),
+            acceleration: r.acceleration(k).to_vec(),
+            jerk: if k + 1 < n {
+                r.acceleration(k + 1)
+                    .iter()
+                    .zip(r.acceleration(k))
+                    .map(|(b, a)| (b - a) / period)
+                    .collect()
+            } else {
+                vec![0.0; dim]
+            },
+        })
+        .collect();
+    Ok(Outcome {
+        samples,
+        passes: r
+            .hits
+            .iter()
+            .filter(|h| h.point > 0)
+            .map(|h| (h.point, h.step, h.distance))
+            .collect(),
+        axis_limits,
+        path_limits: None,
+    })
 }
 
 /// A G-code program's points: the start, then every move's end point (arcs divided so that
 /// no chord leaves the arc by more than `precision / 2`), and each point's source line.
-fn gcode_points(text: &str, precision: f64) -> Result<(Vec<Vec<f64>>, Option<Vec<usize>>), String> {
+fn gcode_points(text: &str, precision: f64) -> Result<(Points, Option<Vec<usize>>), String> {
     use kerf_gcode::{read_program, Motion, ReaderSettings};
     let motions = read_program(text, ReaderSettings::default()).map_err(|e| e.to_string())?;
     let mut points: Vec<Vec<f64>> = Vec::new();
@@ -256,7 +358,10 @@ fn gcode_points(text: &str, precision: f64) -> Result<(Vec<Vec<f64>>, Option<Vec
     let mut zero_length = 0usize;
     let mut push = |p: [f64; 3], line: usize, points: &mut Vec<Vec<f64>>| {
         // A move to where the machine already is has no point of its own to pass.
-        if points.last().is_some_and(|last: &Vec<f64>| last.as_slice() == p.as_slice()) {
+        if points
+            .last()
+            .is_some_and(|last: &Vec<f64>| last.as_slice() == p.as_slice())
+        {
             zero_length += 1;
             return;
         }
@@ -265,7 +370,10 @@ fn gcode_points(text: &str, precision: f64) -> Result<(Vec<Vec<f64>>, Option<Vec
     };
     for m in &motions {
         match m {
-            Motion::Rapid { start, end, line } | Motion::Line { start, end, line, .. } => {
+            Motion::Rapid { start, end, line }
+            | Motion::Line {
+                start, end, line, ..
+            } => {
                 if points.is_empty() {
                     push(*start, *line, &mut points);
                 }
@@ -304,18 +412,24 @@ fn gcode_points(text: &str, precision: f64) -> Result<(Vec<Vec<f64>>, Option<Vec
 fn joint_limits(
     robot: Robot,
     points: &[Vec<f64>],
-) -> Result<(Vec<Limits>, Option<Vec<(f64, f64)>>), String> {
+) -> Result<(Vec<Limits>, Option<Ranges>), String> {
     let model = robot.model()?;
     let joints = model.joints();
     let mut limits = Vec::with_capacity(joints.len());
     let mut ranges = Vec::with_capacity(joints.len());
     for j in joints {
         let a = j.max_acceleration.ok_or_else(|| {
-            format!("--joints: joint {} has no acceleration limit in its limits file", j.name)
+            format!(
+                "--joints: joint {} has no acceleration limit in its limits file",
+                j.name
+            )
         })?;
-        let jerk = j
-            .max_jerk
-            .ok_or_else(|| format!("--joints: joint {} has no jerk limit in its limits file", j.name))?;
+        let jerk = j.max_jerk.ok_or_else(|| {
+            format!(
+                "--joints: joint {} has no jerk limit in its limits file",
+                j.name
+            )
+        })?;
         limits.push(Limits::new(j.max_velocity, a, jerk));
         ranges.push((j.min_position, j.max_position));
     }
@@ -342,10 +456,7 @@ fn joint_limits(
 
 /// Refuses a trajectory whose samples leave a joint range (the path between two points may
 /// bulge beyond them).
-fn check_ranges(
-    ranges: &[(f64, f64)],
-    samples: &[kerf_stepping::multi::AxisSample],
-) -> Result<(), String> {
+fn check_ranges(ranges: &[(f64, f64)], samples: &[AxisSample]) -> Result<(), String> {
     for (k, s) in samples.iter().enumerate() {
         for (j, (q, (lo, hi))) in s.position.iter().zip(ranges).enumerate() {
             if q < lo || q > hi {

@@ -35,7 +35,8 @@ fn text(o: &Output) -> String {
 /// Every sample's per-axis finite differences within `limits` (v, a, j), each point of
 /// `points` passed within `precision` by a sample, rest on the last.
 fn judge(json: &Path, points: &[Vec<f64>], limits: &[[f64; 3]], precision: f64) -> usize {
-    let doc: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(json).unwrap()).unwrap();
+    let doc: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(json).unwrap()).unwrap();
     let period = doc["period"].as_f64().unwrap();
     let x: Vec<Vec<f64>> = doc["samples"]
         .as_array()
@@ -51,7 +52,11 @@ fn judge(json: &Path, points: &[Vec<f64>], limits: &[[f64; 3]], precision: f64) 
         })
         .collect();
     let dist = |a: &[f64], b: &[f64]| -> f64 {
-        a.iter().zip(b).map(|(p, q)| (p - q).powi(2)).sum::<f64>().sqrt()
+        a.iter()
+            .zip(b)
+            .map(|(p, q)| (p - q).powi(2))
+            .sum::<f64>()
+            .sqrt()
     };
     for (k, p) in points.iter().enumerate().skip(1) {
         let best = x.iter().map(|s| dist(s, p)).fold(f64::INFINITY, f64::min);
@@ -78,8 +83,11 @@ fn judge(json: &Path, points: &[Vec<f64>], limits: &[[f64; 3]], precision: f64) 
 }
 
 fn read_points(file: &str, scale: f64) -> Vec<Vec<f64>> {
-    kerf_stepping::points::parse_points(&std::fs::read_to_string(Path::new(ROOT).join(file)).unwrap(), scale)
-        .unwrap()
+    kerf_stepping::points::parse_points(
+        &std::fs::read_to_string(Path::new(ROOT).join(file)).unwrap(),
+        scale,
+    )
+    .unwrap()
 }
 
 /// The README's `kerf step` examples (`cargo run --release -- step …`), as written.
@@ -99,14 +107,22 @@ fn readme_examples() -> Vec<Vec<String>> {
 #[test]
 fn the_readme_examples_run_as_written_and_their_trajectories_hold() {
     let examples = readme_examples();
-    assert!(examples.len() >= 3, "README has {} kerf step examples", examples.len());
+    assert!(
+        examples.len() >= 3,
+        "README has {} kerf step examples",
+        examples.len()
+    );
     for args in &examples {
         let refs: Vec<&str> = args.iter().map(String::as_str).collect();
         let o = kerf(&refs);
         assert!(o.status.success(), "{args:?}: {}", text(&o));
         let out = &args[args.iter().position(|a| a == "--out").unwrap() + 1];
         let file = &args[1];
-        let scale = if args.iter().any(|a| a == "mm") { 1e-3 } else { 1.0 };
+        let scale = if args.iter().any(|a| a == "mm") {
+            1e-3
+        } else {
+            1.0
+        };
         let points = read_points(file, scale);
         let precision = args
             .iter()
@@ -121,16 +137,23 @@ fn the_readme_examples_run_as_written_and_their_trajectories_hold() {
             model
                 .joints()
                 .iter()
-                .map(|j| [j.max_velocity, j.max_acceleration.unwrap(), j.max_jerk.unwrap()])
+                .map(|j| {
+                    [
+                        j.max_velocity,
+                        j.max_acceleration.unwrap(),
+                        j.max_jerk.unwrap(),
+                    ]
+                })
                 .collect()
         } else {
-            let l = args
-                .iter()
-                .position(|a| a == "--limits")
-                .map_or([8.0 / 60.0, 3.0, 30.0], |k| {
-                    let v: Vec<f64> = args[k + 1].split(',').map(|x| x.parse().unwrap()).collect();
-                    [v[0], v[1], v[2]]
-                });
+            let l =
+                args.iter()
+                    .position(|a| a == "--limits")
+                    .map_or([8.0 / 60.0, 3.0, 30.0], |k| {
+                        let v: Vec<f64> =
+                            args[k + 1].split(',').map(|x| x.parse().unwrap()).collect();
+                        [v[0], v[1], v[2]]
+                    });
             vec![l; points[0].len()]
         };
         let steps = judge(Path::new(out), &points, &limits, precision);
@@ -141,12 +164,27 @@ fn the_readme_examples_run_as_written_and_their_trajectories_hold() {
 #[test]
 fn a_gcode_programs_points_are_stepped() {
     let program = temp("square.nc");
-    std::fs::write(&program, "G21 G90\nG0 X0 Y0\nG1 X5 F600\nG3 X10 Y5 I0 J5\nG1 Y8\nM2\n").unwrap();
+    std::fs::write(
+        &program,
+        "G21 G90\nG0 X0 Y0\nG1 X5 F600\nG3 X10 Y5 I0 J5\nG1 Y8\nM2\n",
+    )
+    .unwrap();
     let out = temp("square.json");
-    let o = kerf(&["step", program.to_str().unwrap(), "--gcode", "--out", out.to_str().unwrap()]);
+    let o = kerf(&[
+        "step",
+        program.to_str().unwrap(),
+        "--gcode",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
     assert!(o.status.success(), "{}", text(&o));
-    assert!(text(&o).contains("1 move(s) of zero length"), "{}", text(&o));
-    let doc: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&out).unwrap()).unwrap();
+    assert!(
+        text(&o).contains("1 move(s) of zero length"),
+        "{}",
+        text(&o)
+    );
+    let doc: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&out).unwrap()).unwrap();
     let last = doc["samples"].as_array().unwrap().last().unwrap()["position"].clone();
     let end = [0.010, 0.008, 0.0];
     for k in 0..3 {
@@ -162,16 +200,29 @@ fn bad_points_are_refused_naming_the_problem() {
         ("0\n", &[], "a start and at least one point"),
         ("0\n1\n", &["--precision", "0"], "--precision"),
         ("0\n1\n", &["--precision", "-1e-5"], "--precision"),
-        ("0 -0.2 0.3 0 0.4 0\n0 -0.2 9 0 0.4 0\n", &["--joints", "irb6660"], "out of reach"),
+        (
+            "0 -0.2 0.3 0 0.4 0\n0 -0.2 9 0 0.4 0\n",
+            &["--joints", "irb6660"],
+            "out of reach",
+        ),
     ];
     for (k, (points, extra, want)) in cases.iter().enumerate() {
         let file = temp(&format!("bad{k}.txt"));
         std::fs::write(&file, points).unwrap();
         let out = temp("bad.json");
-        let mut args = vec!["step", file.to_str().unwrap(), "--out", out.to_str().unwrap()];
+        let mut args = vec![
+            "step",
+            file.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+        ];
         args.extend_from_slice(extra);
         let o = kerf(&args);
         assert_eq!(o.status.code(), Some(2), "{points:?}: {}", text(&o));
-        assert!(text(&o).contains(want), "{points:?}: want {want:?} in {}", text(&o));
+        assert!(
+            text(&o).contains(want),
+            "{points:?}: want {want:?} in {}",
+            text(&o)
+        );
     }
 }

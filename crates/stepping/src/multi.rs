@@ -156,7 +156,11 @@ impl MultiCourse {
                 time: k as f64 * lat.period,
                 position: x.clone(),
                 velocity: d1.iter().map(|v| v * sd).collect(),
-                acceleration: d2.iter().zip(d1).map(|(c, v)| c * sd * sd + v * sdd).collect(),
+                acceleration: d2
+                    .iter()
+                    .zip(d1)
+                    .map(|(c, v)| c * sd * sd + v * sdd)
+                    .collect(),
                 jerk: d3
                     .iter()
                     .zip(d2)

@@ -301,7 +301,12 @@ impl Rpro {
     fn crawls_into(&mut self, course: &Course, y: State, j: usize) -> bool {
         let last = course.targets() - 1;
         let crawl = course.crawl;
-        let slow: Vec<i64> = self.levels.iter().copied().filter(|l| *l <= crawl).collect();
+        let slow: Vec<i64> = self
+            .levels
+            .iter()
+            .copied()
+            .filter(|l| *l <= crawl)
+            .collect();
         if j == last {
             return slow
                 .iter()

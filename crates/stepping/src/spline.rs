@@ -185,7 +185,8 @@ impl Spline {
         for (axis, ((m0, m1), (x0, x1))) in ends.zip(values).enumerate() {
             let c0 = x0 / h - m0 * h / 6.0;
             let c1 = x1 / h - m1 * h / 6.0;
-            out[0][axis] = m0 * l.powi(3) / (6.0 * h) + m1 * r.powi(3) / (6.0 * h) + c0 * l + c1 * r;
+            out[0][axis] =
+                m0 * l.powi(3) / (6.0 * h) + m1 * r.powi(3) / (6.0 * h) + c0 * l + c1 * r;
             out[1][axis] = -m0 * l * l / (2.0 * h) + m1 * r * r / (2.0 * h) - c0 + c1;
             out[2][axis] = (m0 * l + m1 * r) / h;
             out[3][axis] = (m1 - m0) / h;
@@ -233,7 +234,11 @@ fn natural_second_derivatives(knots: &[f64], points: &[Vec<f64>], dim: usize) ->
         }
         let mut x = vec![0.0; inner];
         for j in (0..inner).rev() {
-            let next = if j + 1 < inner { upper[j] * x[j + 1] } else { 0.0 };
+            let next = if j + 1 < inner {
+                upper[j] * x[j + 1]
+            } else {
+                0.0
+            };
             x[j] = (rhs[j] - next) / diag[j];
         }
         for j in 0..inner {
@@ -261,7 +266,12 @@ mod tests {
 
     #[test]
     fn the_spline_interpolates_and_its_derivatives_match_differences() {
-        let pts = vec![vec![0.0, 0.0], vec![1.0, 0.5], vec![2.0, -0.3], vec![2.5, 1.0]];
+        let pts = vec![
+            vec![0.0, 0.0],
+            vec![1.0, 0.5],
+            vec![2.0, -0.3],
+            vec![2.5, 1.0],
+        ];
         let s = Spline::new(pts.clone(), 1e-5).unwrap();
         let mut b = s.buffer();
         for (k, p) in pts.iter().enumerate() {

@@ -16,16 +16,36 @@ fn judge(points: Vec<Vec<f64>>, limits: &[Limits], precision: f64) -> usize {
     for (k, p) in points.iter().enumerate().skip(1) {
         let best = x
             .iter()
-            .map(|s| s.iter().zip(p).map(|(a, b)| (a - b).powi(2)).sum::<f64>().sqrt())
+            .map(|s| {
+                s.iter()
+                    .zip(p)
+                    .map(|(a, b)| (a - b).powi(2))
+                    .sum::<f64>()
+                    .sqrt()
+            })
             .fold(f64::INFINITY, f64::min);
         assert!(best <= precision * (1.0 + 1e-9), "point {k}: {best}");
     }
     let end = x.last().unwrap();
     let last = points.last().unwrap();
-    let d: f64 = end.iter().zip(last).map(|(a, b)| (a - b).powi(2)).sum::<f64>().sqrt();
-    assert!(d <= precision * (1.0 + 1e-9), "rest {d} from the last point");
+    let d: f64 = end
+        .iter()
+        .zip(last)
+        .map(|(a, b)| (a - b).powi(2))
+        .sum::<f64>()
+        .sqrt();
+    assert!(
+        d <= precision * (1.0 + 1e-9),
+        "rest {d} from the last point"
+    );
     let dim = points[0].len();
-    let lim = |i: usize| if limits.len() == 1 { limits[0] } else { limits[i] };
+    let lim = |i: usize| {
+        if limits.len() == 1 {
+            limits[0]
+        } else {
+            limits[i]
+        }
+    };
     for i in 0..dim {
         let l = lim(i);
         for w in x.windows(4) {
@@ -33,7 +53,10 @@ fn judge(points: Vec<Vec<f64>>, limits: &[Limits], precision: f64) -> usize {
             let a = (w[2][i] - 2.0 * w[1][i] + w[0][i]) / period.powi(2);
             let j = (w[3][i] - 3.0 * w[2][i] + 3.0 * w[1][i] - w[0][i]) / period.powi(3);
             assert!(v.abs() <= l.velocity * (1.0 + 1e-6), "axis {i}: v {v}");
-            assert!(a.abs() <= l.acceleration * (1.0 + 1e-6) + 1e-9, "axis {i}: a {a}");
+            assert!(
+                a.abs() <= l.acceleration * (1.0 + 1e-6) + 1e-9,
+                "axis {i}: a {a}"
+            );
             assert!(j.abs() <= l.jerk * (1.0 + 1e-6) + 1e-6, "axis {i}: j {j}");
         }
         assert!(r.samples[0].velocity[i] == 0.0);
@@ -87,15 +110,19 @@ fn a_joint_path_of_six_axes_is_stepped() {
 
 #[test]
 fn one_increasing_axis_is_the_papers_course_exactly() {
-    let pts: Vec<Vec<f64>> = kerf_stepping::database::path(15, kerf_stepping::database::Density::High, 2)
-        .into_iter()
-        .map(|p| vec![p])
-        .collect();
+    let pts: Vec<Vec<f64>> =
+        kerf_stepping::database::path(15, kerf_stepping::database::Density::High, 2)
+            .into_iter()
+            .map(|p| vec![p])
+            .collect();
     let l = Limits::new(0.1, 2.0, 20.0);
     let mc = MultiCourse::new(pts, &[l], 1e-5, 0.002).unwrap();
     // The same lattice as the single axis (the limits agree to rounding).
     let lat = kerf_stepping::Lattice::new(l, 0.002).unwrap();
-    assert_eq!((mc.course.lattice.max_n, mc.course.lattice.max_m), (lat.max_n, lat.max_m));
+    assert_eq!(
+        (mc.course.lattice.max_n, mc.course.lattice.max_m),
+        (lat.max_n, lat.max_m)
+    );
     assert!((mc.course.lattice.unit_p / lat.unit_p - 1.0).abs() < 1e-12);
     assert!((mc.course.precision - 1e-5).abs() < 1e-15);
 }
