@@ -166,7 +166,10 @@ impl Triple {
         }
         let mut p = [0.0; 3];
         for (k, (part, name)) in parts.iter().zip(self.names).enumerate() {
-            p[k] = self.value.check(part).map_err(|why| format!("{name}: {why}"))?;
+            p[k] = self
+                .value
+                .check(part)
+                .map_err(|why| format!("{name}: {why}"))?;
         }
         Ok(p)
     }
