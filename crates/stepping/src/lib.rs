@@ -15,6 +15,7 @@
 //! | [`multi`] | stepping along 2D/3D and joint paths: path limits from the axis limits | chain rule |
 //! | [`ruckig_ref`] | jerk-limited reference through the same points (rsruckig), steps and accuracy | Berscheid & Kröger 2021 |
 //! | [`points`] | reference points as text (1 to 6 coordinates per line) | |
+//! | [`stream`] | the executor's streaming mode: rules, batches from rest to rest | issue 29 |
 //! | [`database`] | the paths and limit grid of Table 1, the train/test split | seed 002 Table 1, §3 |
 
 pub mod course;
@@ -28,6 +29,7 @@ pub mod rpro;
 pub mod ruckig_ref;
 pub mod run;
 pub mod spline;
+pub mod stream;
 pub mod tracker;
 
 pub use course::Course;
