@@ -6,7 +6,9 @@ use std::time::{Duration, Instant};
 use kerf_msgs::{
     control_msgs::JointTrajectoryControllerState,
     geometry_msgs,
-    msg::{CutPlan, CutRequest, MillPlan, MillRequest, TrajectoryStatus},
+    msg::{
+        CutPlan, CutRequest, MillPlan, MillRequest, ReferencePoint, StreamStatus, TrajectoryStatus,
+    },
     sensor_msgs::JointState,
     std_msgs,
     trajectory_msgs::JointTrajectory,
@@ -25,6 +27,8 @@ pub const TYPES: &[&str] = &[
     CutPlan::ROS_TYPE,
     MillRequest::ROS_TYPE,
     MillPlan::ROS_TYPE,
+    ReferencePoint::ROS_TYPE,
+    StreamStatus::ROS_TYPE,
     std_msgs::StringMsg::ROS_TYPE,
     std_msgs::Header::ROS_TYPE,
     geometry_msgs::Pose::ROS_TYPE,
@@ -59,6 +63,8 @@ pub fn dispatch<F: ForType>(ros_type: &str, f: F) -> Result<F::Out, String> {
         _ if t == CutPlan::ROS_TYPE => f.run::<CutPlan>(t),
         _ if t == MillRequest::ROS_TYPE => f.run::<MillRequest>(t),
         _ if t == MillPlan::ROS_TYPE => f.run::<MillPlan>(t),
+        _ if t == ReferencePoint::ROS_TYPE => f.run::<ReferencePoint>(t),
+        _ if t == StreamStatus::ROS_TYPE => f.run::<StreamStatus>(t),
         _ if t == std_msgs::StringMsg::ROS_TYPE => f.run::<std_msgs::StringMsg>(t),
         _ if t == std_msgs::Header::ROS_TYPE => f.run::<std_msgs::Header>(t),
         _ if t == geometry_msgs::Pose::ROS_TYPE => f.run::<geometry_msgs::Pose>(t),

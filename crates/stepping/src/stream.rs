@@ -150,7 +150,7 @@ pub struct Stream {
     limits: Vec<Limits>,
     ranges: Vec<(f64, f64)>,
     settings: StreamSettings,
-    /// Where the robot rests: the stream's start, then each batch's end.
+    /// Where the robot rests: the stream's start, then each batch's last sample.
     anchor: Option<Vec<f64>>,
     /// The last point accepted (queued or the anchor).
     last: Option<Vec<f64>>,
@@ -294,7 +294,9 @@ impl Stream {
         let ids: Vec<u32> = points.iter().map(|p| p.id).collect();
         match self.plan(&anchor, &points, make) {
             Ok(batch) => {
-                self.anchor = points.last().map(|p| p.positions.clone());
+                // The robot rests where the batch's last sample is (within the precision of
+                // the last point), and the next batch starts there, not on the point.
+                self.anchor = batch.samples.last().map(|s| s.position.clone());
                 Some(Ok(batch))
             }
             Err(e) => {
@@ -411,7 +413,7 @@ mod tests {
         s.push(point(3, [0.12, 0.05])).unwrap();
         let b2 = s.take_batch(&rpro).unwrap().unwrap();
         assert_eq!(b2.number, 2);
-        assert!(distance(&b2.samples[0].position, &[0.1, 0.03]) < 1e-12);
+        assert!(distance(&b2.samples[0].position, &last.position) < 1e-12);
     }
 
     #[test]

@@ -47,12 +47,13 @@ fn check(points: &[Vec<f64>], limits: &[Limits], method: Method, max_miss: f64) 
     // Start and end at rest, on the first and last point.
     let last = r.samples() - 1;
     assert_eq!(r.position(0), &points[0][..]);
-    for j in 0..axes {
+    let end = &points[points.len() - 1];
+    for (j, goal) in end.iter().enumerate().take(axes) {
         assert_eq!(r.velocity(0)[j], 0.0);
         assert_eq!(r.acceleration(0)[j], 0.0);
         assert!(r.velocity(last)[j].abs() < 1e-9, "{method:?} end v");
         assert!(r.acceleration(last)[j].abs() < 1e-9, "{method:?} end a");
-        assert!((r.position(last)[j] - points[points.len() - 1][j]).abs() < 1e-8);
+        assert!((r.position(last)[j] - goal).abs() < 1e-8);
     }
     // Passes every point, in order.
     for (k, h) in r.hits.iter().enumerate() {

@@ -2,7 +2,8 @@
 //! [`TrajectoryStatus`], the MJTO planner's [`CutRequest`] / [`CutPlan`] (with [`CutRto`], [`CutFeedLimit`],
 //! [`CutMetrics`], [`CutCollision`]) and the milling planner's [`MillRequest`] / [`MillPlan`]
 //! (with [`MillSegment`], [`MillCandidate`]) and the G-code planner's [`GcodeRequest`] / [`GcodePlan`] (with
-//! [`GcodeToolEvent`]), and the simulated cell's [`CellContacts`] (with [`CellContact`]).
+//! [`GcodeToolEvent`]), the simulated cell's [`CellContacts`] (with [`CellContact`]), and the
+//! executor's stream of [`ReferencePoint`]s answered by [`StreamStatus`].
 
 use serde::{Deserialize, Serialize};
 
@@ -21,8 +22,8 @@ pub struct TrajectoryStatus {
     pub header: Header,
     /// `header.stamp` of the trajectory this status refers to (zero if it had none).
     pub trajectory_stamp: Time,
-    /// Where the trajectory came from: [`SOURCE_TOPIC`](Self::SOURCE_TOPIC) or
-    /// [`SOURCE_ACTION`](Self::SOURCE_ACTION).
+    /// Where the trajectory came from: [`SOURCE_TOPIC`](Self::SOURCE_TOPIC),
+    /// [`SOURCE_ACTION`](Self::SOURCE_ACTION) or [`SOURCE_STREAM`](Self::SOURCE_STREAM).
     pub source: String,
     /// Action goal id as 32 lowercase hex digits; empty for the topic input.
     pub goal_id: String,
@@ -55,6 +56,9 @@ impl TrajectoryStatus {
     pub const SOURCE_TOPIC: &'static str = "topic";
     /// Value of `source` for the action input. Not an IDL constant.
     pub const SOURCE_ACTION: &'static str = "action";
+    /// Value of `source` for a batch of the reference-point stream (`~/reference_points`).
+    /// Not an IDL constant.
+    pub const SOURCE_STREAM: &'static str = "stream";
 
     /// Name of a status value (`"ACCEPTED"` …), or `None` for an unknown value.
     pub fn status_name(status: u8) -> Option<&'static str> {
@@ -65,6 +69,74 @@ impl TrajectoryStatus {
             Self::ABORTED => Some("ABORTED"),
             Self::PREEMPTED => Some("PREEMPTED"),
             Self::CANCELED => Some("CANCELED"),
+            _ => None,
+        }
+    }
+}
+
+/// `kerf_msgs/msg/ReferencePoint`: one reference point of a stream, sent by a cell
+/// controller to the trajectory executor's `~/reference_points` topic while the robot moves
+/// (issue 29); answered by [`StreamStatus`] on `~/stream_status`. SI units: rad or m.
+#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
+pub struct ReferencePoint {
+    /// `header.stamp`: when the point was sent (informational; the point is used on receipt).
+    pub header: Header,
+    /// The sender's id of the point, echoed in every [`StreamStatus`] about it.
+    pub id: u32,
+    /// Joint names of `positions`: empty means the robot's joint order; otherwise a
+    /// permutation naming every joint of the robot exactly once.
+    pub joint_names: Vec<String>,
+    /// One position per joint (rad or m).
+    pub positions: Vec<f64>,
+    /// How close the robot must pass (> 0 and ≤ 1; Euclidean over the joints, rad or m).
+    pub precision: f64,
+}
+impl_ros_type!(ReferencePoint, "kerf_msgs", msg, "ReferencePoint");
+
+/// `kerf_msgs/msg/StreamStatus`: what the trajectory executor did with one
+/// [`ReferencePoint`] of a stream, published on `~/stream_status` (issue 29).
+#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
+pub struct StreamStatus {
+    /// `header.stamp`: when this status was produced (executor clock).
+    pub header: Header,
+    /// The id of the point ([`ReferencePoint::id`]).
+    pub id: u32,
+    /// One of the status constants ([`START`](Self::START) …).
+    pub status: u8,
+    /// The batch of the stream the point belongs to (1 = the first); 0 when it is in none.
+    pub batch: u64,
+    /// [`REACHED`](Self::REACHED): distance of the sample that passed the point to it (rad or
+    /// m, Euclidean over the joints); 0 otherwise.
+    pub error: f64,
+    /// [`REACHED`](Self::REACHED): when that sample was commanded, from the start of its
+    /// batch (s); 0 otherwise.
+    pub time_from_batch_start: f64,
+    /// Human-readable reason (refused, not reached) or note; empty when there is nothing to
+    /// report.
+    pub message: String,
+}
+impl_ros_type!(StreamStatus, "kerf_msgs", msg, "StreamStatus");
+
+impl StreamStatus {
+    /// The point starts a stream: the robot is there.
+    pub const START: u8 = 1;
+    /// The point waits for the next batch of the stream.
+    pub const QUEUED: u8 = 2;
+    /// The point was refused and changed nothing; `message` says why.
+    pub const REFUSED: u8 = 3;
+    /// The robot passed the point within its precision; `error` says how close.
+    pub const REACHED: u8 = 4;
+    /// The point will not be reached; `message` says why.
+    pub const NOT_REACHED: u8 = 5;
+
+    /// Name of a status value (`"START"` …), or `None` for an unknown value.
+    pub fn status_name(status: u8) -> Option<&'static str> {
+        match status {
+            Self::START => Some("START"),
+            Self::QUEUED => Some("QUEUED"),
+            Self::REFUSED => Some("REFUSED"),
+            Self::REACHED => Some("REACHED"),
+            Self::NOT_REACHED => Some("NOT_REACHED"),
             _ => None,
         }
     }

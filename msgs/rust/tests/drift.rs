@@ -193,6 +193,8 @@ fn all_mirrors() -> Vec<Mirror> {
         control_msgs::FollowJointTrajectoryResult,
         control_msgs::FollowJointTrajectoryFeedback,
         msg::TrajectoryStatus,
+        msg::ReferencePoint,
+        msg::StreamStatus,
         msg::CellContact,
         msg::CellContacts,
         msg::CutFeedLimit,
@@ -475,6 +477,16 @@ fn rust_constants() -> ConstantTable {
             ],
         ),
         (
+            msg::StreamStatus::ROS_TYPE,
+            vec![
+                c_u8("START", msg::StreamStatus::START),
+                c_u8("QUEUED", msg::StreamStatus::QUEUED),
+                c_u8("REFUSED", msg::StreamStatus::REFUSED),
+                c_u8("REACHED", msg::StreamStatus::REACHED),
+                c_u8("NOT_REACHED", msg::StreamStatus::NOT_REACHED),
+            ],
+        ),
+        (
             msg::CutRequest::ROS_TYPE,
             vec![
                 c_str("START_CURRENT", msg::CutRequest::START_CURRENT),
@@ -682,7 +694,7 @@ fn every_mirror_matches_its_interface_file() {
         "mirror drift:\n{}",
         problems.join("\n")
     );
-    assert_eq!(mirrors.len(), 53, "every mirror is checked");
+    assert_eq!(mirrors.len(), 55, "every mirror is checked");
 }
 
 #[test]
@@ -742,6 +754,8 @@ fn ros_types_name_their_files() {
     check::<msg::MillSegment>();
     check::<msg::MillCandidate>();
     check::<msg::MillPlan>();
+    check::<msg::ReferencePoint>();
+    check::<msg::StreamStatus>();
     check::<action::PlanCutGoal>();
     check::<action::PlanCutResult>();
     check::<action::PlanMillFeedback>();
@@ -1012,5 +1026,5 @@ fn rust_parser_agrees_with_rosidl() {
             mine["file"]
         );
     }
-    assert_eq!(ours.len(), 44, "every interface file is compared");
+    assert_eq!(ours.len(), 46, "every interface file is compared");
 }

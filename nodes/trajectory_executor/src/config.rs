@@ -23,6 +23,9 @@ pub const KNOWN_PARAMS: &[&str] = &[
     "sim_physics_rate",
     "constraints.*",
     "hardware.*",
+    "stream.queue",
+    "stream.max_jump",
+    "stream.lookahead",
 ];
 
 /// Default `hardware.command_topic`: the command topic of ros2_control's
@@ -106,6 +109,32 @@ pub enum DriverConfig {
     Jtc(JtcConfig),
 }
 
+/// Default `stream.queue`: reference points that may wait for a batch.
+pub const DEFAULT_STREAM_QUEUE: i64 = 256;
+
+/// Largest `stream.queue`: one batch plans every waiting point on the request thread.
+pub const MAX_STREAM_QUEUE: i64 = 10_000;
+
+/// Default `stream.max_jump` (rad or m): the largest move of a joint between two points.
+pub const DEFAULT_STREAM_MAX_JUMP: f64 = 0.5;
+
+/// Default `stream.lookahead`: points RPRO looks ahead at a velocity level.
+pub const DEFAULT_STREAM_LOOKAHEAD: i64 = 1;
+
+/// Largest `stream.lookahead` (`kerf_stepping::RproSettings`' bound).
+pub const MAX_STREAM_LOOKAHEAD: i64 = 8;
+
+/// The streaming mode's settings (`stream.*`, [`crate::stream`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct StreamConfig {
+    /// Most points waiting for a batch (`stream.queue`); more are refused.
+    pub queue: usize,
+    /// Largest move of any joint from one point to the next (`stream.max_jump`, rad or m).
+    pub max_jump: f64,
+    /// RPRO's look-ahead in points (`stream.lookahead`).
+    pub lookahead: usize,
+}
+
 /// The simulated cell's settings (`hardware: sim`).
 #[derive(Debug, Clone, PartialEq)]
 pub struct SimConfig {
@@ -142,6 +171,8 @@ pub struct NodeConfig {
     pub sim: Option<SimConfig>,
     /// A real robot's driver (`hardware: topic` or `jtc`); `None` otherwise.
     pub driver: Option<DriverConfig>,
+    /// The streaming mode (`stream.*`).
+    pub stream: StreamConfig,
 }
 
 fn param_err(name: &str, reason: String) -> NodeError {
@@ -218,6 +249,12 @@ impl NodeConfig {
     ///   `robot.initial_positions`.
     /// * `realtime_priority` (0 = normal scheduling, 1–99 = `SCHED_FIFO` for the control
     ///   thread; refused at start-up if the OS does not allow it).
+    /// * Streaming mode ([`crate::stream`]): `stream.queue` (integer from 1 to
+    ///   [`MAX_STREAM_QUEUE`], default [`DEFAULT_STREAM_QUEUE`]: reference points that may wait
+    ///   for a batch; more are refused), `stream.max_jump` (rad or m, finite and > 0, default
+    ///   [`DEFAULT_STREAM_MAX_JUMP`]: the largest move of a joint from one point to the next),
+    ///   `stream.lookahead` (integer from 0 to [`MAX_STREAM_LOOKAHEAD`], default
+    ///   [`DEFAULT_STREAM_LOOKAHEAD`]: points RPRO looks ahead at a velocity level).
     pub fn from_params(params: &Params) -> Result<Self, NodeError> {
         let urdf = PathBuf::from(params.required_string("urdf_file")?);
         let limits_file = PathBuf::from(params.required_string("joint_limits_file")?);
@@ -370,6 +407,8 @@ impl NodeConfig {
             .check_positions(&initial_positions)
             .map_err(|e| param_err("initial_positions", e.to_string()))?;
 
+        let stream = stream_config(params)?;
+
         Ok(Self {
             robot,
             urdf_file: urdf,
@@ -382,8 +421,40 @@ impl NodeConfig {
             realtime_priority,
             sim,
             driver,
+            stream,
         })
     }
+}
+
+/// Reads the `stream.*` parameters.
+fn stream_config(params: &Params) -> Result<StreamConfig, NodeError> {
+    let queue = params.i64_or("stream.queue", DEFAULT_STREAM_QUEUE)?;
+    if !(1..=MAX_STREAM_QUEUE).contains(&queue) {
+        return Err(param_err(
+            "stream.queue",
+            format!("{queue}: must be an integer from 1 to {MAX_STREAM_QUEUE} (points)"),
+        ));
+    }
+    let max_jump = params.f64_or("stream.max_jump", DEFAULT_STREAM_MAX_JUMP)?;
+    if !(max_jump.is_finite() && max_jump > 0.0) {
+        return Err(param_err(
+            "stream.max_jump",
+            format!("{max_jump}: must be finite and > 0 (rad or m)"),
+        ));
+    }
+    let lookahead = params.i64_or("stream.lookahead", DEFAULT_STREAM_LOOKAHEAD)?;
+    if !(0..=MAX_STREAM_LOOKAHEAD).contains(&lookahead) {
+        return Err(param_err(
+            "stream.lookahead",
+            format!("{lookahead}: must be an integer from 0 to {MAX_STREAM_LOOKAHEAD} (points)"),
+        ));
+    }
+    // In range: checked above.
+    Ok(StreamConfig {
+        queue: queue as usize,
+        max_jump,
+        lookahead: lookahead as usize,
+    })
 }
 
 /// Reads `hardware` and the `sim_*` parameters.

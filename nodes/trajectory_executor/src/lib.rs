@@ -13,6 +13,8 @@
 //! | `~/controller_state` | `control_msgs/msg/JointTrajectoryControllerState` | every control cycle |
 //! | `~/joint_command` | `sensor_msgs/msg/JointState` | command stream for a hardware driver |
 //! | `~/trajectory_status` | `kerf_msgs/msg/TrajectoryStatus` | accepted / rejected / finished |
+//! | `~/reference_points` | `kerf_msgs/msg/ReferencePoint` | subscription: the streaming mode's points ([`stream`]) |
+//! | `~/stream_status` | `kerf_msgs/msg/StreamStatus` | each point started, queued, refused, reached or not reached ([`stream`]) |
 //! | `/clock` | `rosgraph_msgs/msg/Clock` | simulated time, every control cycle (`hardware: sim`) |
 //! | `~/contacts` | `kerf_msgs/msg/CellContacts` | the cell's contacts, every control cycle (`hardware: sim`) |
 //! | `hardware.command_topic` | `std_msgs/msg/Float64MultiArray` or `sensor_msgs/msg/JointState` | commands to a robot driver, every control cycle (`hardware: topic`) |
@@ -81,6 +83,7 @@ mod goals;
 pub mod hardware;
 pub mod jtc;
 pub mod memory;
+pub mod stream;
 mod validate_service;
 
 use std::{
@@ -104,7 +107,7 @@ use kerf_msgs::{
         FollowJointTrajectoryFeedback, FollowJointTrajectoryGoal, FollowJointTrajectoryResult,
         JointTrajectoryControllerState,
     },
-    msg::{CellContacts, TrajectoryStatus},
+    msg::{CellContacts, ReferencePoint, StreamStatus, TrajectoryStatus},
     rosgraph_msgs::Clock as ClockMsg,
     sensor_msgs::JointState,
     srv::{ValidateTrajectoryRequest, ValidateTrajectoryResponse},
@@ -132,6 +135,10 @@ pub const DEFAULT_NAME: &str = "trajectory_executor";
 
 /// Samples each outgoing stream may queue before new ones are dropped (0.25 s at 250 Hz).
 const STREAM_QUEUE: usize = 64;
+
+/// History depth of `~/reference_points` and `~/stream_status` and the status queue: a burst
+/// of points (and their answers) is not lost to a keep-last history.
+const REFERENCE_DEPTH: usize = 1000;
 
 /// The request thread waits at most this long for a report of the control thread before it
 /// polls its DDS endpoints again.
@@ -281,13 +288,24 @@ enum Job {
     Validate(RmwRequestId),
     /// An empty topic trajectory: stop the current motion.
     Stop(Source),
+    /// The dry-run check of a stream's start point (its id).
+    StreamStart(u32),
 }
 
 /// Where an executor goal came from.
 #[derive(Debug, Clone)]
 enum Source {
-    Topic { stamp: Time },
-    Action { id: GoalId, stamp: Time },
+    Topic {
+        stamp: Time,
+    },
+    Action {
+        id: GoalId,
+        stamp: Time,
+    },
+    /// A batch of the reference-point stream ([`stream`]).
+    Stream {
+        batch: u64,
+    },
 }
 
 impl Source {
@@ -296,6 +314,7 @@ impl Source {
         match self {
             Source::Topic { .. } => "trajectory from topic".to_string(),
             Source::Action { id, .. } => format!("goal {id:?}"),
+            Source::Stream { batch } => format!("stream batch {batch}"),
         }
     }
 }
@@ -341,6 +360,10 @@ struct ExecutorNode {
     action: FjtServer,
     validate_srv: Server<ValidateTrajectoryRequest, ValidateTrajectoryResponse>,
     status: Streamer<TrajectoryStatus>,
+    /// The streaming mode's points and answers.
+    reference_sub: Inbox<ReferencePoint>,
+    stream_status: Streamer<StreamStatus>,
+    streaming: stream::Streaming,
     goals: action::ActionGoals,
     /// The request behind each running executor goal.
     sources: HashMap<ExecGoalId, Source>,
@@ -399,6 +422,8 @@ fn own_topics(node: &KerfNode) -> Result<Vec<String>, NodeError> {
         "~/controller_state",
         "~/trajectory_status",
         "~/joint_trajectory",
+        "~/reference_points",
+        "~/stream_status",
         "~/contacts",
         "/clock",
     ]
@@ -581,6 +606,19 @@ impl ExecutorNode {
             q,
             rate,
         )?;
+        let reference_sub = node.inbox(
+            "~/reference_points",
+            ReferencePoint::ROS_TYPE,
+            qos::reliable(REFERENCE_DEPTH),
+        )?;
+        let stream_status = node.streamer(
+            "~/stream_status",
+            StreamStatus::ROS_TYPE,
+            qos::reliable(REFERENCE_DEPTH),
+            REFERENCE_DEPTH,
+            rate,
+        )?;
+        let streaming = stream::Streaming::new(&cfg)?;
         let log = node.logger();
         let (limits, exec_cfg) = (cfg.limits.clone(), cfg.executor.clone());
         let prep_clock = clock.clone();
@@ -732,6 +770,9 @@ impl ExecutorNode {
             action,
             validate_srv,
             status,
+            reference_sub,
+            stream_status,
+            streaming,
             goals: action::ActionGoals::default(),
             sources: HashMap::new(),
             prep,
@@ -768,6 +809,7 @@ impl ExecutorNode {
             self.poll_cancels();
             self.poll_result_requests();
             self.poll_validate();
+            self.poll_reference_points();
             self.poll_prepared();
             self.check_driver_types();
             if self.jtc.is_some() {
@@ -779,6 +821,7 @@ impl ExecutorNode {
             while let Ok(r) = self.reports.try_recv() {
                 self.on_report(r);
             }
+            self.next_stream_batch();
             self.answer_results();
             if self.statuses_changed {
                 self.statuses_changed = false;
@@ -819,6 +862,7 @@ impl ExecutorNode {
                 let status = TrajectoryStatus::REJECTED;
                 self.trajectory_status(&source, status, rej.code, &rej.message);
             }
+            job @ Job::StreamStart(_) => self.answer_check(job, Err(rej)),
         }
     }
 
@@ -844,6 +888,10 @@ impl ExecutorNode {
                         g.exec_id = Some(exec_id);
                     }
                 }
+                if !matches!(source, Source::Stream { .. }) {
+                    let out = self.streaming.robot_moved_by_other(&what);
+                    self.publish_stream(out);
+                }
                 self.sources.insert(exec_id, source);
             }
             Report::Refused { tag, rejection } => {
@@ -852,8 +900,10 @@ impl ExecutorNode {
                 }
             }
             Report::Validated { tag, result } => {
-                if let Some(Job::Validate(req_id)) = self.dispatched.remove(&tag) {
-                    self.answer_validate(req_id, result);
+                if let Some(job @ (Job::Validate(_) | Job::StreamStart(_))) =
+                    self.dispatched.remove(&tag)
+                {
+                    self.answer_check(job, result);
                 }
             }
             Report::Stopping { tag, message } => {
@@ -889,6 +939,7 @@ impl ExecutorNode {
                 action::goal_id_hex(id),
                 *stamp,
             ),
+            Source::Stream { .. } => (TrajectoryStatus::SOURCE_STREAM, String::new(), Time::ZERO),
         };
         let msg = TrajectoryStatus {
             header: Header {
@@ -922,6 +973,71 @@ impl ExecutorNode {
                     let source = Source::Topic { stamp: Time::ZERO };
                     self.trajectory_status(&source, TrajectoryStatus::REJECTED, INVALID_GOAL, &msg);
                 }
+            }
+        }
+    }
+
+    /// The streaming mode's points: each answered START (after its check), QUEUED or
+    /// REFUSED.
+    fn poll_reference_points(&mut self) {
+        while let Some(received) = self.reference_sub.try_recv() {
+            let msg = match received {
+                Ok(msg) => msg,
+                Err(e) => {
+                    self.log
+                        .error(&format!("could not read a ReferencePoint sample: {e}"));
+                    continue;
+                }
+            };
+            match self.streaming.push(&msg) {
+                stream::PushOutcome::Answered(out) => self.publish_stream(out),
+                stream::PushOutcome::CheckStart { id, trajectory } => {
+                    self.enqueue(Job::StreamStart(id), Incoming::Trajectory(trajectory));
+                }
+            }
+        }
+    }
+
+    /// Hands the stream's next batch to the executor when none runs and points wait.
+    fn next_stream_batch(&mut self) {
+        let (batch, out) = self.streaming.next_batch();
+        self.publish_stream(out);
+        if let Some((batch, trajectory)) = batch {
+            self.enqueue(
+                Job::Run(Source::Stream { batch }),
+                Incoming::Trajectory(trajectory),
+            );
+        }
+    }
+
+    /// Answers a dry run: the `ValidateTrajectory` service or a stream's start check.
+    fn answer_check(&mut self, job: Job, result: Result<f64, Rejection>) {
+        match job {
+            Job::Validate(req_id) => self.answer_validate(req_id, result),
+            Job::StreamStart(id) => {
+                let out = self
+                    .streaming
+                    .start_checked(id, result.map(|_| ()).map_err(|r| r.message));
+                self.publish_stream(out);
+            }
+            Job::Run(_) | Job::Stop(_) => {}
+        }
+    }
+
+    /// Stamps and publishes stream statuses; refusals and points not reached are logged.
+    fn publish_stream(&mut self, statuses: Vec<StreamStatus>) {
+        for mut msg in statuses {
+            let name = StreamStatus::status_name(msg.status).unwrap_or("?");
+            let line = format!("reference point {}: {name} {}", msg.id, msg.message);
+            match msg.status {
+                StreamStatus::REFUSED | StreamStatus::NOT_REACHED => self.log.warn(&line),
+                _ => self.log.debug(&line),
+            }
+            msg.header.stamp = self.clock.stamp(self.clock.now());
+            let f = &mut self.publish_failures;
+            let warning = control::publish_counted(&self.stream_status, msg, f, "stream status");
+            if let Some(warning) = warning {
+                self.log.warn(&warning);
             }
         }
     }
@@ -1071,6 +1187,11 @@ impl ExecutorNode {
         self.log
             .warn(&format!("rejected {}: {}", source.describe(), rej.message));
         self.trajectory_status(source, TrajectoryStatus::REJECTED, rej.code, &rej.message);
+        if let Source::Stream { batch } = source {
+            let reason = format!("REJECTED by the executor: {}", rej.message);
+            let out = self.streaming.batch_ended(*batch, false, &reason);
+            self.publish_stream(out);
+        }
         if let Source::Action { id, .. } = source {
             self.goals.finish(
                 id,
@@ -1122,7 +1243,7 @@ impl ExecutorNode {
                     let command = control::Command::Stop { tag: ticket };
                     self.dispatch(ticket, Job::Stop(source), command);
                 }
-                Job::Validate(req_id) if self.jtc.is_some() => {
+                job @ (Job::Validate(_) | Job::StreamStart(_)) if self.jtc.is_some() => {
                     let now = self.clock.now();
                     let answer = match (prepared.unwrap_or_else(|| Err(missing())), &self.jtc) {
                         (Ok((prepared, tolerances)), Some(f)) => {
@@ -1131,19 +1252,21 @@ impl ExecutorNode {
                         (Ok(_), None) => Err(missing()),
                         (Err(rej), _) => Err(rej),
                     };
-                    self.answer_validate(req_id, answer);
+                    self.answer_check(job, answer);
                 }
-                Job::Validate(req_id) => match prepared.unwrap_or_else(|| Err(missing())) {
-                    Ok((prepared, tolerances)) => {
-                        let command = control::Command::Validate {
-                            tag: ticket,
-                            prepared,
-                            tolerances,
-                        };
-                        self.dispatch(ticket, Job::Validate(req_id), command);
+                job @ (Job::Validate(_) | Job::StreamStart(_)) => {
+                    match prepared.unwrap_or_else(|| Err(missing())) {
+                        Ok((prepared, tolerances)) => {
+                            let command = control::Command::Validate {
+                                tag: ticket,
+                                prepared,
+                                tolerances,
+                            };
+                            self.dispatch(ticket, job, command);
+                        }
+                        Err(rej) => self.answer_check(job, Err(rej)),
                     }
-                    Err(rej) => self.answer_validate(req_id, Err(rej)),
-                },
+                }
                 Job::Run(source) => {
                     self.start(ticket, source, prepared.unwrap_or_else(|| Err(missing())));
                 }
@@ -1237,6 +1360,12 @@ impl ExecutorNode {
             self.log.warn(&format!("trajectory {name}: {message}"));
         }
         self.trajectory_status(&source, status, code, &message);
+        if let Source::Stream { batch } = source {
+            let reason = format!("{name}: {message}");
+            let succeeded = status == TrajectoryStatus::SUCCEEDED;
+            let out = self.streaming.batch_ended(batch, succeeded, &reason);
+            self.publish_stream(out);
+        }
         if let Source::Action { id: goal_id, .. } = source {
             self.goals.finish(
                 &goal_id,
