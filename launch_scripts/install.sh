@@ -22,6 +22,7 @@
 #   urdf/                                   robot descriptions, limits, meshes, cells, milling cell
 #   crates/mjto/cases/                      the laser-cutting cases of seed 001
 #   crates/millplan/policies/               the milling planner's shipped policies
+#   crates/stepping/weights/                the stepping agent's network (kerf step --controller ddqn)
 #   crates/millplan/data/indicator_cache.bin  the indicator cache of the default cell
 #   crates/gcode/data/programs/             the shipped G-code programs (package://kerf/...)
 #   launch_scripts/params/                  each robot's launch configuration
@@ -121,6 +122,7 @@ if [ "$mode" != --binary-only ]; then
     urdf
     crates/mjto/cases
     crates/millplan/policies
+    crates/stepping/weights
     crates/millplan/data/indicator_cache.bin
     crates/gcode/data/programs
     launch_scripts/params

@@ -17,6 +17,7 @@ use std::{path::PathBuf, time::Instant};
 
 use clap::{Args, ValueEnum};
 use kerf_stepping::{
+    ddqn::{file::from_bytes, Agent, Shielded},
     multi::{AxisSample, MultiCourse},
     points::parse_points,
     ruckig_ref::{reference, Method},
@@ -46,6 +47,12 @@ type Points = Vec<Vec<f64>>;
 /// Joint ranges `(min, max)`.
 type Ranges = Vec<(f64, f64)>;
 
+/// Cap of a DDQN network file (1 MiB; the committed one is 4 kB).
+const NETWORK_CAP: u64 = 1 << 20;
+
+/// The committed DDQN network, relative to the data root.
+const NETWORK: &str = "crates/stepping/weights/ddqn_high_arch2.safetensors";
+
 /// Periods a run may take before it is refused (10⁷: 5.6 h at 2 ms).
 const MAX_STEPS: usize = 10_000_000;
 
@@ -57,6 +64,9 @@ pub enum ControllerArg {
     /// The Ruckig reference: time-optimal jerk-limited sections through the points (rsruckig),
     /// each ending on a sample; per-axis limits, no spline.
     Ruckig,
+    /// Seed 002's DDQN imitation of RPRO behind RPRO's shield: the agent's action where RPRO
+    /// allows it and it keeps the axis moving, RPRO's otherwise (overrides are printed).
+    Ddqn,
 }
 
 /// Unit of the points' numbers.
@@ -108,6 +118,10 @@ pub struct StepArgs {
     /// [0, 8] points.
     #[arg(long, default_value_t = 1, value_parser = Count::<usize>::new(0, 8, "points"))]
     lookahead: usize,
+    /// The DDQN network of `--controller ddqn` (default: the committed
+    /// crates/stepping/weights/ddqn_high_arch2.safetensors; at most 1 MiB).
+    #[arg(long)]
+    network: Option<InputFile>,
     /// Where the trajectory is written as JSON.
     #[arg(long)]
     out: PathBuf,
@@ -145,19 +159,37 @@ pub fn run(args: StepArgs) -> Result<(), String> {
             (vec![Limits::new(v, a, j)], None)
         }
     };
+    let agent = match args.controller {
+        ControllerArg::Ddqn => Some(load_agent(args.network.as_ref())?),
+        _ => {
+            if args.network.is_some() {
+                return Err("--network is the network of --controller ddqn".to_string());
+            }
+            None
+        }
+    };
+    let mut overrides = None;
     let started = Instant::now();
     let outcome = match args.controller {
-        ControllerArg::Rpro => {
+        ControllerArg::Rpro | ControllerArg::Ddqn => {
             let course = MultiCourse::new(points.clone(), &limits, args.precision, args.period)
                 .map_err(name_point)?;
-            let mut rpro = Rpro::new(
-                &course.course,
-                RproSettings::default().lookahead_points(args.lookahead),
-            )
-            .map_err(|e| e.to_string())?;
-            let result = course
-                .run(&mut rpro, MAX_STEPS)
-                .map_err(|e| format!("rpro: {e}"))?;
+            let settings = RproSettings::default().lookahead_points(args.lookahead);
+            let result = match &agent {
+                None => {
+                    let mut rpro =
+                        Rpro::new(&course.course, settings).map_err(|e| e.to_string())?;
+                    course.run(&mut rpro, MAX_STEPS)
+                }
+                Some(agent) => {
+                    let mut shielded = Shielded::new(agent.clone(), &course.course, settings)
+                        .map_err(|e| e.to_string())?;
+                    let r = course.run(&mut shielded, MAX_STEPS);
+                    overrides = Some((shielded.overrides(), shielded.decisions()));
+                    r
+                }
+            }
+            .map_err(|e| format!("{}: {e}", controller_name(args.controller)))?;
             Outcome {
                 passes: result
                     .passes
@@ -211,6 +243,9 @@ pub fn run(args: StepArgs) -> Result<(), String> {
             path.velocity, path.acceleration, path.jerk
         );
     }
+    if let Some((n, of)) = overrides {
+        println!("shield: RPRO overrode the agent in {n} of {of} decisions");
+    }
     if !missed.is_empty() {
         println!("points not passed within the precision: {missed:?}");
     }
@@ -263,7 +298,22 @@ fn controller_name(c: ControllerArg) -> &'static str {
     match c {
         ControllerArg::Rpro => "rpro",
         ControllerArg::Ruckig => "ruckig",
+        ControllerArg::Ddqn => "ddqn",
     }
+}
+
+/// The DDQN agent of `--network`, or the committed one.
+fn load_agent(network: Option<&InputFile>) -> Result<Agent, String> {
+    let bytes = match network {
+        Some(f) => input::read_bytes("--network", f, NETWORK_CAP)?,
+        None => {
+            let path = kerf_robot::data::default_path(NETWORK);
+            std::fs::read(&path)
+                .map_err(|e| format!("the committed DDQN network {}: {e}", path.display()))?
+        }
+    };
+    let (weights, info) = from_bytes(&bytes).map_err(|e| format!("--network: {e}"))?;
+    Agent::new(weights, info).map_err(|e| format!("--network: {e}"))
 }
 
 /// The JSON document of `--out`.

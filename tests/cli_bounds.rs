@@ -401,6 +401,16 @@ fn input_invocation(path: &str, id: &str, dir: &Path) -> Option<Vec<String>> {
             .collect(),
         ("plan gcode", "file") => vec!["plan".into(), "gcode".into(), "{}".into()],
         ("step", "points") => vec!["step".into(), "{}".into(), "--out".into(), out],
+        ("step", "network") => vec![
+            "step".into(),
+            repo("crates/stepping/data/axis_dense.txt"),
+            "--controller".into(),
+            "ddqn".into(),
+            "--out".into(),
+            out,
+            "--network".into(),
+            "{}".into(),
+        ],
         _ => return None,
     };
     Some(v)

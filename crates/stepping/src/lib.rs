@@ -17,9 +17,11 @@
 //! | [`points`] | reference points as text (1 to 6 coordinates per line) | |
 //! | [`stream`] | the executor's streaming mode: rules, batches from rest to rest | issue 29 |
 //! | [`database`] | the paths and limit grid of Table 1, the train/test split | seed 002 Table 1, §3 |
+//! | [`ddqn`] | the DDQN imitation of RPRO: Q-network, agent, shield, training, Tables 4–6 metrics | seed 002 §3, Tables 2–6; van Hasselt et al. 2016 |
 
 pub mod course;
 pub mod database;
+pub mod ddqn;
 pub mod error;
 pub mod lattice;
 pub mod limits;
