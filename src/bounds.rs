@@ -133,6 +133,7 @@ impl Coordinates {
     /// Why the value is refused: not three numbers, or a coordinate as [`Real::check`] says.
     pub fn check(&self, text: &str) -> Result<Point3, String> {
         Triple {
+            what: "coordinates",
             names: ["x", "y", "z"],
             value: self.0,
         }
@@ -144,6 +145,8 @@ impl Coordinates {
 /// The value parser of three named reals `a,b,c` in one range (`--limits V,A,J`).
 #[derive(Debug, Clone, Copy)]
 pub struct Triple {
+    /// What the three are, as the refusal says ("coordinates", "limits").
+    pub what: &'static str,
     /// The three names, as the refusal states them.
     pub names: [&'static str; 3],
     /// The range of each.
@@ -159,8 +162,9 @@ impl Triple {
         let parts: Vec<&str> = text.split(',').collect();
         if parts.len() != 3 {
             return Err(format!(
-                "{} value(s); three values {} separated by commas are required",
+                "{} value(s); three {} {} separated by commas are required",
                 parts.len(),
+                self.what,
                 self.names.join(",")
             ));
         }

@@ -37,6 +37,7 @@ const POINTS_CAP: u64 = 64 << 20;
 
 /// `--limits`: velocity, acceleration and jerk, each in (0, 1e6].
 const LIMITS: Triple = Triple {
+    what: "limits",
     names: ["velocity", "acceleration", "jerk"],
     value: Real::above(0.0, 1e6, "SI"),
 };

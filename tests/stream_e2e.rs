@@ -10,9 +10,11 @@
 //! * a stream faster than the robot (`stream.queue` 4, twelve points at once): the points
 //!   beyond the queue are REFUSED by the queue rule, the accepted ones REACHED, and every
 //!   joint velocity on `/joint_states` stays within the URDF's limits;
-//! * `hardware: sim` (the IRB 6660 in its plate cell): a short stream is REACHED.
+//! * `hardware: sim` (the IRB 6660 in its plate cell): a short stream is REACHED;
+//! * `hardware: topic` with a driver in another process (`tools/sim_driver`): a short stream
+//!   is REACHED and the measured robot rests on its last point.
 //!
-//! Loopback DDS, domains 227-230 (233-236 are beyond the largest domain id, 232: RustDDS's
+//! Loopback DDS, domains 226-230 (233-236 are beyond the largest domain id, 232: RustDDS's
 //! ports overflow there).
 
 #![allow(clippy::unwrap_used, clippy::expect_used, missing_docs)]
@@ -353,7 +355,12 @@ fn bad_points_are_refused_with_the_reason_and_the_stream_goes_on() {
 
 #[test]
 fn a_stream_faster_than_the_robot_is_refused_by_the_queue_rule() {
-    let mut cell = Cell::start(229, &["stream.queue:=4".into()]);
+    // A jump bound wide enough that only the queue refuses: the points after a refused one are
+    // compared with the last accepted, further back.
+    let mut cell = Cell::start(
+        229,
+        &["stream.queue:=4".into(), "stream.max_jump:=2.0".into()],
+    );
     let start = cell.position();
     cell.point(1, &start);
     cell.expect(1, StreamStatus::START, QUICK);
@@ -411,6 +418,42 @@ fn a_stream_on_the_simulated_cell_reaches_every_point() {
         &[
             [0.05, 0.0, 0.0, 0.0, 0.0, 0.0],
             [0.10, 0.02, 0.0, 0.0, 0.0, 0.05],
+        ],
+    );
+}
+
+/// `hardware: topic`: the batches run through a robot driver in another process
+/// (`tools/sim_driver`, no kerf code), judged on its measured states: every point REACHED and
+/// the measured robot rests on the last one.
+#[test]
+fn a_stream_through_a_robot_driver_reaches_every_point() {
+    let domain = 226;
+    let joints: Vec<String> = (1..=6).map(|j| format!("joint_{j}")).collect();
+    let _driver = support::driver::Driver::start(
+        domain,
+        "stream",
+        &[
+            "--joints".to_string(),
+            joints.join(","),
+            "--initial".into(),
+            "0.1,0.2,0.3,0.0,0.5,0.0".into(),
+        ],
+    );
+    let mut cell = Cell::start(
+        domain,
+        &[
+            "hardware:=topic".into(),
+            "hardware.command_topic:=/driver/commands".into(),
+            "hardware.state_topic:=/driver/joint_states".into(),
+            "hardware.feedback_timeout_periods:=25".into(),
+        ],
+    );
+    stream_reaches_every_point(
+        &mut cell,
+        1,
+        &[
+            [0.03, 0.0, 0.0, 0.0, 0.0, 0.0],
+            [0.06, 0.01, 0.0, 0.0, 0.02, 0.0],
         ],
     );
 }
