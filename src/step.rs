@@ -216,8 +216,9 @@ pub fn run(args: StepArgs) -> Result<(), String> {
         .filter(|(_, _, e)| *e > args.precision)
         .map(|(p, _, _)| *p)
         .collect();
+    // Joint positions mix rad and m (the laser cutter has prismatic axes).
     let micro = if args.joints.is_some() {
-        "µrad"
+        "µ joint units"
     } else {
         "µm"
     };
