@@ -14,7 +14,8 @@
 //!   range, repeated, a jump over `stream.max_jump`, `stream.queue` points already waiting:
 //!   a stream faster than the robot is refused point by point, never followed faster than
 //!   the limits allow).
-//! * **Batches.** While no batch runs, the waiting points become one batch: RPRO
+//! * **Batches.** While no batch runs or is being planned, the waiting points become one
+//!   batch, planned on the `stream` thread (points that arrive meanwhile wait): RPRO
 //!   (`kerf_stepping::Rpro`, look-ahead `stream.lookahead`) steps them from rest to rest at
 //!   the control period; the samples (positions, velocities, accelerations) become a
 //!   `JointTrajectory` started on receipt and run through the executor's own path (validated
@@ -37,7 +38,7 @@ use kerf_msgs::{
     trajectory_msgs::{JointTrajectory, JointTrajectoryPoint},
 };
 use kerf_stepping::{
-    stream::{Batch, BatchPass, Pushed, Stream, StreamPoint, StreamSettings},
+    stream::{Batch, BatchJob, BatchPass, Pushed, Stream, StreamPoint, StreamSettings},
     Controller, Course, Limits, Rpro, RproSettings, StepError,
 };
 
@@ -79,7 +80,17 @@ pub struct Streaming {
     pending_start: Option<u32>,
     /// Why every point is refused (a joint without a jerk limit), if so.
     unavailable: Option<String>,
+    /// The batch being planned (on the planner thread): its number and point ids.
+    planning: Option<(u64, Vec<u32>)>,
+    /// Counts resets: a plan made before the last reset is dropped.
+    generation: u64,
 }
+
+/// A batch to plan on the planner thread, tagged with the stream's generation.
+pub type PlanJob = (u64, BatchJob);
+
+/// What the planner thread returns: the job and its result.
+pub type PlanDone = (u64, BatchJob, Result<Batch, StepError>);
 
 /// A status without stamp (the node stamps it when it publishes).
 fn status(id: u32, status: u8, batch: u64, message: impl Into<String>) -> StreamStatus {
@@ -143,6 +154,8 @@ impl Streaming {
             running: None,
             pending_start: None,
             unavailable,
+            planning: None,
+            generation: 0,
         })
     }
 
@@ -271,36 +284,98 @@ impl Streaming {
         self.running.is_some()
     }
 
-    /// The next batch, when none runs and points wait: its number and trajectory, and the
-    /// statuses to publish (NOT_REACHED for a batch that cannot be planned).
-    pub fn next_batch(&mut self) -> (Option<(u64, JointTrajectory)>, Vec<StreamStatus>) {
-        if self.running.is_some() || self.pending_start.is_some() {
-            return (None, Vec::new());
-        }
+    /// The controller factory of this stream's batches (RPRO with the configured
+    /// look-ahead), for the planner thread.
+    pub fn planner(&self) -> impl Fn(PlanJob) -> PlanDone + Send + Sync + 'static {
         let lookahead = self.lookahead;
-        let make = move |course: &Course| -> Result<Box<dyn Controller>, StepError> {
-            Ok(Box::new(Rpro::new(
-                course,
-                RproSettings::default().lookahead_points(lookahead),
-            )?))
+        move |(generation, job): PlanJob| {
+            let make = move |course: &Course| -> Result<Box<dyn Controller>, StepError> {
+                Ok(Box::new(Rpro::new(
+                    course,
+                    RproSettings::default().lookahead_points(lookahead),
+                )?))
+            };
+            let result = job.plan(&make);
+            (generation, job, result)
+        }
+    }
+
+    /// The next batch to plan, when none runs or is being planned and points wait.
+    pub fn next_job(&mut self) -> Option<PlanJob> {
+        if self.running.is_some() || self.pending_start.is_some() || self.planning.is_some() {
+            return None;
+        }
+        let job = self.stream.take_job()?;
+        self.planning = Some((job.number, job.ids()));
+        Some((self.generation, job))
+    }
+
+    /// The planner thread's answer for a job: the batch's number and trajectory to run, and
+    /// the statuses to publish (NOT_REACHED for a batch that cannot be planned, or that was
+    /// planned for a stream reset meanwhile).
+    pub fn planned(
+        &mut self,
+        done: PlanDone,
+    ) -> (Option<(u64, JointTrajectory)>, Vec<StreamStatus>) {
+        let (generation, job, result) = done;
+        if self
+            .planning
+            .as_ref()
+            .is_some_and(|(n, _)| *n == job.number)
+        {
+            self.planning = None;
+        }
+        let not_reached = |message: String| -> Vec<StreamStatus> {
+            job.ids()
+                .into_iter()
+                .map(|id| status(id, StreamStatus::NOT_REACHED, job.number, message.clone()))
+                .collect()
         };
-        match self.stream.take_batch(&make) {
-            None => (None, Vec::new()),
-            Some(Err((ids, e))) => {
-                let message = format!("the batch cannot be planned: {}", self.refusal(&e));
-                let out = ids
-                    .into_iter()
-                    .map(|id| status(id, StreamStatus::NOT_REACHED, 0, message.clone()))
-                    .collect();
-                (None, out)
-            }
-            Some(Ok(batch)) => {
+        if generation != self.generation {
+            return (
+                None,
+                not_reached("the stream was reset while its batch was planned".to_string()),
+            );
+        }
+        self.stream.job_done(&job, &result);
+        match result {
+            Err(e) => (
+                None,
+                not_reached(format!("the batch cannot be planned: {}", self.refusal(&e))),
+            ),
+            Ok(batch) => {
                 let trajectory = self.trajectory(&batch);
                 self.running = Some(Running {
                     number: batch.number,
                     passes: batch.passes,
                 });
                 (Some((batch.number, trajectory)), Vec::new())
+            }
+        }
+    }
+
+    /// The planner thread failed on the batch being planned (it stopped): its points are
+    /// NOT_REACHED and the stream is reset.
+    pub fn planner_failed(&mut self, reason: &str) -> Vec<StreamStatus> {
+        let Some((number, ids)) = self.planning.take() else {
+            return Vec::new();
+        };
+        let message = format!("the batch planner failed: {reason}");
+        let mut out: Vec<StreamStatus> = ids
+            .into_iter()
+            .map(|id| status(id, StreamStatus::NOT_REACHED, number, message.clone()))
+            .collect();
+        out.extend(self.reset_waiting(&message));
+        out
+    }
+
+    /// [`Streaming::next_job`] planned on this thread and [`Streaming::planned`] (tests).
+    pub fn next_batch(&mut self) -> (Option<(u64, JointTrajectory)>, Vec<StreamStatus>) {
+        match self.next_job() {
+            None => (None, Vec::new()),
+            Some(job) => {
+                let plan = self.planner();
+                self.planned(plan(job))
             }
         }
     }
@@ -365,8 +440,10 @@ impl Streaming {
         self.reset_waiting(&format!("{what} moves the robot"))
     }
 
-    /// Resets the stream: NOT_REACHED for the points that were waiting.
+    /// Resets the stream: NOT_REACHED for the points that were waiting (a batch being
+    /// planned is dropped when its plan arrives).
     fn reset_waiting(&mut self, why: &str) -> Vec<StreamStatus> {
+        self.generation += 1;
         let message =
             format!("stream reset: {why}; send the robot's position to start a new stream");
         self.stream
