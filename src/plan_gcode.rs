@@ -4,7 +4,7 @@
 //! kerf plan gcode FILE [--machine laser-cutter|irb6660] [--tolerance M]
 //!                      [--method kerf|kerf-curvature|icr|ccr|nurbs] [--feed-method near-optimal|constant-intervals]
 //!                      [--g RAD] [--origin X,Y,Z] [--plan-memory BYTES] [--plots DIR]
-//!                      [--out plan.json]
+//!                      [--out plan.json] [--normalize L] [--resample N]
 //! ```
 //!
 //! Reads the program as a stream through the CLI's capped reader ([`crate::input::open`]: `-`
@@ -21,6 +21,17 @@
 //! limit curve, chord error, normal acceleration and jerk, contour error, tangential
 //! acceleration and jerk (seed 000 Fig. 5, seed 003 Figs. 12-14).
 //!
+//! `--normalize L` and `--resample N` (issue 30, item 1) apply seed 000's preprocessing of a
+//! contour (section 4.1: "normalized to fit within a [0, 100]² coordinate space", "resampled
+//! to generate 200 equally spaced points") to the program's one G01 cut contour before it is
+//! planned, each optional and independent: the geometry and what is refused (arcs, several
+//! contours, a contour not planar or with a changing feed) are
+//! [`kerf_gcodeplan::preprocess`]'s, documented there. `L` is in the program's own unit (mm
+//! under G21, in under G20; the seed names none): the larger side of the contour's XY box is
+//! scaled to `L` and its lower-left corner moved to the origin. What was done (unit, scale
+//! factor, offset, boxes, points and lengths before and after) is printed before the plan, which
+//! is then of the preprocessed program (its line numbers are that program's).
+//!
 //! Exit code 0 on success; 2 on any failure (its status, line and message are printed).
 
 use std::{f64::consts::PI, path::PathBuf};
@@ -28,8 +39,9 @@ use std::{f64::consts::PI, path::PathBuf};
 use clap::{Args, ValueEnum};
 use kerf_budget::Budget;
 use kerf_gcodeplan::{
-    plan_request_reading, GcodePlan, GcodeRequest, MachineBase, MachineKind, RunKind,
-    MAX_PROGRAM_BYTES,
+    plan_request_reading,
+    preprocess::{preprocess_program, Preprocess, PreprocessReport},
+    GcodePlan, GcodePlanError, GcodeRequest, MachineBase, MachineKind, RunKind, MAX_PROGRAM_BYTES,
 };
 use kerf_msgs::msg::GcodePlan as GcodePlanMsg;
 
@@ -53,6 +65,12 @@ const PLAN_MEMORY: Count<u64> = Count::new(
     kerf_budget::MAX_PLAN_MEMORY,
     "bytes",
 );
+
+/// `--normalize`: the side L of the square the contour is fitted into, in the program's unit.
+const NORMALIZE: Real = Real::above(0.0, 1e6, "program units (mm under G21, in under G20)");
+
+/// `--resample`: the contour's points after resampling (the program's line limit is 10⁶).
+const RESAMPLE: Count<usize> = Count::new(2, 1_000_000, "points");
 
 /// The machines, as named in requests.
 #[derive(Debug, Clone, Copy, ValueEnum)]
@@ -97,6 +115,15 @@ pub struct GcodeArgs {
     /// Write the answer (kerf_msgs/msg/GcodePlan) as JSON here.
     #[arg(long)]
     out: Option<PathBuf>,
+    /// Seed 000's preprocessing: fit the G01 cut contour's XY bounding box into [0, L]², the
+    /// larger side scaled to L, the lower-left corner to the origin, rapids mapped alike: (0,
+    /// 1000000] program units (mm under G21, in under G20).
+    #[arg(long, value_name = "L", value_parser = NORMALIZE)]
+    normalize: Option<f64>,
+    /// Seed 000's preprocessing: replace the G01 cut contour by N points equally spaced in arc
+    /// length along it, first and last kept (after --normalize): [2, 1000000] points.
+    #[arg(long, value_name = "N", value_parser = RESAMPLE)]
+    resample: Option<usize>,
 }
 
 /// Runs `kerf plan gcode`.
@@ -133,18 +160,44 @@ pub fn run(a: GcodeArgs) -> Result<(), String> {
     // Streamed and capped like every input of kerf; the program is named in every failure.
     let label = format!("FILE {}", a.file);
     let input = input::open("FILE", &a.file, MAX_PROGRAM_BYTES)?;
-    let planned = plan_request_reading(
-        &request,
-        &base,
-        &budget,
-        None,
-        std::io::BufReader::new(input),
-    );
-    let plan = planned.map_err(|e| {
+    let failed = |label: &str, e: GcodePlanError| {
         let status = kerf_gcode_planner::convert::status_of(&e);
         let name = GcodePlanMsg::status_name(status).unwrap_or("?");
         format!("{name} ({status}): {label}: {e}")
-    })?;
+    };
+    let options = Preprocess {
+        normalize: a.normalize,
+        resample: a.resample,
+    };
+    let planned = if options == Preprocess::default() {
+        plan_request_reading(
+            &request,
+            &base,
+            &budget,
+            None,
+            std::io::BufReader::new(input),
+        )
+        .map_err(|e| failed(&label, e))
+    } else {
+        let settings = request.settings().map_err(|e| failed(&label, e))?;
+        let pre = preprocess_program(std::io::BufReader::new(input), &settings, &options, &budget)
+            .map_err(|e| failed(&label, e))?;
+        print!("{}", preprocess_summary(&pre.report));
+        // The program written out is held while it is planned.
+        let bytes = pre.program.len() as u64;
+        budget
+            .account(bytes, "the preprocessed program")
+            .map_err(|e| failed(&label, e.into()))?;
+        let planned = plan_request_reading(&request, &base, &budget, None, pre.program.as_bytes());
+        budget.release(bytes);
+        planned.map_err(|e| {
+            failed(
+                &format!("{label} preprocessed (lines of the preprocessed program)"),
+                e,
+            )
+        })
+    };
+    let plan = planned?;
     let took = started.elapsed().as_secs_f64();
     print!("{}", summary(&plan, took));
     if let Some(out) = &a.out {
@@ -178,6 +231,80 @@ pub fn run(a: GcodeArgs) -> Result<(), String> {
         println!("{files} plots written to {}", dir.display());
     }
     Ok(())
+}
+
+/// What the preprocessing did, in the program's unit.
+fn preprocess_summary(r: &PreprocessReport) -> String {
+    use std::fmt::Write;
+    let u = r.unit.metres();
+    let sym = r.unit.symbol();
+    let bx = |b: &kerf_gcodeplan::preprocess::Box2| {
+        format!(
+            "[{:.4}, {:.4}] x [{:.4}, {:.4}] {sym}",
+            b.min[0] / u,
+            b.max[0] / u,
+            b.min[1] / u,
+            b.max[1] / u
+        )
+    };
+    let mut s = String::new();
+    let _ = writeln!(
+        s,
+        "preprocessing (seed 000 section 4.1): contour of lines {}-{} ({}, {sym}): {} points, \
+         length {:.4} {sym}",
+        r.contour_lines.0,
+        r.contour_lines.1,
+        r.unit.gcode(),
+        r.points_before,
+        r.length_before / u
+    );
+    if let Some(n) = &r.normalization {
+        let [tx, ty] = n.map.offset();
+        let _ = writeln!(
+            s,
+            "normalize to [0, {}]^2 {sym}: scale factor {:.6}, offset ({:.4}, {:.4}) {sym}; box {} \
+             -> {}",
+            n.side,
+            n.map.scale,
+            tx / u,
+            ty / u,
+            bx(&n.before),
+            bx(&n.after)
+        );
+    }
+    if let Some(h) = r.spacing {
+        let _ = writeln!(
+            s,
+            "resample: {} points -> {} points, {:.4} {sym} apart along the contour; length \
+             {:.4} -> {:.4} {sym} (chords cut the corners)",
+            r.points_before,
+            r.points_after,
+            h / u,
+            h * r.points_after.saturating_sub(1) as f64 / u,
+            r.length_after / u
+        );
+    }
+    let _ = writeln!(
+        s,
+        "carried through: {} rapids, {} feed moves with the tool off{}{}",
+        r.rapids,
+        r.travel_moves,
+        if r.normalization.is_some() {
+            " (XY mapped by the same scale and offset, Z unchanged)"
+        } else {
+            ""
+        },
+        if r.start_rapid {
+            "; a rapid added first to the start position's image"
+        } else {
+            ""
+        }
+    );
+    let _ = writeln!(
+        s,
+        "the plan below is of the preprocessed program (its line numbers are its own)"
+    );
+    s
 }
 
 /// The printed summary.

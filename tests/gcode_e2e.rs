@@ -93,7 +93,11 @@ fn a_program_runs_from_planner_through_executor_and_bad_ones_are_answered() {
     let last = plan.trajectory.points.last().unwrap().positions.clone();
     assert_eq!(plan.arcs, 1);
     assert_eq!(plan.cut_runs, 1);
-    let switches: Vec<(bool, u32)> = plan.tool_events.iter().map(|e| (e.on, e.line)).collect();
+    let switches: Vec<(bool, u32)> = plan
+        .tool_events
+        .iter()
+        .map(|e| (e.tool_on, e.line))
+        .collect();
     assert_eq!(switches, [(true, 2), (false, 8)]);
     assert!(plan.lower_bound_time > 0.0 && plan.feed_time >= plan.lower_bound_time);
     assert!(plan.max_interpolation_deviation <= 0.1 * plan.tolerance);

@@ -99,6 +99,18 @@ pub enum GcodeError {
         /// The line of the program end.
         end_line: usize,
     },
+    /// The program goes on past the most lines the reader takes
+    /// ([`crate::Program::with_max_lines`]): `line` is the first line beyond the limit.
+    #[error(
+        "line {line}: more than {max} lines (the limit; line {line} is the first beyond it: \
+         split the program)"
+    )]
+    TooManyLines {
+        /// The first line beyond the limit (`max + 1`).
+        line: usize,
+        /// The most lines read.
+        max: usize,
+    },
     /// A setting of the reader is out of range.
     #[error("setting {name} = {value}: {reason}")]
     InvalidSetting {
@@ -131,6 +143,7 @@ impl GcodeError {
             | Self::MissingFeed { line, .. }
             | Self::NoMotionMode { line, .. }
             | Self::AfterEnd { line, .. }
+            | Self::TooManyLines { line, .. }
             | Self::Io { line, .. } => *line,
             Self::InvalidSetting { .. } => 0,
         }

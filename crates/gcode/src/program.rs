@@ -25,6 +25,7 @@ pub struct Program<R> {
     buffer: Vec<u8>,
     done: bool,
     skipped: usize,
+    max_lines: Option<usize>,
 }
 
 impl<R: BufRead> Program<R> {
@@ -41,7 +42,16 @@ impl<R: BufRead> Program<R> {
             buffer: Vec::new(),
             done: false,
             skipped: 0,
+            max_lines: None,
         })
+    }
+
+    /// Reads at most `max` lines: a program with a line `max + 1` (whatever it holds: a
+    /// comment, a blank line) is refused with [`GcodeError::TooManyLines`] naming that line
+    /// as soon as it is reached, before it is read further (no limit by default).
+    pub fn with_max_lines(mut self, max: usize) -> Self {
+        self.max_lines = Some(max);
+        self
     }
 
     /// Lines read so far.
@@ -93,6 +103,22 @@ impl<R: BufRead> Program<R> {
     }
 
     fn advance(&mut self) -> Result<bool, GcodeError> {
+        if let Some(max) = self.max_lines.filter(|max| self.line >= *max) {
+            // Only a line that is there is beyond the limit: a program of exactly `max`
+            // lines (with or without its final line ending) is read whole.
+            if self
+                .source
+                .fill_buf()
+                .map_err(|e| GcodeError::Io {
+                    line: self.line + 1,
+                    message: e.to_string(),
+                })?
+                .is_empty()
+            {
+                return Ok(false);
+            }
+            return Err(GcodeError::TooManyLines { line: max + 1, max });
+        }
         if !self.read_line()? {
             return Ok(false);
         }

@@ -400,3 +400,49 @@ fn a_huge_radius_gives_a_finite_arc() {
     assert!(arc.radius.is_finite() && arc.radius > 1e160);
     assert!(arc.sweep.is_finite() && arc.sweep < 0.0);
 }
+
+/// Issue 30, item 1: a program over the line limit is refused naming its first line beyond
+/// the limit, whatever that line holds, as soon as it is reached.
+#[test]
+fn the_line_limit_names_the_first_line_beyond_it() {
+    let limited = |text: &str, max: usize| -> Result<Vec<Motion>, GcodeError> {
+        Program::new(text.as_bytes(), ReaderSettings::default())
+            .unwrap()
+            .with_max_lines(max)
+            .collect()
+    };
+    // Motions beyond the limit, comments beyond it, a blank line beyond it.
+    for text in [
+        "G1 X1 F600\nG1 X2\nG1 X3\nG1 X4\nG1 X5\n",
+        "G1 X1 F600\nG1 X2\nG1 X3\n(a comment)\n(another)\nG1 X4\n",
+        "G1 X1 F600\n\n(three)\n\n",
+    ] {
+        let e = limited(text, 3).unwrap_err();
+        assert_eq!(e, GcodeError::TooManyLines { line: 4, max: 3 }, "{text:?}");
+        assert_eq!(e.line(), 4);
+        let message = e.to_string();
+        assert!(
+            message.starts_with("line 4:") && message.contains("more than 3 lines"),
+            "{message}"
+        );
+    }
+    // Exactly the limit, with or without the last line ending, is read whole.
+    for text in ["G1 X1 F600\nG1 X2\nG1 X3\n", "G1 X1 F600\nG1 X2\nG1 X3"] {
+        assert_eq!(limited(text, 3).unwrap().len(), 3, "{text:?}");
+    }
+    // The motions before the limit come first; the refusal ends the program.
+    let mut program = Program::new(
+        "G1 X1 F600\nG1 X2\nG1 X3\n".as_bytes(),
+        ReaderSettings::default(),
+    )
+    .unwrap()
+    .with_max_lines(2);
+    assert!(program.next().unwrap().is_ok());
+    assert!(program.next().unwrap().is_ok());
+    assert_eq!(
+        program.next().unwrap().unwrap_err(),
+        GcodeError::TooManyLines { line: 3, max: 2 }
+    );
+    assert!(program.next().is_none());
+    assert_eq!(program.lines_read(), 2);
+}

@@ -52,6 +52,16 @@ pub enum GcodePlanError {
         /// The kinematics' reason.
         reason: String,
     },
+    /// An arc of the program cannot be approximated by chords within the plan's settings:
+    /// it needs more chords than the points allowed, or the settings leave no tolerance for
+    /// them.
+    #[error("line {line}: {reason}")]
+    Arc {
+        /// Source line of the arc.
+        line: usize,
+        /// What is wrong, with the numbers.
+        reason: String,
+    },
     /// The program has no motion to plan.
     #[error("no motion: {reason}")]
     Empty {
@@ -71,9 +81,32 @@ pub enum GcodePlanError {
     /// as executed: a defect of the planner, reported rather than published.
     #[error("the trajectory is not executable: {reason}")]
     NotExecutable {
+        /// The first source line of the run at fault (0 when no run is named).
+        line: usize,
         /// Why.
         reason: String,
     },
+}
+
+impl GcodePlanError {
+    /// The program line the error is tied to (1-based; 0 when none): the reader's line for
+    /// [`GcodePlanError::Program`] (lexer, interpreter, arc, line limit), the motion's for
+    /// [`GcodePlanError::Arc`] and [`GcodePlanError::Unreachable`], the run's first line for
+    /// [`GcodePlanError::Path`] and [`GcodePlanError::NotExecutable`].
+    pub fn line(&self) -> usize {
+        match self {
+            Self::Program(e) => e.line(),
+            Self::Path { line, .. }
+            | Self::Unreachable { line, .. }
+            | Self::Arc { line, .. }
+            | Self::NotExecutable { line, .. } => *line,
+            Self::InvalidSetting { .. }
+            | Self::InvalidRequest { .. }
+            | Self::Empty { .. }
+            | Self::TooManyPoints { .. }
+            | Self::Interrupted(_) => 0,
+        }
+    }
 }
 
 /// Checks that each named value is finite and > 0.

@@ -334,6 +334,7 @@ pub fn run_knots(
                 let dt = w[1].t - w[0].t;
                 if dt < shortest || round == MAX_SPLIT_ROUNDS {
                     return Err(GcodePlanError::NotExecutable {
+                        line,
                         reason: format!(
                             "line {line}: the tool leaves the tolerance by {d:.3e} m between \
                              {:.6} s and {:.6} s into the run even with points {dt:.2e} s \
@@ -391,6 +392,7 @@ pub fn run_knots(
     }
     if !(ratio.is_finite() && ratio <= MAX_SLOWDOWN) {
         return Err(GcodePlanError::NotExecutable {
+            line,
             reason: format!(
                 "line {line}: the {} of {} would need a slowdown of {ratio:.3e} \
                  (more than {MAX_SLOWDOWN}): the joints cannot follow this path",

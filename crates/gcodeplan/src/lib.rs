@@ -11,12 +11,15 @@ pub mod knots;
 pub mod machine;
 mod memory;
 pub mod plan;
+pub mod preprocess;
 pub mod request;
 pub mod runs;
 pub mod settings;
 pub mod timed;
 
 pub use error::GcodePlanError;
+/// The reader's error, as carried by [`GcodePlanError::Program`].
+pub use kerf_gcode::GcodeError;
 pub use machine::{JointBounds, LaserSheet, Machine, MillingPlane, DOF};
 pub use plan::{plan_program, GcodePlan, RunReport, ToolEvent};
 pub use request::{

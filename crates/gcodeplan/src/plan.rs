@@ -358,6 +358,7 @@ pub fn plan_program<R: BufRead>(
         }
         let prepared = check_executable(&limits, &config, &request).map_err(|e| {
             GcodePlanError::NotExecutable {
+                line: 0,
                 reason: e.to_string(),
             }
         })?;
@@ -367,10 +368,17 @@ pub fn plan_program<R: BufRead>(
         }
         round += 1;
         if round > MAX_CHECK_ROUNDS {
+            // Named by the first run still beyond the tolerance.
+            let line = bad
+                .first()
+                .and_then(|(run, _)| placed.get(*run))
+                .map_or(0, |p| p.line);
             return Err(GcodePlanError::NotExecutable {
+                line,
                 reason: format!(
                     "the executed tool tip leaves the interpolation tolerance {:.3e} m by {worst:.3e} m \
-                     after {MAX_CHECK_ROUNDS} rounds of refinement",
+                     after {MAX_CHECK_ROUNDS} rounds of refinement (first in the run from line \
+                     {line})",
                     settings.interpolation_tolerance()
                 ),
             });
@@ -509,6 +517,7 @@ fn prepare_run(
             None => break (samples, caps, plan),
             Some((what, ratio, time)) if attempt == SAMPLE_REFINEMENTS => {
                 return Err(GcodePlanError::NotExecutable {
+                    line,
                     reason: format!(
                         "lines {line}-{last_line}: the feed plan breaks the {what} limit \
                          ({ratio:.4} of it at {time:.3} s into the run) even with the \
@@ -885,7 +894,8 @@ fn executed_deviation(
             let tip = machine
                 .tip(&q)
                 .map_err(|reason| GcodePlanError::NotExecutable {
-                    reason: format!("at {t:.4} s: {reason}"),
+                    line: p.line,
+                    reason: format!("line {}: at {t:.4} s: {reason}", p.line),
                 })?;
             let d = (0..3)
                 .map(|i| (tip[i] - planned[i]).powi(2))

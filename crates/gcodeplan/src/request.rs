@@ -4,9 +4,14 @@
 //! ```yaml
 //! request_id: job-1
 //! machine: laser-cutter        # or irb6660; default laser-cutter
-//! program: "G21 G90\nM3\nG1 X20 F3000\nG1 Y20\nM5\n"   # or program_file: /path/part.ngc
+//! program: "G21 G90\nM3\nG1 X20 F3000\nG1 Y20\nM5\n"   # or program_uri: /path/part.ngc
 //! tolerance: 1.0e-4            # m, default 1e-4
 //! ```
+//!
+//! The keys are the `kerf_msgs/msg/GcodeRequest` field names (`program_uri`, `has_limits`,
+//! `max_feed`, …, `has_placement`, `start_positions`); the earlier names of this form are
+//! kept (`program_file` for `program_uri`, `limits: {…}` for the flat limit fields, `origin` as
+//! a list): [`RequestText`].
 //!
 //! Optional: `method` (`kerf`, `kerf-curvature`, `icr`, `ccr`, `nurbs`), `feed_method` (`near-optimal`,
 //! `constant-intervals`), `limits` (any of `max_feed`, `tangential_acceleration`,
@@ -17,7 +22,7 @@
 //! that does not apply to the request's machine ([`GcodeRequest::check_numbers`], ranges in
 //! [`RANGES`]).
 //!
-//! A `program_file` is read as a stream: a regular file of at most [`MAX_PROGRAM_BYTES`]
+//! A `program_uri` (`program_file`) is read as a stream: a regular file of at most [`MAX_PROGRAM_BYTES`]
 //! (a FIFO, device, socket or directory is refused before it is opened:
 //! [`kerf_robot::file::open_regular`]).
 
@@ -249,9 +254,11 @@ pub struct LimitOverrides {
     pub contour_error: Option<f64>,
 }
 
-/// A request (module documentation).
+/// A request (module documentation). Written with the message's field names (`program_uri`);
+/// read from text through [`RequestText`]: the
+/// `kerf_msgs/msg/GcodeRequest` field names and the earlier names of this form.
 #[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
+#[serde(try_from = "RequestText")]
 pub struct GcodeRequest {
     /// Any text; echoed in the answer.
     #[serde(default)]
@@ -264,7 +271,7 @@ pub struct GcodeRequest {
     pub program: Option<String>,
     /// A program file: a path, a local `file://` URI or `package://kerf/<path>`
     /// ([`kerf_robot::file::resolve_uri`]).
-    #[serde(default)]
+    #[serde(rename = "program_uri")]
     pub program_file: Option<String>,
     /// δ \[m\], default 1e-4.
     #[serde(default)]
@@ -275,7 +282,8 @@ pub struct GcodeRequest {
     /// Feed planner ([`FEED_METHODS`]), default `near-optimal`.
     #[serde(default)]
     pub feed_method: Option<String>,
-    /// Path limits.
+    /// Path limits (as text: `limits: {max_feed: …}`, or the message's flat fields
+    /// `max_feed`, … with an optional `has_limits: true`).
     #[serde(default)]
     pub limits: Option<LimitOverrides>,
     /// G0 speed \[m/s\].
@@ -298,6 +306,233 @@ pub struct GcodeRequest {
     /// none. Resolved and framed by the planner-node harness, not by the planner.
     #[serde(default, skip_serializing_if = "kerf_approach::StartSpec::is_default")]
     pub start: kerf_approach::StartSpec,
+}
+
+/// A request document as read (YAML or JSON): every field of `kerf_msgs/msg/GcodeRequest` by
+/// its message name, and the earlier names of the text form as aliases (`program_file` for
+/// `program_uri`), checked into a [`GcodeRequest`] ([`GcodeRequest::try_from`]). Unknown keys
+/// are refused.
+///
+/// Beyond the names, the text keeps its own meaning of a value: a key left out is "not given"
+/// (a 0 is a value, checked against its range, where the message reads 0 as "not given"). The
+/// message's groups are accepted both ways: the path limits as `limits: {max_feed: …}` or as
+/// the flat `max_feed`, `tangential_acceleration`, … (`has_limits` optional; `false` with a
+/// limit given, or `true` with none, is refused), the placement as `origin`,
+/// `redundancy_angle`, `standoff_axis` (`has_placement` likewise), `origin` as `[x, y, z]` or
+/// `{x: …, y: …, z: …}` (a `geometry_msgs/Point`), and the start as `start: current | none |
+/// [q…]` or the message's pair `start: given` with `start_positions: [q…]`.
+#[derive(Debug, Clone, PartialEq, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RequestText {
+    /// `request_id`.
+    #[serde(default)]
+    pub request_id: String,
+    /// `machine`.
+    #[serde(default)]
+    pub machine: String,
+    /// `program`.
+    #[serde(default)]
+    pub program: Option<String>,
+    /// `program_uri` (alias `program_file`).
+    #[serde(default, alias = "program_file")]
+    pub program_uri: Option<String>,
+    /// `tolerance` \[m\].
+    #[serde(default)]
+    pub tolerance: Option<f64>,
+    /// `method`.
+    #[serde(default)]
+    pub method: Option<String>,
+    /// `feed_method`.
+    #[serde(default)]
+    pub feed_method: Option<String>,
+    /// `has_limits`: whether the path limits are given.
+    #[serde(default)]
+    pub has_limits: Option<bool>,
+    /// `limits`: the path limits as one map (the text form's own name).
+    #[serde(default)]
+    pub limits: Option<LimitOverrides>,
+    /// `max_feed` \[m/s\].
+    #[serde(default)]
+    pub max_feed: Option<f64>,
+    /// `tangential_acceleration` \[m/s²\].
+    #[serde(default)]
+    pub tangential_acceleration: Option<f64>,
+    /// `tangential_jerk` \[m/s³\].
+    #[serde(default)]
+    pub tangential_jerk: Option<f64>,
+    /// `normal_acceleration` \[m/s²\].
+    #[serde(default)]
+    pub normal_acceleration: Option<f64>,
+    /// `normal_jerk` \[m/s³\].
+    #[serde(default)]
+    pub normal_jerk: Option<f64>,
+    /// `chord_error` \[m\].
+    #[serde(default)]
+    pub chord_error: Option<f64>,
+    /// `contour_error` \[m\].
+    #[serde(default)]
+    pub contour_error: Option<f64>,
+    /// `rapid_feed` \[m/s\].
+    #[serde(default)]
+    pub rapid_feed: Option<f64>,
+    /// `has_placement`: whether the placement is given.
+    #[serde(default)]
+    pub has_placement: Option<bool>,
+    /// `origin` \[m\].
+    #[serde(default)]
+    pub origin: Option<OriginText>,
+    /// `redundancy_angle` \[rad\].
+    #[serde(default)]
+    pub redundancy_angle: Option<f64>,
+    /// `standoff_axis` \[m\].
+    #[serde(default)]
+    pub standoff_axis: Option<f64>,
+    /// `time_budget` \[s\].
+    #[serde(default)]
+    pub time_budget: Option<f64>,
+    /// `start`.
+    #[serde(default)]
+    pub start: Option<StartText>,
+    /// `start_positions` (with `start: given`).
+    #[serde(default)]
+    pub start_positions: Option<Vec<f64>>,
+}
+
+/// The program's zero as text: `[x, y, z]` or a `geometry_msgs/Point` `{x, y, z}` \[m\].
+#[derive(Debug, Clone, Copy, PartialEq, Deserialize)]
+#[serde(untagged, expecting = "origin as [x, y, z] or {x: …, y: …, z: …} (m)")]
+pub enum OriginText {
+    /// `[x, y, z]`.
+    List([f64; 3]),
+    /// `{x: …, y: …, z: …}`.
+    Point(PointText),
+}
+
+/// A `geometry_msgs/Point` \[m\]: every coordinate given.
+#[derive(Debug, Clone, Copy, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PointText {
+    /// x.
+    pub x: f64,
+    /// y.
+    pub y: f64,
+    /// z.
+    pub z: f64,
+}
+
+/// The `start` field as text: a word (`current`, `none`, `given`, or empty) or a list of joint
+/// positions.
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(
+    untagged,
+    expecting = "start as \"current\", \"none\", \"given\" (with start_positions) or a list of joint positions"
+)]
+pub enum StartText {
+    /// A word.
+    Word(String),
+    /// Joint positions.
+    Positions(Vec<f64>),
+}
+
+impl TryFrom<RequestText> for GcodeRequest {
+    type Error = String;
+
+    /// The request a document asks for.
+    ///
+    /// # Errors
+    /// A sentence naming the fields for limits given both as `limits` and as the flat fields,
+    /// a `has_limits` or `has_placement` that contradicts the fields given, or a start that
+    /// is not one of the forms above.
+    fn try_from(t: RequestText) -> Result<Self, String> {
+        let flat = LimitOverrides {
+            max_feed: t.max_feed,
+            tangential_acceleration: t.tangential_acceleration,
+            tangential_jerk: t.tangential_jerk,
+            normal_acceleration: t.normal_acceleration,
+            normal_jerk: t.normal_jerk,
+            chord_error: t.chord_error,
+            contour_error: t.contour_error,
+        };
+        let any_flat = flat != LimitOverrides::default();
+        if t.limits.is_some() && any_flat {
+            return Err(
+                "the path limits are given both as limits and as the message's fields \
+                        (max_feed, tangential_acceleration, …): give one form"
+                    .to_string(),
+            );
+        }
+        let limits = t.limits.or(any_flat.then_some(flat));
+        match (t.has_limits, limits.is_some()) {
+            (Some(false), true) => {
+                return Err(
+                    "has_limits is false but path limits are given: set has_limits: \
+                            true or leave the limits out"
+                        .to_string(),
+                )
+            }
+            (Some(true), false) => {
+                return Err("has_limits is true but no path limit is given (max_feed, \
+                            tangential_acceleration, …)"
+                    .to_string())
+            }
+            _ => {}
+        }
+        let origin = t.origin.map(|o| match o {
+            OriginText::List(p) => p,
+            OriginText::Point(p) => [p.x, p.y, p.z],
+        });
+        let placed = origin.is_some() || t.redundancy_angle.is_some() || t.standoff_axis.is_some();
+        match (t.has_placement, placed) {
+            (Some(false), true) => {
+                return Err("has_placement is false but origin, redundancy_angle or \
+                            standoff_axis is given: set has_placement: true or leave them out"
+                    .to_string())
+            }
+            (Some(true), false) => {
+                return Err(
+                    "has_placement is true but neither origin, redundancy_angle nor \
+                            standoff_axis is given"
+                        .to_string(),
+                )
+            }
+            _ => {}
+        }
+        let start = match (t.start, t.start_positions) {
+            (None, None) => kerf_approach::StartSpec::Default,
+            (None, Some(q)) => kerf_approach::StartSpec::from_fields("", &q)?,
+            (Some(StartText::Word(w)), q) => {
+                kerf_approach::StartSpec::from_fields(&w, q.as_deref().unwrap_or(&[]))?
+            }
+            (Some(StartText::Positions(_)), Some(_)) => {
+                return Err(
+                    "start is a list of joint positions and start_positions is given: \
+                            give the positions once (start: [q…], or start: given with \
+                            start_positions)"
+                        .to_string(),
+                )
+            }
+            (Some(StartText::Positions(q)), None) if q.is_empty() => {
+                return Err("start is an empty list: give one position per joint".to_string())
+            }
+            (Some(StartText::Positions(q)), None) => kerf_approach::StartSpec::Given(q),
+        };
+        Ok(GcodeRequest {
+            request_id: t.request_id,
+            machine: t.machine,
+            program: t.program,
+            program_file: t.program_uri,
+            tolerance: t.tolerance,
+            method: t.method,
+            feed_method: t.feed_method,
+            limits,
+            rapid_feed: t.rapid_feed,
+            origin,
+            redundancy_angle: t.redundancy_angle,
+            standoff_axis: t.standoff_axis,
+            time_budget: t.time_budget,
+            start,
+        })
+    }
 }
 
 /// Where the program comes from.
@@ -665,4 +900,108 @@ pub fn plan_request_reading<R: BufRead>(
     }
     let machine = base.place(request)?;
     crate::plan_program(program, machine.as_ref(), &settings, budget)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn read(text: &str) -> GcodeRequest {
+        GcodeRequest::from_yaml_str(text).unwrap_or_else(|e| panic!("{text:?}: {e}"))
+    }
+
+    fn refused(text: &str) -> String {
+        match GcodeRequest::from_yaml_str(text) {
+            Ok(r) => panic!("{text:?} read as {r:?}"),
+            Err(e) => e.to_string(),
+        }
+    }
+
+    /// Issue 30, item 3: every `GcodeRequest` message field name is read, and the earlier
+    /// names give the same request.
+    #[test]
+    fn the_message_names_and_the_earlier_names_give_the_same_request() {
+        let message = read(
+            "request_id: r\nmachine: irb6660\nprogram_uri: package://kerf/a.ngc\n\
+             tolerance: 2.0e-4\nmethod: icr\nfeed_method: constant-intervals\n\
+             has_limits: true\nmax_feed: 0.05\ntangential_acceleration: 0.5\n\
+             tangential_jerk: 10.0\nnormal_acceleration: 0.6\nnormal_jerk: 12.0\n\
+             chord_error: 1.0e-5\ncontour_error: 4.0e-5\nrapid_feed: 0.1\n\
+             has_placement: true\norigin: {x: 1.4, y: -0.3, z: 1.7}\nredundancy_angle: 0.2\n\
+             time_budget: 5.0\nstart: given\nstart_positions: [0, 0.1, 0.2, 0, 0.3, 0]\n",
+        );
+        let earlier = read(
+            "request_id: r\nmachine: irb6660\nprogram_file: package://kerf/a.ngc\n\
+             tolerance: 2.0e-4\nmethod: icr\nfeed_method: constant-intervals\n\
+             limits: {max_feed: 0.05, tangential_acceleration: 0.5, tangential_jerk: 10.0,\n\
+             \x20 normal_acceleration: 0.6, normal_jerk: 12.0, chord_error: 1.0e-5,\n\
+             \x20 contour_error: 4.0e-5}\nrapid_feed: 0.1\norigin: [1.4, -0.3, 1.7]\n\
+             redundancy_angle: 0.2\ntime_budget: 5.0\nstart: [0, 0.1, 0.2, 0, 0.3, 0]\n",
+        );
+        assert_eq!(message, earlier);
+        assert_eq!(
+            message.program_file.as_deref(),
+            Some("package://kerf/a.ngc")
+        );
+        assert_eq!(message.limits.and_then(|l| l.normal_jerk), Some(12.0));
+        assert_eq!(message.origin, Some([1.4, -0.3, 1.7]));
+        assert_eq!(
+            message.start,
+            kerf_approach::StartSpec::Given(vec![0.0, 0.1, 0.2, 0.0, 0.3, 0.0])
+        );
+        // JSON, with the message's names.
+        let json = read(r#"{"program_uri": "package://kerf/a.ngc", "start": "none"}"#);
+        assert_eq!(json.program_file.as_deref(), Some("package://kerf/a.ngc"));
+        assert_eq!(json.start, kerf_approach::StartSpec::None);
+        // Flags false with nothing of their group: the machine's.
+        let r = read("program: G1 X1 F600\nhas_limits: false\nhas_placement: false\n");
+        assert_eq!((r.limits, r.origin), (None, None));
+    }
+
+    /// An unknown key is refused, as are the two spellings of one field together and flags
+    /// that contradict the fields given.
+    #[test]
+    fn unknown_keys_and_contradictions_are_refused() {
+        for (text, says) in [
+            (
+                "program: G1\nprogram_path: x\n",
+                "unknown field `program_path`",
+            ),
+            (
+                "program: G1\nlimits: {max_speed: 1}\n",
+                "unknown field `max_speed`",
+            ),
+            ("program: G1\norigin: {x: 1, y: 2}\n", "origin as [x, y, z]"),
+            ("program: G1\norigin: [1, 2]\n", "origin as [x, y, z]"),
+            ("program_uri: a\nprogram_file: b\n", "duplicate field"),
+            (
+                "program: G1\nlimits: {max_feed: 0.1}\nmax_feed: 0.1\n",
+                "give one form",
+            ),
+            (
+                "program: G1\nhas_limits: false\nmax_feed: 0.1\n",
+                "has_limits is false",
+            ),
+            ("program: G1\nhas_limits: true\n", "has_limits is true"),
+            (
+                "program: G1\nhas_placement: false\norigin: [0, 0, 0]\n",
+                "has_placement is false",
+            ),
+            (
+                "program: G1\nhas_placement: true\n",
+                "has_placement is true",
+            ),
+            ("program: G1\nstart: given\n", "start_positions is empty"),
+            (
+                "program: G1\nstart: [1, 2]\nstart_positions: [1, 2]\n",
+                "give the positions once",
+            ),
+            ("program: G1\nstart_positions: [1, 2]\n", "start"),
+            ("program: G1\nstart: []\n", "empty list"),
+            ("program: G1\nstart: sometimes\n", "sometimes"),
+        ] {
+            let e = refused(text);
+            assert!(e.contains(says), "{text:?}: {e}");
+        }
+    }
 }

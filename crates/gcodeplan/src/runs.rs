@@ -111,8 +111,11 @@ struct Open {
 ///
 /// # Errors
 /// The reader's first error ([`GcodePlanError::Program`], with line and
-/// column); [`GcodePlanError::InvalidSetting`] for bad settings or an arc
-/// in a program planned with no approximation share.
+/// column; a program longer than [`PlanSettings::max_lines`] is
+/// [`kerf_gcode::GcodeError::TooManyLines`] naming its first line beyond the
+/// limit); [`GcodePlanError::InvalidSetting`] for bad settings;
+/// [`GcodePlanError::Arc`] for an arc in a program planned with no
+/// approximation share, or one needing more chords than points allowed.
 pub fn read_steps<R: BufRead>(
     source: R,
     settings: &PlanSettings,
@@ -159,7 +162,9 @@ pub(crate) fn read_into<R: BufRead>(
         budget,
         stopped: &stopped,
     };
-    let mut program = Program::new(source, settings.reader)?;
+    // The line limit is the reader's: a program is refused at its first line beyond it
+    // (whatever that line holds), naming it, before the rest is read.
+    let mut program = Program::new(source, settings.reader)?.with_max_lines(settings.max_lines);
     let mut reading = Reading {
         start: settings.reader.start,
         ..Reading::default()
@@ -171,15 +176,6 @@ pub(crate) fn read_into<R: BufRead>(
             Some(interrupt) => GcodePlanError::Interrupted(interrupt),
             None => GcodePlanError::Program(e),
         })?;
-        if program.lines_read() > settings.max_lines {
-            return Err(GcodePlanError::InvalidRequest {
-                field: "program".to_string(),
-                reason: format!(
-                    "more than {} lines (the limit of this planner: split the program)",
-                    settings.max_lines
-                ),
-            });
-        }
         let control = program.interpreter().path_control();
         let (exact, corner_tolerance) = match control {
             PathControl::Exact => (true, settings.corner_tolerance()),
@@ -426,11 +422,12 @@ fn chords(
 ) -> Result<Vec<[f64; 3]>, GcodePlanError> {
     let sagitta = 0.5 * settings.approximation_tolerance();
     if sagitta <= 0.0 {
-        return Err(GcodePlanError::InvalidSetting {
-            name: "approximation share [-]".to_string(),
-            value: settings.approximation_share,
+        return Err(GcodePlanError::Arc {
+            line,
             reason: format!(
-                "line {line} has an arc, and a share of 0 leaves no tolerance for its chords"
+                "an arc, and the approximation share [-] = {} leaves no tolerance for its \
+                 chords",
+                settings.approximation_share
             ),
         });
     }
@@ -442,11 +439,11 @@ fn chords(
     };
     let chords = (arc.sweep.abs() / step).ceil().max(1.0);
     if chords.is_nan() || chords > settings.max_points as f64 {
-        return Err(GcodePlanError::InvalidRequest {
-            field: "program".to_string(),
+        return Err(GcodePlanError::Arc {
+            line,
             reason: format!(
-                "line {line}: the arc of radius {:.6e} m needs {chords:.3e} chords within \
-                 {sagitta:.1e} m, more than the {} points allowed",
+                "the arc of radius {:.6e} m needs {chords:.3e} chords within {sagitta:.1e} m, \
+                 more than the {} points allowed",
                 arc.radius, settings.max_points
             ),
         });

@@ -148,7 +148,10 @@ fn bad_settings_are_named() {
         ..PlanSettings::laser_cutter()
     };
     let e = laser_plan("G1 X10 F600\nG3 X0 Y10 R10\n", &settings).unwrap_err();
-    assert!(e.to_string().contains("line 2 has an arc"), "{e}");
+    assert!(
+        e.to_string().starts_with("line 2: an arc") && e.line() == 2,
+        "{e}"
+    );
     assert!(
         laser_plan(program, &settings).is_ok(),
         "no arc: a share of 0 is fine"
@@ -167,6 +170,18 @@ fn a_program_longer_than_the_line_limit_is_refused_while_reading() {
     let settings = PlanSettings::laser_cutter().with_max_lines(3);
     let e = laser_plan("G1 X1 F600\nG1 X2\nG1 X3\nG1 X4\nG1 X5\n", &settings).unwrap_err();
     assert!(e.to_string().contains("more than 3 lines"), "{e}");
+    // Issue 30, item 1: the refusal names the first line beyond the limit (its error line),
+    // and lines that hold no motion count: comments past the limit are refused too.
+    assert!(e.to_string().contains("line 4:"), "{e}");
+    assert_eq!(e.line(), 4);
+    for text in [
+        "G1 X1 F600\nG1 X2\nG1 X3\n(comment)\n(comment)\n",
+        "G1 X1 F600\n(comment)\n(comment)\n(comment)\n(comment)\nG1 X2\n",
+    ] {
+        let e = laser_plan(text, &settings).unwrap_err();
+        assert_eq!(e.line(), 4, "{text:?}: {e}");
+        assert!(e.to_string().contains("line 4:"), "{e}");
+    }
     assert!(laser_plan("G1 X1 F600\nG1 X2\nG1 X3\n", &settings).is_ok());
     let e = laser_plan(
         "G1 X1 F600\n",

@@ -802,16 +802,73 @@ impl GcodeRequest {
 }
 
 /// `kerf_msgs/msg/GcodeToolEvent`: a beam or spindle switch of a planned program, at rest.
-#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
+///
+/// Read from text with the earlier key `on` for `tool_on` too (a hand-written `Deserialize`:
+/// a serde `alias` would be a fourth field to the drift test's trace).
+#[derive(Debug, Clone, PartialEq, Default, Serialize)]
 pub struct GcodeToolEvent {
     /// Time from the trajectory's start (s).
     pub time: f64,
-    /// On after it.
-    pub on: bool,
+    /// On after it (`tool_on`, not `on`, which YAML 1.1 readers take for the boolean
+    /// `true`; the text key `on` is still read).
+    pub tool_on: bool,
     /// Source line.
     pub line: u32,
 }
 impl_ros_type!(GcodeToolEvent, "kerf_msgs", msg, "GcodeToolEvent");
+
+impl<'de> Deserialize<'de> for GcodeToolEvent {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        use serde::de::{self, MapAccess, SeqAccess, Visitor};
+        /// The message's fields, in `.msg` order (what CDR and the drift test see).
+        const FIELDS: &[&str] = &["time", "tool_on", "line"];
+        struct Event;
+        impl<'de> Visitor<'de> for Event {
+            type Value = GcodeToolEvent;
+            fn expecting(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+                f.write_str("struct GcodeToolEvent")
+            }
+            fn visit_seq<A: SeqAccess<'de>>(self, mut seq: A) -> Result<GcodeToolEvent, A::Error> {
+                let time = seq
+                    .next_element()?
+                    .ok_or_else(|| de::Error::invalid_length(0, &self))?;
+                let tool_on = seq
+                    .next_element()?
+                    .ok_or_else(|| de::Error::invalid_length(1, &self))?;
+                let line = seq
+                    .next_element()?
+                    .ok_or_else(|| de::Error::invalid_length(2, &self))?;
+                Ok(GcodeToolEvent {
+                    time,
+                    tool_on,
+                    line,
+                })
+            }
+            fn visit_map<A: MapAccess<'de>>(self, mut map: A) -> Result<GcodeToolEvent, A::Error> {
+                let (mut time, mut tool_on, mut line) = (None, None, None);
+                while let Some(key) = map.next_key::<String>()? {
+                    match key.as_str() {
+                        "time" if time.is_none() => time = Some(map.next_value()?),
+                        "tool_on" | "on" if tool_on.is_none() => tool_on = Some(map.next_value()?),
+                        "line" if line.is_none() => line = Some(map.next_value()?),
+                        "time" | "line" => return Err(de::Error::duplicate_field("time or line")),
+                        "tool_on" | "on" => return Err(de::Error::duplicate_field("tool_on")),
+                        // Unknown keys are skipped, as the derived mirrors do.
+                        _ => {
+                            map.next_value::<de::IgnoredAny>()?;
+                        }
+                    }
+                }
+                Ok(GcodeToolEvent {
+                    time: time.ok_or_else(|| de::Error::missing_field("time"))?,
+                    tool_on: tool_on.ok_or_else(|| de::Error::missing_field("tool_on"))?,
+                    line: line.ok_or_else(|| de::Error::missing_field("line"))?,
+                })
+            }
+        }
+        d.deserialize_struct("GcodeToolEvent", FIELDS, Event)
+    }
+}
 
 /// `kerf_msgs/msg/GcodePlan`: the G-code planner's answer to one [`GcodeRequest`], published on
 /// `~/gcode_plan`; failures carry their status and message.
@@ -829,7 +886,7 @@ pub struct GcodePlan {
     pub method: String,
     /// The joint trajectory from rest to rest; empty unless SUCCESS.
     pub trajectory: JointTrajectory,
-    /// The program line at fault (0 when none).
+    /// The program line at fault (0 when none): set for every error of a program line.
     pub error_line: u32,
     /// The trajectory's duration (s).
     pub machining_time: f64,

@@ -10,19 +10,24 @@ use kerf_msgs::numbers::{check_value, Number, NumberError, NumberFields, NumberR
 /// |---|---|
 /// | reader error, a path that cannot be smoothed, an empty program | PROGRAM_ERROR |
 /// | a point out of reach | UNREACHABLE |
-/// | a bad setting or field, too many points | INVALID_REQUEST |
+/// | a bad setting or field, too many points, too many lines, an arc needing too many chords | INVALID_REQUEST |
 /// | the time budget ran out | TIMEOUT |
 /// | the memory budget ran out | RESOURCE_LIMIT |
 /// | cancelled, not executable | INTERNAL_ERROR |
 pub fn status_of(e: &GcodePlanError) -> u8 {
     match e {
+        // The line limit is the planner's, like its most points: the request asks too much.
+        GcodePlanError::Program(kerf_gcodeplan::GcodeError::TooManyLines { .. }) => {
+            msg::GcodePlan::INVALID_REQUEST
+        }
         GcodePlanError::Program(_) | GcodePlanError::Path { .. } | GcodePlanError::Empty { .. } => {
             msg::GcodePlan::PROGRAM_ERROR
         }
         GcodePlanError::Unreachable { .. } => msg::GcodePlan::UNREACHABLE,
         GcodePlanError::InvalidSetting { .. }
         | GcodePlanError::InvalidRequest { .. }
-        | GcodePlanError::TooManyPoints { .. } => msg::GcodePlan::INVALID_REQUEST,
+        | GcodePlanError::TooManyPoints { .. }
+        | GcodePlanError::Arc { .. } => msg::GcodePlan::INVALID_REQUEST,
         GcodePlanError::Interrupted(kerf_budget::Interrupt::TimedOut { .. }) => {
             msg::GcodePlan::TIMEOUT
         }
@@ -35,14 +40,10 @@ pub fn status_of(e: &GcodePlanError) -> u8 {
     }
 }
 
-/// The program line an error names (0 when none).
+/// The program line an error names (0 when none): every error of a program line (the
+/// reader's, the line limit's, an arc's, a motion's) carries it ([`GcodePlanError::line`]).
 pub fn error_line(e: &GcodePlanError) -> u32 {
-    let line = match e {
-        GcodePlanError::Program(g) => g.line(),
-        GcodePlanError::Path { line, .. } | GcodePlanError::Unreachable { line, .. } => *line,
-        _ => 0,
-    };
-    u32::try_from(line).unwrap_or(u32::MAX)
+    u32::try_from(e.line()).unwrap_or(u32::MAX)
 }
 
 /// A number outside its declared rule ([`kerf_msgs::numbers`]) as the planner's error:
@@ -256,7 +257,7 @@ pub fn plan_to_msg(request: &GcodeRequest, plan: &GcodePlan) -> Result<msg::Gcod
             .iter()
             .map(|e| msg::GcodeToolEvent {
                 time: e.time,
-                on: e.on,
+                tool_on: e.on,
                 line: count(e.line),
             })
             .collect(),

@@ -9,6 +9,11 @@
 //! tolerance: 1.0e-4
 //! ```
 //!
+//! Its keys are the message's field names (`program_uri`, `has_limits`, `max_feed`, …,
+//! `has_placement`, `start_positions`); the earlier names (`program_file`, `limits: {…}`,
+//! `origin: [x, y, z]`, `start: [q…]`) are still read, and an unknown key is refused
+//! ([`kerf_gcodeplan::request::RequestText`]).
+//!
 //! Every number is checked against the declared rule of its `kerf_msgs/msg/GcodeRequest`
 //! field ([`kerf_msgs::numbers`]), named as in the message
 //! ([`crate::convert::check_text_numbers`]).
