@@ -1,0 +1,188 @@
+//! One corner of the NURBS method in its local frame: the networks' input
+//! features, the swarm's variables, and the corner built from them.
+//!
+//! # Local frame and inputs (seed 003 Fig. 6 (1))
+//! The vertex V = Pᵢ is the origin, x runs along the incoming direction t₁
+//! and y towards the outgoing side, so t₂ = (cos θ, sin θ) for the turning
+//! angle θ. Method 1's five control points (seed 003 Fig. 2b) are taken at
+//! the two ends of the length `available` = A kerf lets the corner use and
+//! at its middle: Pᵢ₋₂ = −A t₁, Pᵢ₋₁ = −A t₁ / 2, Pᵢ = 0, Pᵢ₊₁ = A t₂ / 2,
+//! Pᵢ₊₂ = A t₂. Divided by A they are ten numbers in the unit disc that
+//! depend on θ only. The paper fixes δ_max, so its five points carry the
+//! whole corner; kerf's tolerance varies, so an eleventh input ln(A / δ)
+//! carries the scale (the swarm's answer depends on θ and A / δ only: its
+//! box is relative to A and its weight is solved from δ).
+//!
+//! # Outputs
+//! The swarm's own variables x = (ℓ / A, α, β) of
+//! [`kerf_toolpath::baseline::nurbs`]: the added points are
+//! Pᵢ₊₃ = −βαℓ t₁ and its mirror Pᵢ₊₄ = βαℓ t₂ (seed 003 Fig. 6 (2)), and
+//! the outer ones move to ℓ and αℓ. They are bounded (the swarm's box),
+//! scale-free, and every x of the box gives a corner; the weight w then
+//! follows from δ in closed form (seed 003 eq. 7, last line, as nurbs.rs
+//! solves it), so the deviation is exactly ≤ δ whatever the network says.
+
+use kerf_toolpath::baseline::nurbs::{self, CENTRE_WEIGHT, KNOTS, SIDE_WEIGHT};
+use kerf_toolpath::baseline::CURVATURE_SAMPLES;
+use kerf_toolpath::vec3::{add, scale, sub};
+use kerf_toolpath::ToolpathError;
+use kerf_toolpath::{Binding, CornerCurve, CornerTransition, CubicSpline, NurbsSettings};
+
+/// The number of input features (ten coordinates and ln(A / δ)).
+pub const INPUTS: usize = 11;
+
+/// The number of outputs (ℓ / A, α, β).
+pub const OUTPUTS: usize = 3;
+
+/// The swarm's search box for (ℓ / A, α, β), as nurbs.rs's.
+pub const LOWER: [f64; OUTPUTS] = [0.05, 0.02, 0.02];
+
+/// Its upper corner.
+pub const UPPER: [f64; OUTPUTS] = [1.0, 0.98, 0.98];
+
+/// A corner reduced to what the swarm's answer depends on.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct LocalCorner {
+    /// Turning angle θ \[rad\].
+    pub turn: f64,
+    /// A / δ, the available length over the tolerance.
+    pub ratio: f64,
+}
+
+impl LocalCorner {
+    /// The input features (module documentation), before normalization.
+    pub fn features(&self) -> [f64; INPUTS] {
+        let (s, c) = self.turn.sin_cos();
+        [
+            -1.0,
+            0.0,
+            -0.5,
+            0.0,
+            0.0,
+            0.0,
+            0.5 * c,
+            0.5 * s,
+            c,
+            s,
+            self.ratio.ln(),
+        ]
+    }
+
+    /// The incoming and outgoing directions in the local frame.
+    pub fn directions(&self) -> ([f64; 3], [f64; 3]) {
+        let (s, c) = self.turn.sin_cos();
+        ([1.0, 0.0, 0.0], [c, s, 0.0])
+    }
+
+    /// The swarm's corner at δ = 1 (the swarm's answer is scale-free), its
+    /// seed's index 0 (every corner draws the same swarm).
+    ///
+    /// # Returns
+    /// The swarm's variables and its transition.
+    ///
+    /// # Errors
+    /// [`ToolpathError`] from the swarm (bad settings, no feasible point).
+    ///
+    /// # Performance
+    /// One swarm: particles × (iterations + 1) curve evaluations at 25
+    /// curvature samples each (measured by the example and the bench).
+    pub fn swarm(
+        &self,
+        settings: &NurbsSettings,
+    ) -> Result<([f64; OUTPUTS], CornerTransition), ToolpathError> {
+        let (t1, t2) = self.directions();
+        let t = nurbs::transition([0.0; 3], t1, t2, self.turn, 1.0, self.ratio, settings, 0)?;
+        let x = variables_of(&t, self.ratio).ok_or_else(|| ToolpathError::InvalidParameter {
+            name: "NURBS transition".to_string(),
+            value: t.scale,
+            reason: "not a seven-point NURBS corner".to_string(),
+        })?;
+        Ok((x, t))
+    }
+}
+
+/// The swarm's variables (ℓ / A, α, β) read back from a NURBS transition
+/// at the origin (control points −ℓ t₁, −αℓ t₁, −βαℓ t₁, 0, …).
+///
+/// # Returns
+/// `None` when the curve is not a seven-point spline.
+pub fn variables_of(t: &CornerTransition, available: f64) -> Option<[f64; OUTPUTS]> {
+    let CornerCurve::Spline(s) = t.curve else {
+        return None;
+    };
+    let p = s.control();
+    if p.len() != 7 {
+        return None;
+    }
+    let dist = |q: [f64; 3]| kerf_toolpath::vec3::norm(sub(q, t.vertex));
+    let l = dist(p[0]);
+    let outer = dist(p[1]);
+    let inner = dist(p[2]);
+    Some([l / available, outer / l, inner / outer])
+}
+
+/// The NURBS corner for the swarm's variables `x` (clamped to the box),
+/// built as nurbs.rs builds its candidates: control points
+/// V − ℓ t₁, V − αℓ t₁, V − βαℓ t₁, V, V + βαℓ t₂, V + αℓ t₂, V + ℓ t₂,
+/// weights (1, 1, 1, w, 1, 1, 1), knots [`KNOTS`] (seed 003 eq. 1), and
+/// w = N₂(½)(βαℓ sin θ / δ − 2) / N₃(½) (seed 003 eq. 7, last line, solved
+/// for the distance from the polyline), raised to `min_weight`.
+///
+/// # Returns
+/// The transition, or `None` when the weight needed exceeds
+/// `max_weight` (infeasible: the curve would leave δ) or the spline is
+/// refused.
+///
+/// # Performance
+/// One spline and [`CURVATURE_SAMPLES`] + refinement curvature evaluations
+/// (a few microseconds).
+#[allow(clippy::too_many_arguments)] // the corner's geometry, its limits and the variables
+pub fn build(
+    v: [f64; 3],
+    t1: [f64; 3],
+    t2: [f64; 3],
+    turn: f64,
+    tolerance: f64,
+    available: f64,
+    x: [f64; OUTPUTS],
+    settings: &NurbsSettings,
+) -> Option<CornerTransition> {
+    let x: [f64; OUTPUTS] = std::array::from_fn(|k| x[k].clamp(LOWER[k], UPPER[k]));
+    let l = x[0] * available;
+    let (outer, inner) = (x[1] * l, x[2] * x[1] * l);
+    let sin_turn = turn.sin();
+    let needed = SIDE_WEIGHT * (inner * sin_turn / tolerance - 2.0) / CENTRE_WEIGHT;
+    if needed.is_nan() || needed > settings.max_weight {
+        return None;
+    }
+    let w = needed.max(settings.min_weight);
+    let control = [
+        sub(v, scale(t1, l)),
+        sub(v, scale(t1, outer)),
+        sub(v, scale(t1, inner)),
+        v,
+        add(v, scale(t2, inner)),
+        add(v, scale(t2, outer)),
+        add(v, scale(t2, l)),
+    ];
+    let weights = [1.0, 1.0, 1.0, w, 1.0, 1.0, 1.0];
+    let curve = CubicSpline::new(&control, &weights, &KNOTS).ok()?;
+    // The exact deviation (nurbs.rs, "Deviation (exact)").
+    let deviation = SIDE_WEIGHT * inner * sin_turn / (2.0 * SIDE_WEIGHT + CENTRE_WEIGHT * w);
+    let c = CornerCurve::Spline(curve);
+    Some(CornerTransition {
+        curve: c,
+        vertex: v,
+        turn,
+        shape: None,
+        scale: l,
+        tangent_length: l,
+        deviation,
+        max_curvature: c.max_curvature_on(0.0, 0.5, CURVATURE_SAMPLES),
+        binding: if w > settings.min_weight {
+            Binding::Tolerance
+        } else {
+            Binding::Length
+        },
+    })
+}
