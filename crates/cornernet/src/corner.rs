@@ -22,11 +22,10 @@
 //! follows from δ in closed form (seed 003 eq. 7, last line, as nurbs.rs
 //! solves it), so the deviation is exactly ≤ δ whatever the network says.
 
-use kerf_toolpath::baseline::nurbs::{self, CENTRE_WEIGHT, KNOTS, SIDE_WEIGHT};
-use kerf_toolpath::baseline::CURVATURE_SAMPLES;
-use kerf_toolpath::vec3::{add, scale, sub};
+use kerf_toolpath::baseline::nurbs;
+use kerf_toolpath::vec3::sub;
 use kerf_toolpath::ToolpathError;
-use kerf_toolpath::{Binding, CornerCurve, CornerTransition, CubicSpline, NurbsSettings};
+use kerf_toolpath::{CornerCurve, CornerTransition, NurbsSettings};
 
 /// The number of input features (ten coordinates and ln(A / δ)).
 pub const INPUTS: usize = 11;
@@ -34,11 +33,8 @@ pub const INPUTS: usize = 11;
 /// The number of outputs (ℓ / A, α, β).
 pub const OUTPUTS: usize = 3;
 
-/// The swarm's search box for (ℓ / A, α, β), as nurbs.rs's.
-pub const LOWER: [f64; OUTPUTS] = [0.05, 0.02, 0.02];
-
-/// Its upper corner.
-pub const UPPER: [f64; OUTPUTS] = [1.0, 0.98, 0.98];
+/// The swarm's search box for (ℓ / A, α, β): nurbs.rs's.
+pub use kerf_toolpath::baseline::nurbs::{LOWER, UPPER};
 
 /// A corner reduced to what the swarm's answer depends on.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -121,12 +117,10 @@ pub fn variables_of(t: &CornerTransition, available: f64) -> Option<[f64; OUTPUT
     Some([l / available, outer / l, inner / outer])
 }
 
-/// The NURBS corner for the swarm's variables `x` (clamped to the box),
-/// built as nurbs.rs builds its candidates: control points
+/// The NURBS corner for the swarm's variables `x` (clamped to the box):
+/// [`nurbs::transition_at`], the swarm's own construction (control points
 /// V − ℓ t₁, V − αℓ t₁, V − βαℓ t₁, V, V + βαℓ t₂, V + αℓ t₂, V + ℓ t₂,
-/// weights (1, 1, 1, w, 1, 1, 1), knots [`KNOTS`] (seed 003 eq. 1), and
-/// w = N₂(½)(βαℓ sin θ / δ − 2) / N₃(½) (seed 003 eq. 7, last line, solved
-/// for the distance from the polyline), raised to `min_weight`.
+/// seed 003 eq. 1; the vertex weight from δ, eq. 7's last line).
 ///
 /// # Returns
 /// The transition, or `None` when the weight needed exceeds
@@ -134,8 +128,7 @@ pub fn variables_of(t: &CornerTransition, available: f64) -> Option<[f64; OUTPUT
 /// refused.
 ///
 /// # Performance
-/// One spline and [`CURVATURE_SAMPLES`] + refinement curvature evaluations
-/// (a few microseconds).
+/// One spline and its curvature samples (a few microseconds).
 #[allow(clippy::too_many_arguments)] // the corner's geometry, its limits and the variables
 pub fn build(
     v: [f64; 3],
@@ -147,42 +140,5 @@ pub fn build(
     x: [f64; OUTPUTS],
     settings: &NurbsSettings,
 ) -> Option<CornerTransition> {
-    let x: [f64; OUTPUTS] = std::array::from_fn(|k| x[k].clamp(LOWER[k], UPPER[k]));
-    let l = x[0] * available;
-    let (outer, inner) = (x[1] * l, x[2] * x[1] * l);
-    let sin_turn = turn.sin();
-    let needed = SIDE_WEIGHT * (inner * sin_turn / tolerance - 2.0) / CENTRE_WEIGHT;
-    if needed.is_nan() || needed > settings.max_weight {
-        return None;
-    }
-    let w = needed.max(settings.min_weight);
-    let control = [
-        sub(v, scale(t1, l)),
-        sub(v, scale(t1, outer)),
-        sub(v, scale(t1, inner)),
-        v,
-        add(v, scale(t2, inner)),
-        add(v, scale(t2, outer)),
-        add(v, scale(t2, l)),
-    ];
-    let weights = [1.0, 1.0, 1.0, w, 1.0, 1.0, 1.0];
-    let curve = CubicSpline::new(&control, &weights, &KNOTS).ok()?;
-    // The exact deviation (nurbs.rs, "Deviation (exact)").
-    let deviation = SIDE_WEIGHT * inner * sin_turn / (2.0 * SIDE_WEIGHT + CENTRE_WEIGHT * w);
-    let c = CornerCurve::Spline(curve);
-    Some(CornerTransition {
-        curve: c,
-        vertex: v,
-        turn,
-        shape: None,
-        scale: l,
-        tangent_length: l,
-        deviation,
-        max_curvature: c.max_curvature_on(0.0, 0.5, CURVATURE_SAMPLES),
-        binding: if w > settings.min_weight {
-            Binding::Tolerance
-        } else {
-            Binding::Length
-        },
-    })
+    nurbs::transition_at(v, t1, t2, turn, tolerance, available, x, settings)
 }

@@ -74,9 +74,9 @@ pub const SIDE_WEIGHT: f64 = 1.0 / 6.0;
 pub const CENTRE_WEIGHT: f64 = 2.0 / 3.0;
 
 /// The swarm's search box for (ℓ / available, α, β).
-const LOWER: [f64; 3] = [0.05, 0.02, 0.02];
+pub const LOWER: [f64; 3] = [0.05, 0.02, 0.02];
 /// Its upper corner.
-const UPPER: [f64; 3] = [1.0, 0.98, 0.98];
+pub const UPPER: [f64; 3] = [1.0, 0.98, 0.98];
 
 /// Curvature samples on the half curve inside the swarm's objective.
 const OBJECTIVE_SAMPLES: usize = 24;
@@ -306,20 +306,68 @@ pub fn transition_within(
             })
         }
     };
+    Ok(assemble(&corner, turn, curve, w, deviation, l))
+}
+
+/// The transition of a corner's curve with its weight `w`, deviation and
+/// tangent length `l`.
+fn assemble(
+    corner: &Corner,
+    turn: f64,
+    curve: CubicSpline,
+    w: f64,
+    deviation: f64,
+    l: f64,
+) -> CornerTransition {
     let c = CornerCurve::Spline(curve);
-    Ok(CornerTransition {
+    CornerTransition {
         curve: c,
-        vertex: v,
+        vertex: corner.v,
         turn,
         shape: None,
         scale: l,
         tangent_length: l,
         deviation,
         max_curvature: c.max_curvature_on(0.0, 0.5, super::CURVATURE_SAMPLES),
-        binding: if w > settings.min_weight {
+        binding: if w > corner.settings.min_weight {
             Binding::Tolerance
         } else {
             Binding::Length
         },
-    })
+    }
+}
+
+/// The NURBS transition for given swarm variables `x = (ℓ / available, α,
+/// β)` (each clamped to the swarm's box), without the swarm: what a learned
+/// model's prediction builds (`kerf_cornernet`).
+///
+/// # Returns
+/// `None` when the vertex weight that δ needs exceeds `max_weight` (the
+/// curve would leave δ), or the spline is refused.
+///
+/// # Performance
+/// One spline and its curvature samples (a few microseconds).
+#[allow(clippy::too_many_arguments)] // the corner's geometry, its limits and the variables
+pub fn transition_at(
+    v: [f64; 3],
+    t1: [f64; 3],
+    t2: [f64; 3],
+    turn: f64,
+    tolerance: f64,
+    available: f64,
+    x: [f64; 3],
+    settings: &NurbsSettings,
+) -> Option<CornerTransition> {
+    let corner = Corner {
+        v,
+        t1,
+        t2,
+        sin_turn: turn.sin(),
+        tolerance,
+        available,
+        settings,
+    };
+    let x: [f64; 3] = std::array::from_fn(|k| x[k].clamp(LOWER[k], UPPER[k]));
+    let (curve, w, deviation, l) = candidate(&corner, &x)?;
+    Some(assemble(&corner, turn, curve, w, deviation, l))
 }
