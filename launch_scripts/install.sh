@@ -23,6 +23,7 @@
 #   crates/mjto/cases/                      the laser-cutting cases of seed 001
 #   crates/millplan/policies/               the milling planner's shipped policies
 #   crates/stepping/weights/                the stepping agent's network (kerf step --controller ddqn)
+#   crates/cornernet/weights/               the learned NURBS corner (G-code method drls-net)
 #   crates/millplan/data/indicator_cache.bin  the indicator cache of the default cell
 #   crates/gcode/data/programs/             the shipped G-code programs (package://kerf/...)
 #   launch_scripts/params/                  each robot's launch configuration
@@ -123,6 +124,7 @@ if [ "$mode" != --binary-only ]; then
     crates/mjto/cases
     crates/millplan/policies
     crates/stepping/weights
+    crates/cornernet/weights
     crates/millplan/data/indicator_cache.bin
     crates/gcode/data/programs
     launch_scripts/params

@@ -2,7 +2,7 @@
 //!
 //! ```sh
 //! kerf plan gcode FILE [--machine laser-cutter|irb6660] [--tolerance M]
-//!                      [--method kerf|kerf-curvature|icr|ccr|nurbs] [--feed-method near-optimal|constant-intervals]
+//!                      [--method kerf|kerf-curvature|icr|ccr|nurbs|drls-net] [--feed-method near-optimal|constant-intervals]
 //!                      [--g RAD] [--origin X,Y,Z] [--plan-memory BYTES] [--plots DIR]
 //!                      [--out plan.json] [--normalize L] [--resample N]
 //! ```
@@ -93,7 +93,9 @@ pub struct GcodeArgs {
     /// Largest distance of the executed tool tip from the programmed path: [0.0000001, 0.01] m.
     #[arg(long, value_parser = TOLERANCE)]
     tolerance: Option<f64>,
-    /// Corner smoothing method: kerf, kerf-curvature, icr, ccr, nurbs.
+    /// Corner smoothing method: kerf, kerf-curvature, icr, ccr, nurbs, drls-net (seed 003's
+    /// learned NURBS corner, the committed network, falling back to the nurbs swarm; the
+    /// corners predicted and the fallbacks are printed).
     #[arg(long)]
     method: Option<String>,
     /// Feed planner: near-optimal, constant-intervals.
@@ -200,6 +202,12 @@ pub fn run(a: GcodeArgs) -> Result<(), String> {
     let plan = planned?;
     let took = started.elapsed().as_secs_f64();
     print!("{}", summary(&plan, took));
+    if request.method.as_deref() == Some(kerf_gcodeplan::DRLS_NET) {
+        println!(
+            "drls-net: {} corners predicted, {} fell back to the NURBS swarm",
+            plan.corner_predictions, plan.corner_fallbacks
+        );
+    }
     if let Some(out) = &a.out {
         let m = kerf_gcode_planner::convert::plan_to_msg(&request, &plan)?;
         let json = serde_json::to_string_pretty(&m)

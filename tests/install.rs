@@ -114,6 +114,8 @@ fn an_installed_kerf_plans_case_1_and_draws_lobes_from_another_directory() {
         "crates/millplan/policies/ddpg.json",
         "crates/millplan/policies/fixed_g.safetensors",
         "crates/stepping/weights/ddqn_high_arch2.safetensors",
+        "crates/cornernet/weights/drls.safetensors",
+        "crates/cornernet/weights/drls.json",
         "crates/millplan/data/indicator_cache.bin",
         "crates/gcode/data/programs/w_shape.ngc",
         "launch_scripts/params/irb6660.yaml",

@@ -98,3 +98,40 @@ fn a_program_on_standard_input_plans() {
     );
     assert!(text.contains("laser-cutter: 4 lines"), "{text}");
 }
+
+/// Issue 30, item 3: `--method drls-net` plans with the committed network and prints the
+/// corners predicted and the fallbacks; `--out` writes them as `corner_fallbacks`.
+#[test]
+fn drls_net_prints_and_writes_its_fallbacks() {
+    let d = scratch("drls");
+    let program = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/crates/gcode/data/programs/w_shape.ngc"
+    );
+    let json = d.join("plan.json");
+    let (out, _) = plan(
+        &[
+            program,
+            "--method",
+            "drls-net",
+            "--out",
+            json.to_str().unwrap(),
+        ],
+        Stdio::null(),
+    );
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(
+        text.contains("drls-net: 3 corners predicted, 0 fell back to the NURBS swarm"),
+        "{text}"
+    );
+    let answer: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+    assert_eq!(answer["method"], "drls-net");
+    assert_eq!(answer["corner_fallbacks"], 0);
+    let _ = std::fs::remove_dir_all(&d);
+}

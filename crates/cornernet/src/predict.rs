@@ -14,6 +14,7 @@
 //! parametrization that equation has a closed-form solution for w, which
 //! is exact where a second network could only add error and break δ.
 
+use kerf_budget::Budget;
 use kerf_toolpath::vec3::{dot, norm, scale, sub};
 use kerf_toolpath::{CornerTransition, NurbsSettings};
 
@@ -108,6 +109,36 @@ impl DrlsNet {
         tolerance: f64,
         available: f64,
     ) -> Result<DrlsCorner, CornerNetError> {
+        self.transition_within(
+            prev,
+            vertex,
+            next,
+            tolerance,
+            available,
+            0,
+            &Budget::unlimited(),
+        )
+    }
+
+    /// [`Self::transition`] as a corner of a polyline under a budget: the fallback swarm
+    /// mixes `index` (the vertex's index in its polyline) into its seed and checks `budget`
+    /// at every particle's move, as `kerf_toolpath::CornerMethod::transition_within`.
+    ///
+    /// # Errors
+    /// As [`Self::transition`], the swarm's error (its
+    /// `kerf_toolpath::ToolpathError::Interrupted` when the budget runs out) carried by
+    /// [`CornerNetError::Corner`] with `index`.
+    #[allow(clippy::too_many_arguments)] // the corner, its limits, its index, the budget
+    pub fn transition_within(
+        &mut self,
+        prev: [f64; 3],
+        vertex: [f64; 3],
+        next: [f64; 3],
+        tolerance: f64,
+        available: f64,
+        index: usize,
+        budget: &Budget,
+    ) -> Result<DrlsCorner, CornerNetError> {
         let reason = match self.attempt(prev, vertex, next, tolerance, available) {
             Ok(t) => {
                 self.counts.network += 1;
@@ -120,8 +151,8 @@ impl DrlsNet {
         };
         self.counts.fallback += 1;
         let t = kerf_toolpath::CornerMethod::Nurbs(self.swarm)
-            .transition(prev, vertex, next, tolerance, available, 0)
-            .map_err(|source| CornerNetError::Corner { index: 0, source })?;
+            .transition_within(prev, vertex, next, tolerance, available, index, budget)
+            .map_err(|source| CornerNetError::Corner { index, source })?;
         Ok(DrlsCorner {
             transition: t,
             source: Source::Fallback(reason),

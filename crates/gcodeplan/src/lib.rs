@@ -10,6 +10,7 @@ pub mod error;
 pub mod knots;
 pub mod machine;
 mod memory;
+pub mod network;
 pub mod plan;
 pub mod preprocess;
 pub mod request;
@@ -21,11 +22,12 @@ pub use error::GcodePlanError;
 /// The reader's error, as carried by [`GcodePlanError::Program`].
 pub use kerf_gcode::GcodeError;
 pub use machine::{JointBounds, LaserSheet, Machine, MillingPlane, DOF};
-pub use plan::{plan_program, GcodePlan, RunReport, ToolEvent};
+pub use network::{committed_network, load_network, NETWORK_FILE};
+pub use plan::{plan_program, plan_program_with, GcodePlan, RunReport, ToolEvent};
 pub use request::{
     corner_method, feed_method, open_program, plan_request, plan_request_reading,
     plan_request_within, GcodeRequest, LimitOverrides, MachineBase, MachineKind, ProgramSource,
-    Range, FEED_METHODS, MAX_PROGRAM_BYTES, METHODS, RANGES,
+    Range, DRLS_NET, FEED_METHODS, MAX_PROGRAM_BYTES, METHODS, RANGES,
 };
 pub use runs::{read_steps, read_steps_within, Reading, Run, RunKind, Step};
 pub use settings::PlanSettings;

@@ -33,6 +33,7 @@ use crate::error::{path as path_error_at, GcodePlanError};
 use crate::knots::{knot_at, run_knots, Peak, RunKnots};
 use crate::machine::{Machine, DOF};
 use crate::memory::Held;
+use crate::network::{committed_network, LearnedCorners};
 use crate::runs::{read_into, Run, RunKind, Step};
 use crate::settings::PlanSettings;
 use crate::timed::TimedRun;
@@ -146,6 +147,13 @@ pub struct GcodePlan {
     pub skipped_blocks: usize,
     /// What the user should know (a feed capped, a run slowed).
     pub warnings: Vec<String>,
+    /// `drls-net` ([`PlanSettings::learned_corners`]): corners the network predicted and its
+    /// check accepted (0 for the other methods).
+    pub corner_predictions: usize,
+    /// `drls-net`: corners that fell back to the NURBS swarm (outside the trained
+    /// distribution, or a prediction that broke δ or its check; the first one's reason is in
+    /// [`GcodePlan::warnings`]); 0 for the other methods.
+    pub corner_fallbacks: usize,
     /// Each run's smoothed path and feed plan (aligned with `runs`), for plots and checks.
     pub timed: Vec<TimedRun>,
 }
@@ -210,7 +218,38 @@ pub fn plan_program<R: BufRead>(
     settings: &PlanSettings,
     budget: &Budget,
 ) -> Result<GcodePlan, GcodePlanError> {
+    plan_program_inner(source, machine, settings, None, budget)
+}
+
+/// [`plan_program`] with `network` as the DRLS network of the `drls-net` corners
+/// ([`PlanSettings::learned_corners`]) instead of the committed one; other methods ignore it.
+///
+/// # Errors
+/// As [`plan_program`].
+pub fn plan_program_with<R: BufRead>(
+    source: R,
+    machine: &dyn Machine,
+    settings: &PlanSettings,
+    network: &kerf_cornernet::Model,
+    budget: &Budget,
+) -> Result<GcodePlan, GcodePlanError> {
+    plan_program_inner(source, machine, settings, Some(network), budget)
+}
+
+/// [`plan_program`] with the network given or, for the `drls-net` corners, the committed one.
+fn plan_program_inner<R: BufRead>(
+    source: R,
+    machine: &dyn Machine,
+    settings: &PlanSettings,
+    network: Option<&kerf_cornernet::Model>,
+    budget: &Budget,
+) -> Result<GcodePlan, GcodePlanError> {
     settings.validate()?;
+    let mut learned = match (settings.learned_corners, network) {
+        (false, _) => None,
+        (true, Some(model)) => Some(LearnedCorners::new(model)),
+        (true, None) => Some(LearnedCorners::new(committed_network()?)),
+    };
     // What the plan holds (the runs read, each placed run's path, samples, plan and points),
     // accounted on the budget until the plan returns.
     let mut held = Held::new(budget);
@@ -242,7 +281,14 @@ pub fn plan_program<R: BufRead>(
             }),
             Step::Run(run) => {
                 reachable(machine, run, reference.as_ref(), budget)?;
-                let mut prepared = prepare_run(run, machine, settings, &mut warnings, budget)?;
+                let mut prepared = prepare_run(
+                    run,
+                    machine,
+                    settings,
+                    learned.as_mut(),
+                    &mut warnings,
+                    budget,
+                )?;
                 let line = run.lines[0];
                 let knots = run_joints(
                     machine,
@@ -388,6 +434,11 @@ pub fn plan_program<R: BufRead>(
     let peak_ratios = joint_peaks(machine, &placed, budget)?;
     let timed: Vec<TimedRun> = placed.into_iter().map(|p| p.timed).collect();
     let duration = trajectory.points.last().map_or(0.0, |p| p.time_from_start);
+    let counts = learned
+        .as_ref()
+        .map(LearnedCorners::counts)
+        .unwrap_or_default();
+    warnings.extend(learned.as_ref().and_then(LearnedCorners::warning));
     Ok(GcodePlan {
         machine: machine.name().to_string(),
         trajectory,
@@ -410,6 +461,8 @@ pub fn plan_program<R: BufRead>(
         zero_length_moves: reading.zero_length_moves,
         skipped_blocks: reading.skipped_blocks,
         warnings,
+        corner_predictions: counts.network,
+        corner_fallbacks: counts.fallback,
         timed,
     })
 }
@@ -464,6 +517,7 @@ fn prepare_run(
     run: &Run,
     machine: &dyn Machine,
     settings: &PlanSettings,
+    learned: Option<&mut LearnedCorners>,
     warnings: &mut Vec<String>,
     budget: &Budget,
 ) -> Result<Prepared, GcodePlanError> {
@@ -485,12 +539,15 @@ fn prepare_run(
     let feed = feeds.iter().copied().fold(0.0, f64::max);
     let mut limits: FeedLimits = settings.limits;
     limits.curvature.feed = feed;
-    let path = smooth_polyline_within(
-        &run.points,
-        run.corner_tolerance,
-        &settings.corner_method,
-        budget,
-    )
+    let path = match learned {
+        Some(corners) => corners.smooth(&run.points, run.corner_tolerance, line, budget),
+        None => smooth_polyline_within(
+            &run.points,
+            run.corner_tolerance,
+            &settings.corner_method,
+            budget,
+        ),
+    }
     .map_err(path_error)?;
     // The feed plan, checked on its output at the interpolation period against every limit
     // (kerf_toolpath::check_plan); where it breaks one between its samples, the path is

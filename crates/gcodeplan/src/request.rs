@@ -13,7 +13,7 @@
 //! kept (`program_file` for `program_uri`, `limits: {…}` for the flat limit fields, `origin` as
 //! a list): [`RequestText`].
 //!
-//! Optional: `method` (`kerf`, `kerf-curvature`, `icr`, `ccr`, `nurbs`), `feed_method` (`near-optimal`,
+//! Optional: `method` (`kerf`, `kerf-curvature`, `icr`, `ccr`, `nurbs`, `drls-net`), `feed_method` (`near-optimal`,
 //! `constant-intervals`), `limits` (any of `max_feed`, `tangential_acceleration`,
 //! `tangential_jerk`, `normal_acceleration`, `normal_jerk`, `chord_error`, `contour_error`,
 //! each replacing the machine's default), `rapid_feed`, `origin` (the program's zero in the
@@ -78,13 +78,18 @@ impl MachineKind {
 
 /// The corner smoothing methods: kerf's quintic (its shape of least jerk norm; `kerf-curvature`:
 /// of least κ_max), the baselines ICR (Zhao, Zhu and Ding 2013), CCR (Xu and Sun 2018) and seed
-/// 003's NURBS corner by PSO ([`kerf_toolpath::CornerMethod`]).
-pub const METHODS: &[&str] = &["kerf", "kerf-curvature", "icr", "ccr", "nurbs"];
+/// 003's NURBS corner by PSO ([`kerf_toolpath::CornerMethod`]), and seed 003's learned NURBS
+/// corner with the swarm as its fallback (`drls-net`, [`crate::network`]).
+pub const METHODS: &[&str] = &["kerf", "kerf-curvature", "icr", "ccr", "nurbs", "drls-net"];
+
+/// The learned corner method's name ([`crate::PlanSettings::learned_corners`]).
+pub const DRLS_NET: &str = "drls-net";
 
 /// The feed planners ([`kerf_toolpath::FeedMethod`]).
 pub const FEED_METHODS: &[&str] = &["near-optimal", "constant-intervals"];
 
-/// The corner method named `name` (empty: kerf).
+/// The corner method named `name` (empty: kerf); for `drls-net`, its fallback (the NURBS
+/// swarm: the method is [`crate::PlanSettings::learned_corners`]).
 ///
 /// # Errors
 /// [`GcodePlanError::InvalidSetting`] naming the method and the ones known.
@@ -95,7 +100,7 @@ pub fn corner_method(name: &str) -> Result<kerf_toolpath::CornerMethod, GcodePla
         "kerf-curvature" => Ok(CornerMethod::KerfCurvature),
         "icr" => Ok(CornerMethod::Icr),
         "ccr" => Ok(CornerMethod::Ccr),
-        "nurbs" => Ok(CornerMethod::Nurbs(NurbsSettings::default())),
+        "nurbs" | DRLS_NET => Ok(CornerMethod::Nurbs(NurbsSettings::default())),
         other => Err(GcodePlanError::InvalidRequest {
             field: format!("method '{other}'"),
             reason: format!("unknown; use one of {}", METHODS.join(", ")),
@@ -668,7 +673,9 @@ impl GcodeRequest {
         if let Some(t) = self.tolerance {
             s.tolerance = t;
         }
-        s.corner_method = corner_method(self.method.as_deref().unwrap_or(""))?;
+        let method = self.method.as_deref().unwrap_or("");
+        s.corner_method = corner_method(method)?;
+        s.learned_corners = method == DRLS_NET;
         s.feed_method = feed_method(self.feed_method.as_deref().unwrap_or(""))?;
         if let Some(l) = &self.limits {
             let c = &mut s.limits.curvature;

@@ -54,8 +54,15 @@ pub struct PlanSettings {
     pub max_lines: usize,
     /// How the program is read.
     pub reader: ReaderSettings,
-    /// How corners are smoothed (default kerf's quintic).
+    /// How corners are smoothed (default kerf's quintic); unused when
+    /// [`PlanSettings::learned_corners`] is set.
     pub corner_method: CornerMethod,
+    /// The `drls-net` method (issue 30, item 3): every corner predicted by seed 003's DRLS
+    /// network, verified, and built by its NURBS swarm where the prediction falls back
+    /// ([`crate::network`]; default `false`). The plan reads the committed network
+    /// ([`crate::network::committed_network`]) unless one is given
+    /// ([`crate::plan::plan_program_with`]).
+    pub learned_corners: bool,
     /// How the feed is planned (default the near time-optimal planner).
     pub feed_method: FeedMethod,
     /// Whether the feed plan also bounds the machine's Cartesian axes (the laser cutter's
@@ -138,6 +145,7 @@ impl PlanSettings {
             max_lines: 1_000_000,
             reader: ReaderSettings::default(),
             corner_method: CornerMethod::Kerf,
+            learned_corners: false,
             feed_method: FeedMethod::NearOptimal,
             feed_axis_limits: false,
             feed_whole_normal_jerk: false,
@@ -171,6 +179,12 @@ impl PlanSettings {
     /// With the corner method.
     pub fn with_corner_method(mut self, method: CornerMethod) -> Self {
         self.corner_method = method;
+        self
+    }
+
+    /// With the `drls-net` corners ([`PlanSettings::learned_corners`]) or without.
+    pub fn with_learned_corners(mut self, on: bool) -> Self {
+        self.learned_corners = on;
         self
     }
 

@@ -60,7 +60,7 @@ pub use metrics::{metrics, metrics_within, Metrics};
 pub use plan_check::{check_plan, check_plan_within, PlanCheck, Worst};
 pub use samples::{derivatives_at, point_at, sample_path, sample_path_within, PathSample};
 pub use smooth::{smooth_polyline, Piece, SmoothedPath};
-pub use smooth::{smooth_polyline_with, smooth_polyline_within};
+pub use smooth::{smooth_polyline_by, smooth_polyline_with, smooth_polyline_within};
 pub use speed_limit::{CurvatureLimits, Servo};
 pub use spline::CubicSpline;
 pub mod plot;

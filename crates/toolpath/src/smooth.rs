@@ -157,6 +157,41 @@ pub fn smooth_polyline_within(
     budget: &Budget,
 ) -> Result<SmoothedPath, ToolpathError> {
     method.check()?;
+    smooth_polyline_by(
+        polyline,
+        tolerance,
+        budget,
+        |prev, vertex, next, tolerance, available, index| {
+            method.transition_within(prev, vertex, next, tolerance, available, index, budget)
+        },
+    )
+}
+
+/// [`smooth_polyline_within`] with every corner built by `corner` (a method this crate does
+/// not know, e.g. a learned one with its own state): called once per inner vertex, in order,
+/// as `corner(prev, vertex, next, tolerance, available, index)` with the arguments of
+/// [`CornerMethod::transition`]. The caller's corner must keep the contract of
+/// [`CornerMethod::transition`]: within δ of the polyline, at most `available` on each side.
+///
+/// # Errors
+/// As [`smooth_polyline_within`]; `corner`'s own errors (an `InvalidParameter` named with the
+/// corner's point).
+pub fn smooth_polyline_by<F>(
+    polyline: &[[f64; 3]],
+    tolerance: f64,
+    budget: &Budget,
+    mut corner: F,
+) -> Result<SmoothedPath, ToolpathError>
+where
+    F: FnMut(
+        [f64; 3],
+        [f64; 3],
+        [f64; 3],
+        f64,
+        f64,
+        usize,
+    ) -> Result<Option<CornerTransition>, ToolpathError>,
+{
     let vertices = polyline.len() as u64;
     budget.check_memory(
         bytes_of::<Piece>(vertices.saturating_mul(2))
@@ -204,28 +239,26 @@ pub fn smooth_polyline_within(
     for v in 1..n - 1 {
         budget.check("corner smoothing")?;
         let available = share(v - 1).min(share(v));
-        match method
-            .transition_within(
-                polyline[v - 1],
-                polyline[v],
-                polyline[v + 1],
-                tolerance,
-                available,
-                v,
-                budget,
-            )
-            .map_err(|e| match e {
-                ToolpathError::InvalidParameter {
-                    name,
-                    value,
-                    reason,
-                } => ToolpathError::InvalidParameter {
-                    name: format!("corner at point {v}: {name}"),
-                    value,
-                    reason,
-                },
-                other => other,
-            })? {
+        match corner(
+            polyline[v - 1],
+            polyline[v],
+            polyline[v + 1],
+            tolerance,
+            available,
+            v,
+        )
+        .map_err(|e| match e {
+            ToolpathError::InvalidParameter {
+                name,
+                value,
+                reason,
+            } => ToolpathError::InvalidParameter {
+                name: format!("corner at point {v}: {name}"),
+                value,
+                reason,
+            },
+            other => other,
+        })? {
             None => {}
             Some(c) => {
                 let start = c.curve.start();

@@ -795,6 +795,8 @@ impl GcodeRequest {
     pub const METHOD_CCR: &'static str = "ccr";
     /// Seed 003's NURBS corner by PSO.
     pub const METHOD_NURBS: &'static str = "nurbs";
+    /// Seed 003's learned NURBS corner, verified, with the PSO swarm as its fallback.
+    pub const METHOD_DRLS_NET: &'static str = "drls-net";
     /// The near time-optimal feed planner.
     pub const FEED_NEAR_OPTIMAL: &'static str = "near-optimal";
     /// Seed 003's constant-interval feed planner.
@@ -928,6 +930,9 @@ pub struct GcodePlan {
     pub corners: u32,
     /// Arcs read.
     pub arcs: u32,
+    /// `drls-net`: corners where the learned corner fell back to the swarm (0 for the other
+    /// methods).
+    pub corner_fallbacks: u32,
     /// Beam or spindle switches.
     pub tool_events: Vec<GcodeToolEvent>,
     /// Warnings.

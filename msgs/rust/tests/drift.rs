@@ -556,6 +556,7 @@ fn rust_constants() -> ConstantTable {
                 c_str("METHOD_ICR", Gr::METHOD_ICR),
                 c_str("METHOD_CCR", Gr::METHOD_CCR),
                 c_str("METHOD_NURBS", Gr::METHOD_NURBS),
+                c_str("METHOD_DRLS_NET", Gr::METHOD_DRLS_NET),
                 c_str("FEED_NEAR_OPTIMAL", Gr::FEED_NEAR_OPTIMAL),
                 c_str("FEED_CONSTANT_INTERVALS", Gr::FEED_CONSTANT_INTERVALS),
                 c_str("START_CURRENT", Gr::START_CURRENT),

@@ -252,6 +252,7 @@ pub fn plan_to_msg(request: &GcodeRequest, plan: &GcodePlan) -> Result<msg::Gcod
         cut_runs: count(plan.runs.iter().filter(|r| r.kind == RunKind::Cut).count()),
         corners: count(plan.runs.iter().map(|r| r.corners).sum()),
         arcs: count(plan.arcs),
+        corner_fallbacks: count(plan.corner_fallbacks),
         tool_events: plan
             .events
             .iter()

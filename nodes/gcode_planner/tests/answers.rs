@@ -250,3 +250,33 @@ fn tool_events_are_written_tool_on_and_read_either_way() {
     let back: GcodePlan = kerf_robot::document::from_yaml_or_json(&earlier).unwrap();
     assert_eq!(back.tool_events, plan.tool_events);
 }
+
+/// Issue 30, item 3: a `drls-net` request is planned by the learned corner, and the answer
+/// counts the corners that fell back to the swarm (here the 178.85° corner outside the trained
+/// distribution) and says why among its warnings.
+#[test]
+fn a_drls_net_answer_counts_its_fallbacks() {
+    let service = service();
+    let request = GcodeRequest {
+        request_id: "drls".into(),
+        method: Some(kerf_msgs::msg::GcodeRequest::METHOD_DRLS_NET.into()),
+        program: Some(
+            "G21 G90\nM3\nG1 X20 F3000\nG1 X20 Y15\nG1 X0 Y15\nG1 X20 Y15.4\nM5\n".into(),
+        ),
+        ..GcodeRequest::default()
+    };
+    let answer = service.plan(request, &Budget::unlimited());
+    assert_eq!(answer.status, GcodePlan::SUCCESS, "{}", answer.message);
+    assert_eq!(answer.method, "drls-net");
+    assert_eq!(answer.corners, 3);
+    assert_eq!(answer.corner_fallbacks, 1, "{:?}", answer.warnings);
+    assert!(
+        answer
+            .warnings
+            .iter()
+            .any(|w| w.contains("1 of 3 corners fell back") && w.contains("turning angle")),
+        "{:?}",
+        answer.warnings
+    );
+    assert!(answer.max_corner_deviation <= answer.tolerance);
+}
