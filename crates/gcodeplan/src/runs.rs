@@ -213,6 +213,14 @@ pub(crate) fn read_into<R: BufRead>(
             }
             Motion::End { .. } => {
                 close(&mut open, &mut reading, settings, budget)?;
+                // Read on to the end, so that the reader refuses text after M2/M30 (it allows
+                // only blanks and comments there) instead of the plan ignoring it.
+                for rest in program.by_ref() {
+                    rest.map_err(|e| match stopped.borrow_mut().take() {
+                        Some(interrupt) => GcodePlanError::Interrupted(interrupt),
+                        None => GcodePlanError::Program(e),
+                    })?;
+                }
                 break;
             }
         };

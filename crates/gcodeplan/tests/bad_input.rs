@@ -62,6 +62,20 @@ fn reader_errors_keep_their_line_and_column() {
 }
 
 #[test]
+fn text_after_the_program_end_is_refused_not_ignored() {
+    let settings = PlanSettings::laser_cutter();
+    let e = laser_plan("G21 G90\nG1 X10 F1000\nM2\nG1 X20\n", &settings).unwrap_err();
+    assert!(
+        matches!(e, GcodePlanError::Program(ref g) if g.line() == 4),
+        "{e}"
+    );
+    assert!(e.to_string().contains("after the program end"), "{e}");
+    assert_eq!(e.line(), 4);
+    // Blank lines and comments after it are fine.
+    laser_plan("G21 G90\nG1 X10 F1000\nM30\n\n(done)\n; end\n", &settings).unwrap();
+}
+
+#[test]
 fn a_program_that_does_not_move_is_refused() {
     let e = laser_plan(
         "G21 G90\nG1 X0 Y0 F100\nM30\n",
