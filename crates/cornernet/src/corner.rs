@@ -116,29 +116,3 @@ pub fn variables_of(t: &CornerTransition, available: f64) -> Option<[f64; OUTPUT
     let inner = dist(p[2]);
     Some([l / available, outer / l, inner / outer])
 }
-
-/// The NURBS corner for the swarm's variables `x` (clamped to the box):
-/// [`nurbs::transition_at`], the swarm's own construction (control points
-/// V − ℓ t₁, V − αℓ t₁, V − βαℓ t₁, V, V + βαℓ t₂, V + αℓ t₂, V + ℓ t₂,
-/// seed 003 eq. 1; the vertex weight from δ, eq. 7's last line).
-///
-/// # Returns
-/// The transition, or `None` when the weight needed exceeds
-/// `max_weight` (infeasible: the curve would leave δ) or the spline is
-/// refused.
-///
-/// # Performance
-/// One spline and its curvature samples (a few microseconds).
-#[allow(clippy::too_many_arguments)] // the corner's geometry, its limits and the variables
-pub fn build(
-    v: [f64; 3],
-    t1: [f64; 3],
-    t2: [f64; 3],
-    turn: f64,
-    tolerance: f64,
-    available: f64,
-    x: [f64; OUTPUTS],
-    settings: &NurbsSettings,
-) -> Option<CornerTransition> {
-    nurbs::transition_at(v, t1, t2, turn, tolerance, available, x, settings)
-}

@@ -1,5 +1,5 @@
 //! The `drls_net` corner: predict the swarm's variables with FDLS, build
-//! the NURBS corner from them ([`crate::corner::build`]), verify it, and
+//! the NURBS corner from them (`kerf_toolpath::baseline::nurbs::transition_at`), verify it, and
 //! fall back to the swarm itself when the corner lies outside the trained
 //! distribution or the verification fails; fallbacks are counted.
 //!
@@ -15,10 +15,10 @@
 //! is exact where a second network could only add error and break δ.
 
 use kerf_budget::Budget;
-use kerf_toolpath::vec3::{dot, norm, scale, sub};
-use kerf_toolpath::{CornerTransition, NurbsSettings};
+use kerf_toolpath::baseline::nurbs;
+use kerf_toolpath::{corner_frame, CornerTransition, NurbsSettings};
 
-use crate::corner::{build, LocalCorner, OUTPUTS};
+use crate::corner::{LocalCorner, OUTPUTS};
 use crate::error::CornerNetError;
 use crate::file::Model;
 
@@ -168,13 +168,11 @@ impl DrlsNet {
         tolerance: f64,
         available: f64,
     ) -> Result<CornerTransition, String> {
-        let (d1, d2) = (sub(vertex, prev), sub(next, vertex));
-        let (l1, l2) = (norm(d1), norm(d2));
-        if !(l1 > 0.0 && l2 > 0.0 && tolerance > 0.0 && available > 0.0) {
-            return Err("degenerate corner or limits".to_string());
-        }
-        let (t1, t2) = (scale(d1, 1.0 / l1), scale(d2, 1.0 / l2));
-        let turn = dot(t1, t2).clamp(-1.0, 1.0).acos();
+        // The checks and the frame every corner method shares (toolpath's).
+        let frame = corner_frame(prev, vertex, next, tolerance, available)
+            .map_err(|e| e.to_string())?
+            .ok_or_else(|| "a straight corner (no transition)".to_string())?;
+        let (t1, t2, turn) = (frame.t1, frame.t2, frame.turn);
         let corner = LocalCorner {
             turn,
             ratio: available / tolerance,
@@ -183,8 +181,8 @@ impl DrlsNet {
             return Err(format!("outside the trained distribution: {why}"));
         }
         let x = self.variables(&corner);
-        let t =
-            build(vertex, t1, t2, turn, tolerance, available, x, &self.swarm).ok_or_else(|| {
+        let t = nurbs::transition_at(vertex, t1, t2, turn, tolerance, available, x, &self.swarm)
+            .ok_or_else(|| {
                 "infeasible prediction: the weight needed exceeds max_weight".to_string()
             })?;
         if t.deviation.is_nan() || t.deviation > tolerance * (1.0 + 1e-9) {

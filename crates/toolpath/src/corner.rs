@@ -211,7 +211,7 @@ fn direction(a: [f64; 3], b: [f64; 3]) -> ([f64; 3], f64) {
 
 /// A corner's incoming and outgoing unit directions and turning angle.
 #[derive(Debug, Clone, Copy)]
-pub(crate) struct CornerFrame {
+pub struct CornerFrame {
     /// t₁.
     pub t1: [f64; 3],
     /// t₂.
@@ -228,7 +228,7 @@ pub(crate) struct CornerFrame {
 ///
 /// # Errors
 /// As [`corner_transition`].
-pub(crate) fn corner_frame(
+pub fn corner_frame(
     prev: [f64; 3],
     vertex: [f64; 3],
     next: [f64; 3],

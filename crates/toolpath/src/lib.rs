@@ -43,8 +43,8 @@ pub use baseline::{CornerMethod, NurbsSettings};
 pub use bezier::QuinticBezier;
 pub use constraints::FeedConstraints;
 pub use corner::{
-    corner_transition, corner_transition_with, Binding, CornerShape, CornerTransition,
-    ShapeObjective,
+    corner_frame, corner_transition, corner_transition_with, Binding, CornerFrame, CornerShape,
+    CornerTransition, ShapeObjective,
 };
 pub use corner_curve::CornerCurve;
 pub use error::ToolpathError;
