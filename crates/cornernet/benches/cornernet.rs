@@ -34,7 +34,7 @@ fn main() {
     let path = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("weights/drls.safetensors");
     let distribution = Distribution::default();
     let model = Model::load(&path, &distribution).expect("run examples/train_cornernet first");
-    let swarm = model.sidecar.swarm.into();
+    let swarm = model.sidecar.swarm;
     let layers = model.net.architecture.layers;
     let mut drls = DrlsNet::new(model);
     let mut rng = Rng::new(0xbe7c_4003);

@@ -70,7 +70,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 architecture: arch,
                 normalization,
                 distribution,
-                swarm: swarm.into(),
+                swarm,
                 dataset_seed: SEED,
                 dataset_size: samples,
                 train: settings,

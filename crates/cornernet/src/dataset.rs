@@ -118,61 +118,6 @@ impl Distribution {
     }
 }
 
-/// nurbs.rs's swarm settings, in a form a sidecar can store.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-pub struct SwarmSettings {
-    /// Particles.
-    pub particles: usize,
-    /// Iterations.
-    pub iterations: usize,
-    /// Inertia w of seed 003 eq. 8.
-    pub inertia: f64,
-    /// c₁ of eq. 8.
-    pub c1: f64,
-    /// c₂ of eq. 8.
-    pub c2: f64,
-    /// c₃ of eq. 8.
-    pub c3: f64,
-    /// The swarm's seed.
-    pub seed: u64,
-    /// Smallest vertex weight.
-    pub min_weight: f64,
-    /// Largest vertex weight.
-    pub max_weight: f64,
-}
-
-impl From<NurbsSettings> for SwarmSettings {
-    fn from(s: NurbsSettings) -> Self {
-        SwarmSettings {
-            particles: s.particles,
-            iterations: s.iterations,
-            inertia: s.inertia,
-            c1: s.c1,
-            c2: s.c2,
-            c3: s.c3,
-            seed: s.seed,
-            min_weight: s.min_weight,
-            max_weight: s.max_weight,
-        }
-    }
-}
-
-impl From<SwarmSettings> for NurbsSettings {
-    fn from(s: SwarmSettings) -> Self {
-        NurbsSettings {
-            particles: s.particles,
-            iterations: s.iterations,
-            inertia: s.inertia,
-            c1: s.c1,
-            c2: s.c2,
-            c3: s.c3,
-            seed: s.seed,
-            min_weight: s.min_weight,
-            max_weight: s.max_weight,
-        }
-    }
-}
-
 /// One swarm-solved corner.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct Sample {
@@ -202,7 +147,7 @@ pub struct Dataset {
     /// The corners' distribution.
     pub distribution: Distribution,
     /// The swarm that labelled them.
-    pub swarm: SwarmSettings,
+    pub swarm: NurbsSettings,
     /// The seed of the draws.
     pub seed: u64,
     /// The samples, in draw order.
@@ -272,7 +217,7 @@ impl Dataset {
         }
         Ok(Dataset {
             distribution,
-            swarm: (*swarm).into(),
+            swarm: *swarm,
             seed,
             samples,
         })

@@ -16,10 +16,11 @@ use candle_core::{DType, Device, Tensor};
 use serde::{Deserialize, Serialize};
 
 use crate::corner::{INPUTS, OUTPUTS};
-use crate::dataset::{Distribution, SwarmSettings};
+use crate::dataset::Distribution;
 use crate::error::CornerNetError;
 use crate::net::{Architecture, Dense, Normalization, ResMlp};
 use crate::train::{TrainReport, TrainSettings};
+use kerf_toolpath::NurbsSettings;
 
 /// The sidecar's format tag.
 pub const FORMAT: &str = "kerf_cornernet DRLS v1";
@@ -36,7 +37,7 @@ pub struct Sidecar {
     /// The corners it was trained for.
     pub distribution: Distribution,
     /// The swarm that labelled them (and the fallback's).
-    pub swarm: SwarmSettings,
+    pub swarm: NurbsSettings,
     /// The dataset's seed.
     pub dataset_seed: u64,
     /// Its size (training and held-out).

@@ -26,7 +26,7 @@ pub mod predict;
 pub mod train;
 
 pub use corner::{LocalCorner, INPUTS, OUTPUTS};
-pub use dataset::{Dataset, Distribution, Sample, SwarmSettings};
+pub use dataset::{Dataset, Distribution, Sample};
 pub use error::CornerNetError;
 pub use file::{Model, Sidecar};
 pub use net::{Architecture, Normalization, ResMlp};

@@ -63,7 +63,7 @@ impl DrlsNet {
     /// The method of a trained model; its fallback swarm is the one that
     /// labelled the data.
     pub fn new(model: Model) -> Self {
-        let swarm = model.sidecar.swarm.into();
+        let swarm = model.sidecar.swarm;
         DrlsNet {
             model,
             swarm,

@@ -42,7 +42,7 @@ fn tiny_model() -> (Dataset, Model) {
         architecture: arch,
         normalization,
         distribution: data.distribution,
-        swarm: swarm.into(),
+        swarm,
         dataset_seed: data.seed,
         dataset_size: data.samples.len(),
         train: settings,

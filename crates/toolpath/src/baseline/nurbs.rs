@@ -82,7 +82,7 @@ pub const UPPER: [f64; 3] = [1.0, 0.98, 0.98];
 const OBJECTIVE_SAMPLES: usize = 24;
 
 /// The settings of the NURBS corner's swarm.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct NurbsSettings {
     /// Particles, ≥ 2.
     pub particles: usize,
