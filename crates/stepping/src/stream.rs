@@ -218,9 +218,14 @@ impl Stream {
                 self.limits.len()
             )));
         }
-        if !(point.precision.is_finite() && point.precision > 0.0 && point.precision <= 1.0) {
+        // As kerf_msgs's declared rule of ReferencePoint.precision: (0, 1], not denormal (the
+        // lattice's windows divide by it).
+        if !(point.precision.is_finite()
+            && point.precision >= f64::MIN_POSITIVE
+            && point.precision <= 1.0)
+        {
             return Err(refuse(format!(
-                "precision {} must be in (0, 1]",
+                "precision {} must be in (0, 1] and not denormal",
                 point.precision
             )));
         }
@@ -481,6 +486,14 @@ mod tests {
                     precision: 0.0,
                 },
                 "precision",
+            ),
+            (
+                StreamPoint {
+                    id: 7,
+                    positions: vec![0.1, 0.0],
+                    precision: 5e-324,
+                },
+                "not denormal",
             ),
             (
                 StreamPoint {

@@ -11,7 +11,8 @@
 //! The rules live next to each message's definition, one file per request:
 //! [`cut`] (`kerf_msgs/msg/CutRequest`), [`mill`] (`MillRequest`), [`gcode`] (`GcodeRequest`),
 //! [`trajectory`] (`trajectory_msgs/JointTrajectory`, the
-//! `control_msgs/action/FollowJointTrajectory` goal, `kerf_msgs/srv/ValidateTrajectory`).
+//! `control_msgs/action/FollowJointTrajectory` goal, `kerf_msgs/srv/ValidateTrajectory`),
+//! [`reference`] (`kerf_msgs/msg/ReferencePoint`, the executor's streaming points).
 //! The planner libraries keep their own validation (it knows the semantics: min < max, unit
 //! axes, odd grid sizes, …); these rules never accept a value the library refuses for a plain
 //! range reason, and refuse it earlier, with the message's field name.
@@ -31,6 +32,7 @@ pub mod cut;
 pub mod gcode;
 pub mod mill;
 pub mod probe;
+pub mod reference;
 mod rule;
 pub mod trajectory;
 mod walk;

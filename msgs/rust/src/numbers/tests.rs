@@ -276,6 +276,13 @@ fn every_numeric_field_of_every_request_is_probed() {
         probe_every_leaf(&ValidateTrajectoryRequest {
             trajectory: trajectory(),
         }),
+        probe_every_leaf(&crate::msg::ReferencePoint {
+            header: stamp(),
+            id: 7,
+            joint_names: vec!["a".into(), "b".into()],
+            positions: vec![0.1, -0.2],
+            precision: 1e-4,
+        }),
     ];
     assert!(counts.iter().all(|c| *c > 20), "{counts:?}");
 }
