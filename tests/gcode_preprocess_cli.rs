@@ -4,6 +4,11 @@
 //! the command plans offline.
 #![allow(clippy::unwrap_used, clippy::expect_used)] // tests report failures by panicking
 
+#[path = "support/scratch.rs"]
+mod scratch;
+
+use scratch::scratch;
+
 use std::process::{Command, Output};
 
 const PROGRAMS: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/crates/gcode/data/programs");
@@ -116,8 +121,7 @@ fn what_the_seed_does_not_define_is_refused() {
         &["an arc (G2/G3)", "G01 polylines only"],
     );
     // Two contours.
-    let d = std::env::temp_dir().join(format!("kerf_gcode_preprocess_{}", std::process::id()));
-    std::fs::create_dir_all(&d).unwrap();
+    let d = scratch("gcode_preprocess", "contours");
     let two = d.join("two.ngc");
     std::fs::write(
         &two,

@@ -4,9 +4,14 @@
 #![allow(clippy::unwrap_used, clippy::expect_used)] // tests report failures by panicking
 
 use std::{
-    path::{Path, PathBuf},
+    path::Path,
     process::{Command, Output},
 };
+
+#[path = "support/scratch.rs"]
+mod scratch;
+
+use scratch::scratch;
 
 const ROOT: &str = env!("CARGO_MANIFEST_DIR");
 
@@ -16,12 +21,6 @@ fn kerf(args: &[&str]) -> Output {
         .args(args)
         .output()
         .expect("run kerf step")
-}
-
-fn temp(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("kerf_step_cli_{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    dir.join(name)
 }
 
 fn text(o: &Output) -> String {
@@ -163,13 +162,14 @@ fn the_readme_examples_run_as_written_and_their_trajectories_hold() {
 
 #[test]
 fn a_gcode_programs_points_are_stepped() {
-    let program = temp("square.nc");
+    let dir = scratch("step_cli", "gcode");
+    let program = dir.join("square.nc");
     std::fs::write(
         &program,
         "G21 G90\nG0 X0 Y0\nG1 X5 F600\nG3 X10 Y5 I0 J5\nG1 Y8\nM2\n",
     )
     .unwrap();
-    let out = temp("square.json");
+    let out = dir.join("square.json");
     let o = kerf(&[
         "step",
         program.to_str().unwrap(),
@@ -207,9 +207,10 @@ fn bad_points_are_refused_naming_the_problem() {
         ),
     ];
     for (k, (points, extra, want)) in cases.iter().enumerate() {
-        let file = temp(&format!("bad{k}.txt"));
+        let dir = scratch("step_cli", &format!("bad{k}"));
+        let file = dir.join("points.txt");
         std::fs::write(&file, points).unwrap();
-        let out = temp("bad.json");
+        let out = dir.join("bad.json");
         let mut args = vec![
             "step",
             file.to_str().unwrap(),
